@@ -1,0 +1,13 @@
+"""The root of every exception Odin raises on purpose.
+
+Each package derives its own meaningful subclasses (a bad request, a file that does not parse,
+an ODE configuration that does not fit); a Portal turns any ``OdinError`` into a service answer
+``success: false`` with ``str(error)`` as the message.
+"""
+
+
+class OdinError(Exception):
+    """Something the caller asked for, or a file it gave, cannot be done or read.
+
+    The message says what was wrong, with the offending value and where it came from.
+    """

@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Builds the catkin workspace build/ws (its src/Odin is a link to the stack) with the venv's
+# Python. Called by tools/install.sh; run it again after editing .msg/.srv or the C extension.
+set -eo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+ws="$root/build/ws"
+mkdir -p "$ws/src"
+ln -sfn "$root/Odin" "$ws/src/Odin"
+python="$root/.venv/bin/python"
+force=()
+# catkin caches the environment of its first configure: configure afresh once so that the
+# venv's python and an empty PYTHONPATH are not frozen into the cache (platform notes).
+if [ ! -f "$ws/build/.odin-configured" ]; then force=(--force-cmake); fi
+# catkin_make runs Python tools; keep the venv first on PATH.
+export PATH="$root/.venv/bin:$PATH"
+catkin_make -C "$ws" "${force[@]}" -DPYTHON_EXECUTABLE="$python" -DCATKIN_ENABLE_TESTING=OFF \
+  > "$root/build/catkin_make.log" 2>&1 || { tail -40 "$root/build/catkin_make.log" >&2; exit 1; }
+touch "$ws/build/.odin-configured"
+echo "build.sh: catkin workspace built in $ws"
