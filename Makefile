@@ -1,0 +1,30 @@
+# Odin's entry points. Every target that needs the build runs `setup` first (idempotent).
+SHELL := /bin/bash
+ROOT  := $(CURDIR)
+ENV   := set -eo pipefail; source $(ROOT)/setup.bash;
+
+.PHONY: setup build demo test bench experiments lint clean
+
+setup:
+	@tools/install.sh
+
+build:
+	@source .venv/bin/activate && tools/build.sh
+
+demo: setup
+	@$(ENV) python tools/demo.py
+
+test: setup
+	@$(ENV) python -m pytest -p no:cacheprovider
+
+bench: setup
+	@$(ENV) python tools/bench/run.py
+
+experiments: setup
+	@$(ENV) python tools/experiments/run.py
+
+lint: setup
+	@$(ENV) catkin_lint --strict -W2 Odin
+
+clean:
+	rm -rf build out .pytest_cache

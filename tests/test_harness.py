@@ -1,0 +1,21 @@
+"""The ROS harness itself: a private master comes up, answers, and leaves nothing behind."""
+import subprocess
+
+from ros_harness import RosMaster
+
+
+def test_private_master_starts_and_stops_cleanly():
+    with RosMaster() as master:
+        assert master.run(["rosparam", "get", "/rosdistro"]).returncode == 0
+        roscore = master._processes[0]
+        pid = roscore.pid
+    assert roscore.poll() is not None
+    alive = subprocess.run(["pgrep", "-g", str(pid)], capture_output=True)
+    assert alive.returncode == 1, "processes of the master's group survived"
+
+
+def test_two_masters_do_not_share_a_port():
+    with RosMaster() as first, RosMaster() as second:
+        assert first.port != second.port
+        first.run(["rosparam", "set", "/odin_probe", "1"])
+        assert second.run(["rosparam", "get", "/odin_probe"], check=False).returncode != 0
