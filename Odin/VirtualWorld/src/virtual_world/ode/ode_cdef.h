@@ -1,5 +1,281 @@
-/* The part of ODE's C API (libode 0.16, double precision) and of odin_step.h that Python sees. */
+/* The part of ODE's C API (libode 0.16, double precision) and of odin_step.h that Python sees.
+ * Enum values marked "..." are read from ODE's own headers by cffi (API mode), never guessed. */
 typedef double dReal;
+typedef dReal dVector3[4];
+typedef dReal dVector4[4];
+typedef dReal dMatrix3[4 * 3];
+typedef dReal dQuaternion[4];
+typedef uint32_t dTriIndex;
+
+typedef struct dxWorld *dWorldID;
+typedef struct dxSpace *dSpaceID;
+typedef struct dxBody *dBodyID;
+typedef struct dxGeom *dGeomID;
+typedef struct dxJoint *dJointID;
+typedef struct dxJointGroup *dJointGroupID;
+typedef struct dxTriMeshData *dTriMeshDataID;
+
+typedef struct dMass { dReal mass; dVector3 c; dMatrix3 I; } dMass;
+
+static const double dInfinity;
+
+typedef enum {
+  dJointTypeNone, dJointTypeBall, dJointTypeHinge, dJointTypeSlider, dJointTypeContact,
+  dJointTypeUniversal, dJointTypeHinge2, dJointTypeFixed, dJointTypeNull, dJointTypeAMotor,
+  dJointTypeLMotor, dJointTypePlane2D, dJointTypePR, dJointTypePU, dJointTypePiston, ...
+} dJointType;
+
+enum {
+  dParamLoStop, dParamHiStop, dParamVel, dParamLoVel, dParamHiVel, dParamFMax,
+  dParamFudgeFactor, dParamBounce, dParamCFM, dParamStopERP, dParamStopCFM,
+  dParamSuspensionERP, dParamSuspensionCFM, dParamERP, dParamGroup, ...
+};
+enum { dAMotorUser, dAMotorEuler, ... };
+
+/* init and configuration */
 int dInitODE2(unsigned int uiInitFlags);
 void dCloseODE(void);
 int dCheckConfiguration(const char *token);
+
+/* world */
+dWorldID dWorldCreate(void);
+void dWorldDestroy(dWorldID);
+void dWorldSetGravity(dWorldID, dReal x, dReal y, dReal z);
+void dWorldSetERP(dWorldID, dReal erp);
+void dWorldSetCFM(dWorldID, dReal cfm);
+void dWorldSetQuickStepNumIterations(dWorldID, int num);
+void dWorldSetContactMaxCorrectingVel(dWorldID, dReal vel);
+void dWorldSetContactSurfaceLayer(dWorldID, dReal depth);
+void dWorldSetLinearDamping(dWorldID w, dReal scale);
+void dWorldSetAngularDamping(dWorldID w, dReal scale);
+void dWorldSetLinearDampingThreshold(dWorldID w, dReal threshold);
+void dWorldSetAngularDampingThreshold(dWorldID w, dReal threshold);
+void dWorldSetMaxAngularSpeed(dWorldID w, dReal max_speed);
+
+/* spaces and joint groups */
+dSpaceID dHashSpaceCreate(dSpaceID space);
+void dSpaceDestroy(dSpaceID);
+void dSpaceSetCleanup(dSpaceID space, int mode);
+int dSpaceGetNumGeoms(dSpaceID);
+dJointGroupID dJointGroupCreate(int max_size);
+void dJointGroupDestroy(dJointGroupID);
+void dJointGroupEmpty(dJointGroupID);
+
+/* bodies */
+dBodyID dBodyCreate(dWorldID);
+void dBodyDestroy(dBodyID);
+void dBodySetPosition(dBodyID, dReal x, dReal y, dReal z);
+void dBodySetQuaternion(dBodyID, const dQuaternion q);
+void dBodySetLinearVel(dBodyID, dReal x, dReal y, dReal z);
+void dBodySetAngularVel(dBodyID, dReal x, dReal y, dReal z);
+const dReal *dBodyGetPosition(dBodyID);
+const dReal *dBodyGetQuaternion(dBodyID);
+const dReal *dBodyGetLinearVel(dBodyID);
+const dReal *dBodyGetAngularVel(dBodyID);
+const dReal *dBodyGetForce(dBodyID);
+const dReal *dBodyGetTorque(dBodyID);
+void dBodySetMass(dBodyID, const dMass *mass);
+void dBodyGetMass(dBodyID, dMass *mass);
+void dBodySetKinematic(dBodyID);
+int dBodyIsKinematic(dBodyID);
+void dBodyGetRelPointPos(dBodyID, dReal px, dReal py, dReal pz, dVector3 result);
+void dBodyVectorToWorld(dBodyID, dReal px, dReal py, dReal pz, dVector3 result);
+
+/* mass */
+void dMassSetZero(dMass *);
+void dMassSetParameters(dMass *, dReal themass, dReal cgx, dReal cgy, dReal cgz,
+                        dReal I11, dReal I22, dReal I33, dReal I12, dReal I13, dReal I23);
+void dMassSetSphereTotal(dMass *, dReal total_mass, dReal radius);
+void dMassSetCylinderTotal(dMass *, dReal total_mass, int direction, dReal radius, dReal length);
+void dMassSetBoxTotal(dMass *, dReal total_mass, dReal lx, dReal ly, dReal lz);
+void dMassTranslate(dMass *, dReal x, dReal y, dReal z);
+void dMassRotate(dMass *, const dMatrix3 R);
+void dMassAdd(dMass *a, const dMass *b);
+int dMassCheck(const dMass *m);
+
+/* rotation */
+void dRfromQ(dMatrix3 R, const dQuaternion q);
+
+/* geoms */
+void dGeomDestroy(dGeomID geom);
+void dGeomSetBody(dGeomID geom, dBodyID body);
+dBodyID dGeomGetBody(dGeomID geom);
+void dGeomSetPosition(dGeomID geom, dReal x, dReal y, dReal z);
+void dGeomSetQuaternion(dGeomID geom, const dQuaternion Q);
+const dReal *dGeomGetPosition(dGeomID geom);
+void dGeomGetQuaternion(dGeomID geom, dQuaternion result);
+void dGeomSetOffsetPosition(dGeomID geom, dReal x, dReal y, dReal z);
+void dGeomSetOffsetQuaternion(dGeomID geom, const dQuaternion Q);
+dGeomID dCreateSphere(dSpaceID space, dReal radius);
+dGeomID dCreateBox(dSpaceID space, dReal lx, dReal ly, dReal lz);
+dGeomID dCreateCylinder(dSpaceID space, dReal radius, dReal length);
+dTriMeshDataID dGeomTriMeshDataCreate(void);
+void dGeomTriMeshDataDestroy(dTriMeshDataID g);
+void dGeomTriMeshDataBuildDouble(dTriMeshDataID g, const void *Vertices, int VertexStride,
+                                 int VertexCount, const void *Indices, int IndexCount,
+                                 int TriStride);
+dGeomID dCreateTriMesh(dSpaceID space, dTriMeshDataID Data, void *Callback, void *ArrayCallback,
+                       void *RayCallback);
+
+/* joints */
+void dJointDestroy(dJointID);
+void dJointAttach(dJointID, dBodyID body1, dBodyID body2);
+int dJointGetType(dJointID);
+dBodyID dJointGetBody(dJointID, int index);
+int dAreConnected(dBodyID, dBodyID);
+dJointID dJointCreateBall(dWorldID, dJointGroupID);
+dJointID dJointCreateHinge(dWorldID, dJointGroupID);
+dJointID dJointCreateSlider(dWorldID, dJointGroupID);
+dJointID dJointCreatePiston(dWorldID, dJointGroupID);
+dJointID dJointCreateUniversal(dWorldID, dJointGroupID);
+dJointID dJointCreateHinge2(dWorldID, dJointGroupID);
+dJointID dJointCreatePR(dWorldID, dJointGroupID);
+dJointID dJointCreatePU(dWorldID, dJointGroupID);
+dJointID dJointCreateFixed(dWorldID, dJointGroupID);
+dJointID dJointCreatePlane2D(dWorldID, dJointGroupID);
+dJointID dJointCreateAMotor(dWorldID, dJointGroupID);
+dJointID dJointCreateLMotor(dWorldID, dJointGroupID);
+
+void dJointSetBallAnchor(dJointID, dReal x, dReal y, dReal z);
+void dJointSetHingeAnchor(dJointID, dReal x, dReal y, dReal z);
+void dJointSetHingeAxis(dJointID, dReal x, dReal y, dReal z);
+void dJointSetSliderAxis(dJointID, dReal x, dReal y, dReal z);
+void dJointSetPistonAnchor(dJointID, dReal x, dReal y, dReal z);
+void dJointSetPistonAxis(dJointID, dReal x, dReal y, dReal z);
+void dJointSetUniversalAnchor(dJointID, dReal x, dReal y, dReal z);
+void dJointSetUniversalAxis1(dJointID, dReal x, dReal y, dReal z);
+void dJointSetUniversalAxis2(dJointID, dReal x, dReal y, dReal z);
+void dJointSetHinge2Anchor(dJointID, dReal x, dReal y, dReal z);
+void dJointSetHinge2Axes(dJointID j, const dReal *axis1, const dReal *axis2);
+void dJointSetPRAnchor(dJointID, dReal x, dReal y, dReal z);
+void dJointSetPRAxis1(dJointID, dReal x, dReal y, dReal z);
+void dJointSetPRAxis2(dJointID, dReal x, dReal y, dReal z);
+void dJointSetPUAnchor(dJointID, dReal x, dReal y, dReal z);
+void dJointSetPUAxis1(dJointID, dReal x, dReal y, dReal z);
+void dJointSetPUAxis2(dJointID, dReal x, dReal y, dReal z);
+void dJointSetPUAxis3(dJointID, dReal x, dReal y, dReal z);
+void dJointSetFixed(dJointID);
+
+void dJointGetHingeAxis(dJointID, dVector3 result);
+void dJointGetSliderAxis(dJointID, dVector3 result);
+void dJointGetPistonAxis(dJointID, dVector3 result);
+void dJointGetUniversalAxis1(dJointID, dVector3 result);
+void dJointGetUniversalAxis2(dJointID, dVector3 result);
+void dJointGetHinge2Axis1(dJointID, dVector3 result);
+void dJointGetHinge2Axis2(dJointID, dVector3 result);
+void dJointGetPRAxis1(dJointID, dVector3 result);
+void dJointGetPRAxis2(dJointID, dVector3 result);
+void dJointGetPUAxis1(dJointID, dVector3 result);
+void dJointGetPUAxis2(dJointID, dVector3 result);
+void dJointGetPUAxis3(dJointID, dVector3 result);
+
+dReal dJointGetHingeAngle(dJointID);
+dReal dJointGetHingeAngleRate(dJointID);
+dReal dJointGetSliderPosition(dJointID);
+dReal dJointGetSliderPositionRate(dJointID);
+dReal dJointGetPistonPosition(dJointID);
+dReal dJointGetPistonPositionRate(dJointID);
+dReal dJointGetPistonAngle(dJointID);
+dReal dJointGetPistonAngleRate(dJointID);
+dReal dJointGetUniversalAngle1(dJointID);
+dReal dJointGetUniversalAngle2(dJointID);
+dReal dJointGetUniversalAngle1Rate(dJointID);
+dReal dJointGetUniversalAngle2Rate(dJointID);
+dReal dJointGetHinge2Angle1(dJointID);
+dReal dJointGetHinge2Angle2(dJointID);
+dReal dJointGetHinge2Angle1Rate(dJointID);
+dReal dJointGetHinge2Angle2Rate(dJointID);
+dReal dJointGetPRPosition(dJointID);
+dReal dJointGetPRPositionRate(dJointID);
+dReal dJointGetPRAngle(dJointID);
+dReal dJointGetPRAngleRate(dJointID);
+dReal dJointGetPUPosition(dJointID);
+dReal dJointGetPUPositionRate(dJointID);
+dReal dJointGetPUAngle1(dJointID);
+dReal dJointGetPUAngle2(dJointID);
+dReal dJointGetPUAngle1Rate(dJointID);
+dReal dJointGetPUAngle2Rate(dJointID);
+
+void dJointSetHingeParam(dJointID, int parameter, dReal value);
+void dJointSetSliderParam(dJointID, int parameter, dReal value);
+void dJointSetPistonParam(dJointID, int parameter, dReal value);
+void dJointSetUniversalParam(dJointID, int parameter, dReal value);
+void dJointSetHinge2Param(dJointID, int parameter, dReal value);
+void dJointSetPRParam(dJointID, int parameter, dReal value);
+void dJointSetPUParam(dJointID, int parameter, dReal value);
+void dJointSetBallParam(dJointID, int parameter, dReal value);
+void dJointSetFixedParam(dJointID, int parameter, dReal value);
+void dJointSetAMotorParam(dJointID, int parameter, dReal value);
+void dJointSetLMotorParam(dJointID, int parameter, dReal value);
+dReal dJointGetAMotorParam(dJointID, int parameter);
+dReal dJointGetLMotorParam(dJointID, int parameter);
+
+void dJointSetAMotorMode(dJointID, int mode);
+void dJointSetAMotorNumAxes(dJointID, int num);
+void dJointSetAMotorAxis(dJointID, int anum, int rel, dReal x, dReal y, dReal z);
+void dJointSetLMotorNumAxes(dJointID, int num);
+void dJointSetLMotorAxis(dJointID, int anum, int rel, dReal x, dReal y, dReal z);
+
+/* ---- odin_step.h ---- */
+#define ODIN_MAX_CONTACTS ...
+#define ODIN_RECORD_POINTS ...
+
+typedef struct OdinBodyForce {
+    dBodyID body;
+    int torque;
+    int vector_in_body;
+    int at_point;
+    int point_in_body;
+    double vector[3];
+    double point[3];
+} OdinBodyForce;
+
+typedef struct OdinJointForce {
+    dJointID joint;
+    int type;
+    double magnitude[3];
+} OdinJointForce;
+
+typedef struct OdinMotorGoal {
+    dJointID motor;
+    int kind;
+    int naxes;
+    double velocity[3];
+} OdinMotorGoal;
+
+typedef struct OdinCollision {
+    dGeomID g1, g2;
+    double depth;
+    int npoints;
+    double points[8][3];
+} OdinCollision;
+
+typedef struct OdinWorld {
+    dWorldID world;
+    dSpaceID space;
+    dJointGroupID contact_group;
+    int max_contacts;
+    double mu;
+    double bounce;
+    double bounce_vel;
+    int contact_less;
+    int solver;
+    OdinBodyForce *forces; int n_forces;
+    OdinJointForce *joint_forces; int n_joint_forces;
+    OdinMotorGoal *motors; int n_motors;
+    int last_step_contacts;
+    int recording;
+    int record_overflow;
+    OdinCollision *records; int n_records; int cap_records;
+    int *table; int table_cap;
+} OdinWorld;
+
+void odin_set_geom_tag(dGeomID g, long tag);
+long odin_get_geom_tag(dGeomID g);
+int odin_world_step(OdinWorld *w, double h, int count);
+void odin_world_clear_records(OdinWorld *w);
+void odin_world_free_buffers(OdinWorld *w);
+void odin_read_poses(dGeomID *geoms, int n, double *pos, double *quat);
+void odin_install_handlers(void);
+int odin_drain_message(char *buf, int size, int *errnum);
+void odin_test_message(int num, const char *msg);

@@ -1,2 +1,298 @@
-/* Odin's per-step hot work in C (see odin_step.h). */
+/* Odin's per-step hot work in C (see odin_step.h): the hash-space near-callback with contact
+ * creation and pair recording, persistent forces, joint forces and motor goals, the step loop,
+ * the vectorised pose read-out and ODE's message routing. */
 #include "odin_step.h"
+
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---------------------------------------------------------------- geom tags */
+
+void odin_set_geom_tag(dGeomID g, long tag) { dGeomSetData(g, (void *)(intptr_t)tag); }
+
+long odin_get_geom_tag(dGeomID g) { return (long)(intptr_t)dGeomGetData(g); }
+
+/* ---------------------------------------------------------------- collision records */
+
+static size_t pair_hash(dGeomID a, dGeomID b) {
+    uint64_t x = (uint64_t)(uintptr_t)a * 0x9E3779B97F4A7C15ull;
+    x ^= (uint64_t)(uintptr_t)b + 0x7F4A7C15ull + (x << 6) + (x >> 2);
+    x ^= x >> 29;
+    return (size_t)x;
+}
+
+static int grow_records(OdinWorld *w) {
+    int cap = w->cap_records ? 2 * w->cap_records : 256;
+    OdinCollision *records = realloc(w->records, (size_t)cap * sizeof(OdinCollision));
+    if (!records) return 0;
+    w->records = records;
+    w->cap_records = cap;
+    int tcap = 2 * cap;
+    int *table = realloc(w->table, (size_t)tcap * sizeof(int));
+    if (!table) return 0;
+    w->table = table;
+    w->table_cap = tcap;
+    memset(table, 0, (size_t)tcap * sizeof(int));
+    for (int i = 0; i < w->n_records; ++i) {
+        size_t h = pair_hash(records[i].g1, records[i].g2) & (size_t)(tcap - 1);
+        while (table[h]) h = (h + 1) & (size_t)(tcap - 1);
+        table[h] = i + 1;
+    }
+    return 1;
+}
+
+static void record_pair(OdinWorld *w, dGeomID o1, dGeomID o2, const dContact *c, int n) {
+    dGeomID a = o1, b = o2;
+    if ((uintptr_t)a > (uintptr_t)b) { a = o2; b = o1; }
+    double depth = 0.0;
+    for (int i = 0; i < n; ++i)
+        if (c[i].geom.depth > depth) depth = c[i].geom.depth;
+    OdinCollision *r = NULL;
+    if (w->table_cap) {
+        size_t mask = (size_t)(w->table_cap - 1);
+        size_t h = pair_hash(a, b) & mask;
+        while (w->table[h]) {
+            OdinCollision *q = &w->records[w->table[h] - 1];
+            if (q->g1 == a && q->g2 == b) { r = q; break; }
+            h = (h + 1) & mask;
+        }
+        if (r && depth <= r->depth) return; /* keep the deepest occurrence */
+    }
+    if (!r) {
+        if (w->n_records >= w->cap_records && !grow_records(w)) { w->record_overflow++; return; }
+        r = &w->records[w->n_records++];
+        r->g1 = a;
+        r->g2 = b;
+        size_t mask = (size_t)(w->table_cap - 1);
+        size_t h = pair_hash(a, b) & mask;
+        while (w->table[h]) h = (h + 1) & mask;
+        w->table[h] = w->n_records;
+    }
+    r->depth = depth;
+    r->npoints = n < ODIN_RECORD_POINTS ? n : ODIN_RECORD_POINTS;
+    for (int i = 0; i < r->npoints; ++i)
+        for (int k = 0; k < 3; ++k) r->points[i][k] = c[i].geom.pos[k];
+}
+
+void odin_world_clear_records(OdinWorld *w) {
+    w->n_records = 0;
+    if (w->table) memset(w->table, 0, (size_t)w->table_cap * sizeof(int));
+}
+
+void odin_world_free_buffers(OdinWorld *w) {
+    free(w->records);
+    free(w->table);
+    w->records = NULL;
+    w->table = NULL;
+    w->n_records = w->cap_records = w->table_cap = 0;
+}
+
+/* ---------------------------------------------------------------- near-callback */
+
+static void near_callback(void *data, dGeomID o1, dGeomID o2) {
+    OdinWorld *w = (OdinWorld *)data;
+    long t1 = (long)(intptr_t)dGeomGetData(o1);
+    if (t1 && t1 == (long)(intptr_t)dGeomGetData(o2)) return; /* same entity, no internal collisions */
+    dBodyID b1 = dGeomGetBody(o1), b2 = dGeomGetBody(o2);
+    if (b1 == b2) return; /* parts of one composite, or two static geoms */
+    if (b1 && b2 && dAreConnectedExcluding(b1, b2, dJointTypeContact)) return;
+    if (!w->contact_less) {
+        int dynamic = (b1 && !dBodyIsKinematic(b1)) || (b2 && !dBodyIsKinematic(b2));
+        if (!dynamic) return; /* nothing can move: no contact needed */
+    }
+    dContact contact[ODIN_MAX_CONTACTS];
+    int n = dCollide(o1, o2, w->max_contacts, &contact[0].geom, sizeof(dContact));
+    if (n <= 0) return;
+    if (w->recording) record_pair(w, o1, o2, contact, n);
+    if (w->contact_less) return;
+    int mode = dContactApprox1;
+    if (w->bounce > 0) mode |= dContactBounce;
+    for (int i = 0; i < n; ++i) {
+        contact[i].surface.mode = mode;
+        contact[i].surface.mu = w->mu;
+        contact[i].surface.bounce = w->bounce;
+        contact[i].surface.bounce_vel = w->bounce_vel;
+        dJointID c = dJointCreateContact(w->world, w->contact_group, &contact[i]);
+        dJointAttach(c, b1, b2);
+    }
+    w->last_step_contacts += n;
+}
+
+/* ---------------------------------------------------------------- persistent actions */
+
+static void apply_body_forces(const OdinWorld *w) {
+    for (int i = 0; i < w->n_forces; ++i) {
+        const OdinBodyForce *f = &w->forces[i];
+        const double *v = f->vector, *p = f->point;
+        if (f->torque) {
+            if (f->vector_in_body) dBodyAddRelTorque(f->body, v[0], v[1], v[2]);
+            else dBodyAddTorque(f->body, v[0], v[1], v[2]);
+        } else if (!f->at_point) {
+            if (f->vector_in_body) dBodyAddRelForce(f->body, v[0], v[1], v[2]);
+            else dBodyAddForce(f->body, v[0], v[1], v[2]);
+        } else if (f->vector_in_body) {
+            if (f->point_in_body) dBodyAddRelForceAtRelPos(f->body, v[0], v[1], v[2], p[0], p[1], p[2]);
+            else dBodyAddRelForceAtPos(f->body, v[0], v[1], v[2], p[0], p[1], p[2]);
+        } else {
+            if (f->point_in_body) dBodyAddForceAtRelPos(f->body, v[0], v[1], v[2], p[0], p[1], p[2]);
+            else dBodyAddForceAtPos(f->body, v[0], v[1], v[2], p[0], p[1], p[2]);
+        }
+    }
+}
+
+/* Adds +v to the first body and -v to the second, as torque or force (ODE's own convention). */
+static void add_pair(dJointID j, const dReal *v, int torque) {
+    dBodyID b1 = dJointGetBody(j, 0), b2 = dJointGetBody(j, 1);
+    if (torque) {
+        if (b1) dBodyAddTorque(b1, v[0], v[1], v[2]);
+        if (b2) dBodyAddTorque(b2, -v[0], -v[1], -v[2]);
+    } else {
+        if (b1) dBodyAddForce(b1, v[0], v[1], v[2]);
+        if (b2) dBodyAddForce(b2, -v[0], -v[1], -v[2]);
+    }
+}
+
+static void apply_joint_forces(const OdinWorld *w) {
+    for (int i = 0; i < w->n_joint_forces; ++i) {
+        const OdinJointForce *f = &w->joint_forces[i];
+        const double *m = f->magnitude;
+        dVector3 a1, a2, v;
+        switch (f->type) {
+        case dJointTypeBall:
+            v[0] = m[0]; v[1] = m[1]; v[2] = m[2];
+            add_pair(f->joint, v, 1);
+            break;
+        case dJointTypeHinge: dJointAddHingeTorque(f->joint, m[0]); break;
+        case dJointTypeSlider: dJointAddSliderForce(f->joint, m[0]); break;
+        case dJointTypePiston: dJointAddPistonForce(f->joint, m[0]); break;
+        case dJointTypeUniversal: dJointAddUniversalTorques(f->joint, m[0], m[1]); break;
+        case dJointTypeHinge2: dJointAddHinge2Torques(f->joint, m[0], m[1]); break;
+        case dJointTypePR:
+            dJointGetPRAxis1(f->joint, a1);
+            for (int k = 0; k < 3; ++k) v[k] = a1[k] * m[0];
+            add_pair(f->joint, v, 0);
+            dJointAddPRTorque(f->joint, m[1]);
+            break;
+        case dJointTypePU: /* libode 0.16 declares dJointAddPUTorque but does not export it */
+            dJointGetPUAxis1(f->joint, a1);
+            dJointGetPUAxis2(f->joint, a2);
+            for (int k = 0; k < 3; ++k) v[k] = a1[k] * m[0] + a2[k] * m[1];
+            add_pair(f->joint, v, 1);
+            break;
+        default: break; /* Python never queues other types */
+        }
+    }
+}
+
+static void apply_motor_goals(const OdinWorld *w) {
+    for (int i = 0; i < w->n_motors; ++i) {
+        const OdinMotorGoal *g = &w->motors[i];
+        for (int k = 0; k < g->naxes; ++k) {
+            if (g->kind == 0) dJointSetAMotorParam(g->motor, dParamVel + k * dParamGroup, g->velocity[k]);
+            else dJointSetLMotorParam(g->motor, dParamVel + k * dParamGroup, g->velocity[k]);
+        }
+    }
+}
+
+/* ---------------------------------------------------------------- step (thesis 5.5) */
+
+int odin_world_step(OdinWorld *w, double h, int count) {
+    for (int s = 0; s < count; ++s) {
+        w->last_step_contacts = 0;
+        /* contact policy: the pairs of the last step; contact-less: every step, kept until read */
+        if (!w->contact_less) {
+            w->recording = (s == count - 1);
+            if (w->recording) odin_world_clear_records(w);
+        } else {
+            w->recording = 1;
+        }
+        dSpaceCollide(w->space, w, &near_callback);   /* 1. collisions */
+        apply_body_forces(w);                         /* 2. forces and torques on bodies */
+        apply_joint_forces(w);                        /* 3. joint forces and motor goals */
+        apply_motor_goals(w);
+        if (w->solver == 0) dWorldQuickStep(w->world, h); /* 4. step */
+        else dWorldStep(w->world, h);
+        /* 5. fixed bodies are kinematic (dBodySetKinematic): nothing to reset */
+        dJointGroupEmpty(w->contact_group);           /* 6. contacts last one step */
+    }
+    w->recording = 0;
+    return 0;
+}
+
+/* ---------------------------------------------------------------- read-out */
+
+void odin_read_poses(dGeomID *geoms, int n, double *pos, double *quat) {
+    for (int i = 0; i < n; ++i) {
+        const dReal *p = dGeomGetPosition(geoms[i]);
+        dQuaternion q;
+        dGeomGetQuaternion(geoms[i], q);
+        pos[3 * i] = p[0]; pos[3 * i + 1] = p[1]; pos[3 * i + 2] = p[2];
+        quat[4 * i] = q[0]; quat[4 * i + 1] = q[1]; quat[4 * i + 2] = q[2]; quat[4 * i + 3] = q[3];
+    }
+}
+
+/* ---------------------------------------------------------------- ODE messages */
+
+#define RING 64
+#define TEXT 512
+static struct { int level, num; char text[TEXT]; } ring[RING];
+static int ring_head, ring_count;
+
+static void push(int level, int num, const char *msg, va_list ap) {
+    int slot = (ring_head + ring_count) % RING;
+    if (ring_count == RING) ring_head = (ring_head + 1) % RING; /* drop the oldest */
+    else ring_count++;
+    ring[slot].level = level;
+    ring[slot].num = num;
+    vsnprintf(ring[slot].text, TEXT, msg, ap);
+}
+
+/* dError and dDebug end the process after their handler returns (exit(1) / abort()), and
+ * unwinding out of ODE with longjmp would leave its state corrupt. So these handlers record the
+ * message and print it to stderr at once, where it survives the process's end; Odin validates
+ * every argument before calling ODE so that they never fire. dMessage is non-fatal: buffered
+ * only, and Python drains the buffer into `logging` after each call into ODE. */
+static void on_error(int num, const char *msg, va_list ap) {
+    va_list copy;
+    va_copy(copy, ap);
+    push(2, num, msg, ap);
+    fprintf(stderr, "ODE error %d: ", num);
+    vfprintf(stderr, msg, copy);
+    fputc('\n', stderr);
+    fflush(stderr);
+    va_end(copy);
+}
+
+static void on_debug(int num, const char *msg, va_list ap) {
+    va_list copy;
+    va_copy(copy, ap);
+    push(1, num, msg, ap);
+    fprintf(stderr, "ODE internal error %d: ", num);
+    vfprintf(stderr, msg, copy);
+    fputc('\n', stderr);
+    fflush(stderr);
+    va_end(copy);
+}
+
+static void on_message(int num, const char *msg, va_list ap) { push(0, num, msg, ap); }
+
+void odin_install_handlers(void) {
+    dSetErrorHandler(&on_error);
+    dSetDebugHandler(&on_debug);
+    dSetMessageHandler(&on_message);
+}
+
+int odin_drain_message(char *buf, int size, int *errnum) {
+    if (!ring_count) return -1;
+    int level = ring[ring_head].level;
+    *errnum = ring[ring_head].num;
+    snprintf(buf, (size_t)size, "%s", ring[ring_head].text);
+    ring_head = (ring_head + 1) % RING;
+    ring_count--;
+    return level;
+}
+
+void odin_test_message(int num, const char *msg) { dMessage(num, "%s", msg); }
