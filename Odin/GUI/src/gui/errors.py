@@ -1,0 +1,50 @@
+"""The GUI's exceptions: one root (``GuiError``) under Odin's ``OdinError``.
+
+Messages say what was wrong, with the offending value and where it came from: parsed files
+are named with their line (``file:line: what``) so the command-line tools can print one line.
+"""
+from __future__ import annotations
+
+import os
+from typing import Optional
+
+from odin_common import OdinError
+
+
+class GuiError(OdinError):
+    """Root of everything the GUI raises on purpose."""
+
+
+class ProblemError(GuiError):
+    """A problem, robot, control or path file that cannot be read or does not make sense.
+
+    ``path`` and ``line`` (1-based, ``None`` when unknown) say where; ``str(error)`` is
+    ``"path:line: reason"``.
+    """
+
+    def __init__(self, reason: str, path: Optional[os.PathLike | str] = None,
+                 line: Optional[int] = None):
+        self.reason = reason
+        self.path = None if path is None else str(path)
+        self.line = line
+        where = ""
+        if self.path is not None:
+            where = f"{self.path}:{line}: " if line else f"{self.path}: "
+        super().__init__(f"{where}{reason}")
+
+
+class ShapeError(ProblemError):
+    """A geometry file (VRML, Inventor, STL...) that does not parse or holds no geometry."""
+
+
+class PathFileError(ProblemError):
+    """A path or initial-position file that does not fit the robot it drives."""
+
+
+class WorldError(GuiError):
+    """The VirtualWorld answered ``success: false`` (its message is kept) or did not answer."""
+
+    def __init__(self, service: str, message: str):
+        self.service = service
+        self.world_message = message
+        super().__init__(f"{service}: {message}")

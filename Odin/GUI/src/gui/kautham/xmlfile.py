@@ -1,0 +1,148 @@
+"""A small XML tree that remembers line numbers, and typed attribute readers.
+
+ElementTree forgets where an element was; error messages must name the file and the line,
+so the tree is built here from expat directly. Free text inside elements (Kautham's files
+have plenty) is kept but never needed.
+"""
+from __future__ import annotations
+
+import math
+import os
+import pathlib
+import xml.parsers.expat
+from dataclasses import dataclass, field
+from typing import Iterator, Optional
+
+from gui.errors import ProblemError
+
+
+@dataclass
+class Node:
+    """One XML element: tag, attributes, children, text, and its 1-based line."""
+    tag: str
+    attrib: dict
+    line: int
+    path: str
+    children: list = field(default_factory=list)
+    text: str = ""
+
+    def find(self, tag: str) -> Optional["Node"]:
+        """The first child called ``tag`` (case-insensitive, as Kautham's readers are)."""
+        low = tag.lower()
+        for child in self.children:
+            if child.tag.lower() == low:
+                return child
+        return None
+
+    def findall(self, tag: str) -> Iterator["Node"]:
+        low = tag.lower()
+        return (child for child in self.children if child.tag.lower() == low)
+
+    def get(self, name: str, default: Optional[str] = None) -> Optional[str]:
+        if name in self.attrib:
+            return self.attrib[name]
+        low = name.lower()
+        for key, value in self.attrib.items():
+            if key.lower() == low:
+                return value
+        return default
+
+    def error(self, reason: str) -> ProblemError:
+        return ProblemError(reason, self.path, self.line)
+
+    def require(self, name: str) -> str:
+        value = self.get(name)
+        if value is None:
+            raise self.error(f"<{self.tag}> has no attribute {name}=")
+        return value
+
+    def number(self, name: str, default: Optional[float] = None) -> float:
+        """The attribute as a finite float; a missing one gives ``default`` (or an error
+        when no default is given); a malformed one ("0.01.0") is always an error."""
+        raw = self.get(name)
+        if raw is None:
+            if default is None:
+                raise self.error(f"<{self.tag}> has no attribute {name}=")
+            return default
+        return parse_number(raw, f"<{self.tag} {name}=\"{raw}\">", self.path, self.line)
+
+    def flag(self, name: str, default: bool) -> bool:
+        raw = self.get(name)
+        if raw is None:
+            return default
+        low = raw.strip().lower()
+        if low in ("true", "1", "yes"):
+            return True
+        if low in ("false", "0", "no"):
+            return False
+        raise self.error(f"<{self.tag} {name}=\"{raw}\"> is not true or false")
+
+    def numbers(self, name: str, count: int, default: Optional[tuple] = None) -> tuple:
+        """A space-separated vector attribute (URDF's xyz="0 0 1")."""
+        raw = self.get(name)
+        if raw is None:
+            if default is None:
+                raise self.error(f"<{self.tag}> has no attribute {name}=")
+            return default
+        parts = raw.split()
+        if len(parts) != count:
+            raise self.error(f"<{self.tag} {name}=\"{raw}\"> needs {count} numbers")
+        return tuple(parse_number(p, f"<{self.tag} {name}=\"{raw}\">", self.path, self.line)
+                     for p in parts)
+
+
+def parse_number(raw: str, what: str, path: Optional[str], line: Optional[int]) -> float:
+    try:
+        value = float(raw.strip())
+    except ValueError:
+        raise ProblemError(f"{what}: {raw.strip()!r} is not a number", path, line) from None
+    if not math.isfinite(value):
+        raise ProblemError(f"{what}: {raw.strip()!r} is not finite", path, line)
+    return value
+
+
+def read_xml(path: os.PathLike | str, what: str = "file") -> Node:
+    """Parses ``path`` into a ``Node`` tree; a missing or malformed file is a ``ProblemError``
+    naming the file and (for malformed XML) the line."""
+    p = pathlib.Path(path)
+    try:
+        data = p.read_bytes()
+    except FileNotFoundError:
+        raise ProblemError(f"{what} not found", p) from None
+    except OSError as error:
+        raise ProblemError(f"{what} cannot be read: {error.strerror}", p) from None
+    return parse_xml_bytes(data, str(p))
+
+
+def parse_xml_bytes(data: bytes, path: str) -> Node:
+    parser = xml.parsers.expat.ParserCreate()
+    stack: list[Node] = []
+    root: list[Node] = []
+
+    def start(tag, attrib):
+        node = Node(tag, dict(attrib), parser.CurrentLineNumber, path)
+        if stack:
+            stack[-1].children.append(node)
+        else:
+            root.append(node)
+        stack.append(node)
+
+    def end(tag):
+        stack.pop()
+
+    def text(data_):
+        if stack:
+            stack[-1].text += data_
+
+    parser.StartElementHandler = start
+    parser.EndElementHandler = end
+    parser.CharacterDataHandler = text
+    try:
+        parser.Parse(data, True)
+    except xml.parsers.expat.ExpatError as error:
+        reason = xml.parsers.expat.ErrorString(error.code)
+        raise ProblemError(f"malformed XML: {reason} (column {error.offset + 1})", path,
+                           error.lineno) from None
+    if not root:
+        raise ProblemError("no XML element", path)
+    return root[0]
