@@ -1,0 +1,64 @@
+"""Mass properties of triangle meshes, from trimesh (never ODE's dMassSetTrimesh, which is wrong
+for meshes whose origin is not their centre of mass).
+
+Rule:
+  * closed mesh (``is_watertight``): normals repaired (``trimesh.repair.fix_normals``), an
+    inverted mesh turned outside-out, density = mass / |volume|; the exact centre of mass and
+    inertia about it follow (trimesh's surface-integral formulas);
+  * open mesh (or one that stays non-volumetric after the repair): the same for its convex hull
+    with the given mass (a solid that encloses the mesh); if the hull is flat too, the mesh's
+    axis-aligned bounding box as a solid box of that mass, centred on the box.
+The result is expressed in the mesh's own frame.
+"""
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+import trimesh
+
+from virtual_world.errors import InvalidArgument
+
+
+class MeshMass(NamedTuple):
+    """mass: kg; center: (3,) m, mesh frame; inertia: (3,3) kg m^2 about `center`, mesh axes;
+    rule: "closed", "convex hull" or "bounding box" (which rule gave the figures)."""
+    mass: float
+    center: np.ndarray
+    inertia: np.ndarray
+    rule: str
+
+
+def _solid(mesh: trimesh.Trimesh, mass: float):
+    if mesh.volume < 0:
+        mesh.invert()
+    volume = float(mesh.volume)
+    if not np.isfinite(volume) or volume <= 1e-15 * max(mesh.scale, 1e-12) ** 3:
+        return None
+    mesh.density = mass / volume
+    return np.asarray(mesh.center_mass, float), np.asarray(mesh.moment_inertia, float)
+
+
+def mesh_mass(vertices: np.ndarray, triangles: np.ndarray, mass: float) -> MeshMass:
+    """Mass properties of a mesh: vertices (n,3) m, triangles (m,3) indices, mass kg > 0."""
+    mesh = trimesh.Trimesh(np.asarray(vertices, float), np.asarray(triangles, np.int64),
+                           process=True, validate=False)
+    if mesh.is_watertight:
+        trimesh.repair.fix_normals(mesh)
+        if mesh.is_volume:
+            solid = _solid(mesh, mass)
+            if solid is not None:
+                return MeshMass(mass, solid[0], solid[1], "closed")
+    try:
+        hull = mesh.convex_hull
+        solid = _solid(hull, mass) if hull.is_volume else None
+    except Exception:  # qhull refuses flat or degenerate point sets
+        solid = None
+    if solid is not None:
+        return MeshMass(mass, solid[0], solid[1], "convex hull")
+    low, high = np.asarray(vertices, float).min(axis=0), np.asarray(vertices, float).max(axis=0)
+    x, y, z = high - low
+    if sum(side > 0 for side in (x, y, z)) < 2:
+        raise InvalidArgument(f"mesh is degenerate (bounding box sides {x}, {y}, {z})")
+    inertia = mass / 12.0 * np.diag([y * y + z * z, x * x + z * z, x * x + y * y])
+    return MeshMass(mass, (low + high) / 2.0, inertia, "bounding box")
