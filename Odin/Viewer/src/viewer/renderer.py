@@ -137,6 +137,10 @@ class Renderer:
         """Draws ``scene`` from its camera; returns the frame (height, width, 3) uint8 RGB,
         row 0 at the top. The framebuffer follows the camera's image size."""
         camera = scene.camera
+        if (camera.width, camera.height) == (self.width, self.height):
+            # another Renderer may have been made current on this thread since
+            osmesa.OSMesaMakeCurrent(self._context, self._pixels, GL.GL_UNSIGNED_BYTE,
+                                     self.width, self.height)
         self.resize(camera.width, camera.height)
         GL.glClearColor(*scene.background, 1.0)
         GL.glClear(GL.GL_COLOR_BUFFER_BIT | GL.GL_DEPTH_BUFFER_BIT)

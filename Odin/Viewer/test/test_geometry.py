@@ -1,0 +1,94 @@
+"""Shapes, poses and the one place where ODE's (w, x, y, z) quaternion becomes a rotation."""
+import math
+
+import numpy as np
+import pytest
+
+from viewer.errors import ViewerError
+from viewer.geometry import (geometry_from_parameters, pose_matrix, rotation_from_wxyz,
+                             unit_box, unit_cylinder, unit_sphere)
+from odin_common import OdinError
+
+S = math.sqrt(0.5)
+
+
+def test_identity_quaternion_is_w_first():
+    np.testing.assert_allclose(rotation_from_wxyz((1, 0, 0, 0)), np.eye(3), atol=1e-12)
+
+
+def test_quarter_turn_about_z_takes_x_to_y():
+    R = rotation_from_wxyz((S, 0, 0, S))        # (w, x, y, z): 90 degrees about z
+    np.testing.assert_allclose(R @ [1, 0, 0], [0, 1, 0], atol=1e-12)
+    np.testing.assert_allclose(R @ [0, 0, 1], [0, 0, 1], atol=1e-12)
+
+
+def test_half_turn_about_x_read_in_ode_order():
+    # (0, 1, 0, 0) is 180 degrees about x in (w, x, y, z); read as (x, y, z, w) it would be
+    # 180 degrees about y, which sends x to -x instead of keeping it.
+    R = rotation_from_wxyz((0, 1, 0, 0))
+    np.testing.assert_allclose(R @ [1, 0, 0], [1, 0, 0], atol=1e-12)
+    np.testing.assert_allclose(R @ [0, 0, 1], [0, 0, -1], atol=1e-12)
+
+
+def test_nearly_unit_quaternion_is_normalised():
+    R = rotation_from_wxyz((1.05, 0, 0, 0))
+    np.testing.assert_allclose(R, np.eye(3), atol=1e-12)
+
+
+@pytest.mark.parametrize("q", [(0, 0, 0, 0), (2, 0, 0, 0), (math.nan, 0, 0, 1), (1, 0, 0),
+                               (math.inf, 0, 0, 0)])
+def test_bad_quaternions_are_refused(q):
+    with pytest.raises(ViewerError):
+        rotation_from_wxyz(q)
+
+
+def test_pose_matrix_and_nan_position():
+    T = pose_matrix((1, 2, 3), (S, 0, 0, S))
+    np.testing.assert_allclose(T @ [1, 0, 0, 1], [1, 3, 3, 1], atol=1e-12)
+    with pytest.raises(ViewerError, match="position"):
+        pose_matrix((0, math.nan, 0), (1, 0, 0, 0))
+
+
+def test_viewer_error_is_an_odin_error():
+    assert issubclass(ViewerError, OdinError)
+
+
+def test_shape_follows_parameter_count():
+    assert geometry_from_parameters([0.5]).kind == "sphere"
+    cylinder = geometry_from_parameters([0.1, 2.0])
+    assert cylinder.kind == "cylinder" and cylinder.scale_B == (0.1, 0.1, 2.0)
+    box = geometry_from_parameters([1, 2, 3])
+    assert box.kind == "box" and box.radius == pytest.approx(0.5 * math.sqrt(14))
+    mesh = geometry_from_parameters([0, 0, 0, 1, 0, 0, 0, 1, 0], [0, 1, 2])
+    assert mesh.kind == "mesh" and mesh.triangle_count == 1
+    np.testing.assert_allclose(mesh.normals_B, [[0, 0, 1]] * 3)
+
+
+@pytest.mark.parametrize("params, indices, match", [
+    ([], [], "0 parameters"),
+    ([1, 2, 3, 4], [], "4 parameters"),
+    ([0] * 10, [0, 1, 2], "10 parameters"),
+    ([-1.0], [], "radius"),
+    ([0.1, 0.0], [], "length"),
+    ([1, math.nan, 1], [], "side y"),
+    ([0, 0, 0, 1, 0, 0, 0, 1, 0], [], "no triangles"),
+    ([0, 0, 0, 1, 0, 0, 0, 1, 0], [0, 1], "3 per triangle"),
+    ([0, 0, 0, 1, 0, 0, 0, 1, 0], [0, 1, 3], "index 3 out of range"),
+    ([0, 0, 0, 1, 0, 0, 0, math.nan, 0], [0, 1, 2], "finite"),
+])
+def test_bad_shapes_are_refused(params, indices, match):
+    with pytest.raises(ViewerError, match=match):
+        geometry_from_parameters(params, indices)
+
+
+@pytest.mark.parametrize("build", [unit_sphere, unit_cylinder, unit_box])
+def test_unit_primitives_have_outward_counter_clockwise_triangles(build):
+    vertices, normals, indices = build()
+    np.testing.assert_allclose(np.linalg.norm(normals, axis=1), 1, atol=1e-6)
+    tri = vertices[indices.reshape(-1, 3)].astype(float)
+    face_normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    centre = tri.mean(axis=1)
+    keep = np.linalg.norm(face_normal, axis=1) > 1e-9   # poles of the sphere are degenerate
+    assert np.all(np.einsum("ij,ij->i", face_normal[keep], centre[keep]) > 0)
+    assert np.abs(vertices).max() == pytest.approx(1.0 if build is unit_sphere else
+                                                  (1.0 if build is unit_cylinder else 0.5))

@@ -1,0 +1,82 @@
+"""The render thread: it owns the scene and GL, runs callers' work in order, answers them, and
+keeps rendering at its rate whatever they send."""
+import threading
+import time
+
+import pytest
+
+from pixels import is_hue, patch
+from viewer.camera import Camera
+from viewer.errors import ViewerError
+from viewer.loop import RenderLoop
+from viewer.renderer import Renderer
+from viewer.scene import Scene, prepare_view
+
+
+def make_loop(rate=50.0, frames=None):
+    scene = Scene(Camera(width=160, height=120))
+
+    def on_frame(frame, number):
+        if frames is not None:
+            frames.append((number, frame, threading.current_thread().name))
+    return RenderLoop(scene, lambda: Renderer(160, 120), rate, on_frame)
+
+
+def test_work_runs_on_the_render_thread_and_answers():
+    with make_loop() as loop:
+        name = loop.call(lambda scene, renderer: threading.current_thread().name)
+        assert name == "viewer-render"
+        request = prepare_view("ball", [0.5], [], (0, 0, 0.5), (1, 0, 0, 0), (1, 0, 0, 1))
+        assert loop.call(lambda scene, _: scene.view(request)) is False
+        frame = loop.call(lambda scene, renderer: renderer.render(scene))
+        uv = loop.scene.camera.project([(0, 0, 0.5)])[0]
+        assert is_hue(patch(frame, uv), 0)
+
+
+def test_errors_come_back_to_the_caller_and_the_loop_goes_on():
+    frames = []
+    with make_loop(frames=frames) as loop:
+        with pytest.raises(ViewerError, match="no object 'ghost'"):
+            loop.call(lambda scene, _: scene.remove_object("ghost"))
+        with pytest.raises(ZeroDivisionError):
+            loop.call(lambda scene, _: 1 / 0)
+        loop.post(lambda scene, _: 1 / 0)            # logged, not raised
+        seen = len(frames)
+        time.sleep(0.3)
+        assert len(frames) > seen
+        assert loop.call(lambda scene, _: len(scene)) == 0
+
+
+def test_frames_come_at_the_rate_on_the_render_thread():
+    frames = []
+    with make_loop(rate=25.0, frames=frames):
+        time.sleep(1.0)
+    assert 20 <= len(frames) <= 27
+    assert [n for n, _, _ in frames] == list(range(1, len(frames) + 1))
+    assert {thread for _, _, thread in frames} == {"viewer-render"}
+
+
+def test_posted_updates_apply_in_order():
+    with make_loop() as loop:
+        request = prepare_view("ball", [0.5], [], (0, 0, 0), (1, 0, 0, 0), (1, 0, 0, 1))
+        loop.call(lambda scene, _: scene.view(request))
+        for z in range(10):
+            loop.post(lambda scene, _, z=z: scene.update([("ball", (0, 0, z), (1, 0, 0, 0))]))
+        assert loop.call(lambda scene, _: scene.pose_of("ball")[2, 3]) == 9
+
+
+def test_calls_after_stop_are_refused():
+    loop = make_loop()
+    loop.start()
+    loop.stop()
+    loop.stop()
+    with pytest.raises(ViewerError, match="not running"):
+        loop.call(lambda scene, _: None)
+
+
+def test_a_renderer_that_cannot_start_is_reported():
+    def broken():
+        raise RuntimeError("no OSMesa here")
+    loop = RenderLoop(Scene(), broken, 25.0)
+    with pytest.raises(ViewerError, match="no OSMesa here"):
+        loop.start()

@@ -1,0 +1,117 @@
+"""The Viewer's Core without ROS and without OpenGL."""
+import math
+
+import numpy as np
+import pytest
+
+from viewer.camera import Camera
+from viewer.errors import ViewerError
+from viewer.scene import COLLIDING_COLOR, DEFAULT_COLOR, Scene, prepare_view
+
+RED = (1.0, 0.0, 0.0, 1.0)
+BLUE = (0.0, 0.0, 1.0, 1.0)
+
+
+def ball_scene():
+    scene = Scene()
+    scene.view_object("ball", [0.2], position_W=(0, 0, 0.2), color=RED)
+    scene.view_object("cube", [0.3, 0.3, 0.3], position_W=(1, 0, 0.15), color=BLUE)
+    return scene
+
+
+def situation(name, position, q=(1, 0, 0, 0)):
+    return name, position, q
+
+
+def test_objects_keep_their_colour_and_the_all_zero_colour_is_the_default():
+    scene = ball_scene()
+    scene.view_object("plain", [0.1], color=(0, 0, 0, 0))
+    assert scene.color_of("ball") == RED and scene.color_of("plain") == DEFAULT_COLOR
+
+
+def test_colliding_object_is_grey_until_an_update_that_does_not_list_it():
+    scene = ball_scene()
+    scene.collided(["ball", "ghost"])            # unknown names are ignored
+    assert scene.color_of("ball") == COLLIDING_COLOR
+    assert scene.color_of("cube") == BLUE
+    scene.update([situation("ball", (0, 0, 0.3))])   # listed since the previous update
+    assert scene.color_of("ball") == COLLIDING_COLOR
+    scene.update([situation("ball", (0, 0, 0.4))])   # not listed since: original colour
+    assert scene.color_of("ball") == RED
+
+
+def test_collision_listed_every_cycle_stays_grey():
+    scene = ball_scene()
+    for _ in range(3):
+        scene.collided(["cube"])
+        scene.update([])
+        assert scene.color_of("cube") == COLLIDING_COLOR
+    scene.update([])
+    assert scene.color_of("cube") == BLUE
+
+
+def test_update_moves_known_objects_and_skips_unknown_names_and_bad_poses():
+    scene = ball_scene()
+    applied = scene.update([situation("ball", (1, 2, 3), (0, 0, 0, 1)),
+                            situation("not_yet_viewed", (0, 0, 0)),
+                            situation("cube", (math.nan, 0, 0)),
+                            situation("cube", (0, 0, 0), (0, 0, 0, 0))])
+    assert applied == 1
+    np.testing.assert_allclose(scene.pose_of("ball")[:3, 3], (1, 2, 3))
+    np.testing.assert_allclose(scene.pose_of("ball")[:3, :3], np.diag([-1, -1, 1]), atol=1e-12)
+    np.testing.assert_allclose(scene.pose_of("cube")[:3, 3], (1, 0, 0.15))
+
+
+def test_viewing_an_existing_id_replaces_it():
+    scene = ball_scene()
+    assert scene.view_object("ball", [0.5], color=BLUE) is True
+    assert len(scene) == 2 and scene.color_of("ball") == BLUE
+    assert scene.draw_list()[0].geometry.radius == 0.5
+
+
+def test_remove_and_new_scene():
+    scene = ball_scene()
+    scene.remove_object("ball")
+    assert "ball" not in scene and len(scene) == 1
+    with pytest.raises(ViewerError, match="no object 'ball'"):
+        scene.remove_object("ball")
+    scene.new_scene()
+    assert len(scene) == 0 and scene.draw_list() == []
+
+
+def test_bad_view_requests_are_refused_before_touching_the_scene():
+    with pytest.raises(ViewerError, match="non-empty"):
+        prepare_view("", [1.0], [], (0, 0, 0), (1, 0, 0, 0), RED)
+    with pytest.raises(ViewerError, match="'m'.*no triangles"):
+        prepare_view("m", [0] * 9, [], (0, 0, 0), (1, 0, 0, 0), RED)
+    with pytest.raises(ViewerError, match="color"):
+        prepare_view("c", [1.0], [], (0, 0, 0), (1, 0, 0, 0), (2, 0, 0, 1))
+    with pytest.raises(ViewerError, match="quaternion"):
+        prepare_view("q", [1.0], [], (0, 0, 0), (0, 0, 0, 0), RED)
+
+
+def test_adding_objects_refits_the_camera_unless_it_is_fixed():
+    scene = Scene()
+    scene.view_object("a", [0.5], position_W=(10, 0, 0))
+    np.testing.assert_allclose(scene.camera.target_W, (10, 0, 0))
+    scene.view_object("b", [0.5], position_W=(20, 0, 0))
+    np.testing.assert_allclose(scene.camera.target_W, (15, 0, 0))
+    uv = scene.camera.project([(9.5, 0, 0), (20.5, 0, 0)])
+    assert np.all((uv >= 0) & (uv <= [640, 480]))
+
+    fixed = Camera(eye_W=(0, -5, 1), target_W=(0, 0, 0))
+    scene.set_camera(fixed, fixed=True)
+    scene.view_object("c", [0.5], position_W=(30, 0, 0))
+    assert scene.camera == fixed and not scene.fitting
+    scene.set_camera(scene.camera, fixed=False)      # released: fits all three at once
+    np.testing.assert_allclose(scene.camera.target_W, (20, 0, 0))
+
+
+def test_bounds_and_clip_planes_hold_the_scene():
+    scene = ball_scene()
+    centre, radius = scene.bounds()
+    for obj_centre, obj_radius in (((0, 0, 0.2), 0.2), ((1, 0, 0.15), 0.15 * math.sqrt(3))):
+        assert np.linalg.norm(np.subtract(obj_centre, centre)) + obj_radius <= radius + 1e-9
+    near, far = scene.clip_planes()
+    distance = np.linalg.norm(np.subtract(scene.camera.eye_W, centre))
+    assert 0 < near < distance - radius and far > distance + radius
