@@ -897,8 +897,9 @@ class Core:
         ptr = _CREATE[joint_type](self._world.ptr, ffi.NULL)
         owner = handles.new_joint(ptr, self._world, bodies)
         j = owner.ptr
-        lib.dJointAttach(j, objects[0].body.ptr if objects[0] else ffi.NULL,
-                         objects[1].body.ptr if objects[1] else ffi.NULL)
+        # a body joined to the world is ODE's body 1 (body 2 NULL): angles, rates, joint
+        # forces and motors then all describe that body's motion with the axes as given
+        lib.dJointAttach(j, bodies[0].ptr, bodies[1].ptr if len(bodies) > 1 else ffi.NULL)
         a = anchor.tolist()
         if joint_type == BALL:
             lib.dJointSetBallAnchor(j, *a)
@@ -1143,8 +1144,9 @@ class Core:
         bodies = [o.body for o in objects if o is not None]
         owner = handles.new_joint(create(self._world.ptr, ffi.NULL), self._world, bodies)
         m = owner.ptr
-        lib.dJointAttach(m, objects[0].body.ptr if objects[0] else ffi.NULL,
-                         objects[1].body.ptr if objects[1] else ffi.NULL)
+        if objects[0] is None:  # the body is ODE's body 1, as for joints (see create_joint)
+            frames = [{0: 0, 1: 2, 2: 1}[f] for f in frames]
+        lib.dJointAttach(m, bodies[0].ptr, bodies[1].ptr if len(bodies) > 1 else ffi.NULL)
         if kind == ANGULAR:
             lib.dJointSetAMotorMode(m, lib.dAMotorUser)
             lib.dJointSetAMotorNumAxes(m, naxes)

@@ -5,9 +5,11 @@ Rule:
   * closed mesh (``is_watertight``): normals repaired (``trimesh.repair.fix_normals``), an
     inverted mesh turned outside-out, density = mass / |volume|; the exact centre of mass and
     inertia about it follow (trimesh's surface-integral formulas);
-  * open mesh (or one that stays non-volumetric after the repair): the same for its convex hull
-    with the given mass (a solid that encloses the mesh); if the hull is flat too, the mesh's
-    axis-aligned bounding box as a solid box of that mass, centred on the box.
+  * open mesh (or one that stays non-volumetric after the repair; a third of Kautham's link
+    meshes are open or hold several bodies): the mesh's axis-aligned bounding box as a solid
+    box of the given mass, centred on the box. (The convex hull would be tighter but needs
+    scipy, which Odin does not depend on.) A mesh flat in one direction gets a flat box's
+    inertia; one flat in two directions is an error.
 The result is expressed in the mesh's own frame.
 """
 from __future__ import annotations
@@ -22,7 +24,7 @@ from virtual_world.errors import InvalidArgument
 
 class MeshMass(NamedTuple):
     """mass: kg; center: (3,) m, mesh frame; inertia: (3,3) kg m^2 about `center`, mesh axes;
-    rule: "closed", "convex hull" or "bounding box" (which rule gave the figures)."""
+    rule: "closed" or "bounding box" (which rule gave the figures)."""
     mass: float
     center: np.ndarray
     inertia: np.ndarray
@@ -49,13 +51,6 @@ def mesh_mass(vertices: np.ndarray, triangles: np.ndarray, mass: float) -> MeshM
             solid = _solid(mesh, mass)
             if solid is not None:
                 return MeshMass(mass, solid[0], solid[1], "closed")
-    try:
-        hull = mesh.convex_hull
-        solid = _solid(hull, mass) if hull.is_volume else None
-    except Exception:  # qhull refuses flat or degenerate point sets
-        solid = None
-    if solid is not None:
-        return MeshMass(mass, solid[0], solid[1], "convex hull")
     low, high = np.asarray(vertices, float).min(axis=0), np.asarray(vertices, float).max(axis=0)
     x, y, z = high - low
     if sum(side > 0 for side in (x, y, z)) < 2:
