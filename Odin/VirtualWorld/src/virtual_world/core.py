@@ -368,6 +368,10 @@ def _check_mass(what: str, m) -> None:
     matrix = np.array([[m.I[4 * r + c] for c in range(3)] for r in range(3)])
     if not np.all(np.isfinite(matrix)) or np.min(np.linalg.eigvalsh(matrix)) <= 0:
         raise InvalidArgument(f"{what}: inertia {matrix.tolist()} is not positive definite")
+    principal = np.linalg.eigvalsh(matrix)
+    if principal[0] + principal[1] < principal[2] * (1 - 1e-9):
+        raise InvalidArgument(f"{what}: principal moments {principal.tolist()} break the "
+                              "triangle inequality (no rigid body has them)")
     if not lib.dMassCheck(m):
         drain_ode_messages()
         raise InvalidArgument(f"{what}: ODE rejects the mass parameters (dMassCheck)")
