@@ -1,0 +1,168 @@
+"""Every owner frees its ODE handle exactly once; removals and New Scene free everything."""
+import collections
+import gc
+
+import numpy as np
+import pytest
+
+from virtual_world import core as vc
+from virtual_world import handles
+from virtual_world.core import CompositeSpec, Core, ObjectSpec, PartSpec
+from virtual_world.ode.bindings import ffi
+
+BOX_V = [x for c in [(-.1, -.1, -.1), (.1, -.1, -.1), (-.1, .1, -.1), (.1, .1, -.1),
+                     (-.1, -.1, .1), (.1, -.1, .1), (-.1, .1, .1), (.1, .1, .1)] for x in c]
+BOX_I = [0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6, 0, 1, 5, 0, 5, 4, 2, 6, 7, 2, 7, 3, 0, 4, 6, 0, 6, 2,
+         1, 3, 7, 1, 7, 5]
+
+
+@pytest.fixture
+def spy(monkeypatch):
+    """Counts every destroy call per (kind, address) while still freeing."""
+    freed = collections.Counter()
+    for kind, destroy in list(handles.DESTROYERS.items()):
+        def wrapper(ptr, kind=kind, destroy=destroy):
+            freed[(kind, int(ffi.cast("uintptr_t", ptr)))] += 1
+            destroy(ptr)
+        monkeypatch.setitem(handles.DESTROYERS, kind, wrapper)
+    return freed
+
+
+def kinds(freed):
+    return collections.Counter(kind for kind, _ in freed)
+
+
+def build_scene(core):
+    core.build_object(ObjectSpec("ground", [4, 4, 1], position=(0, 0, -0.5), geometry_only=True))
+    core.build_object(ObjectSpec("s", [0.1], position=(0, 0, 1)))
+    core.build_object(ObjectSpec("mesh", BOX_V, BOX_I, position=(1, 0, 1)))
+    core.build_composite(CompositeSpec([PartSpec("p1", [0.1]),
+                                        PartSpec("p2", [0.1, 0.1, 0.1], position=(0.3, 0, 0))],
+                                       position=(2, 0, 1)))
+    core.create_joint(vc.HINGE, "s", "mesh", anchor=(0.5, 0, 1))
+    core.create_motor(joint="1:s&mesh")
+    core.create_joint(vc.BALL, ">p1>p2", "", anchor=(2, 0, 1))
+    core.add_body_force("s", vc.FORCE, (0, 0, 1))
+    core.add_joint_force("1:s&mesh", [0.1])
+    core.step(0.001, 10)
+
+
+def test_owner_frees_once_and_children_first(spy):
+    world = handles.new_world()
+    body = handles.new_body(world)
+    joint = handles.new_joint(vc.lib.dJointCreateBall(world.ptr, ffi.NULL), world, [body])
+    body.close()  # closes the joint attached to it first
+    assert joint.closed and body.closed and not world.closed
+    body.close()
+    joint.close()
+    world.close()
+    world.close()
+    assert kinds(spy) == {"world": 1, "body": 1, "joint": 1}
+    assert all(count == 1 for count in spy.values())
+    with pytest.raises(ValueError):
+        world.ptr
+
+
+def test_forgotten_owner_is_freed_once_by_gc(spy):
+    world = handles.new_world()
+    body = handles.new_body(world)
+    del world  # the body keeps its world alive
+    gc.collect()
+    assert not spy
+    del body
+    gc.collect()
+    assert kinds(spy) == {"world": 1, "body": 1}
+
+
+def test_trimesh_owner_keeps_arrays_and_frees_data_after_geom(spy):
+    space = handles.new_space()
+    vertices = ffi.new("double[]", BOX_V)
+    indices = ffi.new("dTriIndex[]", BOX_I)
+    geom = handles.new_trimesh(space, vertices, indices)
+    order = []
+    spy_keys = list(spy)
+    del vertices, indices
+    gc.collect()
+    assert not spy
+    geom.close()
+    order = [kind for kind, _ in spy]
+    assert order == ["geom", "trimeshdata"]
+    space.close()
+    assert kinds(spy) == {"geom": 1, "trimeshdata": 1, "space": 1}
+    assert spy_keys == []
+
+
+def test_remove_object_frees_its_handles_and_reports_ids(spy):
+    core = Core()
+    build_scene(core)
+    spy.clear()
+    removed = core.remove_object("mesh")
+    assert removed == vc.Removed(("1:s&mesh",), ("motor:1:s&mesh",),
+                                 ("jointforce:1:s&mesh:0",), ("mesh",))
+    assert kinds(spy) == {"joint": 2, "geom": 1, "trimeshdata": 1, "body": 1}
+    spy.clear()
+    removed = core.remove_object(">p1>p2")
+    assert removed.geometries == ("p1", "p2") and removed.joints == ("0:>p1>p2&",)
+    assert kinds(spy) == {"joint": 1, "geom": 2, "body": 1}
+    assert core.poses()[0] == ["ground", "s"]
+    core.step(0.001, 10)
+    core.close()
+
+
+def test_new_scene_and_close_free_everything_once(spy):
+    core = Core()
+    build_scene(core)
+    core.new_scene()
+    assert kinds(spy) == {"world": 1, "space": 1, "jointgroup": 1, "body": 3, "geom": 5,
+                          "trimeshdata": 1, "joint": 3}
+    assert all(count == 1 for count in spy.values())
+    assert core.poses()[0] == [] and core.object_ids() == [] and core.sim_time == 0.0
+    assert core.joint_ids() == [] and core.motor_ids() == [] and core.body_force_ids() == []
+    build_scene(core)  # the same names are free again
+    spy.clear()
+    core.close()
+    core.close()
+    assert kinds(spy) == {"world": 1, "space": 1, "jointgroup": 1, "body": 3, "geom": 5,
+                          "trimeshdata": 1, "joint": 3}
+    assert all(count == 1 for count in spy.values())
+
+
+def test_new_scene_keeps_world_parameters():
+    core = Core()
+    core.set_world_parameters(gravity=(0, 0, -1), max_contacts=5)
+    core.new_scene()
+    assert core.world_parameters.gravity == (0, 0, -1) and core._cworld.max_contacts == 5
+    core.build_object(ObjectSpec("s", [0.1]))
+    core.step(0.01, 100)
+    assert core.body_state("s")[2][2] == pytest.approx(-1.0)
+    core.close()
+
+
+def test_removal_mid_contact_less_keeps_other_pairs():
+    core = Core()
+    core.set_world_parameters(gravity=(0, 0, 0), contact_less=True)
+    for i, x in enumerate((0, 0.15, 0.3)):
+        core.build_object(ObjectSpec(f"s{i}", [0.1], position=(x, 0, 0)))
+    core.step(0.001)
+    core.remove_object("s2")
+    assert [(c.first, c.second) for c in core.read_collisions()] == [("s0", "s1")]
+    core.close()
+
+
+def test_poses_are_cheap_arrays():
+    core = Core()
+    for i in range(1000):
+        core.build_object(ObjectSpec(f"s{i}", [0.1], position=(i, 0, 0)))
+    names, positions, quaternions = core.poses()
+    assert len(names) == 1000 and positions.shape == (1000, 3) and quaternions.shape == (1000, 4)
+    np.testing.assert_allclose(positions[:, 0], np.arange(1000))
+    core.close()
+
+
+def test_ode_messages_are_drained_into_logging(caplog):
+    Core().close()  # installs the handlers
+    vc.lib.odin_test_message(7, b"hello from ODE")
+    with caplog.at_level("WARNING", logger="virtual_world.core"):
+        assert vc.drain_ode_messages() == ["hello from ODE"]
+    assert "hello from ODE" in caplog.text
+    assert vc.drain_ode_messages() == []
