@@ -1,7 +1,11 @@
-"""pytest configuration for the whole repository: the ROS test harness lives in tests/."""
+"""pytest configuration for the whole repository: the ROS test harness lives in tests/, and
+tests marked ``forked`` run in a child process of their own (rospy.init_node works once per
+process). The child sends its reports back through pytest's own report serialisation."""
+import json
 import os
 import pathlib
 import sys
+import tempfile
 
 import pytest
 
@@ -33,3 +37,45 @@ def kautham_dir() -> pathlib.Path:
     if not (path / "MANIFEST.md").exists():
         pytest.fail(f"Kautham corpus not found at {path} (set ODIN_KAUTHAM_DIR)")
     return path
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_runtest_protocol(item, nextitem):
+    if item.get_closest_marker("forked") is None:
+        return None
+    hook = item.ihook
+    hook.pytest_runtest_logstart(nodeid=item.nodeid, location=item.location)
+    for report in _run_forked(item):
+        hook.pytest_runtest_logreport(report=report)
+    hook.pytest_runtest_logfinish(nodeid=item.nodeid, location=item.location)
+    return True
+
+
+def _run_forked(item) -> list:
+    from _pytest.reports import TestReport
+    from _pytest.runner import runtestprotocol
+
+    config = item.config
+    with tempfile.NamedTemporaryFile(suffix=".json", delete=False) as handle:
+        result_path = handle.name
+    pid = os.fork()
+    if pid == 0:  # the child: run setup, call and teardown, write the reports, leave at once
+        code = 1
+        try:
+            reports = runtestprotocol(item, log=False, nextitem=None)
+            data = [config.hook.pytest_report_to_serializable(config=config, report=r)
+                    for r in reports]
+            pathlib.Path(result_path).write_text(json.dumps(data))
+            code = 0
+        finally:
+            os._exit(code)
+    _, status = os.waitpid(pid, 0)
+    try:
+        data = json.loads(pathlib.Path(result_path).read_text() or "null")
+    finally:
+        os.unlink(result_path)
+    if not data:
+        return [TestReport(item.nodeid, item.location, {}, "failed",
+                           f"the forked test process ended with status {status:#x} "
+                           "before reporting", "call")]
+    return [config.hook.pytest_report_from_serializable(config=config, data=d) for d in data]

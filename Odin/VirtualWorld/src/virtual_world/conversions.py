@@ -1,0 +1,151 @@
+"""Between ROS messages and the Core's plain values; no rospy, only the generated classes.
+
+Units and frames pass through unchanged (SI, world frame, quaternions (w, x, y, z) on both
+sides), so these functions only reshape.
+"""
+from __future__ import annotations
+
+import struct
+from typing import Sequence
+
+import numpy as np
+
+from Messages.msg import Collided, CollisionPair, JointData, Situation, SpaceDistribution
+from geometry_msgs.msg import Point
+from Services.srv import ViewObjectRequest
+
+from virtual_world.core import CompositeSpec, ObjectSpec, PartSpec
+
+
+def object_spec(message) -> ObjectSpec:
+    """Messages/Object -> ObjectSpec."""
+    return ObjectSpec(name=message.name, parameters=tuple(message.parameters),
+                      indices=tuple(message.indices), mass=message.mass,
+                      inertia=tuple(message.inertia), position=tuple(message.position),
+                      orientation=tuple(message.orientation), color=tuple(message.color),
+                      fixed=message.fixed, geometry_only=message.geometry_only)
+
+
+def composite_spec(message) -> CompositeSpec:
+    """Messages/Composite -> CompositeSpec."""
+    parts = tuple(PartSpec(name=part.name, parameters=tuple(part.parameters),
+                           indices=tuple(part.indices), mass=part.mass,
+                           position=tuple(part.position), orientation=tuple(part.orientation),
+                           color=tuple(part.color))
+                  for part in message.parts)
+    return CompositeSpec(parts=parts, position=tuple(message.position),
+                         orientation=tuple(message.orientation), fixed=message.fixed,
+                         geometry_only=message.geometry_only)
+
+
+def view_requests(shapes: Sequence[tuple], poses: dict) -> list:
+    """View Object requests for geometries ``(id, parameters, indices, color)`` at ``poses``
+    (``{id: (position, orientation)}``)."""
+    requests = []
+    for geometry_id, parameters, indices, color in shapes:
+        position, orientation = poses[geometry_id]
+        requests.append(ViewObjectRequest(geometry_id, list(parameters), list(indices),
+                                          list(position), list(orientation), list(color)))
+    return requests
+
+
+def shapes_of_object(spec: ObjectSpec) -> list:
+    return [(spec.name, spec.parameters, spec.indices, spec.color)]
+
+
+def shapes_of_composite(spec: CompositeSpec) -> list:
+    return [(part.name, part.parameters, part.indices, part.color) for part in spec.parts]
+
+
+def collided_message(collisions, stamp) -> Collided:
+    """Core collisions (first, second, depth, points) -> Messages/Collided."""
+    message = Collided()
+    message.header.stamp = stamp
+    message.header.frame_id = "world"
+    names = {}
+    for collision in collisions:
+        names.setdefault(collision.first, None)
+        names.setdefault(collision.second, None)
+        message.pairs.append(CollisionPair(
+            collision.first, collision.second, collision.depth,
+            [Point(*point) for point in collision.points]))
+    message.names = list(names)
+    return message
+
+
+def joint_data(states) -> list:
+    return [JointData(state.id, state.type, list(state.positions), list(state.rates))
+            for state in states]
+
+
+class SpaceDistributionWriter:
+    """Serialises SpaceDistribution from the Core's pose arrays without one Python object per
+    geometry: the names are encoded once per scene and the 7 doubles of every geometry are
+    scattered into that template with one vectorised copy. Subscribers receive an ordinary
+    Messages/SpaceDistribution (the wire format is the same)."""
+
+    _POSE_BYTES = 7 * 8
+
+    def __init__(self):
+        self._names: tuple = ()
+        self._template = bytearray()
+        self._scatter = np.zeros(0, dtype=np.intp)
+
+    def message(self, names: Sequence[str], positions: np.ndarray, quaternions: np.ndarray,
+                stamp) -> SpaceDistribution:
+        if tuple(names) != self._names:
+            self._layout(names)
+        poses = np.ascontiguousarray(np.hstack([positions, quaternions]), dtype="<f8")
+        body = np.frombuffer(self._template, dtype=np.uint8).copy()
+        body[self._scatter] = poses.view(np.uint8).ravel()
+        return _PreSerialised(stamp, body.tobytes())
+
+    def _layout(self, names: Sequence[str]) -> None:
+        chunks, offsets, cursor = [struct.pack("<I", len(names))], [], 4
+        for name in names:
+            encoded = name.encode("utf-8")
+            chunk = struct.pack("<I", len(encoded)) + encoded
+            chunks.append(chunk + bytes(self._POSE_BYTES))
+            offsets.append(cursor + len(chunk))
+            cursor += len(chunk) + self._POSE_BYTES
+        self._names = tuple(names)
+        self._template = bytearray(b"".join(chunks))
+        starts = np.asarray(offsets, dtype=np.intp)
+        self._scatter = (starts[:, None] + np.arange(self._POSE_BYTES)).ravel()
+
+
+class _PreSerialised(SpaceDistribution):
+    """A SpaceDistribution whose situations are already serialised (see the writer)."""
+
+    __slots__ = ("_body",)
+
+    def __init__(self, stamp, body: bytes):
+        super().__init__()
+        self.header.stamp = stamp
+        self.header.frame_id = "world"
+        self._body = body
+
+    def serialize(self, buff) -> None:
+        header = self.header
+        frame = header.frame_id.encode("utf-8")
+        buff.write(struct.pack("<3I", header.seq, header.stamp.secs, header.stamp.nsecs))
+        buff.write(struct.pack("<I", len(frame)) + frame)
+        buff.write(self._body)
+
+    def situations_list(self) -> list:
+        """Decodes the situations (for tests and in-process users)."""
+        decoded = SpaceDistribution()
+        buffer = bytearray()
+
+        class _Sink:
+            def write(self, data):
+                buffer.extend(data)
+
+        self.serialize(_Sink())
+        decoded.deserialize(bytes(buffer))
+        return decoded.situations
+
+
+__all__ = ["object_spec", "composite_spec", "view_requests", "shapes_of_object",
+           "shapes_of_composite", "collided_message", "joint_data", "SpaceDistributionWriter",
+           "Situation"]

@@ -1,0 +1,75 @@
+"""A small rospy client of the VirtualWorld node for tests, benches and experiments."""
+from __future__ import annotations
+
+import time
+
+import rospy
+
+from Messages import msg
+from Services import srv
+
+#: ROS name suffix -> service class of every world service.
+WORLD_SERVICES = {
+    "new_scene": srv.NewScene, "set_world": srv.SetWorld, "set_step": srv.SetStep,
+    "step_once": srv.StepOnce, "start": srv.Start, "build_object": srv.BuildObject,
+    "build_composite": srv.BuildComposite, "build_entity": srv.BuildEntity,
+    "remove_object": srv.RemoveObject, "set_joint": srv.SetJoint, "set_motor": srv.SetMotor,
+    "set_position": srv.SetPosition, "set_velocity": srv.SetVelocity,
+    "set_external_force": srv.SetExternalForce, "set_joint_force": srv.SetJointForce,
+}
+
+
+class WorldClient:
+    """Calls ``/virtual_world/<name>`` with keyword fields; returns the response as it is."""
+
+    def __init__(self, namespace: str = "/virtual_world", timeout: float = 30.0):
+        self.namespace = namespace
+        self._proxies = {}
+        rospy.wait_for_service(f"{namespace}/start", timeout=timeout)
+
+    def __call__(self, name: str, **fields):
+        proxy = self._proxies.get(name)
+        if proxy is None:
+            service_class = WORLD_SERVICES[name]
+            proxy = rospy.ServiceProxy(f"{self.namespace}/{name}", service_class,
+                                       persistent=True)
+            self._proxies[name] = proxy
+        request = proxy.request_class(**fields)
+        return proxy(request)
+
+    def ok(self, name: str, **fields):
+        """Calls and insists on success."""
+        response = self(name, **fields)
+        assert response.success, f"{name} refused: {response.message}"
+        return response
+
+    def close(self) -> None:
+        for proxy in self._proxies.values():
+            proxy.close()
+
+    def poses(self, timeout: float = 10.0) -> dict:
+        """{geometry id: (position, orientation)} from the next world_update."""
+        update = rospy.wait_for_message(f"{self.namespace}/world_update", msg.SpaceDistribution,
+                                        timeout=timeout)
+        return {s.name: (tuple(s.position), tuple(s.orientation)) for s in update.situations}
+
+
+def sphere(name: str, radius: float = 0.1, position=(0, 0, 1), mass: float = 1.0, **extra):
+    return msg.Object(name=name, parameters=[radius], mass=mass, position=list(position),
+                      orientation=[1, 0, 0, 0], **extra)
+
+
+def box(name: str, sides=(1, 1, 1), position=(0, 0, 0), mass: float = 1.0, **extra):
+    return msg.Object(name=name, parameters=list(sides), mass=mass, position=list(position),
+                      orientation=[1, 0, 0, 0], **extra)
+
+
+def wait_until(predicate, timeout: float = 10.0, period: float = 0.05):
+    """Polls ``predicate`` until it returns a true value (returned) or raises TimeoutError."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        value = predicate()
+        if value:
+            return value
+        time.sleep(period)
+    raise TimeoutError("condition not met in time")
