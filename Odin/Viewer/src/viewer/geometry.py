@@ -72,9 +72,11 @@ class Geometry:
     kind: "sphere", "cylinder", "box" or "mesh".
     scale_B: (3,) factors applied to the kind's unit primitive (sphere radius 1, cylinder radius 1
         and length 1 along z, box of side 1, all centred); (1, 1, 1) for meshes.
-    vertices_B, normals_B: (n, 3) float32, body frame, metres; meshes only, one vertex per
-        triangle corner (flat shading), empty for primitives.
+    vertices_B, normals_B: (n, 3) float32, body frame, metres, and indices_B (3 m,) uint32, three
+        per triangle; meshes only, empty for primitives.
     radius: m, radius of a sphere about the body origin that holds the whole shape.
+    closed: the surface is closed and its triangles face outwards (counter-clockwise), so back
+        faces are never seen: the renderer culls them and lights one side only.
     key: unique per Geometry, so that a renderer can cache GPU buffers by it.
     """
     kind: str
@@ -82,11 +84,13 @@ class Geometry:
     radius: float
     vertices_B: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.float32))
     normals_B: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.float32))
+    indices_B: np.ndarray = field(default_factory=lambda: np.zeros(0, np.uint32))
+    closed: bool = True
     key: int = field(default_factory=lambda: next(_keys))
 
     @property
     def triangle_count(self) -> int:
-        return len(self.vertices_B) // 3
+        return len(self.indices_B) // 3
 
 
 def _positive(values: Sequence[float], names: Sequence[str], shape: str) -> list:
@@ -121,8 +125,14 @@ def geometry_from_parameters(parameters: Sequence[float], indices: Sequence[int]
     return mesh_geometry(params.reshape(-1, 3), indices)
 
 
+#: corners whose face turns more than this from the smoothed vertex normal get a vertex of
+#: their own with the face's normal (hard edges stay hard, curved surfaces look smooth)
+CREASE_ANGLE = math.radians(40.0)
+
+
 def mesh_geometry(vertices_B: np.ndarray, indices: Sequence[int]) -> Geometry:
-    """A flat-shaded mesh from vertices (n, 3) m and triangle indices (3 per triangle)."""
+    """An indexed mesh from vertices (n, 3) m and triangle indices (3 per triangle), with
+    area-weighted vertex normals split at creases sharper than ``CREASE_ANGLE``."""
     vertices = np.asarray(vertices_B, dtype=float)
     if not np.all(np.isfinite(vertices)):
         raise ViewerError("mesh vertices must be finite numbers (m)")
@@ -136,13 +146,36 @@ def mesh_geometry(vertices_B: np.ndarray, indices: Sequence[int]) -> Geometry:
         raise ViewerError(f"mesh index {int(idx[bad][0])} out of range: the mesh has "
                           f"{len(vertices)} vertices")
     corners = vertices[idx].reshape(-1, 3, 3)
-    normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-    lengths = np.linalg.norm(normals, axis=1, keepdims=True)
-    normals = np.where(lengths > 1e-20, normals / np.maximum(lengths, 1e-300), [0.0, 0.0, 1.0])
+    area_normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    lengths = np.linalg.norm(area_normals, axis=1, keepdims=True)
+    face_normals = np.where(lengths > 1e-20, area_normals / np.maximum(lengths, 1e-300),
+                            [0.0, 0.0, 1.0])
+    vertex_normals = np.zeros_like(vertices)
+    np.add.at(vertex_normals, idx, np.repeat(area_normals, 3, axis=0))
+    norms = np.linalg.norm(vertex_normals, axis=1, keepdims=True)
+    vertex_normals = vertex_normals / np.maximum(norms, 1e-300)
+    corner_face = np.repeat(face_normals, 3, axis=0)
+    sharp = np.einsum("ij,ij->i", vertex_normals[idx], corner_face) < math.cos(CREASE_ANGLE)
+    out_idx = idx.copy()
+    out_idx[sharp] = len(vertices) + np.arange(int(sharp.sum()))
     radius = float(np.max(np.linalg.norm(vertices[np.unique(idx)], axis=1)))
     return Geometry("mesh", (1.0, 1.0, 1.0), radius,
-                    vertices_B=corners.reshape(-1, 3).astype(np.float32),
-                    normals_B=np.repeat(normals, 3, axis=0).astype(np.float32))
+                    vertices_B=np.concatenate([vertices, vertices[idx[sharp]]]).astype(np.float32),
+                    normals_B=np.concatenate([vertex_normals, corner_face[sharp]]).astype(np.float32),
+                    indices_B=out_idx.astype(np.uint32),
+                    closed=_closed_and_outward(idx.reshape(-1, 3), corners))
+
+
+def _closed_and_outward(triangles: np.ndarray, corners: np.ndarray) -> bool:
+    """Every directed edge appears once and its reverse once, and the signed volume is > 0."""
+    edges = np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]])
+    n = int(triangles.max()) + 1
+    forward = np.sort(edges[:, 0] * n + edges[:, 1])
+    backward = np.sort(edges[:, 1] * n + edges[:, 0])
+    if np.any(forward[1:] == forward[:-1]) or not np.array_equal(forward, backward):
+        return False
+    volume = np.einsum("ij,ij->i", corners[:, 0], np.cross(corners[:, 1], corners[:, 2])).sum()
+    return bool(volume > 0)
 
 
 # -- unit primitives, tessellated once ------------------------------------------------------
