@@ -124,7 +124,9 @@ class JointRequest:
     body1: str
     body2: str
     anchor: tuple = (0.0, 0.0, 0.0)
-    axis1: tuple = (0.0, 0.0, 0.0)
+    axis1: tuple = (0.0, 0.0, 1.0)   # FIXED ignores it (the world refuses a zero axis)
+    axis2: tuple = (1.0, 0.0, 0.0)   # unused by hinge/slider/fixed; non-zero for the same reason
+    axis3: tuple = (0.0, 1.0, 0.0)
     parameters: tuple = ()           # ((parameter, axis, value), ...)
 
     @property

@@ -52,21 +52,21 @@ class WorldClient:
         "set_external_force": "SetExternalForce", "set_joint_force": "SetJointForce",
     }
 
-    def call(self, name: str, **fields):
+    def call(self, service: str, /, **fields):
         """Calls one service with request ``fields``; returns the response or raises."""
-        proxy = self._proxies.get(name)
+        proxy = self._proxies.get(service)
         if proxy is None:
-            service_class = getattr(self._srv, self._TYPES[name])
-            proxy = self._rospy.ServiceProxy(f"{self.namespace}/{name}", service_class,
+            service_class = getattr(self._srv, self._TYPES[service])
+            proxy = self._rospy.ServiceProxy(f"{self.namespace}/{service}", service_class,
                                              persistent=True)
-            self._proxies[name] = proxy
+            self._proxies[service] = proxy
         try:
             response = proxy(proxy.request_class(**fields))
         except (self._rospy.ServiceException, OSError) as error:
-            self._proxies.pop(name, None)
-            raise WorldError(f"{self.namespace}/{name}", f"call failed: {error}") from None
+            self._proxies.pop(service, None)
+            raise WorldError(f"{self.namespace}/{service}", f"call failed: {error}") from None
         if not response.success:
-            raise WorldError(f"{self.namespace}/{name}", response.message)
+            raise WorldError(f"{self.namespace}/{service}", response.message)
         return response
 
     def close(self) -> None:
@@ -119,7 +119,7 @@ class WorldClient:
         return self.call("set_joint", action=SET_JOINT_CREATE, type=req.type,
                          body1=ids.get(req.body1, req.body1), body2=ids.get(req.body2, req.body2),
                          anchor=list(req.anchor), axis1=list(req.axis1),
-                         parameters=params).id
+                         axis2=list(req.axis2), axis3=list(req.axis3), parameters=params).id
 
     def set_motor(self, joint_id: str, kind: int) -> str:
         return self.call("set_motor", joint=joint_id, kind=kind).id
@@ -142,38 +142,42 @@ class WorldClient:
     # -- plans --------------------------------------------------------------------------------
     def execute(self, plan: BuildPlan,
                 progress: Optional[Callable[[int, object, str], None]] = None) -> dict:
-        """Sends every request of ``plan`` in order; returns {plan key or name: world ID}.
+        """Sends every request of ``plan`` in order; returns the world's IDs:
+        {"bodies": {planned body ID: world ID}, "joints": {joint key: world ID},
+        "motors": {joint key: world motor ID}}.
 
         Joint and motor IDs the world returns replace the predicted ones in ``plan.robots``.
         Stops at the first refusal (``WorldError``); what was built before stays built."""
-        ids: dict = {}
+        bodies: dict = {}
+        joints: dict = {}
+        motors: dict = {}
         for k, step in enumerate(plan.steps, start=1):
             if isinstance(step, EntityRequest):
                 members = list(step.objects) + list(step.composites)
                 answer = self.build_entity(step)
                 for member, got in zip(members, answer):
-                    ids[member.id] = got
+                    bodies[member.id] = got
                 label = step.name
             elif isinstance(step, ObjectRequest):
-                label = ids[step.id] = self.build_object(step)
+                label = bodies[step.id] = self.build_object(step)
             elif isinstance(step, CompositeRequest):
-                label = ids[step.id] = self.build_composite(step)
+                label = bodies[step.id] = self.build_composite(step)
             elif isinstance(step, JointRequest):
-                label = ids[step.key] = self.set_joint(step, ids)
+                label = joints[step.key] = self.set_joint(step, bodies)
             elif isinstance(step, MotorRequest):
-                label = ids["motor:" + step.joint_key] = self.set_motor(ids[step.joint_key],
-                                                                        step.kind)
+                label = motors[step.joint_key] = self.set_motor(joints[step.joint_key],
+                                                                step.kind)
             else:
                 raise TypeError(f"unknown plan step {step!r}")
             if progress is not None:
                 progress(k, step, label)
         for handle in plan.robots:
             for body in handle.bodies:
-                body.body_id = ids.get(body.body_id, body.body_id)
+                body.body_id = bodies.get(body.body_id, body.body_id)
             if handle.joint_keys:
-                handle.joint_ids = [ids[k] for k in handle.joint_keys]
-                handle.motor_ids = [ids["motor:" + k] for k in handle.joint_keys]
-        return ids
+                handle.joint_ids = [joints[k] for k in handle.joint_keys]
+                handle.motor_ids = [motors[k] for k in handle.joint_keys]
+        return {"bodies": bodies, "joints": joints, "motors": motors}
 
 
 def run_position_path(client: WorldClient, handle: RobotHandle, rows: np.ndarray,
