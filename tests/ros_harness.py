@@ -139,14 +139,14 @@ def _stop_group(process: subprocess.Popen) -> None:
     process.wait()
 
 
-def run_rostest(package: str, test_file: str, env: dict | None = None,
+def run_rostest(test_file: str, env: dict | None = None,
                 timeout: float = 300) -> subprocess.CompletedProcess:
-    """Runs ``rostest PACKAGE FILE`` (a fresh master of its own) with a private ROS_HOME and
-    returns the completed process; ``returncode`` is non-zero when a test case failed."""
+    """Runs ``rostest FILE`` (a fresh master of its own) with a private ROS_HOME and returns
+    the completed process; ``returncode`` is non-zero when a test case failed."""
     home = tempfile.mkdtemp(prefix="odin_rostest_")
     run_env = dict(env or os.environ)
     run_env.update(ROS_HOME=home, ROS_LOG_DIR=str(pathlib.Path(home) / "log"),
                    ROS_IP="127.0.0.1", PYTHONUNBUFFERED="1")
-    return subprocess.run(["rostest", "--text", package, test_file], env=run_env,
+    return subprocess.run(["rostest", "--text", test_file], env=run_env,
                           capture_output=True, text=True, timeout=timeout,
                           stdin=subprocess.DEVNULL, start_new_session=True)
