@@ -344,6 +344,10 @@ def _prepare_shape(what: str, parameters, indices) -> _Shape:
     return _Shape("mesh", (), np.ascontiguousarray(vertices), np.ascontiguousarray(triangles))
 
 
+_MESH_MASS_CACHE: Dict[Tuple[bytes, bytes], object] = {}
+"""LRU of unit-mass mesh properties (the same robot's meshes come back on every New Scene)."""
+
+
 def _shape_mass(what: str, shape: _Shape, mass: float):
     """dMass of `shape` with total `mass`, in the shape's frame (centre may be off the origin)."""
     m = ffi.new("dMass *")
@@ -354,9 +358,16 @@ def _shape_mass(what: str, shape: _Shape, mass: float):
     elif shape.kind == "box":
         lib.dMassSetBoxTotal(m, mass, *shape.dims)
     else:
-        props = mesh_mass(shape.vertices, shape.triangles, mass)
-        if props.rule != "closed":
-            log.info("%s: open mesh, inertia from its %s", what, props.rule)
+        key = (shape.vertices.tobytes(), shape.triangles.tobytes())
+        unit = _MESH_MASS_CACHE.pop(key, None)
+        if unit is None:  # mass properties of a unit mass scale linearly with the mass
+            unit = mesh_mass(shape.vertices, shape.triangles, 1.0)
+            if unit.rule != "closed":
+                log.info("%s: open mesh, inertia from its %s", what, unit.rule)
+        _MESH_MASS_CACHE[key] = unit  # most recently used last
+        while len(_MESH_MASS_CACHE) > 256:
+            del _MESH_MASS_CACHE[next(iter(_MESH_MASS_CACHE))]
+        props = unit._replace(mass=mass, inertia=unit.inertia * mass)
         i = props.inertia
         lib.dMassSetParameters(m, mass, 0.0, 0.0, 0.0, i[0, 0], i[1, 1], i[2, 2], i[0, 1],
                                i[0, 2], i[1, 2])

@@ -1,0 +1,144 @@
+"""Benchmarks of the VirtualWorld Core against native C programs doing the same work with libode.
+
+Figures (ratios measured alternately in one run, 5 rounds each, ratio of the medians):
+  core_spheres100_ratio  100 spheres (r 0.1) dropped on a plane (a static box), hash space,
+                         3 contacts per pair, mu 1, QuickStep, 2000 steps of 1 ms;
+                         native_time / odin_time (goal >= 0.95).
+  core_pile_ratio        the same inside four walls so they pile up (~230 contacts a step).
+  core_forces_ratio      the pile plus 100 persistent forces and 20 motors (goal >= 0.90).
+  core_newscene_leak_kb  resident memory growth (kB) over 1000 New Scene cycles of a
+                         100-object scene (50 spheres, 50 box meshes), after 50 warm-up cycles,
+                         measured with /proc/self/statm in a subprocess (goal < 5000).
+The native program (native/core_scene.c) is compiled here with gcc -lode into out_dir.
+Odin's side steps with one Core.step(0.001, 2000) call (the whole loop in C).
+"""
+import pathlib
+import statistics
+import subprocess
+import sys
+import time
+
+HERE = pathlib.Path(__file__).resolve().parent
+STEPS = 2000
+ROUNDS = 5
+CASES = {  # figure -> (mode, forces, motors)
+    "core_spheres100_ratio": (0, 0, 0),
+    "core_pile_ratio": (1, 0, 0),
+    "core_forces_ratio": (1, 100, 20),
+}
+
+
+def _compile(out_dir: pathlib.Path) -> pathlib.Path:
+    exe = out_dir / "core_scene"
+    src = HERE / "native" / "core_scene.c"
+    subprocess.run(["gcc", "-O2", "-DdDOUBLE", str(src), "-lode", "-o", str(exe)], check=True)
+    return exe
+
+
+def _native(exe: pathlib.Path, mode: int, forces: int, motors: int):
+    out = subprocess.run([str(exe), str(mode), str(STEPS), str(forces), str(motors)], check=True,
+                         capture_output=True, text=True).stdout.split()
+    return float(out[0]), int(out[1])
+
+
+def build_scene(core, mode: int, forces: int, motors: int) -> None:
+    """The scene of native/core_scene.c through the Core API."""
+    from virtual_world.core import FORCE, ObjectSpec
+
+    core.build_object(ObjectSpec("ground", [20, 20, 1], position=(0, 0, -0.5),
+                                 geometry_only=True))
+    if mode == 1:
+        for name, pos, size in (("w1", (0.65, 0, 1), (0.2, 1.5, 2)),
+                                ("w2", (-0.65, 0, 1), (0.2, 1.5, 2)),
+                                ("w3", (0, 0.65, 1), (1.5, 0.2, 2)),
+                                ("w4", (0, -0.65, 1), (1.5, 0.2, 2))):
+            core.build_object(ObjectSpec(name, list(size), position=pos, geometry_only=True))
+    for i in range(100):
+        if mode == 0:
+            pos = ((i % 10) * 0.25 - 1.125, (i // 10) * 0.25 - 1.125, 0.5)
+        else:
+            layer = i // 25
+            o = 0.06 if layer % 2 else 0.0
+            pos = ((i % 5) * 0.21 - 0.42 + o + 0.001 * (i % 7), ((i // 5) % 5) * 0.21 - 0.42 + o,
+                   0.15 + layer * 0.21)
+        core.build_object(ObjectSpec(f"s{i}", [0.1], mass=1.0, position=pos))
+    for i in range(forces):
+        core.add_body_force(f"s{i % 100}", FORCE, (0.0, 0.0, 0.5))
+    ids = [core.create_motor(body1=f"s{i}", axes=[0, 0, 1], axis_frames=[1])
+           for i in range(motors)]
+    core.set_motor_velocities({motor: [0.5] for motor in ids})
+
+
+def _odin(mode: int, forces: int, motors: int):
+    from virtual_world.core import Core
+
+    core = Core()
+    try:
+        build_scene(core, mode, forces, motors)
+        started = time.perf_counter()
+        core.step(0.001, STEPS)
+        elapsed = time.perf_counter() - started
+        return elapsed, core.last_step_contacts
+    finally:
+        core.close()
+
+
+LEAK_SCRIPT = r"""
+import os, sys
+from virtual_world.core import Core, ObjectSpec
+page_kb = os.sysconf("SC_PAGE_SIZE") // 1024
+def rss_kb():
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * page_kb
+corners = [(x, y, z) for x in (-.1, .1) for y in (-.1, .1) for z in (-.1, .1)]
+V = [c for p in corners for c in p]
+I = [0, 1, 3, 0, 3, 2, 4, 6, 7, 4, 7, 5, 0, 4, 5, 0, 5, 1, 2, 3, 7, 2, 7, 6, 0, 2, 6, 0, 6, 4,
+     1, 5, 7, 1, 7, 3]
+core = Core()
+cycles, warm = int(sys.argv[1]), 50
+start = None
+for cycle in range(warm + cycles):
+    if cycle == warm:
+        start = rss_kb()
+    core.new_scene()
+    core.build_object(ObjectSpec("ground", [20, 20, 1], position=(0, 0, -0.5), geometry_only=True))
+    for i in range(50):
+        core.build_object(ObjectSpec(f"s{i}", [0.1], position=(i * 0.3, 0, 0.2)))
+        core.build_object(ObjectSpec(f"m{i}", V, I, position=(i * 0.3, 1, 0.2)))
+    core.step(0.001, 5)
+    core.poses()
+core.close()
+print(rss_kb() - start)
+"""
+
+
+def _leak_kb(cycles: int = 1000) -> float:
+    out = subprocess.run([sys.executable, "-c", LEAK_SCRIPT, str(cycles)], check=True,
+                         capture_output=True, text=True).stdout.split()
+    return float(out[-1])
+
+
+def run(out_dir: pathlib.Path) -> dict:
+    out_dir.mkdir(parents=True, exist_ok=True)
+    exe = _compile(out_dir)
+    figures = {}
+    details = []
+    for figure, (mode, forces, motors) in CASES.items():
+        native_times, odin_times = [], []
+        for _ in range(ROUNDS):
+            t, native_contacts = _native(exe, mode, forces, motors)
+            native_times.append(t)
+            t, odin_contacts = _odin(mode, forces, motors)
+            odin_times.append(t)
+        ratio = statistics.median(native_times) / statistics.median(odin_times)
+        figures[figure] = round(ratio, 3)
+        details.append(f"{figure}: native {native_times} s ({native_contacts} contacts), "
+                       f"odin {odin_times} s ({odin_contacts} contacts)")
+    figures["core_newscene_leak_kb"] = _leak_kb()
+    (out_dir / "bench_core.txt").write_text("\n".join(details) + "\n")
+    return figures
+
+
+if __name__ == "__main__":
+    root = HERE.parent.parent
+    print(run(root / "out" / "bench"))

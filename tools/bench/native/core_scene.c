@@ -1,0 +1,97 @@
+/* Native baseline for bench_core.py: the same scene and step loop as the Odin Core, in plain C
+ * over libode. Usage: core_scene MODE STEPS NFORCES NMOTORS (MODE 0 spheres on a plane, 1 pile
+ * inside four walls). Prints the seconds spent in the step loop and the last step's contacts. */
+#include <ode/ode.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+
+static dWorldID world;
+static dJointGroupID group;
+static int contacts_last;
+
+static void near_cb(void *data, dGeomID o1, dGeomID o2) {
+    (void)data;
+    long t1 = (long)(intptr_t)dGeomGetData(o1);
+    if (t1 && t1 == (long)(intptr_t)dGeomGetData(o2)) return;
+    dBodyID b1 = dGeomGetBody(o1), b2 = dGeomGetBody(o2);
+    if (b1 == b2) return;
+    if (b1 && b2 && dAreConnectedExcluding(b1, b2, dJointTypeContact)) return;
+    dContact c[3];
+    int n = dCollide(o1, o2, 3, &c[0].geom, sizeof(dContact));
+    for (int i = 0; i < n; ++i) {
+        c[i].surface.mode = dContactApprox1;
+        c[i].surface.mu = 1.0;
+        c[i].surface.bounce = 0;
+        c[i].surface.bounce_vel = 0.1;
+        dJointAttach(dJointCreateContact(world, group, &c[i]), b1, b2);
+    }
+    contacts_last += n > 0 ? n : 0;
+}
+
+static void wall(dSpaceID space, double x, double y, double z, double lx, double ly, double lz) {
+    dGeomID g = dCreateBox(space, lx, ly, lz);
+    dGeomSetPosition(g, x, y, z);
+}
+
+int main(int argc, char **argv) {
+    if (argc != 5) { fprintf(stderr, "usage: core_scene MODE STEPS NFORCES NMOTORS\n"); return 2; }
+    int mode = atoi(argv[1]), steps = atoi(argv[2]), nforces = atoi(argv[3]), nmotors = atoi(argv[4]);
+    dInitODE2(0);
+    world = dWorldCreate();
+    dSpaceID space = dHashSpaceCreate(0);
+    group = dJointGroupCreate(0);
+    dWorldSetGravity(world, 0, 0, -9.81);
+    dWorldSetERP(world, 0.2);
+    dWorldSetCFM(world, 1e-5);
+    dWorldSetContactSurfaceLayer(world, 0.001);
+    dWorldSetQuickStepNumIterations(world, 20);
+    dWorldSetLinearDampingThreshold(world, 0.01);
+    dWorldSetAngularDampingThreshold(world, 0.01);
+    wall(space, 0, 0, -0.5, 20, 20, 1);
+    if (mode == 1) {
+        wall(space, 0.65, 0, 1, 0.2, 1.5, 2);
+        wall(space, -0.65, 0, 1, 0.2, 1.5, 2);
+        wall(space, 0, 0.65, 1, 1.5, 0.2, 2);
+        wall(space, 0, -0.65, 1, 1.5, 0.2, 2);
+    }
+    dBodyID bodies[100];
+    for (int i = 0; i < 100; ++i) {
+        double x, y, z;
+        if (mode == 0) { x = (i % 10) * 0.25 - 1.125; y = (i / 10) * 0.25 - 1.125; z = 0.5; }
+        else { int layer = i / 25; double o = (layer % 2) ? 0.06 : 0.0; x = (i % 5) * 0.21 - 0.42 + o + 0.001 * (i % 7); y = ((i / 5) % 5) * 0.21 - 0.42 + o; z = 0.15 + layer * 0.21; }
+        dBodyID b = dBodyCreate(world);
+        dMass m;
+        dMassSetSphereTotal(&m, 1.0, 0.1);
+        dBodySetMass(b, &m);
+        dBodySetPosition(b, x, y, z);
+        dGeomID g = dCreateSphere(space, 0.1);
+        dGeomSetBody(g, b);
+        bodies[i] = b;
+    }
+    dJointID motors[100];
+    for (int i = 0; i < nmotors; ++i) {
+        dJointID j = dJointCreateAMotor(world, 0);
+        dJointAttach(j, bodies[i], 0);
+        dJointSetAMotorMode(j, dAMotorUser);
+        dJointSetAMotorNumAxes(j, 1);
+        dJointSetAMotorAxis(j, 0, 1, 0, 0, 1);
+        dJointSetAMotorParam(j, dParamFMax, dInfinity);
+        motors[i] = j;
+    }
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    for (int s = 0; s < steps; ++s) {
+        contacts_last = 0;
+        dSpaceCollide(space, 0, &near_cb);
+        for (int i = 0; i < nforces; ++i) dBodyAddForce(bodies[i % 100], 0.0, 0.0, 0.5);
+        for (int i = 0; i < nmotors; ++i) dJointSetAMotorParam(motors[i], dParamVel, 0.5);
+        dWorldQuickStep(world, 0.001);
+        dJointGroupEmpty(group);
+    }
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    printf("%.6f %d\n", (t1.tv_sec - t0.tv_sec) + 1e-9 * (t1.tv_nsec - t0.tv_nsec), contacts_last);
+    dCloseODE();
+    return 0;
+}
