@@ -136,8 +136,8 @@ class RenderLoop:
                 if now >= deadline:
                     self._render_one()
                     deadline += self.period
-                    if deadline < time.monotonic():   # late: skip, don't catch up in a burst
-                        deadline = time.monotonic() + self.period
+                    if deadline < time.monotonic():   # late: next frame at once, no burst
+                        deadline = time.monotonic()
         finally:
             with self._wake:
                 self._running = False

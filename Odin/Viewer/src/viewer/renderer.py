@@ -165,7 +165,7 @@ class Renderer:
         GL.glEnableClientState(GL.GL_NORMAL_ARRAY)
         opaque = [item for item in items if item.color[3] >= 1.0]
         clear = [item for item in items if item.color[3] < 1.0]
-        self._two_sided = None
+        self._two_sided = self._normalize = None
         for item in opaque:
             self._draw_item(item)
         if clear:
@@ -193,6 +193,7 @@ class Renderer:
         else:
             buffer = self._primitives[geometry.kind]
         self._set_sides(not geometry.closed)
+        self._set_normalize(geometry.scale_B != (1.0, 1.0, 1.0))
         GL.glColor4d(*item.color)
         GL.glPushMatrix()
         GL.glMultMatrixd(np.ascontiguousarray(item.model_W.T))
@@ -211,6 +212,13 @@ class Renderer:
             GL.glDisable(GL.GL_CULL_FACE)
         else:
             GL.glEnable(GL.GL_CULL_FACE)
+
+    def _set_normalize(self, scaled: bool) -> None:
+        """Re-normalise normals only for scaled primitives (meshes have unit normals)."""
+        if scaled == self._normalize:
+            return
+        self._normalize = scaled
+        (GL.glEnable if scaled else GL.glDisable)(GL.GL_NORMALIZE)
 
     def _draw_grid(self, scene: Scene) -> None:
         grid = scene.grid()
