@@ -92,3 +92,34 @@ def test_unit_primitives_have_outward_counter_clockwise_triangles(build):
     assert np.all(np.einsum("ij,ij->i", face_normal[keep], centre[keep]) > 0)
     assert np.abs(vertices).max() == pytest.approx(1.0 if build is unit_sphere else
                                                   (1.0 if build is unit_cylinder else 0.5))
+
+
+CUBE_VERTICES = [x for i in range(8) for x in ((i & 1) - 0.5, (i >> 1 & 1) - 0.5,
+                                                  (i >> 2 & 1) - 0.5)]
+CUBE_TRIANGLES = [0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4,
+                  2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5]
+
+
+def test_cube_mesh_is_closed_and_keeps_hard_edges():
+    cube = geometry_from_parameters(CUBE_VERTICES, CUBE_TRIANGLES)
+    assert cube.closed and cube.triangle_count == 12
+    normals = cube.normals_B[cube.indices_B]
+    # every corner of a cube is a crease: each corner carries its face's axis-aligned normal
+    np.testing.assert_allclose(np.sort(np.abs(normals), axis=1), [[0, 0, 1]] * 36, atol=1e-6)
+
+
+def test_inverted_or_open_meshes_are_not_closed():
+    inverted = np.array(CUBE_TRIANGLES).reshape(-1, 3)[:, ::-1].ravel()
+    assert not geometry_from_parameters(CUBE_VERTICES, inverted).closed
+    assert not geometry_from_parameters(CUBE_VERTICES, CUBE_TRIANGLES[:-3]).closed
+
+
+def test_finely_tessellated_surface_is_smooth():
+    # a fan of 16 triangles around a shallow cone apex: one shared, averaged normal at the apex
+    ring = [(math.cos(a), math.sin(a), -0.1) for a in np.linspace(0, 2 * math.pi, 16,
+                                                                  endpoint=False)]
+    vertices = [0.0, 0.0, 0.0] + [c for p in ring for c in p]
+    triangles = [k for i in range(16) for k in (0, 1 + i, 1 + (i + 1) % 16)]
+    mesh = geometry_from_parameters(vertices, triangles)
+    apex = mesh.normals_B[mesh.indices_B[0::3]]
+    np.testing.assert_allclose(apex, [[0, 0, 1]] * 16, atol=1e-6)
