@@ -27,20 +27,20 @@ class WorldClient:
         self._proxies = {}
         rospy.wait_for_service(f"{namespace}/start", timeout=timeout)
 
-    def __call__(self, name: str, **fields):
-        proxy = self._proxies.get(name)
+    def __call__(self, service: str, /, **fields):
+        proxy = self._proxies.get(service)
         if proxy is None:
-            service_class = WORLD_SERVICES[name]
-            proxy = rospy.ServiceProxy(f"{self.namespace}/{name}", service_class,
+            service_class = WORLD_SERVICES[service]
+            proxy = rospy.ServiceProxy(f"{self.namespace}/{service}", service_class,
                                        persistent=True)
-            self._proxies[name] = proxy
+            self._proxies[service] = proxy
         request = proxy.request_class(**fields)
         return proxy(request)
 
-    def ok(self, name: str, **fields):
+    def ok(self, service: str, /, **fields):
         """Calls and insists on success."""
-        response = self(name, **fields)
-        assert response.success, f"{name} refused: {response.message}"
+        response = self(service, **fields)
+        assert response.success, f"{service} refused: {response.message}"
         return response
 
     def close(self) -> None:

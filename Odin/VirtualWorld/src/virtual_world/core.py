@@ -81,6 +81,11 @@ _CREATE = {
     HINGE2: lib.dJointCreateHinge2, PR: lib.dJointCreatePR, PU: lib.dJointCreatePU,
     FIXED: lib.dJointCreateFixed, PLANE2D: lib.dJointCreatePlane2D,
 }
+_AXES_USED = {  # which of axis1..axis3 each joint type reads
+    BALL: (), HINGE: ("axis1",), SLIDER: ("axis1",), PISTON: ("axis1",),
+    UNIVERSAL: ("axis1", "axis2"), HINGE2: ("axis1", "axis2"), PR: ("axis1", "axis2"),
+    PU: ("axis1", "axis2", "axis3"), FIXED: (), PLANE2D: (),
+}
 _SET_PARAM = {
     BALL: lib.dJointSetBallParam, HINGE: lib.dJointSetHingeParam,
     SLIDER: lib.dJointSetSliderParam, PISTON: lib.dJointSetPistonParam,
@@ -622,14 +627,14 @@ class Core:
         name = _name("object name", spec.name)
         what = f"object {name!r}"
         shape = _prepare_shape(what, spec.parameters, spec.indices)
+        geometry_only = _bool(f"{what}: geometry_only", spec.geometry_only)
         mass = _number(f"{what}: mass", spec.mass)
-        if mass <= 0:
+        if mass <= 0 and not geometry_only:  # a body-less geometry has no mass to check
             raise InvalidArgument(f"{what}: mass {spec.mass!r} must be positive")
         position = _vector(f"{what}: position", spec.position)
         orientation = _quaternion(f"{what}: orientation", spec.orientation)
         color = tuple(_vector(f"{what}: color", spec.color, 4).tolist())
         fixed = _bool(f"{what}: fixed", spec.fixed)
-        geometry_only = _bool(f"{what}: geometry_only", spec.geometry_only)
         part = _PreparedPart(name, shape, mass, np.zeros(3), np.array([1.0, 0, 0, 0]), color)
         inertia = None
         if len(spec.inertia):
@@ -904,7 +909,10 @@ class Core:
         if joint_id in self._joints or joint_id in self._motors:
             raise DuplicateName(f"joint id {joint_id!r} is already taken")
         anchor = _vector("anchor", anchor)
-        a1, a2, a3 = _axis("axis1", axis1), _axis("axis2", axis2), _axis("axis3", axis3)
+        # only the axes the type uses are checked: a request leaves the others at zero
+        uses = _AXES_USED[joint_type]
+        a1, a2, a3 = (_axis(name, value) if name in uses else None
+                      for name, value in (("axis1", axis1), ("axis2", axis2), ("axis3", axis3)))
         if joint_type in (UNIVERSAL, HINGE2, PU, PR) and abs(float(a1 @ a2)) > 1 - 1e-6:
             raise InvalidArgument(f"axis1 {tuple(axis1)} and axis2 {tuple(axis2)} are parallel")
         # ---- ODE
@@ -1194,6 +1202,11 @@ class Core:
     @_locked
     def motor_ids(self) -> List[str]:
         return list(self._motors)
+
+    @_locked
+    def motor_axis_counts(self, motor_ids: Sequence[str]) -> List[int]:
+        """Number of axes of each motor (how many goal speeds it takes); unknown ids raise."""
+        return [self._motor(motor_id).naxes for motor_id in motor_ids]
 
     @_locked
     def remove_motor(self, motor_id: str) -> None:

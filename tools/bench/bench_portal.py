@@ -1,0 +1,239 @@
+"""Benchmarks of the VirtualWorld node (the Portal) through ROS.
+
+Figures:
+  portal_calls_under_load          failures (crashed node + wrong answers) among 10,000 mixed
+                                   calls from 4 client processes while the world runs free
+                                   (goal 0); also ..._median_ms and ..._p99_ms latencies.
+  portal_publish_1000_cpu          share of one core the paused node spends over 10 s with
+                                   1,000 objects published at 25 Hz to a subscriber (goal <= 0.1).
+  portal_rtf_spheres100            real-time factor of the 100-sphere scene of bench_core run
+                                   back to back (~free_run), divided by the native C program's
+                                   steps per second times the step size, measured alternately
+                                   (goal >= 0.90).
+"""
+from __future__ import annotations
+
+import multiprocessing
+import os
+import pathlib
+import statistics
+import sys
+import time
+
+HERE = pathlib.Path(__file__).resolve().parent
+ROOT = HERE.parent.parent
+sys.path.insert(0, str(ROOT / "tests"))
+sys.path.insert(0, str(HERE))
+
+from ros_harness import RosMaster  # noqa: E402
+
+CLIENTS = 4
+CALLS = 10_000
+CPU_WINDOW = 10.0
+RTF_WINDOW = 8.0
+RTF_ROUNDS = 3
+
+
+def _cpu_seconds(pid: int) -> float:
+    fields = pathlib.Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def _node_pid(master: RosMaster, process) -> int:
+    """The python process of a node started with rosrun (rosrun execs, but be safe)."""
+    children = pathlib.Path(f"/proc/{process.pid}/task/{process.pid}/children")
+    kids = children.read_text().split() if children.exists() else []
+    return int(kids[0]) if kids else process.pid
+
+
+def _start_world(master: RosMaster, *params: str):
+    node = master.rosrun("VirtualWorld", "virtualWorld", *params)
+    master.wait_for_service("/virtual_world/set_joint_force")
+    time.sleep(0.3)
+    return node
+
+
+# -- calls under load ----------------------------------------------------------------------
+def _client(index: int, count: int, results) -> None:
+    """One load client: mixed calls, each with the answer it must get."""
+    import rospy
+    from world_client import WorldClient, sphere
+    from Messages.msg import Situation
+
+    client = WorldClient()
+    latencies, wrong = [], []
+    nan = float("nan")
+    for i in range(count):
+        name = f"c{index}_{i}"
+        kind = i % 8
+        started = time.perf_counter()
+        try:
+            if kind == 0:
+                ok = client("build_object", object=sphere(name, 0.05, (index, i % 20 * 0.2, 2)))
+                expect = True
+            elif kind == 1:
+                ok = client("set_position", situations=[Situation(
+                    f"c{index}_{i - 1}", [index, 0, 3], [1, 0, 0, 0])])
+                expect = True
+            elif kind == 2:
+                ok = client("set_velocity", object=f"c{index}_{i - 2}", set_linear=True,
+                            linear=[0, 0, 1])
+                expect = True
+            elif kind == 3:
+                ok = client("build_object", object=sphere(f"c{index}_{i - 3}"))  # duplicate
+                expect = False
+            elif kind == 4:
+                ok = client("set_external_force", object=f"c{index}_{i - 4}", vector=[0, 0, 1])
+                expect = True
+            elif kind == 5:
+                ok = client("set_world", set_erp=True, erp=nan)                   # bad value
+                expect = False
+            elif kind == 6:
+                ok = client("remove_object", id=f"c{index}_{i - 6}")
+                expect = True
+            else:
+                ok = client("remove_object", id=f"nobody_{index}_{i}")            # unknown
+                expect = False
+            if ok.success != expect:
+                wrong.append(f"{kind}: {ok.message}")
+        except Exception as error:  # a transport failure counts as a wrong answer
+            wrong.append(f"{kind}: {type(error).__name__}: {error}")
+        latencies.append(time.perf_counter() - started)
+    client.close()
+    results.put((latencies, wrong))
+
+
+def calls_under_load() -> dict:
+    with RosMaster() as master:
+        master.apply_to_this_process()
+        node = _start_world(master, "_simulate:=true", "_free_run:=true")
+        from world_client import WorldClient, box
+        setup = WorldClient()
+        setup.ok("build_object", object=box("ground", (20, 20, 1), (0, 0, -0.5),
+                                            geometry_only=True))
+        setup.close()
+        context = multiprocessing.get_context("fork")
+        results = context.Queue()
+        clients = [context.Process(target=_client, args=(i, CALLS // CLIENTS, results))
+                   for i in range(CLIENTS)]
+        for process in clients:
+            process.start()
+        collected = [results.get(timeout=900) for _ in clients]
+        for process in clients:
+            process.join(30)
+        crashed = node.poll() is not None
+    latencies = sorted(t for chunk, _ in collected for t in chunk)
+    wrong = [w for _, chunk in collected for w in chunk]
+    if wrong:
+        print(f"  wrong answers (first 5): {wrong[:5]}")
+    return {"portal_calls_under_load": float(int(crashed) + len(wrong)),
+            "portal_calls_under_load_wrong": float(len(wrong)),
+            "portal_calls_under_load_crashes": float(int(crashed)),
+            "portal_calls_under_load_median_ms": 1000 * statistics.median(latencies),
+            "portal_calls_under_load_p99_ms": 1000 * latencies[int(0.99 * len(latencies))]}
+
+
+# -- publication cost ------------------------------------------------------------------------
+def publish_1000_cpu() -> dict:
+    with RosMaster() as master:
+        master.apply_to_this_process()
+        node = _start_world(master)
+        import rospy
+        from Messages.msg import SpaceDistribution
+        from world_client import WorldClient, box
+        rospy.init_node("bench_portal", anonymous=True, disable_signals=True)
+        client = WorldClient()
+        client.ok("build_entity", name="crowd", objects=[
+            box(f"b{i}", (0.1, 0.1, 0.1), (i % 40 * 0.2, i // 40 * 0.2, 0.05),
+                geometry_only=True) for i in range(1000)])
+        received = []
+        subscriber = rospy.Subscriber("/virtual_world/world_update", SpaceDistribution,
+                                      lambda m: received.append(len(m.situations)))
+        time.sleep(2.0)
+        pid = _node_pid(master, node)
+        cpu0, wall0, count0 = _cpu_seconds(pid), time.monotonic(), len(received)
+        time.sleep(CPU_WINDOW)
+        cpu1, wall1, count1 = _cpu_seconds(pid), time.monotonic(), len(received)
+        subscriber.unregister()
+        client.close()
+    rate = (count1 - count0) / (wall1 - wall0)
+    print(f"  received {rate:.1f} updates/s of {received[-1]} situations")
+    return {"portal_publish_1000_cpu": (cpu1 - cpu0) / (wall1 - wall0),
+            "portal_publish_1000_rate_hz": rate}
+
+
+# -- real-time factor against native C ----------------------------------------------------------
+def _world_rtf(master_env_ready) -> float:
+    from world_client import WorldClient, sphere, box
+    client = WorldClient()
+    client.ok("build_object", object=box("ground", (20, 20, 1), (0, 0, -0.5), geometry_only=True))
+    client.ok("build_entity", name="spheres", internal_collisions=True, objects=[
+        sphere(f"s{i}", 0.1, ((i % 10) * 0.25 - 1.125, (i // 10) * 0.25 - 1.125, 0.5))
+        for i in range(100)])
+    import rospy
+    from rosgraph_msgs.msg import Clock
+    client.ok("start", simulate=True)
+    time.sleep(0.5)
+    sim0 = rospy.wait_for_message("/clock", Clock, timeout=5).clock.to_sec()
+    wall0 = time.monotonic()
+    time.sleep(RTF_WINDOW)
+    sim1 = rospy.wait_for_message("/clock", Clock, timeout=5).clock.to_sec()
+    wall1 = time.monotonic()
+    client.ok("start", simulate=False)
+    client.close()
+    return (sim1 - sim0) / (wall1 - wall0)
+
+
+def rtf_spheres100(out_dir: pathlib.Path) -> dict:
+    import bench_core
+    exe = bench_core._compile(out_dir)
+    world, native = [], []
+    with RosMaster() as master:
+        master.apply_to_this_process()
+        import rospy
+        rospy.init_node("bench_portal_rtf", anonymous=True, disable_signals=True)
+        for _ in range(RTF_ROUNDS):
+            seconds, _ = bench_core._native(exe, 0, 0, 0)
+            native.append(bench_core.STEPS / seconds * 0.001)   # simulated s per wall s
+            node = _start_world(master, "_free_run:=true")
+            world.append(_world_rtf(master))
+            node.send_signal(2)
+            node.wait(10)
+    ratio = statistics.median(world) / statistics.median(native)
+    print(f"  world rtf {statistics.median(world):.2f}, native {statistics.median(native):.2f}")
+    return {"portal_rtf_spheres100": ratio}
+
+
+def run(out_dir: pathlib.Path) -> dict:
+    figures = {}
+    figures.update(_in_child(publish_1000_cpu))
+    figures.update(_in_child(rtf_spheres100, out_dir))
+    figures.update(_in_child(calls_under_load))
+    return figures
+
+
+def _in_child(function, *args) -> dict:
+    """Runs a measurement in a forked process (rospy.init_node works once per process)."""
+    context = multiprocessing.get_context("fork")
+    queue = context.Queue()
+
+    def target():
+        try:
+            queue.put(function(*args))
+        except BaseException as error:
+            queue.put({"error": repr(error)})
+            raise
+
+    process = context.Process(target=target)
+    process.start()
+    result = queue.get(timeout=1800)
+    process.join(60)
+    if "error" in result:
+        raise RuntimeError(f"{function.__name__}: {result['error']}")
+    return result
+
+
+if __name__ == "__main__":
+    out = ROOT / "out" / "bench"
+    out.mkdir(parents=True, exist_ok=True)
+    print(run(out))
