@@ -1,0 +1,81 @@
+"""load_problem and run_path against a live VirtualWorld (each test with its own roscore)."""
+from __future__ import annotations
+
+import math
+import os
+import pathlib
+
+import numpy as np
+import pytest
+
+pytestmark = pytest.mark.forked
+
+KAUTHAM = pathlib.Path(os.environ.get("ODIN_KAUTHAM_DIR",
+                                      pathlib.Path(__file__).resolve().parents[4] / "shared"
+                                      / "kautham"))
+LEGACY = KAUTHAM / "legacy_2012" / "examples"
+
+
+@pytest.fixture
+def world(ros_master):
+    node = ros_master.rosrun("VirtualWorld", "virtualWorld")
+    ros_master.wait_for_service("/virtual_world/set_joint_force")
+    yield ros_master
+    assert node.poll() is None, "virtualWorld died:\n" + ros_master.log_text(node)[-3000:]
+
+
+def test_load_problem_builds_the_hand_and_prints_progress(world):
+    result = world.run(["rosrun", "GUI", "load_problem",
+                        str(LEGACY / "TX90_RHand_ICRA10_5PMD_TwoCan.xml")], timeout=120)
+    lines = result.stdout.splitlines()
+    assert lines[-1].startswith("built ")
+    assert any("[1/54] entity TX90 SAHand Right: 25 bodies" in l for l in lines)
+    assert sum(" motor on " in l for l in lines) == 24
+
+
+def test_load_problem_error_builds_nothing(world, tmp_path):
+    bad = tmp_path / "bad.xml"
+    bad.write_text('<?xml version="1.0"?>\n<Problem>\n <Robot robot="nope.rob"/>\n</Problem>\n')
+    result = world.run(["rosrun", "GUI", "load_problem", str(bad)], check=False, timeout=60)
+    assert result.returncode != 0
+    assert result.stderr.strip().count("\n") == 0 and f"{bad}:3:" in result.stderr
+
+
+def test_initial_position_and_paths_move_the_links(world, tmp_path):
+    import rospy
+    from Messages.msg import SpaceDistribution
+
+    from gui.build import plan_problem
+    from gui.client import WorldClient
+    from gui.kautham.problem import load_problem
+
+    problem_file = LEGACY / "TRO" / "2DRR_obstacle.xml"
+    world.run(["rosrun", "GUI", "load_problem", str(problem_file)], timeout=60)
+    initial = tmp_path / "initial.txt"
+    initial.write_text("30 45 0\n")
+    world.run(["rosrun", "GUI", "run_path", str(problem_file), "--initial", str(initial)],
+              timeout=60)
+    handle = plan_problem(load_problem(problem_file)).robots[0]
+    expected = {n: (p, q) for n, p, q in handle.situations(np.radians([30, 45, 0]))}
+
+    client = WorldClient()
+    client.call("step_once", cycles=1)
+    update = rospy.wait_for_message("/virtual_world/world_update", SpaceDistribution,
+                                    timeout=10)
+    poses = {s.name: (s.position, s.orientation) for s in update.situations}
+    # x, y only: after one cycle the 2DRR chain (composite links) already sags a few mm in z
+    # in the world (reported to the VirtualWorld's owner); the placement itself is exact.
+    assert poses["2D-Robot/tcp"][0][:2] == pytest.approx(expected["2D-Robot/tcp"][0][:2],
+                                                         abs=5e-3)
+
+    position = tmp_path / "position.txt"
+    position.write_text("0 0 0\n10 10 0\n20 20 0\n")
+    result = world.run(["rosrun", "GUI", "run_path", str(problem_file), "--position",
+                        str(position), "--double", "1", "--rate", "50"], timeout=60)
+    assert "5 rows" in result.stdout
+    velocity = tmp_path / "velocity.txt"
+    velocity.write_text("10 0 0\n10 0 0\n")
+    result = world.run(["rosrun", "GUI", "run_path", str(problem_file), "--velocity",
+                        str(velocity), "--rate", "50"], timeout=60)
+    assert "2 rows" in result.stdout
+    client.close()
