@@ -1,0 +1,40 @@
+"""Odin's GUI window (thesis chapter 7): ``rosrun GUI gui``.
+
+Modules: ``main_window`` (the window, message log, connection state), one module per tab
+(``simulation_tab``, ``settings_tab``, ``objects_tab``, ``motion_tab``, ``joints_tab``),
+``plot_panel`` (joint positions and speeds from /joint_states), ``viewer_panel`` (the Viewer's
+image), ``worker`` (service calls on a QThread, never the GUI thread), ``ros_link`` (topics ->
+Qt signals), ``scene`` (what the window knows of the scene), ``fields`` (input limits).
+
+Node ``gui``; parameters: ``~world`` ("/virtual_world": namespace of the world's services and
+topics), ``~viewer`` ("/viewer": namespace of the Viewer's image topic).
+Services called: every ``<~world>/*`` service. Topics read: ``<~world>/world_update``,
+``<~world>/joint_data``, ``/joint_states``, ``<~viewer>/image``.
+"""
+from __future__ import annotations
+
+import signal
+import sys
+from typing import Optional, Sequence
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    import rospy
+    from PyQt5.QtCore import QTimer
+    from PyQt5.QtWidgets import QApplication
+
+    from gui.window.main_window import MainWindow
+    args = rospy.myargv(list(argv) if argv is not None else sys.argv)
+    app = QApplication(args)
+    rospy.init_node("gui", anonymous=False, disable_signals=True)
+    window = MainWindow(world=rospy.get_param("~world", "/virtual_world"),
+                        viewer=rospy.get_param("~viewer", "/viewer"))
+    window.show()
+    signal.signal(signal.SIGINT, lambda *_: app.quit())
+    tick = QTimer()
+    tick.timeout.connect(lambda: None)      # lets Python see Ctrl-C while Qt runs
+    tick.start(200)
+    status = app.exec_()
+    window.shutdown()
+    rospy.signal_shutdown("window closed")
+    return status

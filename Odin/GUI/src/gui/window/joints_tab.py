@@ -1,0 +1,225 @@
+"""Fifth tab (thesis 7.5): create joints, set their parameters, list and remove them.
+
+The joint type chooses which rows are enabled (anchor; first, second, third axis), as the
+world uses them. The two bodies come from the objects in the world, or the static environment.
+Parameters (stops, bounce, ERP, CFM, stop ERP / CFM, suspension ERP / CFM, fudge factor), each
+with a check box, go with a new joint (applied after creation) or to the joint chosen in the
+list (Set parameters). A motor can be put on the chosen joint (then driven from the Motion tab).
+"""
+from __future__ import annotations
+
+from PyQt5.QtWidgets import (QCheckBox, QComboBox, QGridLayout, QGroupBox, QHBoxLayout,
+                             QLabel, QListWidget, QPushButton, QVBoxLayout, QWidget)
+
+from gui.window.fields import InputError, VectorRow, checked_spin, int_spin
+from gui.window.scene import JOINT_TYPES
+
+STATIC = "Static environment"
+#: (Messages/JointParameter constant, label, default, low, high)
+PARAMETERS = [
+    (0, "Low stop (rad or m)", -1.0, -1e3, 1e3), (1, "High stop (rad or m)", 1.0, -1e3, 1e3),
+    (2, "Stop bounce", 0.0, 0.0, 1.0), (3, "CFM", 1e-5, 0.0, 1.0), (4, "ERP", 0.2, 0.0, 1.0),
+    (5, "Stop ERP", 0.2, 0.0, 1.0), (6, "Stop CFM", 1e-5, 0.0, 1.0),
+    (7, "Suspension ERP (hinge2)", 0.2, 0.0, 1.0),
+    (8, "Suspension CFM (hinge2)", 1e-5, 0.0, 1.0), (9, "Fudge factor", 1.0, 0.0, 1.0),
+]
+#: joint type -> motor kind (0 angular, 1 linear) for "Add motor"
+MOTOR_KIND = {1: 0, 2: 1, 3: 1, 4: 0, 5: 0, 6: 1, 7: 0}
+MOTOR_AXES = {1: 1, 2: 1, 3: 1, 4: 2, 5: 2, 6: 1, 7: 2}
+
+
+class JointsTab(QWidget):
+    def __init__(self, window, parent=None):
+        super().__init__(parent)
+        self.window = window
+        self.type = QComboBox()
+        self.type.addItems([t[0] for t in JOINT_TYPES])
+        self.type.setCurrentIndex(1)
+        self.body1 = QComboBox()
+        self.body2 = QComboBox()
+        self.anchor = VectorRow("xyz", (0.0, 0.0, 0.0), -1e4, 1e4, 3, 0.1, "m")
+        self.axes = [VectorRow("xyz", v, -1e3, 1e3, 3, 0.1)
+                     for v in ((0.0, 0.0, 1.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0))]
+        self.create_button = QPushButton("Create joint")
+
+        create = QGroupBox("New joint")
+        grid = QGridLayout(create)
+        grid.addWidget(QLabel("Joint type"), 0, 0)
+        grid.addWidget(self.type, 0, 1)
+        grid.addWidget(QLabel("First object"), 1, 0)
+        grid.addWidget(self.body1, 1, 1)
+        grid.addWidget(QLabel("Second object"), 2, 0)
+        grid.addWidget(self.body2, 2, 1)
+        grid.addWidget(QLabel("Anchor"), 3, 0)
+        grid.addWidget(self.anchor, 3, 1)
+        for k, row in enumerate(self.axes):
+            grid.addWidget(QLabel(["First axis", "Second axis", "Third axis"][k]), 4 + k, 0)
+            grid.addWidget(row, 4 + k, 1)
+        grid.addWidget(self.create_button, 7, 1)
+
+        params = QGroupBox("Parameters (for a new joint, or Set on the chosen one)")
+        pgrid = QGridLayout(params)
+        self.param_axis = int_spin(1, 1, 3, "axis the parameters apply to")
+        pgrid.addWidget(QLabel("Axis"), 0, 0)
+        pgrid.addWidget(self.param_axis, 0, 1)
+        self.param_fields = {}
+        for k, (code, label, value, low, high) in enumerate(PARAMETERS):
+            check, box = checked_spin(label, value, low, high, 6, 0.05)
+            box.valueChanged.connect(lambda _v, c=check: c.setChecked(True))
+            self.param_fields[code] = (check, box)
+            pgrid.addWidget(check, 1 + k // 2, 2 * (k % 2))
+            pgrid.addWidget(box, 1 + k // 2, 2 * (k % 2) + 1)
+
+        self.list = QListWidget()
+        self.remove_button = QPushButton("Remove")
+        self.set_button = QPushButton("Set parameters")
+        self.motor_button = QPushButton("Add motor")
+        listing = QGroupBox("Joint list")
+        lay = QHBoxLayout(listing)
+        lay.addWidget(self.list, 1)
+        side = QVBoxLayout()
+        side.addWidget(self.remove_button)
+        side.addWidget(self.set_button)
+        side.addWidget(self.motor_button)
+        side.addStretch(1)
+        lay.addLayout(side)
+
+        top = QHBoxLayout()
+        top.addWidget(create, 1)
+        layout = QVBoxLayout(self)
+        layout.addLayout(top)
+        layout.addWidget(params)
+        layout.addWidget(listing, 1)
+
+        self.type.currentIndexChanged.connect(self._type_changed)
+        self.create_button.clicked.connect(self.create)
+        self.remove_button.clicked.connect(self.remove)
+        self.set_button.clicked.connect(self.set_parameters)
+        self.motor_button.clicked.connect(self.add_motor)
+        window.scene.changed.connect(self._scene_changed)
+        self._scene_changed("objects")
+        self._type_changed(self.type.currentIndex())
+
+    def _type_changed(self, index: int) -> None:
+        _, anchor, axes = JOINT_TYPES[index]
+        self.anchor.setEnabled(anchor)
+        for k, row in enumerate(self.axes):
+            row.setEnabled(k < axes)
+        self.body2.setEnabled(index != 9)    # Plane 2D: body1 only
+
+    def enabled_rows(self) -> list:
+        """Names of the enabled geometry rows (for tests and tool tips)."""
+        names = ["anchor"] if self.anchor.isEnabled() else []
+        return names + [f"axis{k + 1}" for k, row in enumerate(self.axes) if row.isEnabled()]
+
+    def _scene_changed(self, what: str) -> None:
+        scene = self.window.scene
+        if what == "objects":
+            for combo in (self.body1, self.body2):
+                current = combo.currentText()
+                combo.blockSignals(True)
+                combo.clear()
+                combo.addItems([STATIC] + scene.objects)
+                if current in scene.objects:
+                    combo.setCurrentText(current)
+                combo.blockSignals(False)
+        elif what == "joints":
+            current = self.selected()
+            self.list.clear()
+            names = sorted(scene.joints)
+            self.list.addItems(names)
+            if current in names:
+                self.list.setCurrentRow(names.index(current))
+
+    def selected(self):
+        item = self.list.currentItem()
+        return item.text() if item is not None else None
+
+    def parameters(self) -> list:
+        from Messages.msg import JointParameter
+        axis = int(self.param_axis.value())
+        return [JointParameter(parameter=code, axis=axis, value=float(box.value()))
+                for code, (check, box) in self.param_fields.items() if check.isChecked()]
+
+    def _clear_checks(self) -> None:
+        for check, _ in self.param_fields.values():
+            check.setChecked(False)
+
+    def create(self) -> None:
+        joint_type = self.type.currentIndex()
+        body1 = self.body1.currentText()
+        body2 = self.body2.currentText() if self.body2.isEnabled() else STATIC
+        body1 = "" if body1 in (STATIC, "") else body1
+        body2 = "" if body2 in (STATIC, "") else body2
+        if not body1 and not body2:
+            self.window.show_error("Create joint: choose at least one object (both are the "
+                                   "static environment)")
+            return
+        if body1 and body1 == body2:
+            self.window.show_error(f"Create joint: {body1} cannot be joined to itself")
+            return
+        fields = dict(action=0, type=joint_type, body1=body1, body2=body2,
+                      anchor=list(self.anchor.values()),
+                      axis1=list(self.axes[0].values()), axis2=list(self.axes[1].values()),
+                      axis3=list(self.axes[2].values()), parameters=self.parameters())
+        for k in range(JOINT_TYPES[joint_type][2]):
+            if not any(fields[f"axis{k + 1}"]):
+                self.window.show_error(f"Create joint: axis {k + 1} is zero; give it a "
+                                       "direction")
+                return
+
+        def done(response):
+            self._clear_checks()
+            self.window.simulation.add_built("Joints", response.id, response.id)
+            self.window.show_info(f"Built joint {response.id}")
+
+        self.window.call("Create Joint", lambda client, job: client.call("set_joint",
+                                                                          **fields), done)
+
+    def set_parameters(self) -> None:
+        joint_id = self.selected()
+        params = self.parameters()
+        try:
+            if joint_id is None:
+                raise InputError("Set parameters: choose a joint in the list")
+            if not params:
+                raise InputError("Set parameters: check at least one parameter")
+        except InputError as error:
+            self.window.show_error(str(error))
+            return
+
+        def done(_):
+            self._clear_checks()
+            self.window.show_info(f"Parameters of {joint_id} set")
+
+        self.window.call("Set Joint parameters", lambda client, job: client.call(
+            "set_joint", action=1, id=joint_id, parameters=params), done)
+
+    def remove(self) -> None:
+        joint_id = self.selected()
+        if joint_id is None:
+            self.window.show_error("Remove: choose a joint in the list")
+            return
+
+        def done(_):
+            self.window.simulation.remove_built(joint_id)
+            self.window.show_info(f"Removed {joint_id}")
+
+        self.window.call("Remove Joint", lambda client, job: client.call(
+            "set_joint", action=2, id=joint_id), done)
+
+    def add_motor(self) -> None:
+        joint_id = self.selected()
+        joint_type = self.window.scene.joints.get(joint_id)
+        if joint_id is None or joint_type not in MOTOR_KIND:
+            self.window.show_error("Add motor: choose a hinge, slider, piston, universal, "
+                                   "hinge2, PR or PU joint in the list")
+            return
+
+        def done(response):
+            self.window.scene.add_motor(response.id, MOTOR_AXES[joint_type])
+            self.window.simulation.add_built("Motors", response.id, response.id)
+            self.window.show_info(f"Built motor {response.id}")
+
+        self.window.call("Add motor", lambda client, job: client.call(
+            "set_motor", joint=joint_id, kind=MOTOR_KIND[joint_type]), done)

@@ -1,0 +1,342 @@
+"""Fourth tab (thesis 7.4): a tool box to move objects, joints, motors and robots.
+
+Move object: a force (at the centre of mass or at a point), a torque, or a linear / angular
+velocity; vectors and points in the world or the body frame. Forces and torques persist until
+deleted: their IDs (the world's answers) are listed for deletion. Velocities act once.
+Move joint: a force / torque per joint axis (as many magnitudes as the joint type takes), with
+the list of joint forces. Move motor: goal speeds. Move robot: initial position, velocity
+path and position path files (``gui.paths``), optionally refined by double path precision; a
+path runs on a worker of its own (Stop ends it) so the other tabs stay usable meanwhile.
+"""
+from __future__ import annotations
+
+import pathlib
+
+from PyQt5.QtWidgets import (QButtonGroup, QCheckBox, QComboBox, QFileDialog, QGridLayout,
+                             QHBoxLayout, QLabel, QListWidget, QPushButton, QRadioButton,
+                             QToolBox, QVBoxLayout, QWidget)
+
+from gui.window.fields import InputError, VectorRow, int_spin, spin
+from gui.window.scene import JOINT_FORCE_AXES, JOINT_TYPES
+
+ACTIONS = ["force", "torque", "angular velocity", "linear velocity"]
+
+
+class MotionTab(QWidget):
+    def __init__(self, window, parent=None):
+        super().__init__(parent)
+        self.window = window
+        self.toolbox = QToolBox()
+
+        # -- move object
+        page = QWidget()
+        grid = QGridLayout(page)
+        self.object = QComboBox()
+        self.action_group = QButtonGroup(page)
+        actions = QHBoxLayout()
+        self.action_buttons = []
+        for k, label in enumerate(ACTIONS):
+            button = QRadioButton(label)
+            self.action_group.addButton(button, k)
+            self.action_buttons.append(button)
+            actions.addWidget(button)
+        self.action_buttons[0].setChecked(True)
+        self.vector = VectorRow("xyz", (0.0, 0.0, 10.0), -1e6, 1e6, 3, 1.0)
+        self.vector_relative = QCheckBox("relative (body frame)")
+        self.at_point = QCheckBox("at point")
+        self.point = VectorRow("xyz", (0.0, 0.0, 0.0), -1e4, 1e4, 3, 0.1, "m")
+        self.point_relative = QCheckBox("relative (body frame)")
+        self.move_button = QPushButton("Move")
+        self.forces = QListWidget()
+        self.delete_force_button = QPushButton("Delete")
+        grid.addWidget(QLabel("Object"), 0, 0)
+        grid.addWidget(self.object, 0, 1, 1, 2)
+        grid.addLayout(actions, 1, 0, 1, 3)
+        grid.addWidget(QLabel("Intensity"), 2, 0)
+        grid.addWidget(self.vector, 2, 1)
+        grid.addWidget(self.vector_relative, 2, 2)
+        grid.addWidget(self.at_point, 3, 0)
+        grid.addWidget(self.point, 3, 1)
+        grid.addWidget(self.point_relative, 3, 2)
+        grid.addWidget(self.move_button, 4, 2)
+        grid.addWidget(self.forces, 5, 0, 1, 2)
+        grid.addWidget(self.delete_force_button, 5, 2)
+        self.toolbox.addItem(page, "Move object")
+
+        # -- move joint
+        page = QWidget()
+        grid = QGridLayout(page)
+        self.joint = QComboBox()
+        self.magnitudes = VectorRow(["1", "2", "3"], (1.0, 0.0, 0.0), -1e6, 1e6, 3, 0.5)
+        self.joint_force_button = QPushButton("Add force")
+        self.joint_forces = QListWidget()
+        self.delete_joint_force_button = QPushButton("Delete")
+        grid.addWidget(QLabel("Joint"), 0, 0)
+        grid.addWidget(self.joint, 0, 1, 1, 2)
+        grid.addWidget(QLabel("Magnitudes per axis\n(N m rotations, N translations)"), 1, 0)
+        grid.addWidget(self.magnitudes, 1, 1)
+        grid.addWidget(self.joint_force_button, 1, 2)
+        grid.addWidget(QLabel("Forces and torques"), 2, 0)
+        grid.addWidget(self.joint_forces, 3, 0, 1, 2)
+        grid.addWidget(self.delete_joint_force_button, 3, 2)
+        self.toolbox.addItem(page, "Move joint")
+
+        # -- move motor
+        page = QWidget()
+        grid = QGridLayout(page)
+        self.motor = QComboBox()
+        self.motor_speeds = VectorRow(["1", "2", "3"], (0.5, 0.0, 0.0), -1e3, 1e3, 3, 0.1)
+        self.motor_button = QPushButton("Set velocity")
+        grid.addWidget(QLabel("Motor"), 0, 0)
+        grid.addWidget(self.motor, 0, 1, 1, 2)
+        grid.addWidget(QLabel("Goal speed per axis\n(rad/s or m/s)"), 1, 0)
+        grid.addWidget(self.motor_speeds, 1, 1)
+        grid.addWidget(self.motor_button, 1, 2)
+        grid.setRowStretch(2, 1)
+        self.toolbox.addItem(page, "Move motor")
+
+        # -- move robot
+        page = QWidget()
+        grid = QGridLayout(page)
+        self.robot = QComboBox()
+        self.units = QComboBox()
+        self.units.addItems(["degrees (mm)", "radians (m)"])
+        self.initial_button = QPushButton("Set initial position...")
+        self.velocity_button = QPushButton("Velocity path...")
+        self.position_button = QPushButton("Position path...")
+        self.double = int_spin(0, 0, 6, "times the path precision is doubled (2^n finer)")
+        self.stop_button = QPushButton("Stop path")
+        self.stop_button.setEnabled(False)
+        self.path_status = QLabel("No path running.")
+        grid.addWidget(QLabel("Robot"), 0, 0)
+        grid.addWidget(self.robot, 0, 1, 1, 2)
+        grid.addWidget(QLabel("Units in files"), 1, 0)
+        grid.addWidget(self.units, 1, 1)
+        grid.addWidget(self.initial_button, 2, 1)
+        grid.addWidget(self.velocity_button, 3, 0)
+        grid.addWidget(self.position_button, 3, 1)
+        grid.addWidget(QLabel("Double path precision (times)"), 4, 0)
+        grid.addWidget(self.double, 4, 1)
+        grid.addWidget(self.stop_button, 5, 1)
+        grid.addWidget(self.path_status, 6, 0, 1, 3)
+        grid.setRowStretch(7, 1)
+        self.toolbox.addItem(page, "Move robot")
+
+        layout = QVBoxLayout(self)
+        layout.addWidget(self.toolbox)
+
+        self.action_group.buttonClicked.connect(lambda _b: self._action_changed())
+        self.at_point.toggled.connect(lambda _b: self._action_changed())
+        self.move_button.clicked.connect(self.move_object)
+        self.delete_force_button.clicked.connect(self.delete_force)
+        self.joint.currentIndexChanged.connect(lambda _i: self._joint_changed())
+        self.joint_force_button.clicked.connect(self.add_joint_force)
+        self.delete_joint_force_button.clicked.connect(self.delete_joint_force)
+        self.motor.currentIndexChanged.connect(lambda _i: self._motor_changed())
+        self.motor_button.clicked.connect(self.set_motor_velocity)
+        self.initial_button.clicked.connect(lambda: self.choose_path("initial"))
+        self.velocity_button.clicked.connect(lambda: self.choose_path("velocity"))
+        self.position_button.clicked.connect(lambda: self.choose_path("position"))
+        self.stop_button.clicked.connect(self.stop_path)
+        window.scene.changed.connect(self._scene_changed)
+        self._action_changed()
+        self._joint_changed()
+
+    # -- lists ----------------------------------------------------------------------------
+    @staticmethod
+    def _refill(combo: QComboBox, items) -> None:
+        current = combo.currentText()
+        combo.blockSignals(True)
+        combo.clear()
+        combo.addItems(list(items))
+        if current in items:
+            combo.setCurrentText(current)
+        combo.blockSignals(False)
+
+    def _scene_changed(self, what: str) -> None:
+        scene = self.window.scene
+        if what == "objects":
+            self._refill(self.object, scene.objects)
+        elif what == "joints":
+            self._refill(self.joint, sorted(scene.joints))
+            self._joint_changed()
+        elif what == "motors":
+            self._refill(self.motor, sorted(scene.motors))
+            self._motor_changed()
+        elif what == "forces":
+            self.forces.clear()
+            self.forces.addItems(scene.forces)
+            self.joint_forces.clear()
+            self.joint_forces.addItems(scene.joint_forces)
+        elif what == "robots":
+            self._refill(self.robot, list(scene.robots))
+            if scene.problem_format is not None:
+                self.units.setCurrentIndex(0 if scene.problem_format == "2012" else 1)
+
+    def _action_changed(self) -> None:
+        action = self.action_group.checkedId()
+        force = action == 0
+        self.vector_relative.setEnabled(action in (0, 1))
+        self.at_point.setEnabled(force)
+        self.point.setEnabled(force and self.at_point.isChecked())
+        self.point_relative.setEnabled(force and self.at_point.isChecked())
+        self.move_button.setText("Add force" if action == 0 else "Add torque" if action == 1
+                                 else "Set velocity")
+
+    def _joint_changed(self) -> None:
+        joint_type = self.window.scene.joints.get(self.joint.currentText())
+        count = JOINT_FORCE_AXES.get(joint_type, 0) if joint_type is not None else 3
+        for k, box in enumerate(self.magnitudes.boxes):
+            box.setEnabled(k < count)
+        self.joint_force_button.setEnabled(count > 0)
+        if joint_type is not None:
+            self.joint_force_button.setToolTip(f"{JOINT_TYPES[joint_type][0]}: {count} "
+                                               "magnitude(s)")
+
+    def _motor_changed(self) -> None:
+        axes = self.window.scene.motors.get(self.motor.currentText(), 1)
+        for k, box in enumerate(self.motor_speeds.boxes):
+            box.setEnabled(k < axes)
+
+    # -- objects --------------------------------------------------------------------------
+    def move_object(self) -> None:
+        object_id = self.object.currentText()
+        if not object_id:
+            self.window.show_error("Move object: choose an object (build one first)")
+            return
+        action = self.action_group.checkedId()
+        vector = list(self.vector.values())
+        if action in (0, 1):
+            fields = dict(object=object_id, kind=action, vector=vector,
+                          vector_in_body_frame=self.vector_relative.isChecked(),
+                          at_point=action == 0 and self.at_point.isChecked(),
+                          point=list(self.point.values()),
+                          point_in_body_frame=self.point_relative.isChecked())
+
+            def done(response):
+                self.window.scene.add_force(response.id)
+                self.window.show_info(f"Added {response.id}")
+
+            self.window.call("Set External Force", lambda client, job: client.call(
+                "set_external_force", **fields), done)
+        else:
+            fields = dict(object=object_id)
+            if action == 2:
+                fields.update(set_angular=True, angular=vector)
+            else:
+                fields.update(set_linear=True, linear=vector)
+            self.window.call("Set Velocity", lambda client, job: client.call(
+                "set_velocity", **fields),
+                lambda _: self.window.show_info(f"Velocity of {object_id} set"))
+
+    def delete_force(self) -> None:
+        item = self.forces.currentItem()
+        if item is None:
+            self.window.show_error("Delete: select a force or torque in the list")
+            return
+        force_id = item.text()
+        self.window.call("Remove External Force", lambda client, job: client.call(
+            "set_external_force", remove=True, id=force_id),
+            lambda _: self.window.scene.remove_force(force_id))
+
+    # -- joints ---------------------------------------------------------------------------
+    def add_joint_force(self) -> None:
+        joint_id = self.joint.currentText()
+        if not joint_id:
+            self.window.show_error("Move joint: choose a joint (build one first)")
+            return
+        joint_type = self.window.scene.joints.get(joint_id)
+        count = JOINT_FORCE_AXES.get(joint_type, 1)
+        magnitudes = list(self.magnitudes.values()[:count])
+
+        def done(response):
+            self.window.scene.add_joint_force(response.id)
+            self.window.show_info(f"Added {response.id}")
+
+        self.window.call("Set Joint Force", lambda client, job: client.call(
+            "set_joint_force", joint=joint_id, magnitudes=magnitudes), done)
+
+    def delete_joint_force(self) -> None:
+        item = self.joint_forces.currentItem()
+        if item is None:
+            self.window.show_error("Delete: select a joint force in the list")
+            return
+        force_id = item.text()
+        self.window.call("Remove Joint Force", lambda client, job: client.call(
+            "set_joint_force", remove=True, id=force_id),
+            lambda _: self.window.scene.remove_force(force_id))
+
+    # -- motors ---------------------------------------------------------------------------
+    def set_motor_velocity(self) -> None:
+        motor_id = self.motor.currentText()
+        if not motor_id:
+            self.window.show_error("Move motor: choose a motor (load a robot or add one in "
+                                   "the Joints tab)")
+            return
+        axes = self.window.scene.motors.get(motor_id, 1)
+        speeds = list(self.motor_speeds.values()[:axes])
+        self.window.call("Set Velocity", lambda client, job: client.set_velocity(
+            [motor_id], speeds), lambda _: self.window.show_info(f"{motor_id}: goal {speeds}"))
+
+    # -- robots ---------------------------------------------------------------------------
+    def choose_path(self, kind: str) -> None:
+        path, _ = QFileDialog.getOpenFileName(self, f"{kind.capitalize()} file", "",
+                                              "Path files (*.txt *.path *.xml);;All files (*)")
+        if path:
+            self.run_path(kind, path)
+
+    def run_path(self, kind: str, path: str) -> None:
+        """``kind``: "initial", "velocity" or "position"; runs on the path worker."""
+        from gui.paths import DEGREES, RADIANS, load_robot_path, refine
+        handle = self.window.scene.robots.get(self.robot.currentText())
+        if handle is None:
+            self.window.show_error("Move robot: open a problem with a robot first")
+            return
+        units = DEGREES if self.units.currentIndex() == 0 else RADIANS
+        try:
+            rows = load_robot_path(path, handle, units)
+        except Exception as error:  # a bad file is the user's: say what and where
+            self.window.show_error(f"Move robot: {error}")
+            return
+        if kind == "initial":
+            self.window.call("Initial position", lambda client, job: client.set_position(
+                handle.situations(rows[0]), reset_velocity=True),
+                lambda _: self.window.show_info(f"{handle.name}: initial position set"))
+            return
+        if kind == "position" and self.double.value():
+            rows = refine(rows, int(self.double.value()))
+        rate = self.window.publication_rate or 25.0
+        total = len(rows)
+        name = pathlib.Path(path).name
+
+        def work(client, job):
+            from gui.client import run_position_path, run_velocity_path
+            runner = run_position_path if kind == "position" else run_velocity_path
+            from gui.window.worker import Cancelled
+            try:
+                runner(client, handle, rows, rate, progress=job.progress, sleep=job.sleep)
+            except Cancelled:
+                if kind == "velocity":   # leave the robot still, as a finished path does
+                    client.set_velocity(handle.motor_ids, [0.0] * len(handle.motor_ids))
+                raise
+            return total
+
+        def progress(k):
+            self.path_status.setText(f"{kind} path {name}: row {k}/{total} at {rate:g} Hz")
+
+        def finished(_):
+            self.stop_button.setEnabled(False)
+            self.path_status.setText(f"{kind} path {name}: {total} rows done")
+            self.window.show_info(f"{handle.name}: {kind} path done ({total} rows)")
+
+        def failed(message):
+            self.stop_button.setEnabled(False)
+            self.path_status.setText(f"{kind} path {name}: {message}")
+            self.window.show_error(message)
+
+        self.stop_button.setEnabled(True)
+        self.path_status.setText(f"{kind} path {name}: starting ({total} rows)")
+        self.window.path_worker.submit(f"{kind} path", work, finished, failed, progress)
+
+    def stop_path(self) -> None:
+        self.window.path_worker.cancel()

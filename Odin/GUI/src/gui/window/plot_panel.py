@@ -1,0 +1,121 @@
+"""Past the thesis: chosen joints' positions and speeds over time, from ``/joint_states``.
+
+Samples go into one bounded deque per joint axis (``history`` seconds of simulated time); the
+plot is repainted by a timer at ``fps`` (never per message), with QPainter: positions on top,
+speeds below, one colour per chosen joint, a shared time axis (simulated seconds).
+"""
+from __future__ import annotations
+
+import collections
+import math
+
+from PyQt5.QtCore import QPointF, QRectF, Qt, QTimer
+from PyQt5.QtGui import QColor, QPainter, QPen, QPolygonF
+from PyQt5.QtWidgets import (QHBoxLayout, QListWidget, QListWidgetItem, QSplitter,
+                             QVBoxLayout, QWidget)
+
+COLORS = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2",
+          "#17becf"]
+
+
+class PlotCanvas(QWidget):
+    def __init__(self, panel, parent=None):
+        super().__init__(parent)
+        self.panel = panel
+        self.setMinimumSize(240, 160)
+
+    def paintEvent(self, _event) -> None:
+        painter = QPainter(self)
+        painter.fillRect(self.rect(), Qt.white)
+        chosen = self.panel.chosen()
+        w, h = self.width(), self.height()
+        half = h / 2
+        t_now = self.panel.latest_time
+        t0 = t_now - self.panel.history
+        for index, (title, field) in enumerate((("position (rad | m)", 1),
+                                                ("speed (rad/s | m/s)", 2))):
+            area = QRectF(44, index * half + 16, w - 52, half - 30)
+            painter.setPen(QPen(QColor("#999999")))
+            painter.drawRect(area)
+            painter.setPen(Qt.black)
+            painter.drawText(QPointF(46, index * half + 12), title)
+            series = [(name, self.panel.samples.get(name, ())) for name in chosen]
+            values = [s[field] for _, data in series for s in data if s[0] >= t0]
+            if not values:
+                continue
+            low, high = min(values), max(values)
+            if high - low < 1e-9:
+                low, high = low - 1.0, high + 1.0
+            pad = 0.05 * (high - low)
+            low, high = low - pad, high + pad
+            painter.drawText(QPointF(2, area.top() + 10), f"{high:.3g}")
+            painter.drawText(QPointF(2, area.bottom()), f"{low:.3g}")
+            for k, (name, data) in enumerate(series):
+                poly = QPolygonF()
+                for sample in data:
+                    if sample[0] < t0:
+                        continue
+                    x = area.left() + (sample[0] - t0) / self.panel.history * area.width()
+                    y = area.bottom() - (sample[field] - low) / (high - low) * area.height()
+                    poly.append(QPointF(x, y))
+                painter.setPen(QPen(QColor(COLORS[k % len(COLORS)]), 1.5))
+                painter.drawPolyline(poly)
+        painter.setPen(Qt.black)
+        painter.drawText(QPointF(46, h - 4), f"simulated time {t0:.1f} .. {t_now:.1f} s")
+        painter.end()
+
+
+class JointPlotPanel(QWidget):
+    """Check joints in the list to plot them."""
+
+    def __init__(self, history: float = 10.0, fps: float = 10.0, parent=None):
+        super().__init__(parent)
+        self.history = history
+        self.samples: dict = {}
+        self.latest_time = 0.0
+        self.list = QListWidget()
+        self.list.setToolTip("check the joints to plot")
+        self.canvas = PlotCanvas(self)
+        splitter = QSplitter(Qt.Horizontal)
+        splitter.addWidget(self.list)
+        splitter.addWidget(self.canvas)
+        splitter.setStretchFactor(1, 3)
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(0, 0, 0, 0)
+        layout.addWidget(splitter)
+        self._dirty = False
+        self._timer = QTimer(self)
+        self._timer.timeout.connect(self._repaint)
+        self._timer.start(int(1000 / fps))
+
+    def chosen(self) -> list:
+        return [self.list.item(i).text() for i in range(self.list.count())
+                if self.list.item(i).checkState() == Qt.Checked]
+
+    def choose(self, name: str, on: bool = True) -> None:
+        for i in range(self.list.count()):
+            if self.list.item(i).text() == name:
+                self.list.item(i).setCheckState(Qt.Checked if on else Qt.Unchecked)
+
+    def on_joint_states(self, msg) -> None:
+        t = msg.header.stamp.to_sec()
+        if t < self.latest_time - 1e-9:          # New Scene or a restarted world
+            self.samples.clear()
+        self.latest_time = t
+        keep = int(self.history * 100) + 1
+        for k, name in enumerate(msg.name):
+            data = self.samples.get(name)
+            if data is None:
+                data = self.samples[name] = collections.deque(maxlen=keep)
+                item = QListWidgetItem(name)
+                item.setCheckState(Qt.Unchecked)
+                self.list.addItem(item)
+            position = msg.position[k] if k < len(msg.position) else math.nan
+            velocity = msg.velocity[k] if k < len(msg.velocity) else math.nan
+            data.append((t, position, velocity))
+        self._dirty = True
+
+    def _repaint(self) -> None:
+        if self._dirty and self.isVisible():
+            self._dirty = False
+            self.canvas.update()

@@ -1,0 +1,240 @@
+"""Second tab (thesis 7.2): step values and world parameters, in a tool box.
+
+Step: any subset of the four step values (a check box each; unchecked means "not given"); the
+world resolves conflicts and answers the values in force, which are shown beside the fields.
+World parameters: each with a check box (zero is a valid value of most), sent together in one
+Set World (all-or-nothing); the values in force come back and are shown. The values in force
+are read when the world comes up (a Set Step / Set World with nothing set).
+"""
+from __future__ import annotations
+
+from PyQt5.QtWidgets import (QButtonGroup, QCheckBox, QComboBox, QGridLayout, QHBoxLayout,
+                             QLabel, QPushButton, QRadioButton, QToolBox, QVBoxLayout, QWidget)
+
+from gui.window.fields import VectorRow, checked_spin, int_spin, spin
+
+#: (request field, label, default, low, high, decimals, step, unit) of the scalar parameters
+SCALARS = {
+    "ERP and CFM": [
+        ("erp", "Error reduction parameter (ERP)", 0.2, 0.0, 1.0, 4, 0.05, ""),
+        ("cfm", "Constraint force mixing (CFM)", 1e-5, 0.0, 1.0, 7, 1e-5, ""),
+    ],
+    "Speed limits and contact layer": [
+        ("max_angular_speed", "Maximum angular speed (0: none)", 0.0, 0.0, 1e4, 3, 1.0,
+         "rad/s"),
+        ("contact_max_correcting_velocity", "Contact max correcting velocity (0: unlimited)",
+         0.0, 0.0, 1e4, 3, 0.1, "m/s"),
+        ("contact_surface_layer", "Contact surface layer", 0.001, 0.0, 1.0, 4, 0.001, "m"),
+    ],
+    "Damping": [
+        ("linear_damping", "Linear damping", 0.0, 0.0, 1.0, 4, 0.01, ""),
+        ("linear_damping_threshold", "Linear damping threshold", 0.01, 0.0, 1e3, 4, 0.01,
+         "m/s"),
+        ("angular_damping", "Angular damping", 0.0, 0.0, 1.0, 4, 0.01, ""),
+        ("angular_damping_threshold", "Angular damping threshold", 0.01, 0.0, 1e3, 4, 0.01,
+         "rad/s"),
+    ],
+    "Contacts": [
+        ("friction", "Friction (Coulomb mu)", 1.0, 0.0, 1e3, 3, 0.1, ""),
+        ("bounce", "Bounce (restitution)", 0.0, 0.0, 1.0, 3, 0.05, ""),
+        ("bounce_velocity", "Bounce velocity", 0.1, 0.0, 1e3, 3, 0.05, "m/s"),
+    ],
+}
+
+
+class SettingsTab(QWidget):
+    def __init__(self, window, parent=None):
+        super().__init__(parent)
+        self.window = window
+        self.toolbox = QToolBox()
+        self.in_force: dict = {}
+        self.in_force_labels: dict = {}
+
+        # -- step page
+        page = QWidget()
+        grid = QGridLayout(page)
+        self.step_fields = {
+            "step": checked_spin("Step", 0.001, 1e-6, 1.0, 6, 0.0005, "s"),
+            "steps_per_cycle": (QCheckBox("Steps per cycle"), int_spin(40, 1, 100000)),
+            "cycle_time": checked_spin("Cycle time", 0.04, 1e-6, 10.0, 5, 0.01, "s"),
+            "rate": checked_spin("Rate (publications / s)", 25.0, 0.01, 1000.0, 2, 1.0, "Hz"),
+        }
+        grid.addWidget(QLabel("<b>send</b>"), 0, 0)
+        grid.addWidget(QLabel("<b>in force</b>"), 0, 2)
+        for row, (key, (check, box)) in enumerate(self.step_fields.items(), start=1):
+            grid.addWidget(check, row, 0)
+            grid.addWidget(box, row, 1)
+            label = QLabel("?")
+            self.in_force_labels[key] = label
+            grid.addWidget(label, row, 2)
+            box.valueChanged.connect(lambda _v, c=check: c.setChecked(True))
+        self.set_step_button = QPushButton("Set step")
+        grid.addWidget(self.set_step_button, 5, 1)
+        grid.setRowStretch(6, 1)
+        self.toolbox.addItem(page, "Step sizes")
+        self.set_step_button.clicked.connect(self.send_step)
+
+        # -- world pages
+        self.world_checks: dict = {}
+        self.world_boxes: dict = {}
+        page = QWidget()
+        grid = QGridLayout(page)
+        self.gravity_check = QCheckBox("Set gravity")
+        self.gravity = VectorRow("xyz", (0.0, 0.0, -9.81), -1e3, 1e3, 3, 0.1, "m/s²")
+        grid.addWidget(self.gravity_check, 0, 0)
+        grid.addWidget(self.gravity, 0, 1)
+        self._in_force_label(grid, "gravity", 1)
+        self.toolbox.addItem(page, "Gravity")
+
+        page = QWidget()
+        grid = QGridLayout(page)
+        self.policy_check = QCheckBox("Set collision policy")
+        self.contacts_radio = QRadioButton("Create contacts")
+        self.highlight_radio = QRadioButton("Detect and report only (highlight objects)")
+        self.contacts_radio.setChecked(True)
+        group = QButtonGroup(page)
+        group.addButton(self.contacts_radio)
+        group.addButton(self.highlight_radio)
+        grid.addWidget(self.policy_check, 0, 0)
+        grid.addWidget(self.contacts_radio, 0, 1)
+        grid.addWidget(self.highlight_radio, 1, 1)
+        self.max_contacts_check = QCheckBox("Maximum contacts per pair")
+        self.max_contacts = int_spin(3, 1, 64)
+        grid.addWidget(self.max_contacts_check, 2, 0)
+        grid.addWidget(self.max_contacts, 2, 1)
+        self._in_force_label(grid, "contact_less", 0)
+        self._in_force_label(grid, "max_contacts", 2)
+        self.toolbox.addItem(page, "Collision policy")
+
+        for title, rows in SCALARS.items():
+            page = QWidget()
+            grid = QGridLayout(page)
+            for row, (key, label, value, low, high, decimals, step, unit) in enumerate(rows):
+                if key == "bounce_velocity":
+                    check = QCheckBox(label + " (sent with bounce)")
+                    check.setEnabled(False)
+                    box = spin(value, low, high, decimals, step, unit)
+                else:
+                    check, box = checked_spin(label, value, low, high, decimals, step, unit)
+                    box.valueChanged.connect(lambda _v, c=check: c.setChecked(True))
+                self.world_checks[key] = check
+                self.world_boxes[key] = box
+                grid.addWidget(check, row, 0)
+                grid.addWidget(box, row, 1)
+                self._in_force_label(grid, key, row)
+            grid.setRowStretch(len(rows), 1)
+            self.toolbox.addItem(page, title)
+
+        page = QWidget()
+        grid = QGridLayout(page)
+        self.solver_check = QCheckBox("Set solver")
+        self.solver = QComboBox()
+        self.solver.addItems(["QuickStep (iterative, handles piles)",
+                              "WorldStep (exact, the thesis's)"])
+        self.iterations = int_spin(20, 1, 1000, "QuickStep iterations")
+        grid.addWidget(self.solver_check, 0, 0)
+        grid.addWidget(self.solver, 0, 1)
+        grid.addWidget(QLabel("QuickStep iterations"), 1, 0)
+        grid.addWidget(self.iterations, 1, 1)
+        self._in_force_label(grid, "solver", 0)
+        self.toolbox.addItem(page, "Solver")
+
+        self.set_world_button = QPushButton("Set checked world parameters")
+        self.set_world_button.clicked.connect(self.send_world)
+        self.gravity_check.setChecked(False)
+        for box in self.gravity.boxes:
+            box.valueChanged.connect(lambda _v: self.gravity_check.setChecked(True))
+        self.solver.currentIndexChanged.connect(lambda _i: self.solver_check.setChecked(True))
+        self.iterations.valueChanged.connect(lambda _i: self.solver_check.setChecked(True))
+        self.max_contacts.valueChanged.connect(lambda _i: self.max_contacts_check.setChecked(True))
+        self.contacts_radio.toggled.connect(lambda _b: self.policy_check.setChecked(True))
+
+        layout = QVBoxLayout(self)
+        layout.addWidget(self.toolbox, 1)
+        row = QHBoxLayout()
+        row.addStretch(1)
+        row.addWidget(self.set_world_button)
+        layout.addLayout(row)
+
+    def _in_force_label(self, grid: QGridLayout, key: str, row: int) -> None:
+        label = QLabel("?")
+        label.setToolTip("value in force in the world")
+        self.in_force_labels[key] = label
+        grid.addWidget(label, row, 2)
+
+    # -- step ---------------------------------------------------------------------------------
+    def step_request(self) -> dict:
+        fields = {}
+        for key, (check, box) in self.step_fields.items():
+            if check.isChecked():
+                fields[key] = int(box.value()) if key == "steps_per_cycle" else float(box.value())
+        return fields
+
+    def send_step(self) -> None:
+        fields = self.step_request()
+        self.window.call("Set Step", lambda client, job: client.call("set_step", **fields),
+                         self.show_step)
+
+    def show_step(self, response) -> None:
+        for key in self.step_fields:
+            value = getattr(response, key)
+            self.in_force[key] = value
+            self.in_force_labels[key].setText(f"{value:g}")
+        for check, _ in self.step_fields.values():
+            check.setChecked(False)
+        self.window.publication_rate = float(response.rate)
+
+    # -- world --------------------------------------------------------------------------------
+    def world_request(self) -> dict:
+        fields: dict = {}
+        if self.gravity_check.isChecked():
+            fields.update(set_gravity=True, gravity=list(self.gravity.values()))
+        if self.policy_check.isChecked():
+            fields.update(set_contact_less=True, contact_less=self.highlight_radio.isChecked())
+        if self.max_contacts_check.isChecked():
+            fields.update(set_max_contacts=True, max_contacts=int(self.max_contacts.value()))
+        for key, check in self.world_checks.items():
+            if key != "bounce_velocity" and check.isChecked():
+                fields[f"set_{key}"] = True
+                fields[key] = float(self.world_boxes[key].value())
+        if fields.get("set_bounce"):
+            fields["bounce_velocity"] = float(self.world_boxes["bounce_velocity"].value())
+        if self.solver_check.isChecked():
+            fields.update(set_solver=True, solver=self.solver.currentIndex(),
+                          quickstep_iterations=int(self.iterations.value()))
+        return fields
+
+    def send_world(self) -> None:
+        fields = self.world_request()
+        if not fields:
+            self.window.show_error("Set World: check at least one parameter to send")
+            return
+        self.window.call("Set World", lambda client, job: client.call("set_world", **fields),
+                         self.show_world)
+
+    def show_world(self, response) -> None:
+        for key, label in self.in_force_labels.items():
+            if key in self.step_fields:
+                continue
+            value = getattr(response, key)
+            self.in_force[key] = value
+            if key == "gravity":
+                text = "(" + ", ".join(f"{v:g}" for v in value) + ")"
+            elif key == "contact_less":
+                text = "detect only" if value else "contacts"
+            elif key == "solver":
+                text = ("WorldStep" if value else "QuickStep") + \
+                    f", {response.quickstep_iterations} it."
+            else:
+                text = f"{value:g}"
+            label.setText(text)
+        for check in [self.gravity_check, self.policy_check, self.max_contacts_check,
+                      self.solver_check, *self.world_checks.values()]:
+            check.setChecked(False)
+
+    def refresh(self) -> None:
+        """Reads the values in force (nothing set) and shows them."""
+        self.window.call("Read step values", lambda c, j: c.call("set_step"), self.show_step,
+                         quiet=True)
+        self.window.call("Read world parameters", lambda c, j: c.call("set_world"),
+                         self.show_world, quiet=True)
