@@ -87,9 +87,7 @@ class SpaceDistributionWriter:
     _POSE_BYTES = 7 * 8
 
     def __init__(self):
-        self._names: tuple = ()
-        self._template = bytearray()
-        self._scatter = np.zeros(0, dtype=np.intp)
+        self._layout(())
 
     def message(self, names: Sequence[str], positions: np.ndarray, quaternions: np.ndarray,
                 stamp) -> SpaceDistribution:

@@ -1,0 +1,40 @@
+"""SpaceDistribution written from pose arrays decodes as the ordinary message."""
+import io
+
+import numpy as np
+import pytest
+import rospy
+
+from Messages.msg import SpaceDistribution
+from virtual_world.conversions import SpaceDistributionWriter
+
+
+def _decode(message) -> SpaceDistribution:
+    buffer = io.BytesIO()
+    message.serialize(buffer)
+    decoded = SpaceDistribution()
+    decoded.deserialize(buffer.getvalue())
+    return decoded
+
+
+@pytest.mark.parametrize("names", [[], ["a"], ["ball", "ünïcode", ">not>a>composite", "x" * 300]])
+def test_round_trip(names):
+    writer = SpaceDistributionWriter()
+    rng = np.random.default_rng(1)
+    for _ in range(2):  # the second message reuses the layout of the first
+        positions = rng.normal(size=(len(names), 3))
+        quaternions = rng.normal(size=(len(names), 4))
+        decoded = _decode(writer.message(names, positions, quaternions, rospy.Time(3, 5)))
+        assert decoded.header.stamp == rospy.Time(3, 5) and decoded.header.frame_id == "world"
+        assert [s.name for s in decoded.situations] == names
+        for i, situation in enumerate(decoded.situations):
+            assert list(situation.position) == positions[i].tolist()
+            assert list(situation.orientation) == quaternions[i].tolist()
+
+
+def test_layout_follows_scene_changes():
+    writer = SpaceDistributionWriter()
+    one = _decode(writer.message(["a"], np.zeros((1, 3)), np.ones((1, 4)), rospy.Time(0)))
+    none = _decode(writer.message([], np.zeros((0, 3)), np.zeros((0, 4)), rospy.Time(0)))
+    two = _decode(writer.message(["a", "b"], np.zeros((2, 3)), np.ones((2, 4)), rospy.Time(0)))
+    assert (len(one.situations), len(none.situations), len(two.situations)) == (1, 0, 2)
