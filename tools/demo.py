@@ -19,8 +19,8 @@ sys.path.insert(0, str(ROOT / "tests"))
 from ros_harness import RosMaster  # noqa: E402
 
 OUT = ROOT / "out" / "demo"
-SNAPSHOTS = 12
-SNAPSHOT_PERIOD = 0.25  # s of wall-clock time between snapshots (real-time simulation)
+SNAPSHOTS = 16
+SNAPSHOT_PERIOD = 0.12  # s of wall-clock time between snapshots (real-time simulation)
 
 
 def _raise_keyboard_interrupt(signum, frame):
@@ -28,16 +28,17 @@ def _raise_keyboard_interrupt(signum, frame):
 
 
 def build_scene(srv, msg, call) -> None:
-    """The walking skeleton's scene: ground, a box on it and a sphere 1 m above the box."""
+    """The walking skeleton's scene: ground, a box on it and a bouncy sphere 2 m above it."""
     call("/virtual_world/new_scene", srv.NewScene)
     call("/virtual_world/set_world", srv.SetWorld,
-         srv.SetWorldRequest(set_gravity=True, gravity=[0.0, 0.0, -9.81]))
+         srv.SetWorldRequest(set_gravity=True, gravity=[0.0, 0.0, -9.81], set_bounce=True,
+                             bounce=0.6, bounce_velocity=0.1))
     ground = msg.Object(name="ground", parameters=[4.0, 4.0, 0.1], position=[0, 0, -0.05],
                         orientation=[1, 0, 0, 0], color=[0.55, 0.6, 0.55, 1],
                         geometry_only=True)
     box = msg.Object(name="box", parameters=[0.6, 0.6, 0.4], mass=5.0, position=[0, 0, 0.2],
                      orientation=[1, 0, 0, 0], color=[0.2, 0.4, 0.9, 1])
-    sphere = msg.Object(name="sphere", parameters=[0.15], mass=1.0, position=[0.1, 0, 1.6],
+    sphere = msg.Object(name="sphere", parameters=[0.15], mass=1.0, position=[0.05, 0, 2.6],
                         orientation=[1, 0, 0, 0], color=[0.9, 0.25, 0.2, 1])
     for body in (ground, box, sphere):
         call("/virtual_world/build_object", srv.BuildObject, srv.BuildObjectRequest(body))
@@ -63,14 +64,15 @@ def main() -> int:
         rospy.init_node("odin_demo", disable_signals=True)
         world = master.rosrun("VirtualWorld", "virtualWorld")
         viewer = master.rosrun("Viewer", "viewer", f"_snapshot_dir:={OUT}",
-                               "_eye:=[3.2, -3.2, 2.2]", "_target:=[0, 0, 0.6]")
+                               "_eye:=[3.2, -3.2, 1.8]", "_target:=[0, 0, 1.3]")
         master.wait_for_service("/virtual_world/start")
         master.wait_for_service("/viewer/save_snapshot")
         build_scene(srv, msg, call)
         time.sleep(0.5)  # the Viewer receives the scene from the world's queue
         heights = []
-        call("/virtual_world/start", srv.Start, True)
         for index in range(SNAPSHOTS):
+            if index == 1:
+                call("/virtual_world/start", srv.Start, True)
             time.sleep(SNAPSHOT_PERIOD)
             update = rospy.wait_for_message("/virtual_world/world_update",
                                             msg.SpaceDistribution, timeout=10)
