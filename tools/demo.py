@@ -49,6 +49,7 @@ def main() -> int:
     shutil.rmtree(OUT, ignore_errors=True)
     OUT.mkdir(parents=True)
     with RosMaster() as master:
+        print(f"demo: master {master.uri}", flush=True)
         master.apply_to_this_process()
         import rospy  # after the environment points at our master
         from Messages import msg
