@@ -233,8 +233,33 @@ class SettingsTab(QWidget):
             check.setChecked(False)
 
     def refresh(self) -> None:
-        """Reads the values in force (nothing set) and shows them."""
-        self.window.call("Read step values", lambda c, j: c.call("set_step"), self.show_step,
-                         quiet=True)
-        self.window.call("Read world parameters", lambda c, j: c.call("set_world"),
-                         self.show_world, quiet=True)
+        """Shows the values the world started with: its ``~`` parameters on the parameter
+        server, or their documented defaults (docs/parameters.md). The world answers an empty
+        Set Step / Set World with a refusal, so there is no way to read the values in force
+        without setting one; every later answer replaces these."""
+        namespace = self.window.world_namespace
+
+        def read(client, job):
+            import rospy
+            from types import SimpleNamespace
+            get = lambda name, default: rospy.get_param(f"{namespace}/{name}", default)
+            step = float(get("step", 0.001))
+            steps = int(get("steps_per_cycle", 40))
+            rate = float(get("rate", 25.0))
+            step_values = SimpleNamespace(step=step, steps_per_cycle=steps,
+                                          cycle_time=step * steps, rate=rate)
+            world = SimpleNamespace(**{name: get(name, default) for name, default in [
+                ("gravity", [0.0, 0.0, -9.81]), ("erp", 0.2), ("cfm", 1e-5),
+                ("max_angular_speed", 0.0), ("contact_max_correcting_velocity", 0.0),
+                ("contact_surface_layer", 0.001), ("linear_damping", 0.0),
+                ("linear_damping_threshold", 0.01), ("angular_damping", 0.0),
+                ("angular_damping_threshold", 0.01), ("max_contacts", 3), ("friction", 1.0),
+                ("bounce", 0.0), ("bounce_velocity", 0.1), ("solver", 0),
+                ("quickstep_iterations", 20), ("contact_less", False)]})
+            return step_values, world
+
+        def done(values):
+            self.show_step(values[0])
+            self.show_world(values[1])
+
+        self.window.call("Read the world's parameters", read, done)
