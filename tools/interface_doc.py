@@ -52,7 +52,7 @@ SERVICES = {
                     "orientation: [1, 0, 0, 0]}], internal_collisions: false}"),
     "RemoveObject": ("/virtual_world/remove_object", "VirtualWorld",
                      f"{KNOWN}: thesis 4.2.1; cascaded removal of joints, motors and forces "
-                     f"{RECON}", "{id: ball}"),
+                     f"{RECON}", "{id: a}"),
     "SetJoint": ("/virtual_world/set_joint", "VirtualWorld",
                  f"joint kinds, anchor/axes, stops, \"type:body1&body2\" ids, one joint per pair "
                  f"{KNOWN} (thesis 4.2.2, 5.3, evidence); action field and parameter list "
