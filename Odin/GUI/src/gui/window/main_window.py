@@ -82,6 +82,8 @@ class MainWindow(QMainWindow):
         layout.addWidget(outer)
         self.setCentralWidget(central)
 
+        self.busy_text = ""
+        self.connection_text = ""
         self.connection_label = QLabel()
         self.busy_label = QLabel()
         self.statusBar().addPermanentWidget(self.busy_label)
@@ -142,6 +144,7 @@ class MainWindow(QMainWindow):
         elif was and not connected:
             self.show_error(text)
             self.simulation.set_simulating(False)
+            self.scene.forget_world()
 
     def _show_connection(self, connected: bool, text: str) -> None:
         self.connected = connected

@@ -31,7 +31,8 @@ class PlotCanvas(QWidget):
         w, h = self.width(), self.height()
         half = h / 2
         t_now = self.panel.latest_time
-        t0 = t_now - self.panel.history
+        t0 = max(t_now - self.panel.history, self.panel.first_time)
+        span = max(t_now - t0, 1e-6)
         for index, (title, field) in enumerate((("position (rad | m)", 1),
                                                 ("speed (rad/s | m/s)", 2))):
             area = QRectF(44, index * half + 16, w - 52, half - 30)
@@ -55,7 +56,7 @@ class PlotCanvas(QWidget):
                 for sample in data:
                     if sample[0] < t0:
                         continue
-                    x = area.left() + (sample[0] - t0) / self.panel.history * area.width()
+                    x = area.left() + (sample[0] - t0) / span * area.width()
                     y = area.bottom() - (sample[field] - low) / (high - low) * area.height()
                     poly.append(QPointF(x, y))
                 painter.setPen(QPen(QColor(COLORS[k % len(COLORS)]), 1.5))
@@ -73,17 +74,19 @@ class JointPlotPanel(QWidget):
         self.history = history
         self.samples: dict = {}
         self.latest_time = 0.0
+        self.first_time = 0.0
         self.list = QListWidget()
         self.list.setToolTip("check the joints to plot")
         self.canvas = PlotCanvas(self)
         splitter = QSplitter(Qt.Horizontal)
         splitter.addWidget(self.list)
         splitter.addWidget(self.canvas)
-        splitter.setStretchFactor(1, 3)
+        splitter.setSizes([130, 330])
         layout = QVBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
         layout.addWidget(splitter)
         self._dirty = False
+        self._rechoose: set = set()
         self._timer = QTimer(self)
         self._timer.timeout.connect(self._repaint)
         self._timer.start(int(1000 / fps))
@@ -99,8 +102,12 @@ class JointPlotPanel(QWidget):
 
     def on_joint_states(self, msg) -> None:
         t = msg.header.stamp.to_sec()
-        if t < self.latest_time - 1e-9:          # New Scene or a restarted world
+        if t < self.latest_time - 1e-9 or not self.samples:   # New Scene, a restarted world
+            chosen = set(self.chosen())
             self.samples.clear()
+            self.list.clear()
+            self.first_time = t
+            self._rechoose = chosen
         self.latest_time = t
         keep = int(self.history * 100) + 1
         for k, name in enumerate(msg.name):
@@ -108,7 +115,7 @@ class JointPlotPanel(QWidget):
             if data is None:
                 data = self.samples[name] = collections.deque(maxlen=keep)
                 item = QListWidgetItem(name)
-                item.setCheckState(Qt.Unchecked)
+                item.setCheckState(Qt.Checked if name in self._rechoose else Qt.Unchecked)
                 self.list.addItem(item)
             position = msg.position[k] if k < len(msg.position) else math.nan
             velocity = msg.velocity[k] if k < len(msg.velocity) else math.nan

@@ -125,6 +125,13 @@ class SceneModel(QObject):
         for what in ("motors", "forces", "robots"):
             self.changed.emit(what)
 
+    def forget_world(self) -> None:
+        """The world went away: a world that comes back starts empty."""
+        self.geometries, self.poses, self.objects, self.joints = set(), {}, [], {}
+        self.changed.emit("objects")
+        self.changed.emit("joints")
+        self.clear()
+
     def pose_of(self, object_id: str) -> Optional[tuple]:
         """(position, quaternion) of an object as last reported (None for composites)."""
         return self.poses.get(object_id)

@@ -116,7 +116,7 @@ class SimulationTab(QWidget):
             self.status.setText(f"Built {path} in {self.last_build_seconds:.2f} s: "
                                 f"{len(ids['bodies'])} bodies, {len(ids['joints'])} joints, "
                                 f"{len(ids['motors'])} motors.")
-            self.tree.expandToDepth(0)
+            self.tree.expandAll()
             self.problem_built.emit(path)
 
         def failed(message):
@@ -174,7 +174,9 @@ class SimulationTab(QWidget):
                 links.addChild(QTreeWidgetItem([member.id.rsplit("/", 1)[-1], member.id]))
         elif isinstance(step, (ObjectRequest, CompositeRequest)):
             group = self._group("Scene objects")
-            group.addChild(QTreeWidgetItem([step.id, str(answer)]))
+            label = step.id if isinstance(step, ObjectRequest) else \
+                step.parts[0].name.rsplit("#", 1)[0] + f" ({len(step.parts)} parts)"
+            group.addChild(QTreeWidgetItem([label, str(answer)]))
         elif isinstance(step, JointRequest):
             group = self._group(self._owner_label.get(owner, owner or "?"), "Joints")
             group.addChild(QTreeWidgetItem([step.key.rsplit("/", 1)[-1], str(answer)]))

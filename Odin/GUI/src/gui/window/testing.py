@@ -28,7 +28,8 @@ def pump(seconds: float = 0.05) -> None:
         time.sleep(0.005)
 
 
-def wait_for(predicate: Callable[[], object], timeout: float = 10.0, what: str = "condition"):
+def wait_for(predicate: Callable[[], object], timeout: float = 10.0, what: str = "condition",
+             details: Callable[[], object] = lambda: ""):
     """Runs the event loop until ``predicate()`` is true (returned); AssertionError after
     ``timeout`` seconds."""
     deadline = time.monotonic() + timeout
@@ -38,7 +39,7 @@ def wait_for(predicate: Callable[[], object], timeout: float = 10.0, what: str =
         if value:
             return value
         if time.monotonic() > deadline:
-            raise AssertionError(f"timed out after {timeout} s waiting for {what}")
+            raise AssertionError(f"timed out after {timeout} s waiting for {what} {details()}")
         time.sleep(0.005)
 
 

@@ -1,0 +1,100 @@
+"""The window without a world, with a world that comes, goes and comes back, and with a slow
+call: it says so, refuses cleanly, reconnects, and its event loop never stalls."""
+from __future__ import annotations
+
+import os
+import pathlib
+import signal
+import time
+
+import pytest
+
+pytestmark = pytest.mark.forked
+
+ROOT = pathlib.Path(__file__).resolve().parents[3]
+
+
+def test_window_waits_for_the_world_then_reconnects(ros_master):
+    os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+    import rospy
+    from gui.window.main_window import MainWindow
+    from gui.window.testing import app, click, pump, screenshot, type_into, wait_for
+    app()
+    rospy.init_node("gui", anonymous=False, disable_signals=True)
+    window = MainWindow(poll_period=0.2)
+    window.show()
+    try:
+        pump(0.5)
+        assert not window.connected
+        assert window.connection_text == "World: absent (waiting)"
+        # every button still answers, with a message saying the world is absent
+        click(window.simulation.new_scene_button)
+        click(window.simulation.simulate_button)
+        type_into(window.objects.name, "ball")
+        click(window.objects.create_button)
+        wait_for(lambda: len(window.errors) >= 3, 5, "three refusals")
+        assert all("not running" in e for e in window.errors[-3:])
+        screenshot(window, ROOT / "out" / "gui" / "absent.png")
+
+        node = ros_master.rosrun("VirtualWorld", "virtualWorld")
+        wait_for(lambda: window.connected, 30, "the window to find the world")
+        assert window.connection_text == "World: connected"
+        wait_for(lambda: window.settings.in_force_labels["rate"].text() == "25", 5,
+                 "values in force read on connection")
+        type_into(window.objects.name, "ball")
+        click(window.objects.create_button)
+        wait_for(lambda: "ball" in window.scene.objects, 5, "the ball built")
+
+        # the world goes away: the window says so; it comes back: the window reconnects
+        os.killpg(node.pid, signal.SIGINT)
+        node.wait(10)
+        wait_for(lambda: not window.connected, 10, "the window to see the world gone")
+        assert "absent" in window.last_error
+        ros_master.rosrun("VirtualWorld", "virtualWorld")
+        wait_for(lambda: window.connected, 30, "the window to reconnect")
+        type_into(window.objects.name, "ball")
+        click(window.objects.create_button)
+        wait_for(lambda: "Built object ball" in window.last_info and
+                 "ball" in window.scene.objects, 10,
+                 "the ball built in the new world", lambda: window.errors)
+    finally:
+        window.shutdown()
+
+
+def test_a_slow_call_is_reported_and_never_blocks_the_event_loop(ros_master):
+    os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+    import rospy
+    from PyQt5.QtCore import QTimer
+    from gui.window.main_window import MainWindow
+    from gui.window.testing import app, wait_for
+    ros_master.rosrun("VirtualWorld", "virtualWorld")
+    ros_master.wait_for_service("/virtual_world/set_joint_force")
+    app()
+    rospy.init_node("gui", anonymous=False, disable_signals=True)
+    window = MainWindow(poll_period=0.2)
+    window.show()
+    try:
+        wait_for(lambda: window.connected, 15, "connection")
+        done = []
+        window.call("Slow call", lambda client, job: (time.sleep(2.0), client.call(
+            "step_once", cycles=1))[1], lambda r: done.append(r))
+        # the event loop keeps running: a 10 ms timer never waits long
+        gaps, last = [], [time.monotonic()]
+
+        def tick():
+            now = time.monotonic()
+            gaps.append(now - last[0])
+            last[0] = now
+
+        timer = QTimer()
+        timer.timeout.connect(tick)
+        timer.start(10)
+        wait_for(lambda: window.busy_text.startswith("World slow"), 3, "the slow notice")
+        assert "Slow call" in window.busy_text
+        wait_for(lambda: done, 5, "the slow call's answer")
+        timer.stop()
+        assert done[0].sim_time > 0
+        assert max(gaps) < 0.1, f"event loop stalled {max(gaps) * 1000:.0f} ms"
+        wait_for(lambda: not window.busy_text.startswith("World slow"), 2, "notice cleared")
+    finally:
+        window.shutdown()
