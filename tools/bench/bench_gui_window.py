@@ -1,0 +1,179 @@
+"""GUI window benchmarks, off-screen, against the real VirtualWorld node (own roscore).
+
+gui_open_tx90_hand_s: wall time from the click on Open (file dialog answered at once) on
+    legacy_2012/examples/TX90_RHand_ICRA10_5PMD_TwoCan.xml until every element is in the tree
+    and built in the world (every body reported by world_update, every joint by joint_data):
+    the first open of the process (shapes read from disk). Goal <= 3.0.
+    gui_open_tx90_hand_warm_s: median of two more opens (New Scene first; shapes cached).
+gui_event_latency_p95_ms: 95th percentile of the time between posting a QEvent to the window
+    (from another thread, every 20 ms, like input arriving) and its handling in the GUI thread,
+    over 8 s while a 24-motor velocity path runs on the scene at the world's 25 Hz, the world
+    simulates and publishes world_update, joint_data and /joint_states at 25 Hz, the joint plot
+    draws 4 joints and the tree, lists and status bar are live. Goal <= 50.
+Also: gui_event_latency_max_ms, gui_timer_lag_p95_ms (lateness of a 10 ms QTimer).
+The window runs in a child process (rospy.init_node once per process); details go to
+out_dir/gui_window_bench.json and out_dir/gui_bench_window.png.
+"""
+from __future__ import annotations
+
+import json
+import os
+import pathlib
+import statistics
+import subprocess
+import sys
+import time
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+PROBLEM = "legacy_2012/examples/TX90_RHand_ICRA10_5PMD_TwoCan.xml"
+
+
+def _kautham_dir() -> pathlib.Path:
+    return pathlib.Path(os.environ.get("ODIN_KAUTHAM_DIR", ROOT.parent / "shared" / "kautham"))
+
+
+def run(out_dir: pathlib.Path) -> dict:
+    sys.path.insert(0, str(ROOT / "tests"))
+    from ros_harness import RosMaster
+    out_dir.mkdir(parents=True, exist_ok=True)
+    result_path = out_dir / "gui_window_bench.json"
+    with RosMaster() as master:
+        master.rosrun("VirtualWorld", "virtualWorld")
+        master.wait_for_service("/virtual_world/set_joint_force")
+        env = dict(master.env, QT_QPA_PLATFORM="offscreen")
+        child = subprocess.run([sys.executable, __file__, "--child", str(out_dir)], env=env,
+                               capture_output=True, text=True, timeout=300)
+        if child.returncode != 0:
+            raise RuntimeError(f"GUI bench child failed ({child.returncode}):\n"
+                               + child.stderr[-4000:])
+    details = json.loads(result_path.read_text())
+    return {key: details[key] for key in ("gui_open_tx90_hand_s", "gui_open_tx90_hand_warm_s",
+                                          "gui_event_latency_p95_ms",
+                                          "gui_event_latency_max_ms", "gui_timer_lag_p95_ms")}
+
+
+def _percentile(values, q: float) -> float:
+    ordered = sorted(values)
+    return ordered[min(len(ordered) - 1, int(round(q * (len(ordered) - 1))))]
+
+
+def _child(out_dir: pathlib.Path) -> None:
+    import math
+    import tempfile
+    import threading
+
+    import rospy
+    from PyQt5.QtCore import QEvent, QObject, QTimer
+    from PyQt5.QtWidgets import QApplication, QFileDialog
+
+    from gui.build import CompositeRequest, EntityRequest, ObjectRequest, plan_problem
+    from gui.kautham.problem import load_problem
+    from gui.window.main_window import MainWindow
+    from gui.window.testing import app, click, pump, wait_for
+
+    problem = _kautham_dir() / PROBLEM
+    plan = plan_problem(load_problem(problem))     # only to know what "all built" means
+    n_joints = plan.counts()["JointRequest"]
+    n_elements = sum(len(s.objects) + len(s.composites) if hasattr(s, "objects") else 1
+                     for s in plan.steps)
+    app()
+    rospy.init_node("gui", anonymous=False, disable_signals=True)
+    window = MainWindow(poll_period=0.2)
+    window.show()
+    wait_for(lambda: window.connected and window.updates > 0, 30, "connection")
+    QFileDialog.getOpenFileName = staticmethod(lambda *a, **k: (str(problem), ""))
+    tab = window.simulation
+    bodies = set()
+    for step in plan.steps:
+        if isinstance(step, EntityRequest):
+            bodies.update(m.id for m in list(step.objects) + list(step.composites))
+        elif isinstance(step, (ObjectRequest, CompositeRequest)):
+            bodies.add(step.id)
+
+    opens = []
+    for _ in range(3):
+        started = time.monotonic()
+        click(tab.open_button)
+        wait_for(lambda: not tab.building and tab.element_count() == n_elements
+                 and bodies <= set(window.scene.objects)
+                 and len(window.scene.joints) == n_joints, 60, "the problem built",
+                 lambda: (window.errors[-1:], tab.element_count(), n_elements))
+        opens.append(time.monotonic() - started)
+    pump(0.5)
+
+    # velocity path: every motor, a slow sine (deg/s), 25 rows a second for 12 s
+    handle = next(iter(window.scene.robots.values()))
+    n_motors = len(handle.motor_ids)
+    path = pathlib.Path(tempfile.mkdtemp()) / "velocity.txt"
+    path.write_text("".join(" ".join(f"{10 * math.sin(0.05 * k + j):.4f}"
+                                     for j in range(n_motors)) + "\n" for k in range(300)))
+    for name in list(window.plot.samples)[:4]:
+        window.plot.choose(name)
+    click(tab.simulate_button)
+    wait_for(lambda: tab.simulating, 5, "simulating")
+    window.tabs.setCurrentWidget(window.motion)
+    window.motion.toolbox.setCurrentIndex(3)
+    window.motion.run_path("velocity", str(path))
+    wait_for(lambda: "row" in window.motion.path_status.text(), 10, "the path running")
+
+    latencies: list = []
+    lags: list = []
+    kind = QEvent.Type(QEvent.registerEventType())
+
+    class Probe(QObject):
+        def event(self, ev):
+            if ev.type() == kind:
+                latencies.append(time.monotonic() - ev.sent)
+                return True
+            return super().event(ev)
+
+    probe = Probe()
+    stop = threading.Event()
+
+    def poster():
+        while not stop.wait(0.02):
+            ev = QEvent(kind)
+            ev.sent = time.monotonic()
+            QApplication.postEvent(probe, ev)
+
+    last = [time.monotonic()]
+
+    def tick():
+        now = time.monotonic()
+        lags.append(max(0.0, now - last[0] - 0.010))
+        last[0] = now
+
+    timer = QTimer()
+    timer.timeout.connect(tick)
+    timer.start(10)
+    thread = threading.Thread(target=poster, daemon=True)
+    updates_before = window.updates
+    thread.start()
+    pump(8.0)
+    stop.set()
+    thread.join()
+    timer.stop()
+    updates = window.updates - updates_before
+    status = window.motion.path_status.text()
+    window.grab().save(str(out_dir / "gui_bench_window.png"))
+    window.motion.stop_path()
+    pump(0.3)
+    window.shutdown()
+    details = dict(
+        gui_open_tx90_hand_s=round(opens[0], 3),
+        gui_open_tx90_hand_warm_s=round(statistics.median(opens[1:]), 3),
+        gui_event_latency_p95_ms=round(1000 * _percentile(latencies, 0.95), 2),
+        gui_event_latency_max_ms=round(1000 * max(latencies), 2),
+        gui_timer_lag_p95_ms=round(1000 * _percentile(lags, 0.95), 2),
+        opens_s=[round(v, 3) for v in opens], elements=n_elements, joints=n_joints,
+        motors=n_motors, events=len(latencies), world_updates_in_8s=updates,
+        path_status=status)
+    (out_dir / "gui_window_bench.json").write_text(json.dumps(details, indent=2) + "\n")
+    rospy.signal_shutdown("bench done")
+
+
+if __name__ == "__main__":
+    if len(sys.argv) == 3 and sys.argv[1] == "--child":
+        _child(pathlib.Path(sys.argv[2]))
+        os._exit(0)
+    print(json.dumps(run(ROOT / "out" / "bench"), indent=2))
