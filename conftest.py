@@ -47,6 +47,8 @@ def pytest_runtest_protocol(item, nextitem):
     hook.pytest_runtest_logstart(nodeid=item.nodeid, location=item.location)
     for report in _run_forked(item):
         hook.pytest_runtest_logreport(report=report)
+    # the parent ran no fixtures of this item, but may still hold those of the item before it
+    item.session._setupstate.teardown_exact(nextitem)
     hook.pytest_runtest_logfinish(nodeid=item.nodeid, location=item.location)
     return True
 
