@@ -98,3 +98,37 @@ def test_a_slow_call_is_reported_and_never_blocks_the_event_loop(ros_master):
         wait_for(lambda: not window.busy_text.startswith("World slow"), 2, "notice cleared")
     finally:
         window.shutdown()
+
+
+def test_the_viewer_image_shows_in_the_window(ros_master):
+    os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+    import rospy
+    from gui.window.main_window import MainWindow
+    from gui.window.testing import app, click, screenshot, type_into, wait_for
+    ros_master.rosrun("VirtualWorld", "virtualWorld")
+    ros_master.rosrun("Viewer", "viewer")
+    ros_master.wait_for_service("/virtual_world/set_joint_force")
+    app()
+    rospy.init_node("gui", anonymous=False, disable_signals=True)
+    window = MainWindow(poll_period=0.2)
+    window.show()
+    try:
+        wait_for(lambda: window.connected, 15, "connection")
+        window.tabs.setCurrentWidget(window.objects)
+        window.objects.shape.setCurrentIndex(2)
+        window.objects.box_sides.set_values((1.0, 1.0, 1.0))
+        window.objects.position.set_values((0, 0, 0))
+        type_into(window.objects.name, "cube")
+        click(window.objects.create_button)
+        wait_for(lambda: "cube" in window.scene.objects, 10, "the cube")
+        frames = window.viewer_panel.frames
+        wait_for(lambda: window.viewer_panel.frames > frames + 5, 30, "Viewer frames")
+        image = window.viewer_panel.image
+        assert (image.width(), image.height()) == (640, 480)
+        # the cube is drawn: the picture is not one flat colour
+        colours = {image.pixel(x, y) for x in range(0, 640, 40) for y in range(0, 480, 40)}
+        assert len(colours) > 2
+        assert window.viewer_panel.label.pixmap() is not None
+        screenshot(window, ROOT / "out" / "gui" / "viewer.png")
+    finally:
+        window.shutdown()

@@ -117,6 +117,8 @@ class SimulationTab(QWidget):
                                 f"{len(ids['bodies'])} bodies, {len(ids['joints'])} joints, "
                                 f"{len(ids['motors'])} motors.")
             self.tree.expandAll()
+            self.window.show_info(f"Built {pathlib.Path(path).name} in "
+                                  f"{self.last_build_seconds:.2f} s")
             self.problem_built.emit(path)
 
         def failed(message):
