@@ -83,7 +83,9 @@ class SettingsTab(QWidget):
         self.gravity = VectorRow("xyz", (0.0, 0.0, -9.81), -1e3, 1e3, 3, 0.1, "m/s²")
         grid.addWidget(self.gravity_check, 0, 0)
         grid.addWidget(self.gravity, 0, 1)
-        self._in_force_label(grid, "gravity", 1)
+        grid.addWidget(QLabel("in force:"), 1, 0)
+        self._in_force_label(grid, "gravity", 1, 1)
+        grid.setRowStretch(2, 1)
         self.toolbox.addItem(page, "Gravity")
 
         page = QWidget()
@@ -104,6 +106,7 @@ class SettingsTab(QWidget):
         grid.addWidget(self.max_contacts, 2, 1)
         self._in_force_label(grid, "contact_less", 0)
         self._in_force_label(grid, "max_contacts", 2)
+        grid.setRowStretch(3, 1)
         self.toolbox.addItem(page, "Collision policy")
 
         for title, rows in SCALARS.items():
@@ -137,6 +140,7 @@ class SettingsTab(QWidget):
         grid.addWidget(QLabel("QuickStep iterations"), 1, 0)
         grid.addWidget(self.iterations, 1, 1)
         self._in_force_label(grid, "solver", 0)
+        grid.setRowStretch(2, 1)
         self.toolbox.addItem(page, "Solver")
 
         self.set_world_button = QPushButton("Set checked world parameters")
@@ -156,11 +160,11 @@ class SettingsTab(QWidget):
         row.addWidget(self.set_world_button)
         layout.addLayout(row)
 
-    def _in_force_label(self, grid: QGridLayout, key: str, row: int) -> None:
+    def _in_force_label(self, grid: QGridLayout, key: str, row: int, column: int = 2) -> None:
         label = QLabel("?")
         label.setToolTip("value in force in the world")
         self.in_force_labels[key] = label
-        grid.addWidget(label, row, 2)
+        grid.addWidget(label, row, column)
 
     # -- step ---------------------------------------------------------------------------------
     def step_request(self) -> dict:
