@@ -277,3 +277,34 @@ def test_a_viewer_started_late_receives_the_current_scene(world, ros_master):
     image = np.asarray(Image.open(response.path).convert("RGB")).astype(int)
     reddish = (image[..., 0] > 120) & (image[..., 1] < 90) & (image[..., 2] < 90)
     assert reddish.sum() > 200, "the early box is not in the late Viewer's frame"
+
+
+def test_start_up_parameters_are_read(ros_master):
+    import rospy
+    from std_msgs.msg import Float64
+    from world_client import WorldClient
+
+    ros_master.rosrun("VirtualWorld", "virtualWorld", "_rate:=10", "_step:=0.002",
+                      "_steps_per_cycle:=5", "_contact_less:=true", "_gravity:=[0, 0, -1.5]",
+                      "_max_contacts:=4")
+    ros_master.wait_for_service("/virtual_world/set_joint_force")
+    rospy.init_node("odin_test_client", anonymous=True, disable_signals=True)
+    client = WorldClient()
+    assert client.ok("step_once").sim_time == pytest.approx(0.01)
+    values = client.ok("set_world", set_erp=True, erp=0.2)
+    assert values.contact_less and values.max_contacts == 4
+    assert list(values.gravity) == [0, 0, -1.5]
+    step = client.ok("set_step", rate=10.0)
+    assert (step.step, step.steps_per_cycle) == pytest.approx((0.002, 5))
+    client.ok("start", simulate=True)
+    time.sleep(1.5)
+    rtf = rospy.wait_for_message("/virtual_world/real_time_factor", Float64, timeout=5).data
+    assert rtf == pytest.approx(0.1, rel=0.3)   # 0.01 s simulated per 0.1 s cycle
+    client.close()
+
+
+def test_a_bad_start_up_parameter_ends_the_node_with_one_line(ros_master):
+    node = ros_master.rosrun("VirtualWorld", "virtualWorld", "_erp:=7.0")
+    assert node.wait(timeout=30) != 0
+    log = ros_master.log_text(node)
+    assert "erp" in log and "bad start-up parameter" in log
