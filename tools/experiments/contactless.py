@@ -1,0 +1,196 @@
+"""Experiment 1 (thesis 10.1, table 10.1): collisions without contacts.
+
+The KUKA LWR of ``legacy_2012/examples/Kuka_two_columns.xml`` lies at rest, horizontal (its
+Home configuration, all joints 0, stretches the arm along +x at z = 0.31 m; it is set with the
+initial-position mechanism: one Set Position of every link by forward kinematics). There is no
+gravity. A can (``scenes/can.wrl``, scale 1000 as in the TX90 problem, i.e. the mesh in metres,
+built as a movable body of 0.35 kg, coloured red so that its greying shows) starts above the
+robot's tip and moves straight down by Set Velocity (-0.5 m/s). Its axis is offset from the
+tip's flange so that its side grazes the flange face by a few millimetres: the pair starts to
+touch, then the can slides past and stops touching.
+
+World parameters of table 10.1: contact-less policy, 1 step per cycle, 10 fps, step 0.001 s,
+gravity (0, 0, 0), contact surface layer 0.
+
+Outcome (summary.json): the only pair ever reported is (can, KukaLWR/Link7); it is reported
+on one unbroken run of cycles, with its start and stop times and its maximum depth; the
+Viewer's frames show the can and the link grey exactly while they touch (pixels are read:
+the can's red pixels vanish and the link's pixels turn the Viewer's collision grey).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+import common
+
+PROBLEM = "Kuka_two_columns.xml"
+CAN_FILE = "scenes/can.wrl"
+TIP = "KukaLWR/Link7"
+CAN = "can"
+
+PARAMETERS = {
+    "can_mass_kg": 0.35,
+    "can_color": [0.85, 0.15, 0.1, 1.0],
+    "can_start_m": [0.5967, 0.40, 0.5103],   # centre: bottom 0.1 m above the tip's top
+    "can_velocity_m_s": [0.0, 0.0, -0.5],
+    "robot_configuration_rad": [0.0] * 7,    # horizontal (the Home configuration)
+    "duration_s": 0.8,
+    "frame_every_cycles": 25,
+}
+WORLD = {  # table 10.1
+    "contact_less": True, "steps_per_cycle": 1, "rate": 10.0, "step": 0.001,
+    "gravity": [0.0, 0.0, 0.0], "contact_surface_layer": 0.0, "free_run": True,
+}
+CAMERA = common.Camera(eye=(0.62, -0.02, 0.45), target=(0.575, 0.40, 0.32))
+
+
+def can_request(position, mass: float, color):
+    """The can as a movable mesh body, oriented as the TX90 problem places it (axis z)."""
+    from gui.build import shape_to_body
+    from gui.kinematics import pose_from_axis_angle
+    from gui.shapes import read_shape
+    shape = read_shape(common.EXAMPLES / CAN_FILE, 1.0)  # scale 1000 of a mm problem: metres
+    pose = pose_from_axis_angle(position, (1.0, 0.0, 0.0), math.pi / 2)
+    request, _ = shape_to_body(CAN, shape, pose, mass, static=False)
+    from dataclasses import replace
+    return replace(request, color=tuple(color))
+
+
+def run(quick: bool = False, frames: bool = True) -> dict:
+    p = dict(PARAMETERS)
+    problem, plan = common.load_plan(common.EXAMPLES / PROBLEM)
+    with common.Session("contactless", WORLD, CAMERA, track={CAN, TIP},
+                        frames=frames) as s:
+        s.client.execute(plan)
+        robot = plan.robots[0]
+        s.client.set_position(robot.situations(np.array(p["robot_configuration_rad"])))
+        s.client.build_object(can_request(p["can_start_m"], p["can_mass_kg"], p["can_color"]))
+        s.client.call("set_velocity", object=CAN, set_linear=True,
+                      linear=p["can_velocity_m_s"])
+        cycles = int(round(p["duration_s"] / WORLD["step"]))
+        s.cycle_and_frame()
+        while s.cycles < cycles:
+            if (s.cycles + 1) % p["frame_every_cycles"] == 0:
+                s.cycle_and_frame()
+            else:
+                s.cycle(1)
+        s.finish()
+        facts = analyse(s)
+        common.write_summary(s, facts, p)
+    return facts
+
+
+def analyse(s: "common.Session") -> dict:
+    with s.record.lock:
+        collided = dict(s.record.collided)
+    times = sorted(collided)
+    pairs_seen = sorted({(a, b) for t in times for a, b, _ in collided[t]})
+    pair = tuple(sorted((CAN, TIP)))
+    touching = [t for t in times if any((a, b) == pair for a, b, _ in collided[t])]
+    depth = max((d for t in times for a, b, d in collided[t] if (a, b) == pair), default=0.0)
+    step = WORLD["step"]
+    runs = 0
+    previous = None
+    for t in touching:
+        if previous is None or t - previous > 1.5 * step:
+            runs += 1
+        previous = t
+    reports = sum(len(collided[t]) for t in times)
+    start = touching[0] if touching else None
+    stop = round(touching[-1] + step, 6) if touching else None   # first cycle without the pair
+    facts = {
+        "outcome": {
+            "pairs_reported": [list(p) for p in pairs_seen],
+            "only_the_can_and_tip": pairs_seen == [pair],
+            "collision_start_s": start,
+            "collision_stop_s": stop,
+            "collision_runs": runs,
+            "max_depth_m": round(depth, 6),
+            "collided_messages": len(times),
+            "cycles": s.cycles,
+            "collision_reports_per_sim_s": round(reports / s.sim_time, 3) if s.sim_time else 0,
+        },
+    }
+    if s.frame_paths:
+        facts["frames"] = frame_colours(s, set(touching))
+    return facts
+
+
+def frame_colours(s: "common.Session", touching: set) -> dict:
+    """Reads each frame's pixels against whether the pair touched in the frame's cycle or the
+    one before (the Viewer keeps a colour through the next update): inside the can's image
+    (its centre and radius projected) the share of red pixels; in a patch on the tip's flange
+    its brightness against the first frame (the flange is drawn 0.2 grey, the Viewer's
+    collision colour is 0.35 grey: about 1.75 times brighter)."""
+    from PIL import Image
+    step = WORLD["step"]
+    times, positions, _ = s.trajectory(CAN)
+    rows = []
+    tip_u, tip_v = project(np.array([0.553, 0.362, 0.31]), CAMERA)
+    base = None
+    for path, t in zip(s.frame_paths, s.frame_times):
+        image = np.asarray(Image.open(path).convert("RGB")).astype(float)
+        k = int(np.argmin(np.abs(times - t)))
+        cu, cv = project(positions[k], CAMERA)
+        ru = abs(project(positions[k] + [0.025, 0, 0], CAMERA)[0] - cu)
+        can = image[max(cv - ru, 0):cv + ru + 1, max(cu - ru, 0):cu + ru + 1].reshape(-1, 3)
+        r, g, b = can[:, 0], can[:, 1], can[:, 2]
+        red_share = float(((r > 60) & (r > 1.8 * g) & (r > 1.8 * b)).mean()) if len(can) else 0.0
+        patch = image[tip_v - 2:tip_v + 3, tip_u - 2:tip_u + 3].reshape(-1, 3).mean(0)
+        brightness = float(patch.mean())
+        if base is None:
+            base = brightness
+        touched = round(t, 6) in touching or round(t - step, 6) in touching
+        rows.append({"frame": path.name, "t_s": round(t, 6), "touching": touched,
+                     "can_red_share": round(red_share, 3),
+                     "tip_patch_rgb": [round(float(c), 1) for c in patch],
+                     "tip_brightness_ratio": round(brightness / base, 3) if base else None})
+    touching_rows = [r for r in rows if r["touching"]]
+    free_rows = [r for r in rows if not r["touching"]]
+    return {
+        "per_frame": rows,
+        "frames_touching": len(touching_rows),
+        "frames_free": len(free_rows),
+        "can_grey_exactly_while_touching": bool(touching_rows) and all(
+            r["can_red_share"] < 0.02 for r in touching_rows) and all(
+            r["can_red_share"] > 0.3 for r in free_rows),
+        "tip_grey_exactly_while_touching": bool(touching_rows) and all(
+            r["tip_brightness_ratio"] > 1.4 for r in touching_rows) and all(
+            abs(r["tip_brightness_ratio"] - 1) < 0.1 for r in free_rows),
+    }
+
+
+def project(point_W: np.ndarray, camera: "common.Camera", fov_y: float = 0.8) -> tuple:
+    """Pixel (u, v) of a world point for the Viewer's pinhole camera (z up)."""
+    eye, target = np.asarray(camera.eye, float), np.asarray(camera.target, float)
+    forward = target - eye
+    forward /= np.linalg.norm(forward)
+    right = np.cross(forward, [0.0, 0.0, 1.0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    d = point_W - eye
+    x, y, z = d @ right, d @ up, d @ forward
+    f = (camera.height / 2) / math.tan(fov_y / 2)
+    return int(round(camera.width / 2 + f * x / z)), int(round(camera.height / 2 - f * y / z))
+
+
+def verdict(facts: dict) -> tuple:
+    """(outcome held, one line per fact) for run.py and the tests."""
+    o = facts["outcome"]
+    ok = (o["only_the_can_and_tip"] and o["collision_runs"] == 1 and o["max_depth_m"] > 0
+          and o["collided_messages"] >= o["cycles"])
+    lines = [f"pairs reported: {o['pairs_reported']}",
+             f"pair collides from {o['collision_start_s']} s to {o['collision_stop_s']} s "
+             f"({o['collision_runs']} run), max depth {o['max_depth_m'] * 1000:.2f} mm",
+             f"{o['collided_messages']} Collided messages for {o['cycles']} cycles"]
+    frames = facts.get("frames")
+    if frames:
+        ok = ok and frames["can_grey_exactly_while_touching"] and \
+            frames["tip_grey_exactly_while_touching"]
+        lines.append(f"frames: {frames['frames_touching']} touching, {frames['frames_free']} "
+                     f"free; can grey exactly while touching: "
+                     f"{frames['can_grey_exactly_while_touching']}; tip grey exactly while "
+                     f"touching: {frames['tip_grey_exactly_while_touching']}")
+    return ok, lines

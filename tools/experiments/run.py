@@ -1,0 +1,72 @@
+"""Runs the thesis's three experiments (chapter 10) end to end, headless.
+
+    python tools/experiments/run.py                 # all three
+    python tools/experiments/run.py grasp           # one (contactless, pile, grasp)
+    python tools/experiments/run.py --quick pile    # a shorter run with the same outcome checks
+
+Each experiment starts its own roscore, ``rosrun VirtualWorld virtualWorld`` and ``rosrun
+Viewer viewer``, acts as the GUI, and writes ``out/experiments/<name>/``: numbered Viewer frames
+(``frames/frame_NNNN.png``), ``contact_sheet.png``, ``animation.gif`` and ``summary.json``. The
+exit status is 0 only if every experiment ran and its outcome held.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import pathlib
+import signal
+import sys
+import time
+
+HERE = pathlib.Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+
+NAMES = ("contactless", "pile", "grasp")
+
+
+def _raise_keyboard_interrupt(signum, frame):
+    raise KeyboardInterrupt(f"signal {signum}")
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("names", nargs="*", metavar="name",
+                        help="contactless, pile or grasp (default: all three)")
+    parser.add_argument("--quick", action="store_true", help="shorter runs, same outcome checks")
+    parser.add_argument("--no-frames", action="store_true", help="no Viewer frames")
+    args = parser.parse_args(argv)
+    unknown = [n for n in args.names if n not in NAMES]
+    if unknown:
+        parser.error(f"unknown experiment(s) {', '.join(unknown)}: choose from {', '.join(NAMES)}")
+    signal.signal(signal.SIGTERM, _raise_keyboard_interrupt)
+    failed = []
+    for name in args.names or NAMES:
+        module = importlib.import_module(name)
+        started = time.monotonic()
+        print(f"experiment {name} ...", flush=True)
+        try:
+            facts = module.run(quick=args.quick, frames=not args.no_frames)
+        except KeyboardInterrupt:
+            print("interrupted; every process started was stopped", file=sys.stderr)
+            return 130
+        except Exception as error:
+            print(f"experiment {name}: {type(error).__name__}: {error}", file=sys.stderr)
+            failed.append(name)
+            continue
+        ok, lines = module.verdict(facts)
+        for line in lines:
+            print(f"  {line}")
+        print(f"experiment {name}: {'outcome held' if ok else 'OUTCOME FAILED'} "
+              f"({time.monotonic() - started:.1f} s); out/experiments/{name}/summary.json",
+              flush=True)
+        if not ok:
+            failed.append(name)
+    if failed:
+        print(f"failed: {', '.join(failed)}", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
