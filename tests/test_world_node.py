@@ -308,3 +308,12 @@ def test_a_bad_start_up_parameter_ends_the_node_with_one_line(ros_master):
     assert node.wait(timeout=30) != 0
     log = ros_master.log_text(node)
     assert "erp" in log and "bad start-up parameter" in log
+
+
+def test_refused_set_world_and_set_step_still_report_the_values_in_force(world):
+    refused = world("set_step")
+    assert not refused.success and refused.message
+    assert (refused.step, refused.steps_per_cycle, refused.rate) == pytest.approx((0.001, 40, 25))
+    refused = world("set_world", set_erp=True, erp=5.0)
+    assert not refused.success and "erp" in refused.message
+    assert refused.erp == pytest.approx(0.2) and list(refused.gravity) == [0, 0, -9.81]

@@ -54,6 +54,14 @@ class WorldClient:
 
     def call(self, service: str, /, **fields):
         """Calls one service with request ``fields``; returns the response or raises."""
+        response = self.ask(service, **fields)
+        if not response.success:
+            raise WorldError(f"{self.namespace}/{service}", response.message)
+        return response
+
+    def ask(self, service: str, /, **fields):
+        """Calls one service and returns its response, refused or not (a refused Set Step or
+        Set World still reports the values in force); raises only if the call fails."""
         proxy = self._proxies.get(service)
         if proxy is None:
             service_class = getattr(self._srv, self._TYPES[service])
@@ -65,8 +73,6 @@ class WorldClient:
         except (self._rospy.ServiceException, OSError) as error:
             self._proxies.pop(service, None)
             raise WorldError(f"{self.namespace}/{service}", f"call failed: {error}") from None
-        if not response.success:
-            raise WorldError(f"{self.namespace}/{service}", response.message)
         return response
 
     def close(self) -> None:
@@ -136,8 +142,9 @@ class WorldClient:
                   velocities=[float(v) for v in velocities])
 
     def publication_rate(self) -> float:
-        """The world's publications per wall-clock second (Set Step with nothing given)."""
-        return float(self.call("set_step").rate)
+        """The world's publications per wall-clock second: an empty Set Step is refused but
+        answers with the step values in force."""
+        return float(self.ask("set_step").rate)
 
     # -- plans --------------------------------------------------------------------------------
     def execute(self, plan: BuildPlan,

@@ -146,19 +146,23 @@ class Portal:
     def _guarded(self, service_class, handler: Callable) -> Callable:
         """Runs ``handler(request) -> dict`` on the loop thread and turns the outcome into the
         service's response: an OdinError becomes ``success: false`` with its message, anything
-        unexpected too (logged with its traceback); the node stays up either way."""
+        unexpected too (logged with its traceback); the node stays up either way. Set World and
+        Set Step also report the values in force when they refuse."""
         response_class = service_class._response_class
+        in_force = {srv.SetWorld: lambda: self._world_fields(self.core.world_parameters),
+                    srv.SetStep: self._step_fields}.get(service_class, dict)
 
         def serve(request):
             try:
                 fields = self.loop.call(lambda: handler(request))
                 return response_class(success=True, **fields)
             except OdinError as error:
-                return response_class(success=False, message=str(error))
+                message = str(error)
             except Exception as error:
                 _log.error("%s failed:\n%s", service_class._type, traceback.format_exc())
-                return response_class(success=False,
-                                      message=f"internal error: {type(error).__name__}: {error}")
+                message = f"internal error: {type(error).__name__}: {error}"
+            # values in force are immutable snapshots: safe to read from this thread
+            return response_class(success=False, message=message, **in_force())
         return serve
 
     # -- running ------------------------------------------------------------------------------
@@ -253,7 +257,11 @@ class Portal:
                                            request.steps_per_cycle, request.cycle_time,
                                            request.rate)
         self.loop.step_values = values
-        return {"message": note, "step": values.step, "steps_per_cycle": values.steps_per_cycle,
+        return dict(self._step_fields(), message=note)
+
+    def _step_fields(self) -> dict:
+        values = self.loop.step_values
+        return {"step": values.step, "steps_per_cycle": values.steps_per_cycle,
                 "cycle_time": values.cycle_time, "rate": values.rate}
 
     def step_once(self, request) -> dict:
