@@ -17,6 +17,7 @@ import multiprocessing
 import os
 import pathlib
 import statistics
+import subprocess
 import sys
 import time
 
@@ -32,6 +33,7 @@ CALLS = 10_000
 CPU_WINDOW = 10.0
 RTF_WINDOW = 8.0
 RTF_ROUNDS = 3
+NATIVE_STEPS = 20_000
 
 
 def _cpu_seconds(pid: int) -> float:
@@ -163,42 +165,43 @@ def publish_1000_cpu() -> dict:
 
 
 # -- real-time factor against native C ----------------------------------------------------------
-def _world_rtf(master_env_ready) -> float:
-    from world_client import WorldClient, sphere, box
-    client = WorldClient()
-    client.ok("build_object", object=box("ground", (20, 20, 1), (0, 0, -0.5), geometry_only=True))
-    client.ok("build_entity", name="spheres", internal_collisions=True, objects=[
-        sphere(f"s{i}", 0.1, ((i % 10) * 0.25 - 1.125, (i // 10) * 0.25 - 1.125, 0.5))
-        for i in range(100)])
-    import rospy
-    from rosgraph_msgs.msg import Clock
-    client.ok("start", simulate=True)
-    time.sleep(0.5)
-    sim0 = rospy.wait_for_message("/clock", Clock, timeout=5).clock.to_sec()
-    wall0 = time.monotonic()
-    time.sleep(RTF_WINDOW)
-    sim1 = rospy.wait_for_message("/clock", Clock, timeout=5).clock.to_sec()
-    wall1 = time.monotonic()
-    client.ok("start", simulate=False)
-    client.close()
-    return (sim1 - sim0) / (wall1 - wall0)
+def world_rtf_spheres100() -> dict:
+    """Simulated seconds per wall-clock second of the 100-sphere scene, free running."""
+    with RosMaster() as master:
+        master.apply_to_this_process()
+        _start_world(master, "_free_run:=true")
+        import rospy
+        from rosgraph_msgs.msg import Clock
+        from world_client import WorldClient, sphere, box
+        rospy.init_node("bench_portal_rtf", anonymous=True, disable_signals=True)
+        client = WorldClient()
+        client.ok("build_object", object=box("ground", (20, 20, 1), (0, 0, -0.5),
+                                            geometry_only=True))
+        client.ok("build_entity", name="spheres", internal_collisions=True, objects=[
+            sphere(f"s{i}", 0.1, ((i % 10) * 0.25 - 1.125, (i // 10) * 0.25 - 1.125, 0.5))
+            for i in range(100)])
+        client.ok("start", simulate=True)
+        time.sleep(0.5)
+        sim0 = rospy.wait_for_message("/clock", Clock, timeout=5).clock.to_sec()
+        wall0 = time.monotonic()
+        time.sleep(RTF_WINDOW)
+        sim1 = rospy.wait_for_message("/clock", Clock, timeout=5).clock.to_sec()
+        wall1 = time.monotonic()
+        client.close()
+    return {"rtf": (sim1 - sim0) / (wall1 - wall0)}
 
 
 def rtf_spheres100(out_dir: pathlib.Path) -> dict:
+    """Alternates the node and the native program; the ratio of their medians."""
     import bench_core
     exe = bench_core._compile(out_dir)
     world, native = [], []
-    with RosMaster() as master:
-        master.apply_to_this_process()
-        import rospy
-        rospy.init_node("bench_portal_rtf", anonymous=True, disable_signals=True)
-        for _ in range(RTF_ROUNDS):
-            seconds, _ = bench_core._native(exe, 0, 0, 0)
-            native.append(bench_core.STEPS / seconds * 0.001)   # simulated s per wall s
-            node = _start_world(master, "_free_run:=true")
-            world.append(_world_rtf(master))
-            node.send_signal(2)
-            node.wait(10)
+    for _ in range(RTF_ROUNDS):
+        # long enough that, like the node's window, it is mostly spheres at rest on the plane
+        output = subprocess.run([str(exe), "0", str(NATIVE_STEPS), "0", "0"], check=True,
+                                capture_output=True, text=True).stdout.split()
+        native.append(NATIVE_STEPS * 0.001 / float(output[0]))   # simulated s per wall s
+        world.append(_in_child(world_rtf_spheres100)["rtf"])
     ratio = statistics.median(world) / statistics.median(native)
     print(f"  world rtf {statistics.median(world):.2f}, native {statistics.median(native):.2f}")
     return {"portal_rtf_spheres100": ratio}
