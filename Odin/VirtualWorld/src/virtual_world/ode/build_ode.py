@@ -1,7 +1,8 @@
 """Compiles the cffi extension ``_odin_ode`` (API mode) over Debian's libode.
 
 Layers, each in its own file (pymunk's layout):
-  * ``ode_cdef.h``  -- the C declarations cffi exposes to Python (a real header text);
+  * ``ode_cdef.h``  -- the part of ODE's C API cffi exposes to Python (a real header text);
+  * ``odin_step.h`` -- Odin's own C declarations, read into the cdef too (one source);
   * ``odin_step.c`` -- Odin's own C code compiled into the extension: the per-step hot work;
   * this module     -- the build; ``bindings.py`` only re-exports ``ffi, lib``.
 
@@ -9,6 +10,7 @@ Usage: ``python build_ode.py --out DIR [--tmp DIR]`` (CMake runs it during the c
 """
 import argparse
 import pathlib
+import re
 import subprocess
 
 import cffi
@@ -21,9 +23,23 @@ def _pkg_config(*args: str) -> list:
                           text=True).stdout.split()
 
 
+def odin_declarations(header: str) -> str:
+    """The cdef text of odin_step.h: comments and preprocessor lines dropped, except integer
+    constants, which stay (cffi checks them against the compiled value) and are written into
+    the array sizes that use them (cffi's parser wants literal sizes)."""
+    text = re.sub(r"/\*.*?\*/", "", header, flags=re.S)
+    constants = dict(re.findall(r"^#define\s+(ODIN_\w+)\s+(\d+)\s*$", text, flags=re.M))
+    text = "\n".join(line for line in text.splitlines() if not line.lstrip().startswith("#"))
+    for name, value in constants.items():
+        text = text.replace(f"[{name}]", f"[{value}]")
+    defines = "".join(f"#define {name} {value}\n" for name, value in constants.items())
+    return defines + text
+
+
 def make_builder() -> cffi.FFI:
     ffibuilder = cffi.FFI()
-    ffibuilder.cdef((HERE / "ode_cdef.h").read_text())
+    ffibuilder.cdef((HERE / "ode_cdef.h").read_text()
+                    + odin_declarations((HERE / "odin_step.h").read_text()))
     ffibuilder.set_source(
         "_odin_ode",
         '#include <ode/ode.h>\n#include "odin_step.h"\n',
