@@ -1,0 +1,210 @@
+"""Experiment 3 (thesis 10.3): the TX90 with the Schunk SAH hand takes a can from the table,
+carries it and drops it.
+
+Scene: ``legacy_2012/examples/TX90_RHand_ICRA10_5PMD_TwoCan.xml`` as the GUI loads it, except
+the can that is grasped ("can", the top one of the pile in the file): it is built as a movable
+body, a cylinder primitive of the mesh's size (radius 0.0317 m, length 0.1206 m, 0.35 kg)
+instead of the 4366-triangle mesh (ODE's trimesh-trimesh contacts between the hand and a mesh
+can jitter and cost far more), and it is put on the table within the arm's reach by Set
+Position (the thesis positioned its cans the same way). The other two cans stay static
+geometry.
+
+Driving, as the thesis's GUI did (section 7.4.3), one command per Portal cycle:
+1. starting position: ``Odin/GUI/paths/grasp_initial.txt`` -> one Set Position of every link;
+2. position path: ``grasp_approach.txt`` refined once by "double path precision", one Set
+   Position per cycle: the open hand comes beside the can, palm towards it;
+3. motor velocities: the fingers close (their motors' maximum torque is limited so that they
+   stop on the can and squeeze it), then the arm lifts (ForeArm) and carries (Shoulder), then
+   the fingers open slowly and the can drops to the floor.
+
+World: table 10.2 (contacts, 40 steps of 1 ms per cycle, 25 Hz, gravity -9.81, surface layer
+0.001 m) with the damping read per second (see EXPERIMENTS.md) and friction 1.5, 4 contacts
+per pair.
+
+Outcome (summary.json): the can's height above the table while carried; it stays in the hand
+(its pose relative to the palm changes by millimetres) until the hand opens; it is released
+only after the opening starts, and it ends on the floor.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+import common
+
+PROBLEM = "TX90_RHand_ICRA10_5PMD_TwoCan.xml"
+ROBOT = "TX90 SAHand Right"
+CAN = "can"
+PALM = f"{ROBOT}/Palm"
+TABLE_TOP = 0.5  # m, the ICRA09 scene's table (a 0.5 m cube on the floor)
+
+PARAMETERS = {
+    "can_mass_kg": 0.35,
+    "can_radius_m": 0.0317,
+    "can_length_m": 0.1206,
+    "can_color": [0.85, 0.15, 0.1, 1.0],
+    "can_position_m": [-0.30, 1.00, 0.5603],
+    "finger_close_rad_s": -0.8,
+    "finger_max_torque_N_m": 4.0,
+    "close_s": 1.2,
+    "lift_forearm_rad_s": 0.25,
+    "lift_s": 1.0,
+    "carry_shoulder_rad_s": -0.5,
+    "carry_s": 1.6,
+    "open_rad_s": 0.4,
+    "open_s": 1.6,
+    "fall_s": 1.0,
+    "frame_every_cycles": 4,
+    "double_precision": 1,
+}
+WORLD = {
+    "contact_less": False, "steps_per_cycle": 40, "rate": 25.0, "step": 0.001,
+    "gravity": [0.0, 0.0, -9.81], "linear_damping": 0.0005, "linear_damping_threshold": 0.0,
+    "angular_damping": 0.0002, "angular_damping_threshold": 0.0,
+    "contact_surface_layer": 0.001, "friction": -1.0, "max_contacts": 4, "free_run": True,
+    "solver": 1,
+}
+CAMERA = common.Camera(eye=(0.35, 1.75, 1.15), target=(-0.45, 0.80, 0.55))
+
+#: the hand's finger joints that close (flexion): Prox, Med, Dist of index, middle, ring, and
+#: the thumb's.
+FLEX = ("Thumb-Prox", "Thumb-Med", "Thumb-Dist", "Index-Prox", "Index-Med", "Index-Dist",
+        "Mid-Prox", "Mid-Med", "Mid-Dist", "Ring-Prox", "Ring-Med", "Ring-Dist")
+
+
+def motor_of(handle, link_name: str) -> str:
+    key = f"{ROBOT}/{link_name}"
+    return handle.motor_ids[handle.joint_keys.index(key)]
+
+
+def run(quick: bool = False, frames: bool = True, out_root=None) -> dict:
+    from gui.paths import RADIANS, load_robot_path, refine
+    p = dict(PARAMETERS)
+    problem, plan = common.load_plan(common.EXAMPLES / PROBLEM)
+    common.replace_step(plan, CAN, common.cylinder_can(
+        CAN, (-0.35, 1.18, 0.6803), p["can_mass_kg"], p["can_color"], p["can_radius_m"],
+        p["can_length_m"]))
+    kwargs = {} if out_root is None else {"out_root": out_root}
+    with common.Session("grasp", WORLD, CAMERA, track={CAN, PALM}, frames=frames,
+                        contacts=True, **kwargs) as s:
+        s.client.execute(plan)
+        handle = plan.robots[0]
+        initial = load_robot_path(common.PATHS_DIR / "grasp_initial.txt", handle, RADIANS)
+        approach = refine(load_robot_path(common.PATHS_DIR / "grasp_approach.txt", handle,
+                                          RADIANS), p["double_precision"])
+        s.client.set_position([(CAN, p["can_position_m"], (1.0, 0.0, 0.0, 0.0))])
+        s.client.set_position(handle.situations(initial[0]))
+        flex = [motor_of(handle, name) for name in FLEX]
+        from Messages.msg import JointParameter
+        for motor in flex:  # fingers squeeze with a bounded torque
+            s.client.call("set_joint", action=1, id=motor, parameters=[JointParameter(
+                parameter=11, axis=1, value=p["finger_max_torque_N_m"])])
+        every = p["frame_every_cycles"]
+        phases = []
+
+        def advance(cycles: int, before=None):
+            for _ in range(cycles):
+                if before is not None:
+                    before()
+                if (s.cycles + 1) % every == 0:
+                    s.cycle_and_frame()
+                else:
+                    s.cycle(1)
+
+        def phase(name: str):
+            phases.append((name, round(s.sim_time, 6)))
+
+        per_s = 1.0 / (WORLD["step"] * WORLD["steps_per_cycle"])
+        phase("start")
+        s.cycle_and_frame()
+        advance(4)                                      # the can settles on the table
+        phase("position_path")
+        rows = iter(approach)
+        advance(len(approach), lambda: s.client.set_position(handle.situations(next(rows))))
+        phase("close")
+        s.client.set_velocity(flex, [p["finger_close_rad_s"]] * len(flex))
+        advance(int(p["close_s"] * per_s))
+        phase("lift")
+        forearm = motor_of(handle, "ForeArm")
+        wrist = motor_of(handle, "Wrist")
+        s.client.set_velocity([forearm, wrist], [p["lift_forearm_rad_s"],
+                                                 -p["lift_forearm_rad_s"]])
+        advance(int(p["lift_s"] * per_s))
+        s.client.set_velocity([forearm, wrist], [0.0, 0.0])
+        phase("carry")
+        shoulder = motor_of(handle, "Shoulder")
+        s.client.set_velocity([shoulder], [p["carry_shoulder_rad_s"]])
+        advance(int(p["carry_s"] * per_s))
+        s.client.set_velocity([shoulder], [0.0])
+        advance(int(0.3 * per_s))
+        phase("open")
+        s.client.set_velocity(flex, [p["open_rad_s"]] * len(flex))
+        advance(int(p["open_s"] * per_s))
+        s.client.set_velocity(flex, [0.0] * len(flex))
+        phase("fall")
+        advance(int(p["fall_s"] * per_s))
+        phase("end")
+        s.finish()
+        facts = analyse(s, dict(phases))
+        facts["phases_s"] = dict(phases)
+        common.write_summary(s, facts, p)
+    return facts
+
+
+def analyse(s: "common.Session", phases: dict) -> dict:
+    from gui.kinematics import matrix_from_quaternion
+    t, can, _ = s.trajectory(CAN)
+    tp, palm, palm_q = s.trajectory(PALM)
+    n = min(len(t), len(tp))
+    t, can, palm, palm_q = t[:n], can[:n], palm[:n], palm_q[:n]
+    # the can's centre in the palm's frame
+    rel = np.array([matrix_from_quaternion(q).T @ (c - p) for c, p, q in zip(can, palm, palm_q)])
+    carried = (t >= phases["carry"]) & (t < phases["open"])
+    lifted_at = phases["lift"]
+    held_ref = rel[np.searchsorted(t, phases["carry"])]
+    drift = np.linalg.norm(rel - held_ref, axis=1)
+    in_hand = drift < 0.02
+    after_open = t >= phases["open"]
+    left = np.nonzero(after_open & ~in_hand)[0]
+    released_at = float(t[left[0]]) if len(left) else None
+    before_open_drift = float(drift[(t >= lifted_at) & (t < phases["open"])].max())
+    bottom = can[:, 2] - 0.0603
+    samples = {}
+    for name, at in phases.items():
+        k = min(int(np.searchsorted(t, at)), n - 1)
+        samples[name] = {"t_s": float(t[k]), "can_m": [round(float(v), 4) for v in can[k]],
+                         "palm_m": [round(float(v), 4) for v in palm[k]],
+                         "can_in_palm_frame_m": [round(float(v), 4) for v in rel[k]]}
+    facts = {
+        "at_phase_starts": samples,
+        "outcome": {
+            "can_height_above_table_while_carried_m": {
+                "min": round(float(bottom[carried].min() - TABLE_TOP), 4),
+                "max": round(float(bottom[carried].max() - TABLE_TOP), 4),
+                "mean": round(float(bottom[carried].mean() - TABLE_TOP), 4)},
+            "can_moved_while_carried_m": round(float(np.linalg.norm(
+                can[carried][-1] - can[carried][0])), 4),
+            "max_slip_in_hand_before_opening_m": round(before_open_drift, 4),
+            "hand_opens_at_s": phases["open"],
+            "can_released_at_s": released_at,
+            "released_only_when_hand_opens": bool(released_at is not None
+                                                  and before_open_drift < 0.02),
+            "can_final_position_m": [round(float(v), 4) for v in can[-1]],
+            "can_on_floor_at_end": bool(can[-1, 2] < 0.1),
+        },
+        "contacts": s.contact_rates(),
+    }
+    return facts
+
+
+def verdict(facts: dict) -> tuple:
+    o = facts["outcome"]
+    h = o["can_height_above_table_while_carried_m"]
+    ok = (o["released_only_when_hand_opens"] and h["min"] > 0.02 and o["can_on_floor_at_end"]
+          and o["can_moved_while_carried_m"] > 0.3)
+    lines = [f"can carried {h['min']:.3f}..{h['max']:.3f} m above the table, moved "
+             f"{o['can_moved_while_carried_m']:.2f} m; slip in hand before opening "
+             f"{o['max_slip_in_hand_before_opening_m'] * 1000:.1f} mm",
+             f"hand opens at {o['hand_opens_at_s']} s, can released at "
+             f"{o['can_released_at_s']} s, final position {o['can_final_position_m']}",
+             f"contacts: {facts['contacts']}"]
+    return ok, lines
