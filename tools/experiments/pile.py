@@ -124,13 +124,16 @@ def analyse(s: "common.Session", p: dict) -> dict:
     for name in CANS:
         t, xyz, _ = s.trajectory(name)
         bottom = xyz[:, 2] - p["can_length_m"] / 2   # the lowest point when upright
-        on_floor = xyz[:, 2] < FLOOR_TOP + 0.08       # within a can's length of the floor
+        over_floor = (xyz[:, 0] <= 0.0) & (xyz[:, 0] >= -1.5) & (xyz[:, 1] >= 0.0) \
+            & (xyz[:, 1] <= 2.5)
+        # on the floor slab: centre within a can's half-length (+ 3 cm) of its top
+        on_floor = over_floor & (xyz[:, 2] < FLOOR_TOP + 0.09) & (xyz[:, 2] > FLOOR_TOP)
         first = int(np.argmax(on_floor)) if on_floor.any() else None
         bounced = False
         if first is not None:
             after = xyz[first:, 2]
             low = np.minimum.accumulate(after)
-            bounced = bool((after - low).max() > 0.005)
+            bounced = bool((after - low).max() > 0.01)
         cans[name] = {
             "moved_m": round(float(np.linalg.norm(xyz[-1] - xyz[0])), 4),
             "start_m": [round(float(v), 4) for v in xyz[0]],
@@ -138,6 +141,8 @@ def analyse(s: "common.Session", p: dict) -> dict:
             "hit_ground": first is not None,
             "hit_ground_at_s": float(t[first]) if first is not None else None,
             "bounced": bounced,
+            "knocked_off_the_table": bool(xyz[:, 2].min() < 0.5 - 0.1),
+            "fell_past_the_floor_edge": bool(xyz[-1, 2] < FLOOR_TOP - 0.2),
             "lowest_bottom_z_m": round(float(bottom.min()), 4),
             "z_every_cycle_m": [round(float(v), 4) for v in xyz[:, 2]],
         }
@@ -145,11 +150,14 @@ def analyse(s: "common.Session", p: dict) -> dict:
 
 
 def verdict(facts: dict) -> tuple:
+    """Both cans knocked off the table; at least one lands on the floor slab and bounces
+    (a can thrown past the slab's edge at x = 0 is reported as such)."""
     cans = facts["outcome"]["cans"]
-    ok = all(c["moved_m"] > 0.2 and c["hit_ground"] for c in cans.values()) and any(
-        c["bounced"] for c in cans.values())
-    lines = [f"{name}: moved {c['moved_m']:.3f} m, hit the ground: {c['hit_ground']} "
-             f"(at {c['hit_ground_at_s']} s), bounced: {c['bounced']}"
-             for name, c in cans.items()]
+    ok = all(c["moved_m"] > 0.2 and c["knocked_off_the_table"] for c in cans.values()) and any(
+        c["hit_ground"] and c["bounced"] for c in cans.values())
+    lines = [f"{name}: moved {c['moved_m']:.3f} m, knocked off the table: "
+             f"{c['knocked_off_the_table']}, hit the floor: {c['hit_ground']} "
+             f"(at {c['hit_ground_at_s']} s), bounced: {c['bounced']}, fell past the floor's "
+             f"edge: {c['fell_past_the_floor_edge']}" for name, c in cans.items()]
     lines.append(f"contacts: {facts['contacts']}")
     return ok, lines
