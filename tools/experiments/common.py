@@ -258,6 +258,8 @@ class Session:
         """Saves the Viewer's picture of the current state as the next numbered frame."""
         if not self.save_frames:
             return None
+        if not self.frame_paths:
+            self.wait_for_viewer_scene()
         self.wait_for_update()
         time.sleep(self.frame_settle)  # the Viewer's own subscription gets the same messages
         name = f"frame_{len(self.frame_paths) + 1:04d}.png"
@@ -267,6 +269,23 @@ class Session:
         self.frame_paths.append(pathlib.Path(response.path))
         self.frame_times.append(self.sim_time)
         return self.frame_paths[-1]
+
+    def wait_for_viewer_scene(self, timeout: float = 30.0) -> None:
+        """Until the Viewer shows the whole scene: the world hands geometries to the Viewer
+        from a queue of its own, so a large scene arrives over a second or two. The world is
+        paused between cycles, so the picture stops changing once everything has arrived."""
+        import numpy as np
+        from sensor_msgs.msg import Image
+        deadline = time.monotonic() + timeout
+        previous = None
+        while time.monotonic() < deadline:
+            image = self._rospy.wait_for_message("/viewer/image", Image, timeout=10)
+            pixels = np.frombuffer(image.data, np.uint8)
+            if previous is not None and np.array_equal(previous, pixels):
+                return
+            previous = pixels
+            time.sleep(0.5)
+        raise ExperimentError(f"the Viewer's picture did not settle in {timeout} s")
 
     def wait_for_collided(self, timeout: float = 10.0) -> None:
         """Until the Collided message of the current simulated time has arrived here."""

@@ -44,7 +44,7 @@ PARAMETERS = {
     "can_centres_m": {"can": [-0.35, 1.18, 0.6815], "can_2": [-0.35, 1.18, 0.5606]},
     "pile_moved_to_m": {"can": [-0.30, 1.00, 0.6815], "can_2": [-0.30, 1.00, 0.5606]},
     "can_colors": {"can": [0.85, 0.15, 0.1, 1.0], "can_2": [0.15, 0.35, 0.85, 1.0]},
-    "start_angle_offset_rad": 0.14,
+    "start_angle_offset_rad": -0.14,
     "hand_radius_m": 1.05,
     "hand_height_m": 0.58,
     "base_speed_rad_s": 0.1,
@@ -64,8 +64,8 @@ CAMERA = common.Camera(eye=(0.55, 0.35, 1.25), target=(-0.30, 1.05, 0.35))
 
 def starting_pose(handle, can_xy, p) -> np.ndarray:
     """Joint values: the fingertips at ``hand_radius_m`` from the base axis, the row of fingers
-    vertical, ``start_angle_offset_rad`` anticlockwise of the pile (the base turns clockwise
-    under a positive motor goal)."""
+    vertical, ``start_angle_offset_rad`` from the pile (negative: clockwise of it, since a
+    positive motor goal turns the base anticlockwise, like a positive joint value)."""
     from make_grasp_paths import hand_target
     model, base = handle.instance.model, handle.instance.base_pose
     angle = math.atan2(can_xy[1], can_xy[0]) + p["start_angle_offset_rad"]

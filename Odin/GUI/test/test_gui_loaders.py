@@ -228,12 +228,14 @@ def test_current_format_obstacles_use_home_in_metres():
 def test_robot_plan_joints_motors_and_names():
     plan = plan_problem(load_problem(LEGACY / "Staubli_R6_two_columns.xml"))
     joints = [s for s in plan.steps if isinstance(s, JointRequest)]
-    assert joints[0].type == 8 and joints[0].body1 == "" and joints[0].body2 == "TX90/Base"
+    base = _bodies(plan)["TX90/Base"]
+    assert base.fixed and all(j.body1 and j.body2 for j in joints)   # no joint to the world
     hinges = [j for j in joints if j.type == 1]
     assert [j.body2 for j in hinges] == ["TX90/Shoulder", "TX90/ForeArm", "TX90/Elbow",
                                          "TX90/Arm", "TX90/Wrist", "TX90/Tcp"]
-    # Shoulder: axis = world z through the base; stops from the limits (+-180 degrees).
-    assert hinges[0].axis1 == pytest.approx((0, 0, 1), abs=1e-12)
+    # Shoulder: the joint axis is world z through the base, sent reversed because ODE's angle
+    # is body1's (the parent's) rotation relative to body2; stops from the limits (+-180 deg).
+    assert hinges[0].axis1 == pytest.approx((0, 0, -1), abs=1e-12)
     assert hinges[0].anchor[:2] == pytest.approx((-0.3, 0.4), abs=1e-12)
     assert dict((p, v) for p, _, v in hinges[0].parameters) == pytest.approx(
         {0: -math.pi, 1: math.pi})
@@ -359,7 +361,7 @@ def test_problem_info_prints_json():
     joints = {j["name"]: j for j in info["joints"]}
     assert joints["TX90 SAHand Right/Shoulder"]["type"] == "hinge"
     assert joints["TX90 SAHand Right/Shoulder"]["limits"] == pytest.approx([-math.pi, math.pi])
-    assert joints["TX90 SAHand Right/<base>"]["type"] == "fixed"
+    assert "TX90 SAHand Right/<base>" not in joints    # the base is a fixed body instead
 
 
 def test_problem_info_does_not_import_rospy():

@@ -51,14 +51,14 @@ def test_simulation_tab_opens_a_problem_simulates_and_clears(window, kautham_dir
     click(tab.open_button)
     wait_for(lambda: not tab.building, 30, "the problem to be built")
     assert window.last_error == ""
-    # 8 links + 8 joints (7 hinges and the base's fixed joint) + 7 motors + the columns
-    assert tab.element_count() == 8 + 8 + 7 + 1
+    # 8 links (the base a fixed body) + 7 hinges + 7 motors + the columns
+    assert tab.element_count() == 8 + 7 + 7 + 1
     labels = [tab.tree.topLevelItem(i).text(0) for i in range(tab.tree.topLevelItemCount())]
     assert labels == ["KukaLWR (robot)", "Scene objects"]
     wait_for(lambda: "KukaLWR/Link7" in window.scene.objects
              and any(o.startswith(">columns#0") for o in window.scene.objects), 5,
              "links and columns in world_update")
-    wait_for(lambda: len(window.scene.joints) == 8, 5, "joints from joint_data")
+    wait_for(lambda: len(window.scene.joints) == 7, 5, "joints from joint_data")
     assert len(window.scene.motors) == 7
     assert "KukaLWR" in window.scene.robots
     screenshot(window, SHOTS / "simulation.png")
@@ -319,7 +319,7 @@ def test_motion_tab_forces_joints_motors_and_robot_paths(window, kautham_dir, tm
     window.simulation.open_problem(str(kautham_dir / "legacy_2012/examples/Kuka_two_columns.xml"))
     wait_for(lambda: "KukaLWR" in window.scene.robots and not window.simulation.building, 30,
              "the Kuka")
-    wait_for(lambda: tab.joint.count() == 8, 5, "joints listed")
+    wait_for(lambda: tab.joint.count() == 7, 5, "joints listed")
     tab.toolbox.setCurrentIndex(1)
     tab.joint.setCurrentText("1:KukaLWR/Base&KukaLWR/Link1")
     assert tab.magnitudes.boxes[0].isEnabled() and not tab.magnitudes.boxes[1].isEnabled()

@@ -31,6 +31,8 @@ How a problem maps to the world:
 """
 from __future__ import annotations
 
+import dataclasses
+
 from dataclasses import dataclass, field
 from typing import Optional
 
@@ -256,6 +258,10 @@ def plan_problem(problem: Problem, defaults: BuildDefaults = BuildDefaults()) ->
         if static or (single and inst.role == "obstacle"):
             steps.extend(requests)
             continue
+        if inst.role == "robot" and not single:
+            # The base is a fixed (kinematic) body: it never moves, whatever the motors push,
+            # where a fixed joint to the environment would give a little under their reaction.
+            requests[0] = dataclasses.replace(requests[0], fixed=True)
         steps.append(EntityRequest(
             name=inst.name,
             objects=tuple(r for r in requests if isinstance(r, ObjectRequest)),
@@ -267,9 +273,6 @@ def plan_problem(problem: Problem, defaults: BuildDefaults = BuildDefaults()) ->
             continue
         frames = model.joint_frames(inst.base_pose)
         joint_keys, motors = [], []
-        if inst.role == "robot":
-            steps.append(JointRequest(key=f"{inst.name}/<base>", type=JOINT_FIXED, body1="",
-                                      body2=bodies[0].body_id))
         for i, link in enumerate(model.links):
             if link.parent is None:
                 continue
@@ -280,7 +283,10 @@ def plan_problem(problem: Problem, defaults: BuildDefaults = BuildDefaults()) ->
                                           body2=bodies[i].body_id))
                 continue
             frame = frames[i]
-            axis = frame[:3, :3] @ link.axis
+            # ODE measures a hinge's angle (a slider's position) as body1's motion relative to
+            # body2; the parent is body1, so the axis is reversed: the world's joint value, its
+            # stops and its motor's goal speed then all have the sign of Kautham's joint value.
+            axis = -(frame[:3, :3] @ link.axis)
             params = ()
             if link.limits is not None:
                 h = link.home_value()

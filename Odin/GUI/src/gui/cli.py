@@ -63,13 +63,22 @@ def describe(plan) -> dict:
             lim = limits.get(step.key)
             joints.append(dict(name=step.key, type=_JOINT_NAMES.get(step.type, str(step.type)),
                                parent=step.body1 or None, child=step.body2,
-                               anchor=list(step.anchor), axis=list(step.axis1),
+                               anchor=list(step.anchor), axis=_kinematic_axis(step),
                                limits=None if lim is None else [lim[0], lim[1]]))
     robots = [dict(name=h.name, joints=h.joint_keys, home=[float(v) for v in h.home],
                    motors=h.motor_ids) for h in plan.robots]
     return dict(problem=plan.problem.source, format=plan.problem.format,
                 units=dict(length="m", angle="rad", mass="kg", quaternion="w,x,y,z"),
                 bodies=bodies, joints=joints, robots=robots)
+
+
+def _kinematic_axis(step) -> list:
+    """The joint's axis as the robot model states it (Kautham's sign): a robot's hinges and
+    sliders are sent to the world with the axis reversed (see gui.build)."""
+    from gui.build import JOINT_HINGE, JOINT_SLIDER
+    if step.type in (JOINT_HINGE, JOINT_SLIDER) and step.body1:
+        return [-v for v in step.axis1]
+    return list(step.axis1)
 
 
 def problem_info_main(argv: Optional[Sequence[str]] = None) -> int:
