@@ -317,3 +317,20 @@ def test_refused_set_world_and_set_step_still_report_the_values_in_force(world):
     refused = world("set_world", set_erp=True, erp=5.0)
     assert not refused.success and "erp" in refused.message
     assert refused.erp == pytest.approx(0.2) and list(refused.gravity) == [0, 0, -9.81]
+
+
+def test_a_paused_contact_less_world_reports_what_touches_now(world):
+    import rospy
+    from Messages.msg import Collided, Situation
+    from world_client import box, sphere
+
+    world.ok("set_world", set_contact_less=True, contact_less=True)
+    world.ok("build_object", object=box("wall", (0.2, 2, 2), (0, 0, 0), geometry_only=True))
+    world.ok("build_object", object=sphere("ball", 0.1, (1, 0, 0)))
+    world.ok("set_position", situations=[Situation("ball", [0.15, 0, 0], [1, 0, 0, 0])])
+    for _ in range(3):   # every idle cycle, not only the first after the move
+        report = rospy.wait_for_message("/virtual_world/collided", Collided, timeout=5)
+        assert sorted(report.names) == ["ball", "wall"]
+    world.ok("set_position", situations=[Situation("ball", [1, 0, 0], [1, 0, 0, 0])])
+    time.sleep(0.2)
+    assert rospy.wait_for_message("/virtual_world/collided", Collided, timeout=5).names == []

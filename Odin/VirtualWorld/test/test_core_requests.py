@@ -38,3 +38,24 @@ def test_motor_axis_counts(core):
     assert core.motor_axis_counts([motor]) == [1]
     with pytest.raises(UnknownName):
         core.motor_axis_counts(["motor:none"])
+
+
+def test_detect_collisions_reports_what_touches_now_without_stepping(core):
+    core.set_world_parameters(contact_less=True)
+    core.build_object(ObjectSpec("wall", [0.2, 2, 2], geometry_only=True))
+    core.build_object(ObjectSpec("ball", [0.1], position=(1, 0, 0)))
+    core.detect_collisions()
+    assert core.read_collisions() == []
+    core.set_poses([("ball", (0.15, 0, 0), (1, 0, 0, 0))])
+    core.detect_collisions()
+    (pair,) = core.read_collisions()
+    assert {pair.first, pair.second} == {"wall", "ball"}
+    assert pair.depth == pytest.approx(0.05, abs=1e-6)
+    assert core.sim_time == 0.0
+
+
+def test_detect_collisions_does_nothing_under_the_contact_policy(core):
+    core.build_object(ObjectSpec("wall", [0.2, 2, 2], geometry_only=True))
+    core.build_object(ObjectSpec("ball", [0.1], position=(0.15, 0, 0)))
+    core.detect_collisions()
+    assert core.read_collisions() == [] and core.sim_time == 0.0

@@ -1451,6 +1451,14 @@ class Core:
         self._sim_time += step_size * int(count)
         drain_ode_messages()
 
+    @_locked
+    def detect_collisions(self) -> None:
+        """Contact-less policy: collision detection on the present poses without a step, so
+        that read_collisions() reports what touches now in a paused world whose objects were
+        moved (Set Position). Does nothing under the contact policy."""
+        lib.odin_world_detect(self._cworld)
+        drain_ode_messages()
+
     @property
     def sim_time(self) -> float:
         """Simulated seconds since the scene began."""

@@ -15,7 +15,8 @@ Topics published (every cycle, or at ``~rate`` per wall-clock second under ``~fr
   ``~world_update``      Messages/SpaceDistribution: pose of every geometry (m, world frame,
                          quaternion (w, x, y, z));
   ``~collided``          Messages/Collided: contact-less policy only, the pairs that touched
-                         since the last message, with depth (m) and contact points;
+                         since the last message, with depth (m) and contact points (while
+                         paused: the pairs touching now, e.g. after Set Position);
   ``~contacts``          Messages/Collided: contact policy only, pairs in contact in the last
                          step;
   ``~joint_data``        Messages/JointsData: every joint's positions and rates per axis;
@@ -187,8 +188,11 @@ class Portal:
         with self._poses_lock:
             self._poses_for_viewer = (names, positions.copy(), quaternions.copy())
         self.pub_world.publish(self._writer.message(names, positions, quaternions, stamp))
+        contact_less = self.core.world_parameters.contact_less
+        if contact_less and not report.stepped:
+            self.core.detect_collisions()   # paused: report what touches now, not nothing
         collisions = self.core.read_collisions()
-        if self.core.world_parameters.contact_less:
+        if contact_less:
             self.pub_collided.publish(conversions.collided_message(collisions, stamp))
         elif self.pub_contacts.get_num_connections() > 0:
             self.pub_contacts.publish(conversions.collided_message(collisions, stamp))

@@ -222,6 +222,16 @@ int odin_world_step(OdinWorld *w, double h, int count) {
     return 0;
 }
 
+/* Contact-less policy only: collision detection on the present poses, no step. The pairs go
+ * into the records like a step's (a paused world whose objects were moved still reports what
+ * touches). Under the contact policy it does nothing: contacts exist only inside a step. */
+void odin_world_detect(OdinWorld *w) {
+    if (!w->contact_less) return;
+    w->recording = 1;
+    dSpaceCollide(w->space, w, &near_callback);
+    w->recording = 0;
+}
+
 /* ---------------------------------------------------------------- read-out */
 
 void odin_read_poses(dGeomID *geoms, int n, double *pos, double *quat) {

@@ -78,6 +78,8 @@ long odin_get_geom_tag(dGeomID g);
 
 /* Runs `count` steps of `h` seconds. Returns 0. */
 int odin_world_step(OdinWorld *w, double h, int count);
+/* Contact-less policy: records the pairs touching now, without stepping (no-op otherwise). */
+void odin_world_detect(OdinWorld *w);
 /* Forgets the collision records (contact-less: after a read). */
 void odin_world_clear_records(OdinWorld *w);
 /* Frees the record buffer (close/new scene). */
