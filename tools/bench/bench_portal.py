@@ -8,8 +8,8 @@ Figures:
                                    1,000 objects published at 25 Hz to a subscriber (goal <= 0.1).
   portal_rtf_spheres100            real-time factor of the 100-sphere scene of bench_core run
                                    back to back (~free_run), divided by the native C program's
-                                   steps per second times the step size, measured alternately
-                                   (goal >= 0.90).
+                                   steps per second times the step size, measured alternately,
+                                   fastest round of each (goal >= 0.90).
 """
 from __future__ import annotations
 
@@ -202,8 +202,9 @@ def rtf_spheres100(out_dir: pathlib.Path) -> dict:
                                 capture_output=True, text=True).stdout.split()
         native.append(NATIVE_STEPS * 0.001 / float(output[0]))   # simulated s per wall s
         world.append(_in_child(world_rtf_spheres100)["rtf"])
-    ratio = statistics.median(world) / statistics.median(native)
-    print(f"  world rtf {statistics.median(world):.2f}, native {statistics.median(native):.2f}")
+    # the fastest round of each: the one least disturbed by other work on a shared machine
+    ratio = max(world) / max(native)
+    print(f"  world rtf {world}, native {native}")
     return {"portal_rtf_spheres100": ratio}
 
 
