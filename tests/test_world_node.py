@@ -269,14 +269,18 @@ def test_a_viewer_started_late_receives_the_current_scene(world, ros_master):
                                         color=[0.9, 0.1, 0.1, 1]))
     ros_master.rosrun("Viewer", "viewer", f"_snapshot_dir:={ros_master.ros_home}")
     ros_master.wait_for_service("/viewer/save_snapshot")
-    time.sleep(2.5)   # the world's link looks for a Viewer every second
-    response = rospy.ServiceProxy("/viewer/save_snapshot", SaveSnapshot)("late.png")
-    assert response.success, response.message
     from PIL import Image
     import numpy as np
-    image = np.asarray(Image.open(response.path).convert("RGB")).astype(int)
-    reddish = (image[..., 0] > 120) & (image[..., 1] < 90) & (image[..., 2] < 90)
-    assert reddish.sum() > 200, "the early box is not in the late Viewer's frame"
+    from world_client import wait_until
+
+    def red_pixels():   # the world's link looks for a Viewer every second
+        response = rospy.ServiceProxy("/viewer/save_snapshot", SaveSnapshot)("late.png")
+        assert response.success, response.message
+        image = np.asarray(Image.open(response.path).convert("RGB")).astype(int)
+        reddish = (image[..., 0] > 120) & (image[..., 1] < 90) & (image[..., 2] < 90)
+        return reddish.sum() > 200
+
+    wait_until(red_pixels, timeout=20, period=0.5)   # the early box in the late Viewer's frame
 
 
 def test_start_up_parameters_are_read(ros_master):
