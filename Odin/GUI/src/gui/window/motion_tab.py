@@ -230,14 +230,18 @@ class MotionTab(QWidget):
                 lambda _: self.window.show_info(f"Velocity of {object_id} set"))
 
     def delete_force(self) -> None:
-        item = self.forces.currentItem()
+        self._delete_selected(self.forces, "set_external_force", "Remove External Force",
+                              "a force or torque")
+
+    def _delete_selected(self, listing, service: str, label: str, what: str) -> None:
+        """Removes the force (on an object or a joint) chosen in ``listing``."""
+        item = listing.currentItem()
         if item is None:
-            self.window.show_error("Delete: select a force or torque in the list")
+            self.window.show_error(f"Delete: select {what} in the list")
             return
         force_id = item.text()
-        self.window.call("Remove External Force", lambda client, job: client.call(
-            "set_external_force", remove=True, id=force_id),
-            lambda _: self.window.scene.remove_force(force_id))
+        self.window.call(label, lambda client, job: client.call(service, remove=True, id=force_id),
+                         lambda _: self.window.scene.remove_force(force_id))
 
     # -- joints ---------------------------------------------------------------------------
     def add_joint_force(self) -> None:
@@ -257,14 +261,8 @@ class MotionTab(QWidget):
             "set_joint_force", joint=joint_id, magnitudes=magnitudes), done)
 
     def delete_joint_force(self) -> None:
-        item = self.joint_forces.currentItem()
-        if item is None:
-            self.window.show_error("Delete: select a joint force in the list")
-            return
-        force_id = item.text()
-        self.window.call("Remove Joint Force", lambda client, job: client.call(
-            "set_joint_force", remove=True, id=force_id),
-            lambda _: self.window.scene.remove_force(force_id))
+        self._delete_selected(self.joint_forces, "set_joint_force", "Remove Joint Force",
+                              "a joint force")
 
     # -- motors ---------------------------------------------------------------------------
     def set_motor_velocity(self) -> None:
