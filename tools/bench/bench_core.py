@@ -1,7 +1,8 @@
 """Benchmarks of the VirtualWorld Core against native C programs doing the same work with libode.
 
-Figures (ratios measured alternately in one run, 5 rounds each, ratio of the fastest rounds:
-on a shared machine the fastest round is the one least disturbed by other work):
+Figures (ratios measured alternately in one run, 7 rounds each: the median of the rounds'
+ratios; the two runs of a round are measured back to back, under the same load of a shared
+machine):
   core_spheres100_ratio  100 spheres (r 0.1) dropped on a plane (a static box), hash space,
                          3 contacts per pair, mu 1, QuickStep, 2000 steps of 1 ms;
                          native_time / odin_time (goal >= 0.95).
@@ -14,13 +15,14 @@ The native program (native/core_scene.c) is compiled here with gcc -lode into ou
 Odin's side steps with one Core.step(0.001, 2000) call (the whole loop in C).
 """
 import pathlib
+import statistics
 import subprocess
 import sys
 import time
 
 HERE = pathlib.Path(__file__).resolve().parent
 STEPS = 2000
-ROUNDS = 5
+ROUNDS = 7
 CASES = {  # figure -> (mode, forces, motors)
     "core_spheres100_ratio": (0, 0, 0),
     "core_pile_ratio": (1, 0, 0),
@@ -130,7 +132,7 @@ def run(out_dir: pathlib.Path) -> dict:
             native_times.append(t)
             t, odin_contacts = _odin(mode, forces, motors)
             odin_times.append(t)
-        ratio = min(native_times) / min(odin_times)
+        ratio = statistics.median(n / o for n, o in zip(native_times, odin_times))
         figures[figure] = round(ratio, 3)
         details.append(f"{figure}: native {native_times} s ({native_contacts} contacts), "
                        f"odin {odin_times} s ({odin_contacts} contacts)")
