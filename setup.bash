@@ -13,6 +13,9 @@ source "$_odin_root/build/ws/devel/setup.bash"
 export ODIN_ROOT="$_odin_root"
 export ODIN_KAUTHAM_DIR="${ODIN_KAUTHAM_DIR:-$(cd "$_odin_root/.." && pwd)/shared/kautham}"
 export PYOPENGL_PLATFORM=osmesa
-export QT_QPA_PLATFORM="${QT_QPA_PLATFORM:-offscreen}"
+# no display (CI, Docker, ssh): Qt draws off-screen
+if [ -z "${DISPLAY:-}${WAYLAND_DISPLAY:-}" ]; then
+  export QT_QPA_PLATFORM="${QT_QPA_PLATFORM:-offscreen}"
+fi
 [ "$_odin_had_u" = 1 ] && set -u
 unset _odin_had_u
