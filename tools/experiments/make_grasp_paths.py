@@ -5,12 +5,15 @@
 The TX90 + SAH hand of TX90_RHand_ICRA10_5PMD_TwoCan.xml; 24 values per row, radians, in the
 robot file's order of movable joints (6 arm joints, Palm, Thumb, then the four fingers' Base,
 Prox, Med, Dist). The hand frame is the Palm link's (at Home: x the palm's normal, y along the
-row of fingers towards the thumb, z along the fingers). The "grasp point" is fixed in that frame
-at GRASP_OFFSET: in front of the proximal phalanges, where the can's axis should pass.
+row of fingers towards the thumb, z along the fingers; the fingers close towards +x, the
+palm's side). The "grasp point" is fixed in that frame at GRASP_OFFSET: inside the ring the
+closed fingers make, where the can's axis should pass (found by drawing the closed hand around
+the can with the Viewer's renderer).
 
-- ``grasp_initial.txt``: one row, the starting position: the hand open, fingers horizontal and
-  pointing away from the robot, the palm facing the can from 0.10 m beside it (and 0.03 m
-  higher), found by inverse kinematics (``ik.py``, damped least squares on the DH model).
+- ``grasp_initial.txt``: one row, the starting position: the hand open with the thumb turned to
+  face the fingers (joint "Thumb" at THUMB_OPPOSED), fingers horizontal and pointing away from
+  the robot, the palm facing the can from 0.10 m beside it (and 0.03 m higher), found by
+  inverse kinematics (``ik.py``, damped least squares on the DH model).
 - ``grasp_approach.txt``: the position path: the grasp point moved on a straight line to the
   can's axis, one IK solution per waypoint (each started from the previous one), hand open.
   The experiment doubles its precision once (``gui.paths.double_precision``).
@@ -30,9 +33,11 @@ import ik  # noqa: E402
 
 PROBLEM = "TX90_RHand_ICRA10_5PMD_TwoCan.xml"
 CAN_AT = np.array([-0.30, 1.00, 0.5603])     # m: where the grasp experiment puts the can
-GRASP_OFFSET = np.array([-0.064, -0.02, 0.185])  # m, Palm frame: the can's centre in the hand
-PRE_GRASP = (0.10, 0.03)                      # m: along the back of the hand, and up
+GRASP_OFFSET = np.array([0.045, -0.02, 0.15])   # m, Palm frame: the can's centre, inside
+                                              # the ring the closed fingers make (+x: palm side)
+PRE_GRASP = (-0.10, 0.03)                     # m: away from the palm (-x), and up
 WAYPOINTS = 9
+THUMB_OPPOSED = -1.4   # rad, joint "Thumb": the thumb turned to face the fingers across the can
 ARM = list(range(6))
 PALM_LINK = 7
 
@@ -59,6 +64,7 @@ def compute() -> dict:
     offset[:3, 3] = GRASP_OFFSET
     q = handle.home.copy()
     q[:6] = [1.9, 0.6, 1.2, 0.0, 1.0, 0.0]       # a rough elbow-up guess near the table
+    q[7] = THUMB_OPPOSED
     target = hand_target(CAN_AT)
     start = target.copy()
     start[:3, 3] += PRE_GRASP[0] * target[:3, 0] + np.array([0.0, 0.0, PRE_GRASP[1]])
