@@ -11,8 +11,9 @@ setup:
 build:
 	@source .venv/bin/activate && tools/build.sh
 
+# the three-node chain (a sphere onto a box, out/demo/), then the thesis's grasp (out/experiments/grasp/)
 demo: setup
-	@$(ENV) python tools/demo.py
+	@$(ENV) python tools/demo.py && python tools/experiments/run.py grasp
 
 test: setup
 	@$(ENV) python -m pytest -p no:cacheprovider
