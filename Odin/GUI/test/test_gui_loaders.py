@@ -380,3 +380,17 @@ def test_problem_info_error_is_one_line_with_file_and_line(tmp_path):
     assert result.returncode != 0
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and f"{bad}:4:" in lines[0], result.stderr
+
+
+def test_collision_disabled_scene_objects_reach_the_world_as_no_collisions(corpus):
+    (corpus / "nocollide.xml").write_text(
+        '<?xml version="1.0"?>\n<Problem>\n'
+        ' <Scene scene="scenes/can.wrl" scale="1000"><Location X="0" Y="0" Z="0" WX="0" '
+        'WY="0" WZ="1" TH="0"/><Collision Enable="false"/></Scene>\n'
+        ' <Scene scene="scenes/columns.iv" scale="18"><Location X="250" Y="0" Z="0" WX="1" '
+        'WY="0" WZ="0" TH="0"/></Scene>\n</Problem>\n')
+    bodies = _bodies(plan_problem(load_problem(corpus / "nocollide.xml")))
+    assert bodies["can"].no_collisions
+    assert not any(b.no_collisions for name, b in bodies.items() if name != "can")
+    from gui.client import WorldClient
+    assert WorldClient.object_msg(bodies["can"]).no_collisions

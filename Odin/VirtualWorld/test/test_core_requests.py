@@ -59,3 +59,18 @@ def test_detect_collisions_does_nothing_under_the_contact_policy(core):
     core.build_object(ObjectSpec("ball", [0.1], position=(0.15, 0, 0)))
     core.detect_collisions()
     assert core.read_collisions() == [] and core.sim_time == 0.0
+
+
+def test_an_object_without_collisions_passes_through_everything(core):
+    core.set_world_parameters(gravity=(0, 0, -9.81))
+    core.build_object(ObjectSpec("floor", [2, 2, 0.1], position=(0, 0, -0.05),
+                                 geometry_only=True))
+    core.build_object(ObjectSpec("ghost", [0.1], position=(0, 0, 0.5), no_collisions=True))
+    core.build_object(ObjectSpec("ball", [0.1], position=(1, 0, 0.5)))
+    core.step(0.001, 1000)
+    names, positions, _ = core.poses()
+    z = dict(zip(names, positions[:, 2]))
+    assert z["ball"] == pytest.approx(0.1, abs=0.01)      # rests on the floor
+    assert z["ghost"] < -3.0                              # fell through it
+    with pytest.raises(InvalidArgument):
+        core.build_object(ObjectSpec("bad", [0.1], no_collisions="yes"))

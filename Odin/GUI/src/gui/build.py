@@ -69,6 +69,7 @@ class ObjectRequest:
     geometry_only: bool = False
     inertia: tuple = ()
     triangle_count: int = 0
+    no_collisions: bool = False
 
     @property
     def id(self) -> str:
@@ -95,6 +96,7 @@ class CompositeRequest:
     orientation: tuple
     fixed: bool = False
     geometry_only: bool = False
+    no_collisions: bool = False
 
     @property
     def id(self) -> str:
@@ -255,6 +257,8 @@ def plan_problem(problem: Problem, defaults: BuildDefaults = BuildDefaults()) ->
             request, offset = shape_to_body(name, link.shape, pose, mass, static)
             requests.append(request)
             bodies.append(LinkBody(request.id, offset))
+        if not inst.collision:   # <Collision Enable="false">: the world never pairs it
+            requests = [dataclasses.replace(r, no_collisions=True) for r in requests]
         if static or (single and inst.role == "obstacle"):
             steps.extend(requests)
             continue

@@ -88,7 +88,8 @@ class WorldClient:
                       indices=list(np.asarray(req.indices, dtype=np.uint32)), mass=req.mass,
                       inertia=list(req.inertia), position=list(req.position),
                       orientation=list(req.orientation), color=list(req.color),
-                      fixed=req.fixed, geometry_only=req.geometry_only)
+                      fixed=req.fixed, geometry_only=req.geometry_only,
+                      no_collisions=req.no_collisions)
 
     @staticmethod
     def composite_msg(req: CompositeRequest):
@@ -99,7 +100,7 @@ class WorldClient:
                       color=list(p.color)) for p in req.parts]
         return Composite(parts=parts, position=list(req.position),
                          orientation=list(req.orientation), fixed=req.fixed,
-                         geometry_only=req.geometry_only)
+                         geometry_only=req.geometry_only, no_collisions=req.no_collisions)
 
     # -- services -----------------------------------------------------------------------------
     def new_scene(self) -> None:

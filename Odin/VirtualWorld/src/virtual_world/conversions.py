@@ -23,7 +23,8 @@ def object_spec(message) -> ObjectSpec:
                       indices=tuple(message.indices), mass=message.mass,
                       inertia=tuple(message.inertia), position=tuple(message.position),
                       orientation=tuple(message.orientation), color=tuple(message.color),
-                      fixed=message.fixed, geometry_only=message.geometry_only)
+                      fixed=message.fixed, geometry_only=message.geometry_only,
+                      no_collisions=message.no_collisions)
 
 
 def composite_spec(message) -> CompositeSpec:
@@ -35,7 +36,8 @@ def composite_spec(message) -> CompositeSpec:
                   for part in message.parts)
     return CompositeSpec(parts=parts, position=tuple(message.position),
                          orientation=tuple(message.orientation), fixed=message.fixed,
-                         geometry_only=message.geometry_only)
+                         geometry_only=message.geometry_only,
+                         no_collisions=message.no_collisions)
 
 
 def view_requests(shapes: Sequence[tuple], poses: dict) -> list:

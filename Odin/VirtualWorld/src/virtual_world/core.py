@@ -125,6 +125,7 @@ class ObjectSpec:
         about the object's origin, object axes (then the centre of mass is the origin).
     position (m, world), orientation (wxyz): the object's frame. color: RGBA in [0, 1].
     fixed: a kinematic body that never moves by itself. geometry_only: no body (static).
+    no_collisions: its geometry collides with nothing (Kautham's <Collision Enable="false">).
     """
     name: str
     parameters: Sequence[float]
@@ -136,6 +137,7 @@ class ObjectSpec:
     color: Sequence[float] = (0.0, 0.0, 0.0, 0.0)
     fixed: bool = False
     geometry_only: bool = False
+    no_collisions: bool = False
 
 
 @dataclass(frozen=True)
@@ -152,12 +154,14 @@ class PartSpec:
 
 @dataclass(frozen=True)
 class CompositeSpec:
-    """Parts on one body; the composite's id is ">part1>part2...". Pose of its frame, world."""
+    """Parts on one body; the composite's id is ">part1>part2...". Pose of its frame, world.
+    no_collisions: none of its parts collides with anything."""
     parts: Sequence[PartSpec]
     position: Sequence[float] = (0.0, 0.0, 0.0)
     orientation: Sequence[float] = (1.0, 0.0, 0.0, 0.0)
     fixed: bool = False
     geometry_only: bool = False
+    no_collisions: bool = False
 
 
 class Removed(NamedTuple):
@@ -628,6 +632,7 @@ class Core:
         what = f"object {name!r}"
         shape = _prepare_shape(what, spec.parameters, spec.indices)
         geometry_only = _bool(f"{what}: geometry_only", spec.geometry_only)
+        _bool(f"{what}: no_collisions", spec.no_collisions)
         mass = _number(f"{what}: mass", spec.mass)
         if mass <= 0 and not geometry_only:  # a body-less geometry has no mass to check
             raise InvalidArgument(f"{what}: mass {spec.mass!r} must be positive")
@@ -672,6 +677,7 @@ class Core:
         orientation = _quaternion(f"composite {object_id!r}: orientation", spec.orientation)
         fixed = _bool("composite fixed", spec.fixed)
         geometry_only = _bool("composite geometry_only", spec.geometry_only)
+        _bool("composite no_collisions", spec.no_collisions)
         dmass = None
         if not geometry_only:
             dmass = ffi.new("dMass *")
@@ -687,6 +693,7 @@ class Core:
 
     def _build_prepared(self, prepared, spec, tag: int = 0) -> str:
         object_id, parts, position, orientation, fixed, geometry_only, dmass = prepared
+        no_collisions = bool(spec.no_collisions)   # checked by _prepare_*
         com = np.zeros(3)
         if dmass is not None:
             com = np.array([dmass.c[0], dmass.c[1], dmass.c[2]])
@@ -729,6 +736,9 @@ class Core:
                 self._place_static(geom.ptr, position, orientation, part.position,
                                    part.orientation)
             lib.odin_set_geom_tag(geom.ptr, tag)
+            if no_collisions:  # the hash space never pairs a geom whose bits are all clear
+                lib.dGeomSetCategoryBits(geom.ptr, 0)
+                lib.dGeomSetCollideBits(geom.ptr, 0)
             geometry = _Geometry(part.name, geom, object_id, part.position, part.orientation,
                                  shape, part.color)
             obj.geometries.append(geometry)
