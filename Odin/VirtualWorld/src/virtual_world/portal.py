@@ -115,8 +115,10 @@ class Portal:
 
     def _advertise(self) -> None:
         self.pub_world = rospy.Publisher("~world_update", SpaceDistribution, queue_size=2)
-        self.pub_collided = rospy.Publisher("~collided", Collided, queue_size=10)
-        self.pub_contacts = rospy.Publisher("~contacts", Collided, queue_size=10)
+        # Collided says what touched since the previous message: a subscriber that lags
+        # behind a burst of Step Once cycles must get every one, so its queue is deep
+        self.pub_collided = rospy.Publisher("~collided", Collided, queue_size=1000)
+        self.pub_contacts = rospy.Publisher("~contacts", Collided, queue_size=1000)
         self.pub_joints = rospy.Publisher("~joint_data", JointsData, queue_size=10)
         self.pub_joint_states = rospy.Publisher("/joint_states", JointState, queue_size=10)
         self.pub_clock = rospy.Publisher("/clock", Clock, queue_size=10)
