@@ -43,13 +43,18 @@ def test_pile_cans_knocked_down_fall_and_bounce():
 
 
 @pytest.mark.forked
-def test_grasp_carries_the_can_and_releases_it_when_the_hand_opens():
+def test_grasp_carries_the_can_and_releases_it_when_the_hand_opens(tmp_path):
     import grasp
-    facts = grasp.run(frames=False)
+    facts = grasp.run(frames=False, out_root=tmp_path)  # out/experiments/grasp keeps its frames
     o = facts["outcome"]
     assert o["can_height_above_table_while_carried_m"]["min"] > 0.1
     assert o["can_moved_while_carried_m"] > 0.5
+    # held from the lift until the opening: within millimetres of its place in the palm's frame,
+    # and not sinking through the grip
+    # (10 mm and 3.5 mm when run alone; one run on a loaded machine measured 16 and 13 mm)
     assert o["max_slip_in_hand_before_opening_m"] < 0.02
+    assert o["max_slip_in_hand_while_carried_m"] < 0.015
+    assert o["can_sank_in_hand_before_opening_m"] < 0.003
     assert o["released_only_when_hand_opens"]
     assert o["can_released_at_s"] >= o["hand_opens_at_s"]
     assert o["can_on_floor_at_end"]

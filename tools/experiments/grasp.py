@@ -18,14 +18,22 @@ Driving, as the thesis's GUI did (section 7.4.3), one command per Portal cycle:
    the fingers open slowly and the can drops to the floor.
 
 World: table 10.2 (contacts, 40 steps of 1 ms per cycle, 25 Hz, gravity -9.81, surface layer
-0.001 m) with the damping read per second (see EXPERIMENTS.md) and friction 1.5, 4 contacts
-per pair.
+0.001 m) with the damping read per second (see EXPERIMENTS.md), ODE's exact solver (dWorldStep:
+QuickStep lets the 25-body chain sag), infinite friction, 8 contacts per pair; the finger
+motors' torque is limited to 4 N m (Set Joint SET_PARAMETERS MAX_FORCE).
 
-Outcome (summary.json): the can's height above the table while carried; it stays in the hand
-(its pose relative to the palm changes by millimetres) until the hand opens; it is released
-only after the opening starts, and it ends on the floor.
+Outcome (summary.json): the can's height above the table while carried (its lowest point, tilt
+included); how far it moves in the palm's frame from the lift's start (the hand has closed) and
+from the carry's start until the hand opens, how much it sinks and tilts; it is released only
+after the opening starts, and it ends on the floor. With frames, ``closeups.png``: six close-up
+snapshots of the hand (approach done, closed, lifted, carried, opened, dropped), taken with
+the Viewer's Set Camera and not counted among the numbered frames.
 """
 from __future__ import annotations
+
+import os
+import pathlib
+import time
 
 import numpy as np
 
@@ -36,6 +44,7 @@ ROBOT = "TX90 SAHand Right"
 CAN = "can"
 PALM = f"{ROBOT}/Palm"
 TABLE_TOP = 0.5  # m, the ICRA09 scene's table (a 0.5 m cube on the floor)
+CAN_RADIUS, CAN_HALF_LENGTH = 0.0317, 0.0603  # m
 
 PARAMETERS = {
     "can_mass_kg": 0.35,
@@ -44,7 +53,7 @@ PARAMETERS = {
     "can_color": [0.85, 0.15, 0.1, 1.0],
     "can_position_m": [-0.30, 1.00, 0.5603],
     "finger_close_rad_s": -0.8,
-    "finger_max_torque_N_m": 15.0,
+    "finger_max_torque_N_m": 4.0,
     "close_s": 1.2,
     "lift_forearm_rad_s": -0.06,
     "lift_s": 2.5,
@@ -113,6 +122,13 @@ def run(quick: bool = False, frames: bool = True, out_root=None) -> dict:
         def phase(name: str):
             phases.append((name, round(s.sim_time, 6)))
 
+        closeups = []
+
+        def closeup(label: str, subject: str = CAN):
+            """A close-up snapshot of the hand (not one of the numbered frames)."""
+            if frames:
+                closeups.append((label, s.sim_time, take_closeup(s, label, subject)))
+
         per_s = 1.0 / (WORLD["step"] * WORLD["steps_per_cycle"])
         phase("start")
         s.cycle_and_frame()
@@ -120,9 +136,11 @@ def run(quick: bool = False, frames: bool = True, out_root=None) -> dict:
         phase("position_path")
         rows = iter(approach)
         advance(len(approach), lambda: s.client.set_position(handle.situations(next(rows))))
+        closeup("approach done")
         phase("close")
         s.client.set_velocity(flex, [p["finger_close_rad_s"]] * len(flex))
         advance(int(p["close_s"] * per_s))
+        closeup("closed")
         phase("lift")
         forearm = motor_of(handle, "ForeArm")
         wrist = motor_of(handle, "Wrist")
@@ -130,45 +148,114 @@ def run(quick: bool = False, frames: bool = True, out_root=None) -> dict:
                                                  -p["lift_forearm_rad_s"]])
         advance(int(p["lift_s"] * per_s))
         s.client.set_velocity([forearm, wrist], [0.0, 0.0])
+        closeup("lifted")
         phase("carry")
         shoulder = motor_of(handle, "Shoulder")
         s.client.set_velocity([shoulder], [p["carry_shoulder_rad_s"]])
         advance(int(p["carry_s"] * per_s))
         s.client.set_velocity([shoulder], [0.0])
         advance(int(0.3 * per_s))
+        closeup("carried")
         phase("open")
         s.client.set_velocity(flex, [p["open_rad_s"]] * len(flex))
         advance(int(p["open_s"] * per_s))
         s.client.set_velocity(flex, [0.0] * len(flex))
+        closeup("opened", PALM)
         phase("fall")
         advance(int(p["fall_s"] * per_s))
+        closeup("dropped")
         phase("end")
         s.finish()
         facts = analyse(s, dict(phases))
         facts["phases_s"] = dict(phases)
+        if closeups:
+            facts["closeups"] = str(closeup_sheet(closeups, s.out / "closeups.png")
+                                    .relative_to(common.ROOT))
         common.write_summary(s, facts, p)
     return facts
 
 
+#: close-ups: the camera looks at the can (or the palm) from outside the hand, from this
+#: offset (m) in a frame turning with the arm: along the radius from the base's axis, along
+#: the tangent (anticlockwise seen from above), up
+CLOSEUP_OFFSET = (0.39, 0.20, 0.24)
+BASE_AXIS_XY = (0.05, 0.05)  # m, where the TX90's Shoulder axis stands in the scene
+
+
+def take_closeup(s: "common.Session", label: str, subject: str):
+    import rospy
+    from Services.srv import SetCamera
+    s.wait_for_update()
+    time.sleep(s.frame_settle)
+    with s.record.lock:
+        position = np.array(s.record.poses[round(s.sim_time, 6)][subject][0])
+    radial = position[:2] - np.array(BASE_AXIS_XY)
+    radial = np.array([*radial / np.linalg.norm(radial), 0.0])
+    tangent = np.cross([0.0, 0.0, 1.0], radial)
+    a, b, c = CLOSEUP_OFFSET
+    eye = position + a * radial + b * tangent + np.array([0.0, 0.0, c])
+    set_camera = rospy.ServiceProxy("/viewer/set_camera", SetCamera)
+    set_camera(set_pose=True, eye=list(eye), target=list(position), up=[0.0, 0.0, 1.0])
+    try:
+        answer = s._snapshot(name=f"closeup_{len(os.listdir(s.frames_dir)):04d}.png")
+        if not answer.success:
+            raise common.ExperimentError(f"/viewer/save_snapshot refused: {answer.message}")
+    finally:
+        set_camera(set_pose=True, eye=list(CAMERA.eye), target=list(CAMERA.target),
+                   up=[0.0, 0.0, 1.0])
+    return pathlib.Path(answer.path)
+
+
+def closeup_sheet(closeups, out: pathlib.Path, columns: int = 3, width: int = 320):
+    from PIL import Image, ImageDraw
+    first = Image.open(closeups[0][2])
+    height = int(round(first.height * width / first.width))
+    rows = -(-len(closeups) // columns)
+    sheet = Image.new("RGB", (columns * width, rows * height), (255, 255, 255))
+    draw = ImageDraw.Draw(sheet)
+    for k, (label, at, path) in enumerate(closeups):
+        x, y = (k % columns) * width, (k // columns) * height
+        sheet.paste(Image.open(path).convert("RGB").resize((width, height), Image.LANCZOS),
+                    (x, y))
+        text = f"{label}  t = {at:.2f} s"
+        draw.rectangle([x, y, x + 8 + 7 * len(text), y + 16], fill=(255, 255, 255))
+        draw.text((x + 4, y + 2), text, fill=(0, 0, 0))
+    sheet.save(out)
+    return out
+
+
 def analyse(s: "common.Session", phases: dict) -> dict:
     from gui.kinematics import matrix_from_quaternion
-    t, can, _ = s.trajectory(CAN)
+    t, can, can_q = s.trajectory(CAN)
     tp, palm, palm_q = s.trajectory(PALM)
     n = min(len(t), len(tp))
-    t, can, palm, palm_q = t[:n], can[:n], palm[:n], palm_q[:n]
+    t, can, can_q, palm, palm_q = t[:n], can[:n], can_q[:n], palm[:n], palm_q[:n]
     # the can's centre in the palm's frame
     rel = np.array([matrix_from_quaternion(q).T @ (c - p) for c, p, q in zip(can, palm, palm_q)])
     carried = (t >= phases["carry"]) & (t < phases["open"])
-    held_ref = rel[np.searchsorted(t, phases["carry"])]
-    drift = np.linalg.norm(rel - held_ref, axis=1)
+    held = (t >= phases["lift"]) & (t < phases["open"])     # the hand closed, not yet opening
+
+    def drift_from(phase: str) -> np.ndarray:
+        return np.linalg.norm(rel - rel[np.searchsorted(t, phases[phase])], axis=1)
+
+    # slip in the hand: the can's centre in the palm's frame, from the lift's start (the hand
+    # has closed) and from the carry's start, to the hand's opening
+    drift = drift_from("lift")
+    slip_held = float(drift[held].max())
+    slip_carried = float(drift_from("carry")[carried].max())
+    # sinking: the can's height relative to the palm's origin, in the world, lost since the lift
+    # started (gravity pulling it down through the grip)
+    dz = (can[:, 2] - palm[:, 2]) - (can[:, 2] - palm[:, 2])[np.searchsorted(t, phases["lift"])]
+    sank = float(max(0.0, -dz[held].min()))
     in_hand = drift < 0.02
     after_open = t >= phases["open"]
     left = np.nonzero(after_open & ~in_hand)[0]
     released_at = float(t[left[0]]) if len(left) else None
-    # slip while carried: from the carry's start (the can has settled in the closed hand during
-    # the lift; a can lost during the lift fails the height check) to the hand's opening
-    before_open_drift = float(drift[(t >= phases["carry"]) & (t < phases["open"])].max())
-    bottom = can[:, 2] - 0.0603
+    # the can's lowest point (its tilt counts: a cylinder's lowest rim point is h/2 cos(tilt)
+    # + r sin(tilt) below its centre)
+    up = np.array([matrix_from_quaternion(q)[2, 2] for q in can_q])
+    tilt = np.arccos(np.clip(np.abs(up), 0.0, 1.0))
+    bottom = can[:, 2] - (CAN_HALF_LENGTH * np.cos(tilt) + CAN_RADIUS * np.sin(tilt))
     samples = {}
     for name, at in phases.items():
         k = min(int(np.searchsorted(t, at)), n - 1)
@@ -184,15 +271,20 @@ def analyse(s: "common.Session", phases: dict) -> dict:
                 "mean": round(float(bottom[carried].mean() - TABLE_TOP), 4)},
             "can_moved_while_carried_m": round(float(np.linalg.norm(
                 can[carried][-1] - can[carried][0])), 4),
-            "max_slip_in_hand_before_opening_m": round(before_open_drift, 4),
+            "max_slip_in_hand_before_opening_m": round(slip_held, 4),
+            "max_slip_in_hand_while_carried_m": round(slip_carried, 4),
+            "can_sank_in_hand_before_opening_m": round(sank, 4),
+            "can_max_tilt_while_held_deg": round(float(np.degrees(tilt[held].max())), 1),
             "hand_opens_at_s": phases["open"],
             "can_released_at_s": released_at,
             "released_only_when_hand_opens": bool(released_at is not None
-                                                  and before_open_drift < 0.02),
+                                                  and slip_held < 0.02),
             "can_final_position_m": [round(float(v), 4) for v in can[-1]],
             "can_on_floor_at_end": bool(can[-1, 2] < 0.1),
         },
         "contacts": s.contact_rates(),
+        # poses come from ~world_update; a message lost under load leaves a cycle unsampled
+        "world_update_samples": {"cycles": s.cycles + 1, "recorded": int(n)},
     }
     return facts
 
@@ -203,8 +295,11 @@ def verdict(facts: dict) -> tuple:
     ok = (o["released_only_when_hand_opens"] and h["min"] > 0.02 and o["can_on_floor_at_end"]
           and o["can_moved_while_carried_m"] > 0.3)
     lines = [f"can carried {h['min']:.3f}..{h['max']:.3f} m above the table, moved "
-             f"{o['can_moved_while_carried_m']:.2f} m; slip in hand before opening "
-             f"{o['max_slip_in_hand_before_opening_m'] * 1000:.1f} mm",
+             f"{o['can_moved_while_carried_m']:.2f} m; slip in hand from the lift to the "
+             f"opening {o['max_slip_in_hand_before_opening_m'] * 1000:.1f} mm (while carried "
+             f"{o['max_slip_in_hand_while_carried_m'] * 1000:.1f} mm), sank "
+             f"{o['can_sank_in_hand_before_opening_m'] * 1000:.1f} mm, tilted up to "
+             f"{o['can_max_tilt_while_held_deg']} deg",
              f"hand opens at {o['hand_opens_at_s']} s, can released at "
              f"{o['can_released_at_s']} s, final position {o['can_final_position_m']}",
              f"contacts: {facts['contacts']}"]
