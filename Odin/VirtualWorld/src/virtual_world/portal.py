@@ -114,7 +114,7 @@ class Portal:
                 if rospy.has_param(f"~{name}")}
 
     def _advertise(self) -> None:
-        self.pub_world = rospy.Publisher("~world_update", SpaceDistribution, queue_size=2)
+        self.pub_world = rospy.Publisher("~world_update", SpaceDistribution, queue_size=50)
         # Collided says what touched since the previous message: a subscriber that lags
         # behind a burst of Step Once cycles must get every one, so its queue is deep
         self.pub_collided = rospy.Publisher("~collided", Collided, queue_size=1000)
