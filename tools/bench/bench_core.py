@@ -11,8 +11,12 @@ machine):
   core_newscene_leak_kb  resident memory growth (kB) over 1000 New Scene cycles of a
                          100-object scene (50 spheres, 50 box meshes), after 50 warm-up cycles,
                          measured with /proc/self/statm in a subprocess (goal < 5000).
+  core_*_instructions_ratio  the same three cases counted in instructions instead of seconds
+                         (valgrind's callgrind, 300 steps, only the step loop: native's ODE calls,
+                         Odin's odin_world_step): repeatable whatever else the machine does.
 The native program (native/core_scene.c) is compiled here with gcc -lode into out_dir.
-Odin's side steps with one Core.step(0.001, 2000) call (the whole loop in C).
+Odin's side steps with one Core.step(0.001, 2000) call (the whole loop in C), in a
+process of its own like the native program.
 """
 import pathlib
 import statistics
@@ -71,18 +75,23 @@ def build_scene(core, mode: int, forces: int, motors: int) -> None:
     core.set_motor_velocities({motor: [0.5] for motor in ids})
 
 
-def _odin(mode: int, forces: int, motors: int):
-    from virtual_world.core import Core
+ODIN_TIMED_SCRIPT = (
+    "import sys, time; sys.path.insert(0, {here!r}); import bench_core\n"
+    "from virtual_world.core import Core\n"
+    "core = Core(); bench_core.build_scene(core, {mode}, {forces}, {motors})\n"
+    "started = time.perf_counter(); core.step(0.001, {steps})\n"
+    "print(time.perf_counter() - started, core.last_step_contacts)\n")
 
-    core = Core()
-    try:
-        build_scene(core, mode, forces, motors)
-        started = time.perf_counter()
-        core.step(0.001, STEPS)
-        elapsed = time.perf_counter() - started
-        return elapsed, core.last_step_contacts
-    finally:
-        core.close()
+
+def _odin(mode: int, forces: int, motors: int):
+    """Odin's step loop timed in a process of its own, as the native program is: a long-lived
+    process that has built and freed many scenes steps a few per cent slower (its heap is
+    scattered), which is the process, not the Core (the instruction counts are equal)."""
+    script = ODIN_TIMED_SCRIPT.format(here=str(HERE), mode=mode, forces=forces, motors=motors,
+                                      steps=STEPS)
+    out = subprocess.run([sys.executable, "-c", script], check=True, capture_output=True,
+                         text=True).stdout.split()
+    return float(out[0]), int(out[1])
 
 
 LEAK_SCRIPT = r"""
@@ -120,6 +129,42 @@ def _leak_kb(cycles: int = 1000) -> float:
     return float(out[-1])
 
 
+#: functions whose instructions make up the step loop (callgrind --toggle-collect)
+NATIVE_LOOP = ("dSpaceCollide", "dWorldQuickStep", "dJointGroupEmpty", "dBodyAddForce",
+               "dJointSetAMotorParam")
+ODIN_LOOP = ("odin_world_step",)
+COUNTED_STEPS = 300
+ODIN_STEP_SCRIPT = (
+    "import sys; sys.path.insert(0, {here!r}); import bench_core\n"
+    "from virtual_world.core import Core\n"
+    "core = Core(); bench_core.build_scene(core, {mode}, {forces}, {motors})\n"
+    "core.step(0.001, {steps})\n")
+
+
+def _instructions(command: list, functions: tuple, out_file: pathlib.Path) -> int:
+    """Instructions executed inside ``functions`` (callgrind, inclusive)."""
+    toggles = [f"--toggle-collect={name}" for name in functions]
+    subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out_file}",
+                    *toggles, *command], check=True, capture_output=True)
+    for line in out_file.read_text().splitlines():
+        if line.startswith(("summary:", "totals:")):
+            return int(line.split()[1])
+    raise RuntimeError(f"no instruction total in {out_file}")
+
+
+def instruction_ratios(exe: pathlib.Path, out_dir: pathlib.Path) -> dict:
+    figures = {}
+    for figure, (mode, forces, motors) in CASES.items():
+        native = _instructions([str(exe), str(mode), str(COUNTED_STEPS), str(forces),
+                                str(motors)], NATIVE_LOOP, out_dir / "callgrind.native")
+        script = ODIN_STEP_SCRIPT.format(here=str(HERE), mode=mode, forces=forces,
+                                         motors=motors, steps=COUNTED_STEPS)
+        odin = _instructions([sys.executable, "-c", script], ODIN_LOOP,
+                             out_dir / "callgrind.odin")
+        figures[figure.replace("_ratio", "_instructions_ratio")] = round(native / odin, 3)
+    return figures
+
+
 def run(out_dir: pathlib.Path) -> dict:
     out_dir.mkdir(parents=True, exist_ok=True)
     exe = _compile(out_dir)
@@ -137,6 +182,7 @@ def run(out_dir: pathlib.Path) -> dict:
         details.append(f"{figure}: native {native_times} s ({native_contacts} contacts), "
                        f"odin {odin_times} s ({odin_contacts} contacts)")
     figures["core_newscene_leak_kb"] = _leak_kb()
+    figures.update(instruction_ratios(exe, out_dir))
     (out_dir / "bench_core.txt").write_text("\n".join(details) + "\n")
     return figures
 
