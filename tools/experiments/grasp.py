@@ -19,7 +19,7 @@ Driving, as the thesis's GUI did (section 7.4.3), one command per Portal cycle:
 
 World: table 10.2 (contacts, 40 steps of 1 ms per cycle, 25 Hz, gravity -9.81, surface layer
 0.001 m) with the damping read per second (see EXPERIMENTS.md), ODE's exact solver (dWorldStep:
-QuickStep lets the 25-body chain sag), infinite friction, 8 contacts per pair; the finger
+QuickStep lets the 25-body chain sag), infinite friction, 4 contacts per pair; the finger
 motors' torque is limited to 4 N m (Set Joint SET_PARAMETERS MAX_FORCE).
 
 Outcome (summary.json): the can's height above the table while carried (its lowest point, tilt
@@ -69,7 +69,7 @@ WORLD = {
     "contact_less": False, "steps_per_cycle": 40, "rate": 25.0, "step": 0.001,
     "gravity": [0.0, 0.0, -9.81], "linear_damping": 0.0005, "linear_damping_threshold": 0.0,
     "angular_damping": 0.0002, "angular_damping_threshold": 0.0,
-    "contact_surface_layer": 0.001, "friction": -1.0, "max_contacts": 8, "free_run": True,
+    "contact_surface_layer": 0.001, "friction": -1.0, "max_contacts": 4, "free_run": True,
     "solver": 1,
 }
 CAMERA = common.Camera(eye=(0.45, 1.9, 1.2), target=(-0.40, 0.85, 0.5))
