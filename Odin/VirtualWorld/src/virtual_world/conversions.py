@@ -10,7 +10,7 @@ from typing import Sequence
 
 import numpy as np
 
-from Messages.msg import Collided, CollisionPair, JointData, Situation, SpaceDistribution
+from Messages.msg import Collided, CollisionPair, JointData, SpaceDistribution
 from geometry_msgs.msg import Point
 from Services.srv import ViewObjectRequest
 
@@ -132,20 +132,6 @@ class _PreSerialised(SpaceDistribution):
         buff.write(struct.pack("<I", len(frame)) + frame)
         buff.write(self._body)
 
-    def situations_list(self) -> list:
-        """Decodes the situations (for tests and in-process users)."""
-        decoded = SpaceDistribution()
-        buffer = bytearray()
-
-        class _Sink:
-            def write(self, data):
-                buffer.extend(data)
-
-        self.serialize(_Sink())
-        decoded.deserialize(bytes(buffer))
-        return decoded.situations
-
 
 __all__ = ["object_spec", "composite_spec", "view_requests", "shapes_of_object",
-           "shapes_of_composite", "collided_message", "joint_data", "SpaceDistributionWriter",
-           "Situation"]
+           "shapes_of_composite", "collided_message", "joint_data", "SpaceDistributionWriter"]

@@ -41,6 +41,7 @@ Parameters (read at start):
 from __future__ import annotations
 
 import logging
+import math
 import sys
 import threading
 import traceback
@@ -408,7 +409,6 @@ class Portal:
 
 
 def _check_finite(name: str, vector) -> None:
-    import math
     if not all(math.isfinite(v) for v in vector):
         raise InvalidArgument(f"{name} must be finite, got {list(vector)}")
 

@@ -265,26 +265,21 @@ static void push(int level, int num, const char *msg, va_list ap) {
  * message and print it to stderr at once, where it survives the process's end; Odin validates
  * every argument before calling ODE so that they never fire. dMessage is non-fatal: buffered
  * only, and Python drains the buffer into `logging` after each call into ODE. */
-static void on_error(int num, const char *msg, va_list ap) {
+/* Records a fatal message and prints it to stderr at once (ODE ends the process next). */
+static void report_fatal(int level, const char *label, int num, const char *msg, va_list ap) {
     va_list copy;
     va_copy(copy, ap);
-    push(2, num, msg, ap);
-    fprintf(stderr, "ODE error %d: ", num);
+    push(level, num, msg, ap);
+    fprintf(stderr, "%s %d: ", label, num);
     vfprintf(stderr, msg, copy);
     fputc('\n', stderr);
     fflush(stderr);
     va_end(copy);
 }
 
+static void on_error(int num, const char *msg, va_list ap) { report_fatal(2, "ODE error", num, msg, ap); }
 static void on_debug(int num, const char *msg, va_list ap) {
-    va_list copy;
-    va_copy(copy, ap);
-    push(1, num, msg, ap);
-    fprintf(stderr, "ODE internal error %d: ", num);
-    vfprintf(stderr, msg, copy);
-    fputc('\n', stderr);
-    fflush(stderr);
-    va_end(copy);
+    report_fatal(1, "ODE internal error", num, msg, ap);
 }
 
 static void on_message(int num, const char *msg, va_list ap) { push(0, num, msg, ap); }
