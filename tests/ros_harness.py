@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import os
 import pathlib
+import random
 import signal
 import socket
 import subprocess
@@ -25,24 +26,36 @@ import time
 from typing import Sequence
 
 
+# Masters listen below the kernel's ephemeral range (net.ipv4.ip_local_port_range starts at
+# 32768 on Debian): a port handed out by bind(0) can be taken again by any node's XML-RPC
+# server or outgoing connection before roscore binds it, and rosmaster then hangs for good
+# with its server thread dead ("port ... is already in use").
+_MASTER_PORTS = range(20000, 32768)
+
+
 def free_port() -> int:
-    """A TCP port on 127.0.0.1 that nobody listens on right now."""
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
+    """A TCP port on 127.0.0.1, outside the ephemeral range, that nobody is bound to now."""
+    for _ in range(200):
+        port = random.choice(_MASTER_PORTS)
+        with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
+            try:
+                sock.bind(("127.0.0.1", port))
+            except OSError:
+                continue
+            return port
+    raise RuntimeError(f"no free port in {_MASTER_PORTS.start}-{_MASTER_PORTS.stop - 1}")
 
 
 class RosMaster:
     """A roscore of our own; ``env`` is the environment that points at it."""
 
-    def __init__(self, ros_home: str | os.PathLike | None = None, startup_timeout: float = 20.0):
+    def __init__(self, ros_home: str | os.PathLike | None = None, startup_timeout: float = 30.0):
         self._own_home = ros_home is None
         self.ros_home = pathlib.Path(ros_home or tempfile.mkdtemp(prefix="odin_ros_home_"))
         self.ros_home.mkdir(parents=True, exist_ok=True)
-        self.port = free_port()
-        self.uri = f"http://127.0.0.1:{self.port}"
         self.env = dict(os.environ)
-        self.env.update(ROS_MASTER_URI=self.uri, ROS_HOME=str(self.ros_home),
+        self._use_port(free_port())
+        self.env.update(ROS_HOME=str(self.ros_home),
                         ROS_IP="127.0.0.1", ROS_LOG_DIR=str(self.ros_home / "log"),
                         PYTHONUNBUFFERED="1")
         self.env.pop("ROS_HOSTNAME", None)
@@ -58,15 +71,49 @@ class RosMaster:
     def __exit__(self, *exc_info) -> None:
         self.stop()
 
-    def start(self) -> None:
-        self.popen(["roscore", "-p", str(self.port)], log_name="roscore")
+    def start(self, attempts: int = 3) -> None:
+        """Starts roscore; on a port taken meanwhile (or a roscore that died) tries a new port."""
+        failures = []
+        for _ in range(attempts):
+            roscore = self.popen(["roscore", "-p", str(self.port)], log_name="roscore")
+            try:
+                failure = self._wait_for_master(roscore)
+            except BaseException:
+                self.stop()
+                raise
+            if failure is None:
+                return
+            failures.append(f"port {self.port}: {failure}")
+            self.stop()
+            self._use_port(free_port())
+        raise RuntimeError("roscore did not come up: " + "; ".join(failures))
+
+    def _wait_for_master(self, roscore: subprocess.Popen) -> str | None:
+        """None once the master answers, else why it will not."""
         deadline = time.monotonic() + self._startup_timeout
         while time.monotonic() < deadline:
-            if self.run(["rosparam", "get", "/rosdistro"], check=False, timeout=10).returncode == 0:
-                return
+            if self._master_answers():
+                return None
+            log = self.log_text(roscore)
+            if "already in use" in log:
+                return "port already in use"
+            if roscore.poll() is not None:
+                return f"roscore exited with {roscore.returncode}: {log[-500:]}"
             time.sleep(0.2)
-        self.stop()
-        raise RuntimeError(f"roscore did not come up on port {self.port}")
+        return f"no answer after {self._startup_timeout} s"
+
+    def _master_answers(self) -> bool:
+        # whatever holds a taken port may accept the connection and never answer
+        try:
+            return self.run(["rosparam", "get", "/rosdistro"], check=False,
+                            timeout=5).returncode == 0
+        except subprocess.TimeoutExpired:
+            return False
+
+    def _use_port(self, port: int) -> None:
+        self.port = port
+        self.uri = f"http://127.0.0.1:{port}"
+        self.env["ROS_MASTER_URI"] = self.uri
 
     def stop(self) -> None:
         """Stops every process started here, newest first: SIGINT, then SIGKILL."""
@@ -126,17 +173,41 @@ class RosMaster:
 
 
 def _stop_group(process: subprocess.Popen) -> None:
+    """SIGINT to the process's group, then SIGKILL to the group and to every descendant:
+    roslaunch starts its nodes (rosmaster, rosout, rostest's nodes) in sessions of their own,
+    and a hung rosmaster outlives a killed roscore."""
+    tree = _descendants(process.pid)
     if process.poll() is None:
         try:
             os.killpg(process.pid, signal.SIGINT)
             process.wait(timeout=8)
         except (ProcessLookupError, subprocess.TimeoutExpired):
             pass
-    try:
-        os.killpg(process.pid, signal.SIGKILL)  # also whatever the process left behind
-    except ProcessLookupError:
-        pass
+    tree |= _descendants(process.pid)
+    for kill, target in [(os.killpg, process.pid), *((os.kill, pid) for pid in tree)]:
+        try:
+            kill(target, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
     process.wait()
+
+
+def _descendants(pid: int) -> set[int]:
+    """Process ids of pid's children, their children, and so on (from /proc)."""
+    children: dict[int, list[int]] = {}
+    for stat in pathlib.Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue  # exited meanwhile
+        children.setdefault(int(fields[1]), []).append(int(stat.parent.name))
+    found, frontier = set(), [pid]
+    while frontier:
+        for child in children.get(frontier.pop(), []):
+            if child not in found:
+                found.add(child)
+                frontier.append(child)
+    return found
 
 
 def run_rostest(test_file: str, env: dict | None = None,

@@ -19,3 +19,16 @@ def test_two_masters_do_not_share_a_port():
         assert first.port != second.port
         first.run(["rosparam", "set", "/odin_probe", "1"])
         assert second.run(["rosparam", "get", "/odin_probe"], check=False).returncode != 0
+
+
+def test_master_moves_to_another_port_when_its_port_is_taken():
+    import socket
+    master = RosMaster()
+    taken = master.port
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as squatter:
+        squatter.bind(("127.0.0.1", taken))
+        squatter.listen()
+        with master:
+            assert master.port != taken
+            assert master.env["ROS_MASTER_URI"].endswith(f":{master.port}")
+            assert master.run(["rosparam", "get", "/rosdistro"]).returncode == 0
