@@ -2,7 +2,8 @@
 import numpy as np
 import trimesh
 
-from viewer.geometry import DISPLAY_TOLERANCE, mesh_geometry, simplify_for_display
+from odin_common.meshes import cluster_vertices
+from viewer.geometry import DISPLAY_TOLERANCE, mesh_geometry
 
 
 def test_dense_mesh_is_simplified_within_tolerance():
@@ -24,5 +25,5 @@ def test_small_meshes_are_drawn_as_given():
 def test_clustering_drops_collapsed_and_repeated_triangles():
     vertices = np.array([[0, 0, 0], [1e-5, 0, 0], [0.01, 0, 0], [0, 0.01, 0]], float)
     indices = np.array([0, 1, 2,   0, 2, 3,   1, 2, 3])
-    merged, triangles = simplify_for_display(vertices, indices, tolerance=0.001)
+    merged, triangles = cluster_vertices(vertices, indices, cell=0.001)
     assert len(merged) == 3 and triangles.size == 3

@@ -17,6 +17,7 @@ from typing import Sequence
 
 import numpy as np
 
+from odin_common.meshes import cluster_vertices
 from viewer.errors import ViewerError
 
 #: accepted deviation of a quaternion's norm from 1 before it is refused (it is normalised)
@@ -133,34 +134,17 @@ CREASE_ANGLE = math.radians(40.0)
 #: m: meshes of more than DISPLAY_DETAIL_TRIANGLES triangles are drawn with their vertices
 #: clustered on a grid of this size (detail finer than a millimetre is below a pixel at the
 #: distances a robot scene is watched from, and CAD meshes of hands carry a lot of it: the SAH
-#: hand's 150k triangles become about half). The world's collision mesh is not affected.
+#: hand's 150k triangles become about half; :func:`odin_common.meshes.cluster_vertices`). The
+#: world's collision mesh has a tolerance of its own (the world parameter
+#: collision_mesh_tolerance).
 DISPLAY_TOLERANCE = 0.001
 DISPLAY_DETAIL_TRIANGLES = 2000
-
-
-def simplify_for_display(vertices: np.ndarray, idx: np.ndarray,
-                         tolerance: float = DISPLAY_TOLERANCE) -> tuple:
-    """Vertex clustering: vertices (n, 3) m in the same ``tolerance`` cell become their mean;
-    triangles that collapse or repeat are dropped. Returns (vertices, indices (3 m,))."""
-    cells = np.floor(vertices / tolerance).astype(np.int64)
-    _, cluster = np.unique(cells, axis=0, return_inverse=True)
-    cluster = cluster.reshape(-1)
-    count = int(cluster.max()) + 1
-    merged = np.zeros((count, 3))
-    np.add.at(merged, cluster, vertices)
-    merged /= np.bincount(cluster, minlength=count)[:, None]
-    triangles = cluster[idx].reshape(-1, 3)
-    keep = ((triangles[:, 0] != triangles[:, 1]) & (triangles[:, 1] != triangles[:, 2])
-            & (triangles[:, 0] != triangles[:, 2]))
-    triangles = triangles[keep]
-    _, first = np.unique(np.sort(triangles, axis=1), axis=0, return_index=True)
-    return merged, triangles[np.sort(first)].reshape(-1)
 
 
 def mesh_geometry(vertices_B: np.ndarray, indices: Sequence[int]) -> Geometry:
     """An indexed mesh from vertices (n, 3) m and triangle indices (3 per triangle), with
     area-weighted vertex normals split at creases sharper than ``CREASE_ANGLE``; large meshes
-    are simplified for display (:func:`simplify_for_display`)."""
+    are simplified for display (clustered at ``DISPLAY_TOLERANCE``)."""
     vertices = np.asarray(vertices_B, dtype=float)
     if not np.all(np.isfinite(vertices)):
         raise ViewerError("mesh vertices must be finite numbers (m)")
@@ -175,7 +159,7 @@ def mesh_geometry(vertices_B: np.ndarray, indices: Sequence[int]) -> Geometry:
                           f"{len(vertices)} vertices")
     closed = _closed_and_outward(idx.reshape(-1, 3), vertices[idx].reshape(-1, 3, 3))
     if idx.size > 3 * DISPLAY_DETAIL_TRIANGLES:
-        simple_vertices, simple_idx = simplify_for_display(vertices, idx)
+        simple_vertices, simple_idx = cluster_vertices(vertices, idx, DISPLAY_TOLERANCE)
         if simple_idx.size:  # a mesh smaller than the tolerance keeps its triangles
             vertices, idx = simple_vertices, simple_idx
     corners = vertices[idx].reshape(-1, 3, 3)
