@@ -154,6 +154,13 @@ def test_set_world_returns_values_in_force(world):
     assert (response.erp, response.max_contacts, response.contact_less) == (0.5, 5, True)
     response = world.ok("set_world", set_cfm=True, cfm=0.0)
     assert response.erp == 0.5 and response.cfm == 0.0              # earlier values kept
+    response = world.ok("set_world", set_collision_mesh_tolerance=True,
+                        collision_mesh_tolerance=0.004)
+    assert response.collision_mesh_tolerance == 0.004
+    refused = world("set_world", set_collision_mesh_tolerance=True,
+                    collision_mesh_tolerance=4.0)                   # mm given as m
+    assert not refused.success and "collision_mesh_tolerance" in refused.message
+    assert refused.collision_mesh_tolerance == 0.004                # unchanged
 
 
 def test_joints_motors_and_forces_are_named_and_removed_in_cascade(world):
@@ -290,13 +297,14 @@ def test_start_up_parameters_are_read(ros_master):
 
     ros_master.rosrun("VirtualWorld", "virtualWorld", "_rate:=10", "_step:=0.002",
                       "_steps_per_cycle:=5", "_contact_less:=true", "_gravity:=[0, 0, -1.5]",
-                      "_max_contacts:=4")
+                      "_max_contacts:=4", "_collision_mesh_tolerance:=0.003")
     ros_master.wait_for_service("/virtual_world/set_joint_force")
     rospy.init_node("odin_test_client", anonymous=True, disable_signals=True)
     client = WorldClient()
     assert client.ok("step_once").sim_time == pytest.approx(0.01)
     values = client.ok("set_world", set_erp=True, erp=0.2)
     assert values.contact_less and values.max_contacts == 4
+    assert values.collision_mesh_tolerance == 0.003
     assert list(values.gravity) == [0, 0, -1.5]
     step = client.ok("set_step", rate=10.0)
     assert (step.step, step.steps_per_cycle) == pytest.approx((0.002, 5))

@@ -286,6 +286,7 @@ def test_bad_steps_and_removals(core):
     dict(max_contacts=0), dict(max_contacts=65), dict(max_contacts=2.5), dict(solver=3),
     dict(quickstep_iterations=0), dict(bounce=2), dict(contact_less="no"), dict(nope=1),
     dict(linear_damping=-0.1), dict(friction=NAN), dict(erp=0.5, cfm=-1),
+    dict(collision_mesh_tolerance=-0.001), dict(collision_mesh_tolerance=4.0),
 ])
 def test_bad_world_parameters(core, changes):
     before = core.world_parameters

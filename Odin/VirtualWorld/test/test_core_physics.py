@@ -359,3 +359,49 @@ def test_world_step_solver_and_parameters(core):
     core.step(0.001, 200)
     assert core.last_step_contacts == 4
     assert isinstance(core.world_parameters, WorldParameters)
+
+
+def _dense_sphere(radius):
+    import trimesh
+    sphere = trimesh.creation.icosphere(subdivisions=5, radius=radius)   # 20480 triangles
+    return np.asarray(sphere.vertices).reshape(-1).tolist(), np.asarray(sphere.faces)
+
+
+def test_collision_mesh_tolerance_simplifies_what_collides_not_the_mass(core):
+    vertices, faces = _dense_sphere(0.1)
+    core.build_object(ObjectSpec("exact", vertices, faces.reshape(-1).tolist(), mass=2.0,
+                                 position=(-1, 0, 0)))
+    core.set_world_parameters(collision_mesh_tolerance=0.01)
+    core.build_object(ObjectSpec("coarse", vertices, faces.reshape(-1).tolist(), mass=2.0,
+                                 position=(1, 0, 0)))
+    assert core.collision_triangle_count("exact") == len(faces)
+    assert 100 < core.collision_triangle_count("coarse") < len(faces) / 5
+    assert core.collision_triangle_count("exact") == len(faces)   # built before: unchanged
+    for name in ("exact", "coarse"):   # mass and inertia come from the mesh as given
+        m, _, inertia = core.mass_properties(name)
+        np.testing.assert_allclose(inertia, core.mass_properties("exact")[2], rtol=1e-12)
+    # the Viewer is sent the given mesh
+    assert len(core.object_spec("coarse").indices) == faces.size
+
+
+def test_coarse_collision_mesh_rests_within_its_tolerance(core):
+    """A dense mesh ball dropped on the ground rests on its clustered surface: within
+    sqrt(3) cells of the radius, and exactly as the given mesh would with tolerance 0."""
+    vertices, faces = _dense_sphere(0.1)
+    ground(core)
+    tolerance = 0.004
+    core.set_world_parameters(collision_mesh_tolerance=tolerance, max_contacts=4)
+    core.build_object(ObjectSpec("ball", vertices, faces.reshape(-1).tolist(), mass=1.0,
+                                 position=(0, 0, 0.3)))
+    core.step(0.001, 1500)
+    height = core.body_state("ball")[0][2]
+    assert abs(height - 0.1) < math.sqrt(3) * tolerance + 0.002   # + the surface layer
+
+
+def test_a_mesh_a_few_cells_across_collides_as_given(core):
+    vertices, faces = _dense_sphere(0.02)   # 4 cells across: clustering would lose its shape
+    core.set_world_parameters(collision_mesh_tolerance=0.01)
+    core.build_object(ObjectSpec("bead", vertices, faces.reshape(-1).tolist(), mass=0.01))
+    assert core.collision_triangle_count("bead") == len(faces)
+    with pytest.raises(vc.UnknownName):
+        core.collision_triangle_count("nothing")

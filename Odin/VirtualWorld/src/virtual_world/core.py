@@ -31,6 +31,7 @@ from typing import (Dict, List, Mapping, NamedTuple, Optional, Sequence, Set, Tu
 
 import numpy as np
 
+from odin_common.meshes import cluster_vertices
 from virtual_world import handles
 from virtual_world.errors import (Closed, CoreError, DuplicateName, InvalidArgument,
                                   OdeConfigurationError, Unsupported, UnknownName)
@@ -351,6 +352,24 @@ def _prepare_shape(what: str, parameters, indices) -> _Shape:
     if not np.any(areas > 1e-12 * max(float(np.ptp(vertices)), 1e-12) ** 2):
         raise InvalidArgument(f"{what}: every mesh triangle is degenerate")
     return _Shape("mesh", (), np.ascontiguousarray(vertices), np.ascontiguousarray(triangles))
+
+
+#: a mesh fewer cells across than this (its bounding box's longest side) collides as given:
+#: clustered, it would keep too little of its shape to be worth the saving
+MIN_CELLS_ACROSS = 6
+
+
+def _collision_mesh(shape: _Shape, tolerance: float) -> Tuple[np.ndarray, np.ndarray]:
+    """The (vertices (n,3) m, triangles (m,3)) ODE collides with: the given mesh, or its
+    vertices clustered at ``tolerance`` m (WorldParameters.collision_mesh_tolerance) when the
+    mesh is at least MIN_CELLS_ACROSS cells across."""
+    extent = float(np.ptp(shape.vertices, axis=0).max())
+    if tolerance <= 0 or extent < MIN_CELLS_ACROSS * tolerance:
+        return shape.vertices, shape.triangles
+    vertices, indices = cluster_vertices(shape.vertices, shape.triangles, tolerance)
+    if indices.size == 0:
+        return shape.vertices, shape.triangles
+    return vertices, indices.astype(np.uint32).reshape(-1, 3)
 
 
 _MESH_MASS_CACHE: Dict[Tuple[bytes, bytes], object] = {}
@@ -714,8 +733,10 @@ class Core:
             shape = part.shape
             space = self._space.ptr
             if shape.kind == "mesh":
-                vertices = ffi.new("double[]", shape.vertices.reshape(-1).tolist())
-                indices = ffi.new("dTriIndex[]", shape.triangles.reshape(-1).tolist())
+                collide_vertices, collide_triangles = _collision_mesh(
+                    shape, self._parameters.collision_mesh_tolerance)
+                vertices = ffi.new("double[]", collide_vertices.reshape(-1).tolist())
+                indices = ffi.new("dTriIndex[]", collide_triangles.reshape(-1).tolist())
                 geom = handles.new_trimesh(self._space, vertices, indices, body)
             else:
                 if shape.kind == "sphere":
@@ -831,6 +852,17 @@ class Core:
     def geometry_names(self, object_id: str) -> List[str]:
         """Names of the object's geometries (one, or a composite's parts)."""
         return [g.name for g in self._object(object_id).geometries]
+
+    @_locked
+    def collision_triangle_count(self, geometry_name: str) -> int:
+        """Triangles ODE collides with for a mesh geometry (fewer than given when it was built
+        under a collision_mesh_tolerance); 0 for a primitive."""
+        geometry = self._geometries.get(geometry_name)
+        if geometry is None:
+            raise UnknownName(f"no geometry named {geometry_name!r}")
+        if geometry.shape.kind != "mesh":
+            return 0
+        return int(lib.dGeomTriMeshGetTriangleCount(geometry.owner.ptr))
 
     @_locked
     def object_ids(self) -> List[str]:

@@ -37,6 +37,14 @@ class WorldParameters:
     quickstep_iterations:    iterations of QuickStep, >= 1.
     contact_less:            collision policy: False creates contacts; True only records the
                              colliding pairs (thesis 5.5.2) until read_collisions().
+    collision_mesh_tolerance: m, >= 0. A mesh built while it is positive collides as its
+                             vertices clustered on a grid of this cell size (within sqrt(3)
+                             cells of the given surface; odin_common.meshes); 0 = as given.
+                             Mass, inertia and the Viewer's picture always use the given mesh;
+                             meshes already built keep the collision mesh they were built with.
+                             CAD meshes of robot hands carry tens of thousands of triangles,
+                             and ODE's mesh colliders cost in proportion to the triangles near
+                             a contact.
     """
 
     gravity: Tuple[float, float, float] = (0.0, 0.0, -9.81)
@@ -56,6 +64,7 @@ class WorldParameters:
     solver: int = QUICKSTEP
     quickstep_iterations: int = 20
     contact_less: bool = False
+    collision_mesh_tolerance: float = 0.0
 
     def replace(self, **changes) -> "WorldParameters":
         """A validated copy with `changes`; unknown keys raise InvalidArgument."""
@@ -75,7 +84,7 @@ class WorldParameters:
         for name in ("erp", "cfm", "max_angular_speed", "contact_max_correcting_velocity",
                      "contact_surface_layer", "linear_damping", "linear_damping_threshold",
                      "angular_damping", "angular_damping_threshold", "friction", "bounce",
-                     "bounce_velocity"):
+                     "bounce_velocity", "collision_mesh_tolerance"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)):
                 raise InvalidArgument(f"world parameter {name}={value!r} is not a number")
@@ -83,7 +92,8 @@ class WorldParameters:
                 raise InvalidArgument(f"world parameter {name}={value!r} is not finite")
             if name != "friction" and value < 0:
                 raise InvalidArgument(f"world parameter {name}={value!r} is negative")
-        for name in ("erp", "linear_damping", "angular_damping", "bounce"):
+        for name in ("erp", "linear_damping", "angular_damping", "bounce",
+                     "collision_mesh_tolerance"):   # a tolerance above 1 m is mm taken for m
             if getattr(self, name) > 1:
                 raise InvalidArgument(f"world parameter {name}={getattr(self, name)!r} is above 1")
         for name, low, high in (("max_contacts", 1, 64), ("quickstep_iterations", 1, 100000),

@@ -36,7 +36,8 @@ Parameters (read at start):
   ``~max_angular_speed``, ``~contact_max_correcting_velocity``, ``~contact_surface_layer``,
   ``~linear_damping``, ``~linear_damping_threshold``, ``~angular_damping``,
   ``~angular_damping_threshold``, ``~max_contacts``, ``~friction``, ``~bounce``,
-  ``~bounce_velocity``, ``~solver`` (0 QuickStep, 1 dWorldStep), ``~quickstep_iterations``.
+  ``~bounce_velocity``, ``~solver`` (0 QuickStep, 1 dWorldStep), ``~quickstep_iterations``,
+  ``~collision_mesh_tolerance`` (0 m: meshes collide as given).
 """
 from __future__ import annotations
 
@@ -78,6 +79,7 @@ WORLD_FIELDS = {
     "set_bounce": ("bounce", "bounce_velocity"),
     "set_solver": ("solver", "quickstep_iterations"),
     "set_contact_less": ("contact_less",),
+    "set_collision_mesh_tolerance": ("collision_mesh_tolerance",),
 }
 
 

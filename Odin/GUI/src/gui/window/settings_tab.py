@@ -38,6 +38,8 @@ SCALARS = {
         ("friction", "Friction (Coulomb mu)", 1.0, 0.0, 1e3, 3, 0.1, ""),
         ("bounce", "Bounce (restitution)", 0.0, 0.0, 1.0, 3, 0.05, ""),
         ("bounce_velocity", "Bounce velocity", 0.1, 0.0, 1e3, 3, 0.05, "m/s"),
+        ("collision_mesh_tolerance", "Collision mesh tolerance (0: as given; meshes built "
+         "afterwards)", 0.0, 0.0, 1.0, 4, 0.001, "m"),
     ],
 }
 
@@ -259,7 +261,8 @@ class SettingsTab(QWidget):
                 ("linear_damping_threshold", 0.01), ("angular_damping", 0.0),
                 ("angular_damping_threshold", 0.01), ("max_contacts", 3), ("friction", 1.0),
                 ("bounce", 0.0), ("bounce_velocity", 0.1), ("solver", 0),
-                ("quickstep_iterations", 20), ("contact_less", False)]})
+                ("quickstep_iterations", 20), ("contact_less", False),
+                ("collision_mesh_tolerance", 0.0)]})
             return step_values, world
 
         def done(values):

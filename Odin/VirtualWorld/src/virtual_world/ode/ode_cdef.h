@@ -114,6 +114,7 @@ void dGeomTriMeshDataDestroy(dTriMeshDataID g);
 void dGeomTriMeshDataBuildDouble(dTriMeshDataID g, const void *Vertices, int VertexStride,
                                  int VertexCount, const void *Indices, int IndexCount,
                                  int TriStride);
+int dGeomTriMeshGetTriangleCount(dGeomID g);
 dGeomID dCreateTriMesh(dSpaceID space, dTriMeshDataID Data, void *Callback, void *ArrayCallback,
                        void *RayCallback);
 
