@@ -41,7 +41,8 @@ class WorldParameters:
                              vertices clustered on a grid of this cell size (within sqrt(3)
                              cells of the given surface; odin_common.meshes); 0 = as given.
                              Mass, inertia and the Viewer's picture always use the given mesh;
-                             meshes already built keep the collision mesh they were built with.
+                             meshes already built keep the collision mesh they were built with,
+                             and a mesh fewer than 6 cells across collides as given.
                              CAD meshes of robot hands carry tens of thousands of triangles,
                              and ODE's mesh colliders cost in proportion to the triangles near
                              a contact.
