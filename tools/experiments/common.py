@@ -195,7 +195,11 @@ class Session:
         poses = {s.name: (tuple(s.position), tuple(s.orientation))
                  for s in message.situations if s.name in self.track}
         with self.record.lock:
-            self.record.poses[t] = poses
+            # the first message of a stamp is the cycle's own; a paused world repeats the
+            # stamp of its last cycle with the poses of the moment, which the Set Position
+            # calls between cycles may already have changed (keeping the last one made
+            # repeated runs record different trajectories of one identical simulation)
+            self.record.poses.setdefault(t, poses)
 
     def _on_collided(self, message) -> None:
         t = _t(message.header.stamp)
