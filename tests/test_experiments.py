@@ -58,3 +58,16 @@ def test_grasp_carries_the_can_and_releases_it_when_the_hand_opens(tmp_path):
     assert o["released_only_when_hand_opens"]
     assert o["can_released_at_s"] >= o["hand_opens_at_s"]
     assert o["can_on_floor_at_end"]
+
+
+def test_one_command_runs_several_experiments():
+    """`make experiments` runs them one after another from one command; each has a roscore of
+    its own, which one rospy process cannot follow (it hung on the second before)."""
+    import subprocess
+    result = subprocess.run(
+        [sys.executable, str(ROOT / "tools" / "experiments" / "run.py"), "--quick",
+         "--no-frames", "contactless", "pile"], capture_output=True, text=True, timeout=600,
+        stdin=subprocess.DEVNULL)
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
+    assert "experiment contactless: outcome held" in result.stdout
+    assert "experiment pile: outcome held" in result.stdout

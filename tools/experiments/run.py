@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
-import json
+import os
 import pathlib
 import signal
 import sys
@@ -42,30 +42,59 @@ def main(argv=None) -> int:
     signal.signal(signal.SIGTERM, _raise_keyboard_interrupt)
     failed = []
     for name in args.names or NAMES:
-        module = importlib.import_module(name)
         started = time.monotonic()
         print(f"experiment {name} ...", flush=True)
         try:
-            facts = module.run(quick=args.quick, frames=not args.no_frames)
+            code = _run_in_child(name, quick=args.quick, frames=not args.no_frames)
         except KeyboardInterrupt:
             print("interrupted; every process started was stopped", file=sys.stderr)
             return 130
-        except Exception as error:
-            print(f"experiment {name}: {type(error).__name__}: {error}", file=sys.stderr)
-            failed.append(name)
-            continue
-        ok, lines = module.verdict(facts)
-        for line in lines:
-            print(f"  {line}")
-        print(f"experiment {name}: {'outcome held' if ok else 'OUTCOME FAILED'} "
-              f"({time.monotonic() - started:.1f} s); out/experiments/{name}/summary.json",
-              flush=True)
-        if not ok:
+        if code == 130:
+            print("interrupted; every process started was stopped", file=sys.stderr)
+            return 130
+        if code == 0 or code == 1:
+            print(f"experiment {name}: {'outcome held' if code == 0 else 'OUTCOME FAILED'} "
+                  f"({time.monotonic() - started:.1f} s); out/experiments/{name}/summary.json",
+                  flush=True)
+        if code != 0:
             failed.append(name)
     if failed:
         print(f"failed: {', '.join(failed)}", file=sys.stderr)
         return 1
     return 0
+
+
+def _run_in_child(name: str, quick: bool, frames: bool) -> int:
+    """Runs one experiment in a child process and returns its exit code: 0 the outcome held,
+    1 it did not, 2 the run failed, 130 interrupted. Each experiment has a roscore of its own,
+    and rospy binds a process to the first master it registers with (init_node works once per
+    process): a second experiment in the same process would register with a stopped master
+    and hang."""
+    pid = os.fork()
+    if pid == 0:
+        code = 2
+        try:
+            module = importlib.import_module(name)
+            facts = module.run(quick=quick, frames=frames)
+            ok, lines = module.verdict(facts)
+            for line in lines:
+                print(f"  {line}")
+            code = 0 if ok else 1
+        except KeyboardInterrupt:
+            code = 130
+        except Exception as error:
+            print(f"experiment {name}: {type(error).__name__}: {error}", file=sys.stderr)
+        finally:
+            sys.stdout.flush()
+            sys.stderr.flush()
+            os._exit(code)
+    try:
+        _, status = os.waitpid(pid, 0)
+    except KeyboardInterrupt:   # the child's Session stops its own processes on SIGTERM
+        os.kill(pid, signal.SIGTERM)
+        os.waitpid(pid, 0)
+        raise
+    return os.waitstatus_to_exitcode(status)
 
 
 if __name__ == "__main__":
