@@ -220,6 +220,5 @@ void dJointSetLMotorAxis(dJointID, int anum, int rel, dReal x, dReal y, dReal z)
 /* Category and collide bits (the hash space skips pairs whose bits do not meet). */
 void dGeomSetCategoryBits(dGeomID, unsigned long bits);
 void dGeomSetCollideBits(dGeomID, unsigned long bits);
-unsigned long dGeomGetCollideBits(dGeomID);
 
 /* Odin's own declarations follow, taken from odin_step.h by build_ode.py (one source). */

@@ -261,11 +261,10 @@ static void push(int level, int num, const char *msg, va_list ap) {
 }
 
 /* dError and dDebug end the process after their handler returns (exit(1) / abort()), and
- * unwinding out of ODE with longjmp would leave its state corrupt. So these handlers record the
- * message and print it to stderr at once, where it survives the process's end; Odin validates
- * every argument before calling ODE so that they never fire. dMessage is non-fatal: buffered
- * only, and Python drains the buffer into `logging` after each call into ODE. */
-/* Records a fatal message and prints it to stderr at once (ODE ends the process next). */
+ * unwinding out of ODE with longjmp would leave its state corrupt. So their handlers record the
+ * message and print it to stderr at once (report_fatal), where it survives the process's end;
+ * Odin validates every argument before calling ODE so that they never fire. dMessage is
+ * non-fatal: buffered only, and Python drains the buffer into `logging` after each call. */
 static void report_fatal(int level, const char *label, int num, const char *msg, va_list ap) {
     va_list copy;
     va_copy(copy, ap);
@@ -277,7 +276,10 @@ static void report_fatal(int level, const char *label, int num, const char *msg,
     va_end(copy);
 }
 
-static void on_error(int num, const char *msg, va_list ap) { report_fatal(2, "ODE error", num, msg, ap); }
+static void on_error(int num, const char *msg, va_list ap) {
+    report_fatal(2, "ODE error", num, msg, ap);
+}
+
 static void on_debug(int num, const char *msg, va_list ap) {
     report_fatal(1, "ODE internal error", num, msg, ap);
 }
