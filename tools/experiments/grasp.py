@@ -48,7 +48,6 @@ ROBOT = "TX90 SAHand Right"
 CAN = "can"
 PALM = f"{ROBOT}/Palm"
 TABLE_TOP = 0.5  # m, the ICRA09 scene's table (a 0.5 m cube on the floor)
-CAN_RADIUS, CAN_HALF_LENGTH = 0.0317, 0.0603  # m
 
 PARAMETERS = {
     "can_mass_kg": 0.35,
@@ -259,7 +258,8 @@ def analyse(s: "common.Session", phases: dict) -> dict:
     # + r sin(tilt) below its centre)
     up = np.array([matrix_from_quaternion(q)[2, 2] for q in can_q])
     tilt = np.arccos(np.clip(np.abs(up), 0.0, 1.0))
-    bottom = can[:, 2] - (CAN_HALF_LENGTH * np.cos(tilt) + CAN_RADIUS * np.sin(tilt))
+    radius, half_length = PARAMETERS["can_radius_m"], PARAMETERS["can_length_m"] / 2
+    bottom = can[:, 2] - (half_length * np.cos(tilt) + radius * np.sin(tilt))
     samples = {}
     for name, at in phases.items():
         k = min(int(np.searchsorted(t, at)), n - 1)
