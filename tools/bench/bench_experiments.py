@@ -12,42 +12,33 @@ run alone can read 20 % low); ``rtf_grasp_overall`` also counts the GUI's own se
 and ``rtf_grasp_mesh_tolerance_speedup`` the ratio of the two.
 """
 import json
-import os
 import pathlib
 import statistics
 import sys
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent.parent
+HERE = pathlib.Path(__file__).resolve().parent
+ROOT = HERE.parent.parent
 sys.path.insert(0, str(ROOT / "tools" / "experiments"))
+sys.path.insert(0, str(HERE))
+
+from forked import in_child  # noqa: E402
 
 RUNS = 3
 
 
-def _run_grasp(out_dir: pathlib.Path, world_changes: dict) -> dict:
-    """One headless grasp run in a child process (rospy.init_node works once per process);
-    returns its summary's timing."""
-    pid = os.fork()
-    if pid == 0:
-        code = 1
-        try:
-            import grasp
-            grasp.WORLD.update(world_changes)
-            grasp.run(frames=False, out_root=out_dir)
-            code = 0
-        finally:
-            os._exit(code)
-    _, status = os.waitpid(pid, 0)
-    if status != 0:
-        raise RuntimeError(f"the grasp run ended with status {status:#x}")
-    summary = json.loads((out_dir / "grasp" / "summary.json").read_text())
-    return summary["timing"]
+def _grasp_timing(out_dir: pathlib.Path, world_changes: dict) -> dict:
+    """One headless grasp run (in a child: see forked); its summary's timing."""
+    import grasp
+    grasp.WORLD.update(world_changes)
+    grasp.run(frames=False, out_root=out_dir)
+    return json.loads((out_dir / "grasp" / "summary.json").read_text())["timing"]
 
 
 def run(out_dir: pathlib.Path) -> dict:
     out = pathlib.Path(out_dir) / "experiments"
-    timings = [_run_grasp(out, {}) for _ in range(RUNS)]
-    exact = _run_grasp(pathlib.Path(out_dir) / "experiments_exact_meshes",
-                       {"collision_mesh_tolerance": 0.0})
+    timings = [in_child(_grasp_timing, out, {}) for _ in range(RUNS)]
+    exact = in_child(_grasp_timing, pathlib.Path(out_dir) / "experiments_exact_meshes",
+                     {"collision_mesh_tolerance": 0.0})
     rtf = statistics.median(float(t["rtf_stepping"]) for t in timings)
     return {"rtf_grasp": rtf,
             "rtf_grasp_overall": statistics.median(float(t["rtf_overall"]) for t in timings),

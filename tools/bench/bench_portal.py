@@ -26,6 +26,7 @@ ROOT = HERE.parent.parent
 sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(HERE))
 
+from forked import in_child  # noqa: E402
 from ros_harness import RosMaster  # noqa: E402
 
 CLIENTS = 4
@@ -201,7 +202,7 @@ def rtf_spheres100(out_dir: pathlib.Path) -> dict:
         output = subprocess.run([str(exe), "0", str(NATIVE_STEPS), "0", "0"], check=True,
                                 capture_output=True, text=True).stdout.split()
         native.append(NATIVE_STEPS * 0.001 / float(output[0]))   # simulated s per wall s
-        world.append(_in_child(world_rtf_spheres100)["rtf"])
+        world.append(in_child(world_rtf_spheres100)["rtf"])
     # the median of the rounds' ratios: a round's two runs share the load of a shared machine
     ratio = statistics.median(w / n for w, n in zip(world, native))
     print(f"  world rtf {world}, native {native}")
@@ -210,31 +211,10 @@ def rtf_spheres100(out_dir: pathlib.Path) -> dict:
 
 def run(out_dir: pathlib.Path) -> dict:
     figures = {}
-    figures.update(_in_child(publish_1000_cpu))
-    figures.update(_in_child(rtf_spheres100, out_dir))
-    figures.update(_in_child(calls_under_load))
+    figures.update(in_child(publish_1000_cpu))
+    figures.update(in_child(rtf_spheres100, out_dir))
+    figures.update(in_child(calls_under_load))
     return figures
-
-
-def _in_child(function, *args) -> dict:
-    """Runs a measurement in a forked process (rospy.init_node works once per process)."""
-    context = multiprocessing.get_context("fork")
-    queue = context.Queue()
-
-    def target():
-        try:
-            queue.put(function(*args))
-        except BaseException as error:
-            queue.put({"error": repr(error)})
-            raise
-
-    process = context.Process(target=target)
-    process.start()
-    result = queue.get(timeout=1800)
-    process.join(60)
-    if "error" in result:
-        raise RuntimeError(f"{function.__name__}: {result['error']}")
-    return result
 
 
 if __name__ == "__main__":
