@@ -11,3 +11,9 @@ class OdinError(Exception):
 
     The message says what was wrong, with the offending value and where it came from.
     """
+
+
+class InvalidArgument(OdinError, ValueError):
+    """A value is malformed: not finite, out of its range, the wrong count, not a unit
+    quaternion... Raised by the checks every node shares (``odin_common``); each node's own
+    errors of this kind derive from it."""
