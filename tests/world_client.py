@@ -7,16 +7,8 @@ import rospy
 
 from Messages import msg
 from Services import srv
+from odin_common.interface import WORLD_SERVICES
 
-#: ROS name suffix -> service class of every world service.
-WORLD_SERVICES = {
-    "new_scene": srv.NewScene, "set_world": srv.SetWorld, "set_step": srv.SetStep,
-    "step_once": srv.StepOnce, "start": srv.Start, "build_object": srv.BuildObject,
-    "build_composite": srv.BuildComposite, "build_entity": srv.BuildEntity,
-    "remove_object": srv.RemoveObject, "set_joint": srv.SetJoint, "set_motor": srv.SetMotor,
-    "set_position": srv.SetPosition, "set_velocity": srv.SetVelocity,
-    "set_external_force": srv.SetExternalForce, "set_joint_force": srv.SetJointForce,
-}
 
 
 class WorldClient:
@@ -30,7 +22,7 @@ class WorldClient:
     def __call__(self, service: str, /, **fields):
         proxy = self._proxies.get(service)
         if proxy is None:
-            service_class = WORLD_SERVICES[service]
+            service_class = getattr(srv, WORLD_SERVICES[service])
             proxy = rospy.ServiceProxy(f"{self.namespace}/{service}", service_class,
                                        persistent=True)
             self._proxies[service] = proxy

@@ -1,95 +1,87 @@
-"""Writes docs/INTERFACE.md from the .msg/.srv files and the facts below (run: python
-tools/interface_doc.py). tests/test_interface_doc.py checks that the file is current and runs
-every `rosservice call` example against the live nodes."""
+"""Writes docs/INTERFACE.md and docs/parameters.md from the code: the .msg/.srv files, the
+interface tables of odin_common (services, world parameters) and each node's parameter table,
+plus the provenance and examples below. Run `python tools/interface_doc.py` after changing any
+of them; `--check` only compares (exit 1 when a document is stale). tests/test_interface_doc.py
+compares them and runs every `rosservice call` example against the live nodes."""
 from __future__ import annotations
 
 import pathlib
 import sys
 
+from odin_common import world_parameters
+from odin_common.interface import (VIEWER_NAMESPACE, VIEWER_SERVICES, WORLD_NAMESPACE,
+                                   WORLD_SERVICES)
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 MSG_DIR = ROOT / "Odin" / "Messages" / "msg"
 SRV_DIR = ROOT / "Odin" / "Services" / "srv"
 DOC = ROOT / "docs" / "INTERFACE.md"
+PARAMETERS_DOC = ROOT / "docs" / "parameters.md"
 
 KNOWN = "known"
 RECON = "reconstructed"
 
-# name -> (ROS name, server, provenance, example request YAML or None)
+# service type -> (provenance, example request YAML or None); its ROS name and server come
+# from odin_common.interface's service tables
 SERVICES = {
-    "NewScene": ("/virtual_world/new_scene", "VirtualWorld",
-                 f"{KNOWN}: thesis 3.3.1, 4.6 (empty request); response fields {RECON}", "{}"),
-    "SetWorld": ("/virtual_world/set_world", "VirtualWorld",
-                 f"parameter list {KNOWN} (thesis 4.2, 5.2, 7.2); set_* flags, field names, "
+    "NewScene": (f"{KNOWN}: thesis 3.3.1, 4.6 (empty request); response fields {RECON}", "{}"),
+    "SetWorld": (f"parameter list {KNOWN} (thesis 4.2, 5.2, 7.2); set_* flags, field names, "
                  f"solver, friction, bounce and the values in force {RECON}",
                  "{set_gravity: true, gravity: [0.0, 0.0, -9.81], set_erp: true, erp: 0.2}"),
-    "SetStep": ("/virtual_world/set_step", "VirtualWorld",
-                f"the four values and the conflict rule {KNOWN} (thesis 4.5); 0 = not given "
+    "SetStep": (f"the four values and the conflict rule {KNOWN} (thesis 4.5); 0 = not given "
                 f"{RECON}", "{step: 0.001, cycle_time: 0.04}"),
-    "StepOnce": ("/virtual_world/step_once", "VirtualWorld",
-                 f"{KNOWN}: thesis 4.4.1; `cycles` and `sim_time` {RECON}", "{cycles: 1}"),
-    "Start": ("/virtual_world/start", "VirtualWorld",
-              f"{KNOWN}: the simulate flag (thesis 4.4.1); `simulating` {RECON}",
+    "StepOnce": (f"{KNOWN}: thesis 4.4.1; `cycles` and `sim_time` {RECON}", "{cycles: 1}"),
+    "Start": (f"{KNOWN}: the simulate flag (thesis 4.4.1); `simulating` {RECON}",
               "{simulate: false}"),
-    "BuildObject": ("/virtual_world/build_object", "VirtualWorld",
-                    f"shape by number of parameters, name/quaternion/mass checks {KNOWN} "
+    "BuildObject": (f"shape by number of parameters, name/quaternion/mass checks {KNOWN} "
                     f"(thesis 4.2.1, evidence: odinObject); field layout {RECON}",
                     "{object: {name: ball, parameters: [0.1], mass: 1.0, position: [0, 0, 1], "
                     "orientation: [1, 0, 0, 0], color: [1, 0, 0, 1]}}"),
-    "BuildComposite": ("/virtual_world/build_composite", "VirtualWorld",
-                       f"parts as geoms of one body, id \">p1>p2\" {KNOWN} (thesis 4.2.1, 5.1.3); "
+    "BuildComposite": (f"parts as geoms of one body, id \">p1>p2\" {KNOWN} (thesis 4.2.1, 5.1.3); "
                        f"Part fields {RECON}",
                        "{composite: {parts: [{name: top, parameters: [1.0, 0.6, 0.05], mass: 2.0, "
                        "position: [0, 0, 0.4], orientation: [1, 0, 0, 0]}, {name: leg, "
                        "parameters: [0.03, 0.4], mass: 0.3, position: [0.4, 0.2, 0.2], "
                        "orientation: [1, 0, 0, 0]}], position: [2, 0, 0], "
                        "orientation: [1, 0, 0, 0]}}"),
-    "BuildEntity": ("/virtual_world/build_entity", "VirtualWorld",
-                    f"objects, composites and the internal-collision flag {KNOWN} (thesis 4.2.1);"
+    "BuildEntity": (f"objects, composites and the internal-collision flag {KNOWN} (thesis 4.2.1);"
                     f" name, all-or-nothing and returned ids {RECON}",
                     "{name: pair, objects: [{name: a, parameters: [0.1], mass: 1.0, "
                     "position: [0, 3, 1], orientation: [1, 0, 0, 0]}, {name: b, "
                     "parameters: [0.1], mass: 1.0, position: [0, 3, 1.1], "
                     "orientation: [1, 0, 0, 0]}], internal_collisions: false}"),
-    "RemoveObject": ("/virtual_world/remove_object", "VirtualWorld",
-                     f"{KNOWN}: thesis 4.2.1; cascaded removal of joints, motors and forces "
+    "RemoveObject": (f"{KNOWN}: thesis 4.2.1; cascaded removal of joints, motors and forces "
                      f"{RECON}", "{id: a}"),
-    "SetJoint": ("/virtual_world/set_joint", "VirtualWorld",
-                 f"joint kinds, anchor/axes, stops, \"type:body1&body2\" ids, one joint per pair "
+    "SetJoint": (f"joint kinds, anchor/axes, stops, \"type:body1&body2\" ids, one joint per pair "
                  f"{KNOWN} (thesis 4.2.2, 5.3, evidence); action field and parameter list "
                  f"{RECON}",
                  "{action: 0, type: 1, body1: ball, body2: '', anchor: [0, 0, 1.5], "
                  "axis1: [0, 1, 0], parameters: [{parameter: 0, axis: 1, value: -1.0}]}"),
-    "SetMotor": ("/virtual_world/set_motor", "VirtualWorld",
-                 f"angular/linear motors, axis anchoring, infinite force, zero speed, "
+    "SetMotor": (f"angular/linear motors, axis anchoring, infinite force, zero speed, "
                  f"\"motor:\" ids {KNOWN} (thesis 4.2.2, 5.3.1, evidence); fields {RECON}",
                  "{joint: '1:ball&'}"),
-    "SetPosition": ("/virtual_world/set_position", "VirtualWorld",
-                    f"{KNOWN}: thesis 5.4.1, 7.4.3; several objects per call and reset_velocity "
+    "SetPosition": (f"{KNOWN}: thesis 5.4.1, 7.4.3; several objects per call and reset_velocity "
                     f"{RECON}",
                     "{situations: [{name: ball, position: [0, 0, 2], "
                     "orientation: [1, 0, 0, 0]}]}"),
-    "SetVelocity": ("/virtual_world/set_velocity", "VirtualWorld",
-                    f"object and motor velocities {KNOWN} (thesis 3.3.1, 4.2, 7.4); fields "
+    "SetVelocity": (f"object and motor velocities {KNOWN} (thesis 3.3.1, 4.2, 7.4); fields "
                     f"{RECON}",
                     "{motors: ['motor:1:ball&'], velocities: [0.5]}"),
-    "SetExternalForce": ("/virtual_world/set_external_force", "VirtualWorld",
-                         f"frames, point of application, persistence and numbered ids {KNOWN} "
+    "SetExternalForce": (f"frames, point of application, persistence and numbered ids {KNOWN} "
                          f"(thesis 4.2.2, 5.4.2); fields and id format {RECON}",
                          "{object: ball, kind: 0, vector: [0, 0, 5.0]}"),
-    "SetJointForce": ("/virtual_world/set_joint_force", "VirtualWorld",
-                      f"{KNOWN}: thesis 5.4.3; per-axis magnitudes and id format {RECON}",
+    "SetJointForce": (f"{KNOWN}: thesis 5.4.3; per-axis magnitudes and id format {RECON}",
                       "{joint: '1:ball&', magnitudes: [0.2]}"),
-    "ViewObject": ("/viewer/view_object", "Viewer",
-                   f"{KNOWN}: thesis 3.3.2, 6.4.1; fields {RECON} (those of Build Object's "
+    "ViewObject": (f"{KNOWN}: thesis 3.3.2, 6.4.1; fields {RECON} (those of Build Object's "
                    f"shape)",
                    "{id: marker, parameters: [0.05], position: [0, 0, 0], "
                    "orientation: [1, 0, 0, 0], color: [0, 1, 0, 1]}"),
-    "ViewerRemoveObject": ("/viewer/remove_object", "Viewer", f"{KNOWN}: thesis 3.3.2",
+    "ViewerRemoveObject": (f"{KNOWN}: thesis 3.3.2",
                            "{id: marker}"),
-    "ViewerNewScene": ("/viewer/new_scene", "Viewer", f"{KNOWN}: thesis 3.3.2, 6.4.3", None),
-    "SaveSnapshot": ("/viewer/save_snapshot", "Viewer", "new (past the thesis)",
+    "ViewerNewScene": (f"{KNOWN}: thesis 3.3.2, 6.4.3", None),
+    "SaveSnapshot": ("new (past the thesis)",
                      "{name: example.png}"),
-    "SetCamera": ("/viewer/set_camera", "Viewer", "new (past the thesis)",
+    "SetCamera": ("new (past the thesis)",
                   "{set_pose: true, eye: [3, -3, 2], target: [0, 0, 0.5], up: [0, 0, 1]}"),
 }
 
@@ -141,9 +133,19 @@ because the original .msg/.srv files are not public.
 | `/viewer` | `rosrun Viewer viewer` | View Object, Viewer Remove Object, New Scene, Save Snapshot, Set Camera | `~image` (sensor_msgs/Image, rgb8, 25 Hz) | - |
 | `/gui` | `rosrun GUI gui` (window), `problem_info`, `load_problem`, `run_path` | - | - | the world's services |
 
-Node parameters are listed in each Portal's docstring (`Odin/*/src/*/portal.py`) and below.
+Node parameters are listed in each node's parameter table (`Odin/*/src/*/portal/parameters.py`,\n`Odin/GUI/src/gui/ros/parameters.py`) and below.
 
 """
+
+
+def service_names() -> dict:
+    """Service type -> (ROS name, server node), from odin_common.interface."""
+    names = {}
+    for server, namespace, table in (("VirtualWorld", WORLD_NAMESPACE, WORLD_SERVICES),
+                                     ("Viewer", VIEWER_NAMESPACE, VIEWER_SERVICES)):
+        for name, type_name in table.items():
+            names[type_name] = (f"{namespace}/{name}", server)
+    return names
 
 
 def _block(path: pathlib.Path) -> str:
@@ -151,8 +153,10 @@ def _block(path: pathlib.Path) -> str:
 
 
 def render() -> str:
+    names = service_names()
     parts = [HEADER, "## Services\n"]
-    for name, (ros_name, server, provenance, example) in SERVICES.items():
+    for name, (provenance, example) in SERVICES.items():
+        ros_name, server = names[name]
         parts.append(f"### {name} — `{ros_name}`\n\n"
                      f"Type `Services/{name}`, served by {server}. Provenance: {provenance}.\n\n")
         parts.append(_block(SRV_DIR / f"{name}.srv"))
@@ -165,26 +169,114 @@ def render() -> str:
         parts.append(f"### {name}\n\nType `Messages/{name}`; {use}; published by {publisher}. "
                      f"Provenance: {provenance}.\n\n")
         parts.append(_block(MSG_DIR / f"{name}.msg") + "\n")
-    parts.append((ROOT / "docs" / "parameters.md").read_text())
+    parts.append(render_parameters())
     return "".join(parts)
+
+
+def _value(value) -> str:
+    if value is None:
+        return "unset"
+    if isinstance(value, bool):
+        return str(value).lower()
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_value(v) for v in value) + "]"
+    if isinstance(value, str):
+        return f"`{value}`"
+    return f"{value:g}" if isinstance(value, float) else str(int(value))
+
+
+def _node_table(parameters) -> list:
+    rows = ["| parameter | default | unit | meaning |", "|---|---|---|---|"]
+    rows += [f"| `~{p.name}` | {_value(p.default)} | {p.unit} | {p.what} |" for p in parameters]
+    return rows
+
+
+def _world_table() -> list:
+    rows = ["| parameter | default | unit | range | meaning |", "|---|---|---|---|---|"]
+    for info in world_parameters.PARAMETERS:
+        default = world_parameters.default(info.name)
+        if info.zero_means and default == 0:
+            shown = f"0 ({info.zero_means})"
+        else:
+            shown = _value(default)
+        if info.kind == "bool":
+            bounds = "true, false"
+        elif info.kind == "vector":
+            bounds = "finite"
+        else:
+            low = "-inf" if info.low is None else _value(info.low)
+            high = "inf" if info.high is None else _value(info.high)
+            bounds = f"[{low}, {high}]"
+        notes = "; ".join(n for n in (f"0: {info.zero_means}" if info.zero_means else "",
+                                       f"negative: {info.negative_means}" if info.negative_means
+                                       else "") if n)
+        rows.append(f"| `~{info.name}` | {shown} | {info.unit} | {bounds} | {info.what}"
+                    + (f" ({notes})" if notes else "") + f"; Set World `{info.set_flag}` |")
+    return rows
+
+
+def render_parameters() -> str:
+    """docs/parameters.md: every node's ~parameters and the world parameters, from the code."""
+    from gui.ros.parameters import NODE_PARAMETERS as GUI_PARAMETERS
+    from viewer.portal.parameters import NODE_PARAMETERS as VIEWER_PARAMETERS
+    from virtual_world.portal.parameters import NODE_PARAMETERS as WORLD_NODE_PARAMETERS
+    lines = ["## Node parameters", "",
+             "Generated by `tools/interface_doc.py` from each node's parameter table and "
+             "`odin_common.world_parameters`; do not edit by hand. Read once at start "
+             "(`rosrun VirtualWorld virtualWorld _rate:=10 _contact_less:=true`); a bad "
+             "start-up value ends the node at once with one line saying which parameter and "
+             "why.", "", f"### `{WORLD_NAMESPACE}`", ""]
+    lines += _node_table(WORLD_NODE_PARAMETERS)
+    lines += ["", "The world parameters, each also a `~parameter` of the world node and a field "
+              "of Set World (`set_*` flags select them; the answer holds the values in force):",
+              ""]
+    lines += _world_table()
+    lines += ["", f"### `{VIEWER_NAMESPACE}`", ""]
+    lines += _node_table(VIEWER_PARAMETERS)
+    lines += ["", "Meshes of more than 2,000 triangles are drawn with their vertices clustered "
+              "at 1 mm (`viewer.core.geometry.DISPLAY_TOLERANCE`); the world's collision meshes "
+              "are not affected.", "", "### `/gui`", ""]
+    lines += _node_table(GUI_PARAMETERS)
+    return "\n".join(lines) + "\n"
 
 
 def examples() -> list:
     """(ros name, type, YAML) of every documented call, in documentation order."""
-    return [(ros_name, f"Services/{name}", example)
-            for name, (ros_name, _, _, example) in SERVICES.items()]
+    names = service_names()
+    return [(names[name][0], f"Services/{name}", example)
+            for name, (_, example) in SERVICES.items()]
 
 
-def main() -> int:
+def stale() -> list:
+    """Problems that make the documents differ from the code: undocumented or stale names,
+    and each document whose text is not what render() gives."""
+    problems = []
     missing = ({p.stem for p in SRV_DIR.glob("*.srv")} ^ set(SERVICES)) | \
               ({p.stem for p in MSG_DIR.glob("*.msg")} ^ set(MESSAGES))
     if missing:
-        print(f"interface_doc: undocumented or stale names: {sorted(missing)}", file=sys.stderr)
+        problems.append(f"undocumented or stale names: {sorted(missing)}")
+    for path, text in ((DOC, render()), (PARAMETERS_DOC, render_parameters())):
+        if not path.exists() or path.read_text() != text:
+            problems.append(f"{path.relative_to(ROOT)} is stale")
+    return problems
+
+
+def main(argv: list) -> int:
+    if "--check" in argv:
+        problems = stale()
+        for problem in problems:
+            print(f"interface_doc: {problem} (run python tools/interface_doc.py)",
+                  file=sys.stderr)
+        return 1 if problems else 0
+    problems = [p for p in stale() if p.startswith("undocumented")]
+    if problems:
+        print(f"interface_doc: {problems[0]}", file=sys.stderr)
         return 1
+    PARAMETERS_DOC.write_text(render_parameters())
     DOC.write_text(render())
-    print(f"wrote {DOC}")
+    print(f"wrote {DOC} and {PARAMETERS_DOC}")
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(main(sys.argv[1:]))

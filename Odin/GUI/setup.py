@@ -1,4 +1,6 @@
 from setuptools import setup
 from catkin_pkg.python_setup import generate_distutils_setup
 
-setup(**generate_distutils_setup(packages=["gui"], package_dir={"": "src"}))
+setup(**generate_distutils_setup(
+    packages=["gui", "gui.core", "gui.core.kautham", "gui.ros", "gui.window"],
+    package_dir={"": "src"}))

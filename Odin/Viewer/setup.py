@@ -1,4 +1,5 @@
 from setuptools import setup
 from catkin_pkg.python_setup import generate_distutils_setup
 
-setup(**generate_distutils_setup(packages=["viewer"], package_dir={"": "src"}))
+setup(**generate_distutils_setup(packages=["viewer", "viewer.core", "viewer.portal"],
+                                 package_dir={"": "src"}))

@@ -66,8 +66,8 @@ def _child(out_dir: pathlib.Path) -> None:
     from PyQt5.QtCore import QEvent, QObject, QTimer
     from PyQt5.QtWidgets import QApplication, QFileDialog
 
-    from gui.build import CompositeRequest, EntityRequest, ObjectRequest, plan_problem
-    from gui.kautham.problem import load_problem
+    from gui.core.build import CompositeRequest, EntityRequest, ObjectRequest, plan_problem
+    from gui.core.kautham.problem import load_problem
     from gui.window.main_window import MainWindow
     from gui.window.testing import app, click, pump, wait_for
 

@@ -1,6 +1,6 @@
 """Viewer benchmarks on the TX90 + SAH hand + two cans grasp scene (Kautham legacy_2012,
-TX90_RHand_ICRA10_5PMD_TwoCan.xml), loaded with the GUI's Kautham loader (gui.kautham.problem,
-gui.build: the same requests the GUI sends, ~195k triangles).
+TX90_RHand_ICRA10_5PMD_TwoCan.xml), loaded with the GUI's Kautham loader (gui.core.kautham.problem,
+gui.core.build: the same requests the GUI sends, ~195k triangles).
 
 viewer_frame_ms_grasp: median wall time (ms) to render one 640x480 frame of the scene and read
     it back as an array, Core + renderer in this process (no ROS). Goal <= 40.
@@ -33,9 +33,10 @@ def _kautham_dir() -> pathlib.Path:
 def grasp_scene():
     """(view requests [(id, parameters, indices, position, orientation wxyz, color)],
     robot handle) for the grasp problem, composites split into parts as the world does."""
-    from gui.build import CompositeRequest, EntityRequest, ObjectRequest, plan_problem
-    from gui.kautham.problem import load_problem
-    from gui.kinematics import matrix_from_quaternion, pose_to_position_quaternion
+    from gui.core.build import CompositeRequest, EntityRequest, ObjectRequest, plan_problem
+    from gui.core.kautham.problem import load_problem
+    from gui.core.kinematics import pose_to_position_quaternion
+    from odin_common.rotations import quaternion_to_matrix
 
     plan = plan_problem(load_problem(_kautham_dir() / PROBLEM))
     views = []
@@ -50,11 +51,11 @@ def grasp_scene():
                               step.orientation, step.color))
             elif isinstance(step, CompositeRequest):
                 T = np.eye(4)
-                T[:3, :3] = matrix_from_quaternion(step.orientation)
+                T[:3, :3] = quaternion_to_matrix(step.orientation)
                 T[:3, 3] = step.position
                 for part in step.parts:
                     P = np.eye(4)
-                    P[:3, :3] = matrix_from_quaternion(part.orientation)
+                    P[:3, :3] = quaternion_to_matrix(part.orientation)
                     P[:3, 3] = part.position
                     position, quaternion = pose_to_position_quaternion(T @ P)
                     views.append((part.name, part.parameters, part.indices, position,
@@ -65,9 +66,9 @@ def grasp_scene():
 
 def frame_ms(out_dir: pathlib.Path, frames: int = 40) -> tuple:
     from PIL import Image
-    from viewer.camera import Camera
-    from viewer.renderer import Renderer
-    from viewer.scene import Scene
+    from viewer.core.camera import Camera
+    from viewer.core.renderer import Renderer
+    from viewer.core.scene import Scene
 
     views, _ = grasp_scene()
     scene = Scene(Camera(width=640, height=480))
@@ -144,7 +145,7 @@ def run(out_dir: pathlib.Path) -> dict:
     ms, triangles, objects = frame_ms(out_dir)
     fps = fps_held()
     details = {"viewer_frame_ms_grasp": ms, "viewer_fps_held": fps, "triangles": triangles,
-               "objects": objects, "scene": PROBLEM, "loader": "gui.kautham + gui.build"}
+               "objects": objects, "scene": PROBLEM, "loader": "gui.core.kautham + gui.core.build"}
     (out_dir / "viewer_bench.json").write_text(json.dumps(details, indent=2) + "\n")
     return {"viewer_frame_ms_grasp": round(ms, 2), "viewer_fps_held": round(fps, 2)}
 

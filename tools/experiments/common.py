@@ -6,8 +6,8 @@ three parts of Odin as separate processes started by rosrun or acting as the GUI
 
     VirtualWorld  (``rosrun VirtualWorld virtualWorld`` with the experiment's parameters)
     Viewer        (``rosrun Viewer viewer``, fixed camera, frames into ``<out>/frames``)
-    GUI           this process: ``gui.kautham`` loads the problem, ``gui.build`` plans it and
-                  ``gui.client.WorldClient`` sends it, exactly as ``rosrun GUI load_problem``
+    GUI           this process: ``gui.core.kautham`` loads the problem, ``gui.core.build`` plans it and
+                  ``gui.ros.client.WorldClient`` sends it, exactly as ``rosrun GUI load_problem``
 
 and they talk only through the world's and the Viewer's services and topics.
 
@@ -47,7 +47,7 @@ KAUTHAM_DIR = pathlib.Path(os.environ.get("ODIN_KAUTHAM_DIR", ROOT.parent / "sha
 EXAMPLES = KAUTHAM_DIR / "legacy_2012" / "examples"
 PATHS_DIR = ROOT / "Odin" / "GUI" / "paths"
 
-#: The Viewer's colour for a colliding object (viewer.scene.COLLIDING_COLOR), 0..255.
+#: The Viewer's colour for a colliding object (viewer.core.scene.COLLIDING_COLOR), 0..255.
 COLLIDING_RGB = (89, 89, 89)
 
 
@@ -97,7 +97,7 @@ class Session:
     """Own roscore, the world and Viewer nodes, and this process as the GUI.
 
     ``with Session("pile", world_parameters, camera, track={"can"}) as s:`` then
-    ``s.client`` (gui.client.WorldClient), ``s.cycle()``, ``s.frame()``, ``s.record``.
+    ``s.client`` (gui.ros.client.WorldClient), ``s.cycle()``, ``s.frame()``, ``s.record``.
     """
 
     def __init__(self, name: str, world_parameters: dict, camera: Camera,
@@ -161,7 +161,7 @@ class Session:
             f"_width:={cam.width}", f"_height:={cam.height}")
         master.wait_for_service("/virtual_world/step_once")
         master.wait_for_service("/viewer/save_snapshot")
-        from gui.client import WorldClient
+        from gui.ros.client import WorldClient
         self.client = WorldClient(timeout=30.0)
         self._subscribers = [
             rospy.Subscriber("/virtual_world/world_update", msg.SpaceDistribution,
@@ -354,8 +354,8 @@ class Session:
 # -- the problem, as the GUI builds it --------------------------------------------------------
 def load_plan(problem_file: pathlib.Path):
     """(problem, BuildPlan) of a Kautham problem file, as ``rosrun GUI load_problem`` plans it."""
-    from gui.build import plan_problem
-    from gui.kautham.problem import load_problem
+    from gui.core.build import plan_problem
+    from gui.core.kautham.problem import load_problem
     problem = load_problem(problem_file)
     return problem, plan_problem(problem)
 
@@ -363,7 +363,7 @@ def load_plan(problem_file: pathlib.Path):
 def replace_step(plan, name: str, new_step) -> None:
     """Replaces the plan's Build Object request named ``name`` (the GUI's Objects tab would
     build the object differently; the rest of the plan is sent as loaded)."""
-    from gui.build import ObjectRequest
+    from gui.core.build import ObjectRequest
     for k, step in enumerate(plan.steps):
         if isinstance(step, ObjectRequest) and step.name == name:
             plan.steps[k] = new_step
@@ -373,7 +373,7 @@ def replace_step(plan, name: str, new_step) -> None:
 
 def cylinder_can(name: str, position, mass: float, color, radius: float, length: float):
     """A can as a cylinder primitive (axis along world z), a movable body."""
-    from gui.build import ObjectRequest
+    from gui.core.build import ObjectRequest
     return ObjectRequest(name=name, parameters=(float(radius), float(length)), indices=(),
                          mass=float(mass), position=tuple(float(v) for v in position),
                          orientation=(1.0, 0.0, 0.0, 0.0), color=tuple(color))

@@ -89,7 +89,7 @@ def motor_of(handle, link_name: str) -> str:
 
 
 def run(quick: bool = False, frames: bool = True, out_root=None) -> dict:
-    from gui.paths import RADIANS, load_robot_path, refine
+    from gui.core.paths import RADIANS, load_robot_path, refine
     p = dict(PARAMETERS)
     problem, plan = common.load_plan(common.EXAMPLES / PROBLEM)
     common.replace_step(plan, CAN, common.cylinder_can(
@@ -228,13 +228,13 @@ def closeup_sheet(closeups, out: pathlib.Path, columns: int = 3, width: int = 32
 
 
 def analyse(s: "common.Session", phases: dict) -> dict:
-    from gui.kinematics import matrix_from_quaternion
+    from odin_common.rotations import quaternion_to_matrix
     t, can, can_q = s.trajectory(CAN)
     tp, palm, palm_q = s.trajectory(PALM)
     n = min(len(t), len(tp))
     t, can, can_q, palm, palm_q = t[:n], can[:n], can_q[:n], palm[:n], palm_q[:n]
     # the can's centre in the palm's frame
-    rel = np.array([matrix_from_quaternion(q).T @ (c - p) for c, p, q in zip(can, palm, palm_q)])
+    rel = np.array([quaternion_to_matrix(q).T @ (c - p) for c, p, q in zip(can, palm, palm_q)])
     carried = (t >= phases["carry"]) & (t < phases["open"])
     held = (t >= phases["lift"]) & (t < phases["open"])     # the hand closed, not yet opening
 
@@ -256,7 +256,7 @@ def analyse(s: "common.Session", phases: dict) -> dict:
     released_at = float(t[left[0]]) if len(left) else None
     # the can's lowest point (its tilt counts: a cylinder's lowest rim point is h/2 cos(tilt)
     # + r sin(tilt) below its centre)
-    up = np.array([matrix_from_quaternion(q)[2, 2] for q in can_q])
+    up = np.array([quaternion_to_matrix(q)[2, 2] for q in can_q])
     tilt = np.arccos(np.clip(np.abs(up), 0.0, 1.0))
     radius, half_length = PARAMETERS["can_radius_m"], PARAMETERS["can_length_m"] / 2
     bottom = can[:, 2] - (half_length * np.cos(tilt) + radius * np.sin(tilt))

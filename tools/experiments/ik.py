@@ -1,4 +1,4 @@
-"""Numeric inverse kinematics over Odin's DH model (gui.model.RobotModel), numpy only.
+"""Numeric inverse kinematics over Odin's DH model (gui.core.model.RobotModel), numpy only.
 
 Damped least squares on the pose error of one link frame (position m, orientation as the
 rotation vector of R_target R^T, rad), with a finite-difference Jacobian over the chosen joints.

@@ -16,7 +16,7 @@ the can with the Viewer's renderer).
   inverse kinematics (``ik.py``, damped least squares on the DH model).
 - ``grasp_approach.txt``: the position path: the grasp point moved on a straight line to the
   can's axis, one IK solution per waypoint (each started from the previous one), hand open.
-  The experiment doubles its precision once (``gui.paths.double_precision``).
+  The experiment doubles its precision once (``gui.core.paths.double_precision``).
 """
 from __future__ import annotations
 

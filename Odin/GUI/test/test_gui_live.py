@@ -45,9 +45,9 @@ def test_initial_position_and_paths_move_the_links(world, tmp_path):
     import rospy
     from Messages.msg import SpaceDistribution
 
-    from gui.build import plan_problem
-    from gui.client import WorldClient
-    from gui.kautham.problem import load_problem
+    from gui.core.build import plan_problem
+    from gui.ros.client import WorldClient
+    from gui.core.kautham.problem import load_problem
 
     problem_file = LEGACY / "TRO" / "2DRR_obstacle.xml"
     world.run(["rosrun", "GUI", "load_problem", str(problem_file)], timeout=60)
@@ -87,9 +87,9 @@ def test_motor_goal_joint_value_and_forward_kinematics_share_one_sign(world):
     import rospy
     from Messages.msg import JointsData, SpaceDistribution
 
-    from gui.build import plan_problem
-    from gui.client import WorldClient
-    from gui.kautham.problem import load_problem
+    from gui.core.build import plan_problem
+    from gui.ros.client import WorldClient
+    from gui.core.kautham.problem import load_problem
 
     problem_file = LEGACY / "TRO" / "2DRR_obstacle.xml"
     world.run(["rosrun", "GUI", "load_problem", str(problem_file)], timeout=60)

@@ -13,10 +13,10 @@ import sys
 import numpy as np
 import pytest
 
-from gui.build import CompositeRequest, EntityRequest, JointRequest, ObjectRequest, plan_problem
+from gui.core.build import CompositeRequest, EntityRequest, JointRequest, ObjectRequest, plan_problem
 from gui.errors import GuiError, ProblemError, ShapeError
-from gui.kautham.problem import load_problem
-from gui.kautham.robot_rob import read_dh_robot
+from gui.core.kautham.problem import load_problem
+from gui.core.kautham.robot_rob import read_dh_robot
 
 KAUTHAM = pathlib.Path(os.environ.get("ODIN_KAUTHAM_DIR",
                                       pathlib.Path(__file__).resolve().parents[4] / "shared"
@@ -209,7 +209,7 @@ def test_cans_table_and_columns_land_where_location_says():
     # Location: TH=0 about x; the column's cylinder (radius 8 x scale 18 mm) stands along z.
     cylinder = columns.parts[1]
     assert cylinder.parameters == pytest.approx((0.144, 1.08), rel=1e-6)
-    R = np.array(__import__("gui.kinematics", fromlist=["x"]).matrix_from_quaternion(
+    R = np.array(__import__("odin_common.rotations", fromlist=["x"]).quaternion_to_matrix(
         cylinder.orientation))
     assert abs(R[:, 2] @ (0, 0, 1)) == pytest.approx(1.0, abs=1e-3)
 
@@ -392,5 +392,5 @@ def test_collision_disabled_scene_objects_reach_the_world_as_no_collisions(corpu
     bodies = _bodies(plan_problem(load_problem(corpus / "nocollide.xml")))
     assert bodies["can"].no_collisions
     assert not any(b.no_collisions for name, b in bodies.items() if name != "can")
-    from gui.client import WorldClient
+    from gui.ros.client import WorldClient
     assert WorldClient.object_msg(bodies["can"]).no_collisions

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from gui.errors import PathFileError, ShapeError
-from gui.model import PRISMATIC, REVOLUTE
-from gui.paths import DEGREES, double_precision, read_path, refine, to_si
-from gui.shapes import merge_vertices, read_shape
+from gui.core.model import PRISMATIC, REVOLUTE
+from gui.core.paths import DEGREES, double_precision, read_path, refine, to_si
+from gui.core.shapes import merge_vertices, read_shape
 
 
 def test_merge_vertices_merges_within_tolerance_and_drops_collapsed_triangles():

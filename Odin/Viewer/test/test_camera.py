@@ -4,7 +4,7 @@ import math
 import numpy as np
 import pytest
 
-from viewer.camera import Camera
+from viewer.core.camera import Camera
 from viewer.errors import ViewerError
 
 

@@ -3,7 +3,7 @@ import numpy as np
 import trimesh
 
 from odin_common.meshes import cluster_vertices
-from viewer.geometry import DISPLAY_TOLERANCE, mesh_geometry
+from viewer.core.geometry import DISPLAY_TOLERANCE, mesh_geometry
 
 
 def test_dense_mesh_is_simplified_within_tolerance():

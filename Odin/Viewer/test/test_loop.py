@@ -6,11 +6,11 @@ import time
 import pytest
 
 from pixels import is_hue, patch
-from viewer.camera import Camera
+from viewer.core.camera import Camera
 from viewer.errors import ViewerError
-from viewer.loop import RenderLoop
-from viewer.renderer import Renderer
-from viewer.scene import Scene, prepare_view
+from viewer.core.loop import RenderLoop
+from viewer.core.renderer import Renderer
+from viewer.core.scene import Scene, prepare_view
 
 
 def make_loop(rate=50.0, frames=None):

@@ -65,7 +65,7 @@ class Client:
         raise TimeoutError("no new frame from the viewer")
 
     def camera(self):
-        from viewer.camera import Camera
+        from viewer.core.camera import Camera
         answer = self.set_camera()
         assert answer.success, answer.message
         return Camera(eye_W=answer.eye, target_W=answer.target, up_W=answer.up,

@@ -7,9 +7,9 @@ import pytest
 from PIL import Image
 
 from pixels import is_background, is_grey, is_hue, patch
-from viewer.camera import Camera
-from viewer.renderer import Renderer
-from viewer.scene import Scene
+from viewer.core.camera import Camera
+from viewer.core.renderer import Renderer
+from viewer.core.scene import Scene
 
 RED, GREEN, BLUE = (1, 0, 0, 1), (0, 0.8, 0, 1), (0, 0, 1, 1)
 S = math.sqrt(0.5)

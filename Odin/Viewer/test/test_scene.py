@@ -4,9 +4,9 @@ import math
 import numpy as np
 import pytest
 
-from viewer.camera import Camera
+from viewer.core.camera import Camera
 from viewer.errors import ViewerError
-from viewer.scene import COLLIDING_COLOR, DEFAULT_COLOR, Scene, prepare_view
+from viewer.core.scene import COLLIDING_COLOR, DEFAULT_COLOR, Scene, prepare_view
 
 RED = (1.0, 0.0, 0.0, 1.0)
 BLUE = (0.0, 0.0, 1.0, 1.0)

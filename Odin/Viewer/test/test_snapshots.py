@@ -6,7 +6,7 @@ import pytest
 from PIL import Image
 
 from viewer.errors import ViewerError
-from viewer.snapshots import FrameWriter, snapshot_path, write_png
+from viewer.core.snapshots import FrameWriter, snapshot_path, write_png
 
 
 def frame_of(colour, size=(24, 32)):

@@ -6,7 +6,7 @@ import pytest
 import rospy
 
 from Messages.msg import SpaceDistribution
-from virtual_world.conversions import SpaceDistributionWriter
+from virtual_world.portal.conversions import SpaceDistributionWriter
 
 
 def _decode(message) -> SpaceDistribution:

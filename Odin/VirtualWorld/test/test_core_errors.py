@@ -6,7 +6,7 @@ import pytest
 
 from odin_common import OdinError
 from virtual_world import core as vc
-from virtual_world.core import Core, CompositeSpec, ObjectSpec, PartSpec
+from virtual_world.core import Core, CompositeSpec, EntitySpec, ObjectSpec, PartSpec
 from virtual_world.errors import (Closed, CoreError, DuplicateName, InvalidArgument,
                                   Unsupported, UnknownName)
 
@@ -30,7 +30,7 @@ def core():
 def snapshot(c):
     names, positions, quaternions = c.poses()
     return (names, positions.tolist(), quaternions.tolist(), c.object_ids(), c.joint_ids(),
-            c.motor_ids(), c.body_force_ids(), sorted(c._joint_forces), c.world_parameters,
+            c.motor_ids(), c.body_force_ids(), sorted(c.joint_force_ids()), c.world_parameters,
             c.entities(), c.body_state("a")[2].tolist())
 
 
@@ -112,17 +112,18 @@ def test_bad_entities_build_nothing(core):
     before = snapshot(core)
     good, bad = ObjectSpec("g1", [0.1]), ObjectSpec("g2", [0.1], mass=-1)
     with pytest.raises(InvalidArgument):
-        core.build_entity("e", [good, bad], [], False)
+        core.build_entity(EntitySpec("e", [good, bad], [], False))
     with pytest.raises(DuplicateName):
-        core.build_entity("e", [good, ObjectSpec("g1", [0.2])], [], False)
+        core.build_entity(EntitySpec("e", [good, ObjectSpec("g1", [0.2])], [], False))
     with pytest.raises(DuplicateName):
-        core.build_entity("e", [good], [CompositeSpec([PartSpec("g1", [0.1])])], True)
+        core.build_entity(EntitySpec("e", [good], [CompositeSpec([PartSpec("g1", [0.1])])],
+                                     True))
     with pytest.raises(InvalidArgument):
-        core.build_entity("e", [], [], True)
+        core.build_entity(EntitySpec("e", [], [], True))
     assert snapshot(core) == before
-    core.build_entity("e", [good], [], True)
+    core.build_entity(EntitySpec("e", [good], [], True))
     with pytest.raises(DuplicateName):
-        core.build_entity("e", [ObjectSpec("g3", [0.1])], [], True)
+        core.build_entity(EntitySpec("e", [ObjectSpec("g3", [0.1])], [], True))
 
 
 @pytest.mark.parametrize("args,error", [
@@ -185,7 +186,7 @@ def test_joint_parameters_fit_type(core):
     core.set_joint_parameters("1:a&b", [(vc.LO_STOP, 1, -INF), (vc.MAX_FORCE, 1, -1),
                                         (vc.VELOCITY, 1, 0.5), (vc.FUDGE_FACTOR, 1, 0.5)])
     core.set_joint_parameters("motor:1:a&b", [(vc.MAX_FORCE, 1, 2.0), (vc.VELOCITY, 1, 1.0)])
-    assert core._motors["motor:1:a&b"].velocity == [1.0]
+    assert core.motor_goals()["motor:1:a&b"] == [1.0]
 
 
 def test_bad_motors(core):
@@ -213,7 +214,7 @@ def test_bad_motors(core):
     with pytest.raises(InvalidArgument):
         core.set_motor_velocities({"motor:1:a&b": [NAN]})
     assert snapshot(core) == before
-    assert core._motors["motor:1:a&b"].velocity == [0.0]
+    assert core.motor_goals()["motor:1:a&b"] == [0.0]
     core.build_object(ObjectSpec("c", [0.1], position=(2, 0, 1)))
     ball = core.create_joint(vc.BALL, "c", "")
     with pytest.raises(Unsupported):
@@ -299,7 +300,7 @@ def test_world_parameters_apply(core):
     p = core.set_world_parameters(gravity=(0, 0, -1), erp=0.5, friction=-1,
                                   max_angular_speed=0, contact_less=True)
     assert p.gravity == (0.0, 0.0, -1.0) and p.contact_less and p.erp == 0.5
-    assert core._cworld.mu == math.inf and core._cworld.contact_less == 1
+    assert core._scene.c.struct.mu == math.inf and core._scene.c.struct.contact_less == 1
 
 
 def test_closed_core_refuses_calls():

@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 
 from virtual_world import core as vc
-from virtual_world import handles
+from virtual_world.ode import handles
 from virtual_world.core import CompositeSpec, Core, ObjectSpec, PartSpec
-from virtual_world.ode.bindings import ffi
+from virtual_world.ode.bindings import ffi, lib
+from virtual_world.ode.runtime import drain_messages
 
 BOX_V = [x for c in [(-.1, -.1, -.1), (.1, -.1, -.1), (-.1, .1, -.1), (.1, .1, -.1),
                      (-.1, -.1, .1), (.1, -.1, .1), (-.1, .1, .1), (.1, .1, .1)] for x in c]
@@ -50,7 +51,7 @@ def build_scene(core):
 def test_owner_frees_once_and_children_first(spy):
     world = handles.new_world()
     body = handles.new_body(world)
-    joint = handles.new_joint(vc.lib.dJointCreateBall(world.ptr, ffi.NULL), world, [body])
+    joint = handles.new_joint(world, vc.BALL, [body])
     body.close()  # closes the joint attached to it first
     assert joint.closed and body.closed and not world.closed
     body.close()
@@ -131,7 +132,7 @@ def test_new_scene_keeps_world_parameters():
     core = Core()
     core.set_world_parameters(gravity=(0, 0, -1), max_contacts=5)
     core.new_scene()
-    assert core.world_parameters.gravity == (0, 0, -1) and core._cworld.max_contacts == 5
+    assert core.world_parameters.gravity == (0, 0, -1) and core._scene.c.max_contacts == 5
     core.build_object(ObjectSpec("s", [0.1]))
     core.step(0.01, 100)
     assert core.body_state("s")[2][2] == pytest.approx(-1.0)
@@ -161,8 +162,8 @@ def test_poses_are_cheap_arrays():
 
 def test_ode_messages_are_drained_into_logging(caplog):
     Core().close()  # installs the handlers
-    vc.lib.odin_test_message(7, b"hello from ODE")
+    lib.odin_test_message(7, b"hello from ODE")
     with caplog.at_level("WARNING", logger="virtual_world.core"):
-        assert vc.drain_ode_messages() == ["hello from ODE"]
+        assert drain_messages() == ["hello from ODE"]
     assert "hello from ODE" in caplog.text
-    assert vc.drain_ode_messages() == []
+    assert drain_messages() == []

@@ -4,8 +4,10 @@ import math
 import numpy as np
 import pytest
 
+from odin_common.interface import JOINT_FORCE_MAGNITUDES
 from virtual_world import core as vc
 from virtual_world.core import Core, ObjectSpec, WorldParameters
+from virtual_world.errors import UnknownName
 
 
 @pytest.fixture
@@ -161,11 +163,12 @@ def test_contact_policy_reports_last_step_pairs(core):
 
 def test_entity_without_internal_collisions_gets_no_contacts(core):
     core.set_world_parameters(gravity=(0, 0, 0))
-    name, ids = core.build_entity("", [ObjectSpec("a", [0.1]), ObjectSpec("b", [0.1],
-                                  position=(0.15, 0, 0))], [], internal_collisions=False)
-    assert name == "entity1" and ids == ["a", "b"]
-    core.build_entity("robot2", [ObjectSpec("c", [0.1], position=(5, 0, 0)),
-                                 ObjectSpec("d", [0.1], position=(5.15, 0, 0))], [], True)
+    entity = core.build_entity(vc.EntitySpec("", [ObjectSpec("a", [0.1]), ObjectSpec(
+        "b", [0.1], position=(0.15, 0, 0))], [], internal_collisions=False))
+    assert entity.name == "entity1" and entity.ids == ["a", "b"]
+    core.build_entity(vc.EntitySpec("robot2", [ObjectSpec("c", [0.1], position=(5, 0, 0)),
+                                               ObjectSpec("d", [0.1], position=(5.15, 0, 0))],
+                                    [], True))
     core.step(0.001)
     pairs = [(p.first, p.second) for p in core.read_collisions()]
     assert pairs == [("c", "d")]
@@ -250,7 +253,7 @@ def test_composite_mass_centre_id_and_parts(core):
     core.set_world_parameters(gravity=(0, 0, 0))
     parts = [vc.PartSpec("top", [1.0, 1.0, 0.1], mass=3.0, position=(0, 0, 1.0)),
              vc.PartSpec("leg", [0.05, 1.0], mass=1.0, position=(0, 0, 0.5))]
-    cid = core.build_composite(vc.CompositeSpec(parts, position=(2, 0, 0)))
+    cid = core.build_composite(vc.CompositeSpec(parts, position=(2, 0, 0))).id
     assert cid == ">top>leg"
     assert core.geometry_names(cid) == ["top", "leg"]
     mass, com, inertia = core.mass_properties(cid)
@@ -295,7 +298,7 @@ def test_mesh_inertia_of_shifted_box(core):
 
 
 def test_open_mesh_falls_back_to_bounding_box():
-    from virtual_world.mass import mesh_mass
+    from virtual_world.core.mass import mesh_mass
     a = 1.0
     corners = np.array([[x, y, z] for x in (0, a) for y in (0, a) for z in (0, a)])
     faces = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
@@ -333,8 +336,8 @@ def test_every_joint_type_steps_and_reports(core, joint_type, n):
     jid = core.create_joint(joint_type, "a", body2, anchor=(0.15, 0, 1), axis1=(0, 0, 1),
                             axis2=(0, 1, 0), axis3=(1, 0, 0))
     assert jid == f"{joint_type}:a&{body2}"
-    if joint_type in vc._JOINT_FORCE_AXES:
-        core.add_joint_force(jid, [0.1] * vc._JOINT_FORCE_AXES[joint_type])
+    if joint_type in JOINT_FORCE_MAGNITUDES:
+        core.add_joint_force(jid, [0.1] * len(JOINT_FORCE_MAGNITUDES[joint_type]))
     core.step(0.001, 50)
     (state,) = core.joint_states()
     assert len(state.positions) == len(state.rates) == n
@@ -403,5 +406,5 @@ def test_a_mesh_a_few_cells_across_collides_as_given(core):
     core.set_world_parameters(collision_mesh_tolerance=0.01)
     core.build_object(ObjectSpec("bead", vertices, faces.reshape(-1).tolist(), mass=0.01))
     assert core.collision_triangle_count("bead") == len(faces)
-    with pytest.raises(vc.UnknownName):
+    with pytest.raises(UnknownName):
         core.collision_triangle_count("nothing")

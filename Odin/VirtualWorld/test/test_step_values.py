@@ -2,7 +2,7 @@
 import pytest
 
 from virtual_world.errors import InvalidArgument
-from virtual_world.step_values import StepValues, resolve
+from virtual_world.core.step_values import StepValues, resolve
 
 DEFAULT = StepValues()
 

@@ -4,8 +4,8 @@ import time
 
 import pytest
 
-from virtual_world.loop import LoopStopped, RealTimeFactor, WorldLoop
-from virtual_world.step_values import StepValues
+from virtual_world.core.loop import LoopStopped, RealTimeFactor, WorldLoop
+from virtual_world.core.step_values import StepValues
 
 
 class Recorder:

@@ -1,7 +1,7 @@
-"""Odin's GUI package.
+"""Odin's GUI package: Kautham problems and paths turned into the world's requests.
 
-The Core (everything here but ``client``) is ROS-free and Qt-free: it loads Kautham problems,
-robots, shapes and paths, and turns them into plain request data (``gui.build``). ``gui.client``
-is the thin rospy layer that sends those requests to the VirtualWorld; ``gui.cli`` holds the
-``problem_info``, ``load_problem`` and ``run_path`` tools.
+Layers, each a sub-package: ``gui.core`` is ROS-free and Qt-free (Kautham loaders, robot models,
+shapes, kinematics, build plans, path files); ``gui.ros`` is the rospy client of the world's
+services; ``gui.window`` is the Qt window, which talks to the world only through that client.
+``gui.cli`` holds the ``problem_info``, ``load_problem`` and ``run_path`` tools.
 """

@@ -15,7 +15,7 @@ from typing import Optional, Sequence
 import numpy as np
 
 from gui.errors import GuiError
-from gui.kinematics import pose_to_position_quaternion
+from gui.core.kinematics import pose_to_position_quaternion
 
 _JOINT_NAMES = {1: "hinge", 2: "slider", 8: "fixed"}
 
@@ -28,7 +28,7 @@ def _fail(tool: str, error: Exception) -> int:
 
 def describe(plan) -> dict:
     """The JSON-ready description of a plan: bodies at Home and joints (world frame)."""
-    from gui.build import (CompositeRequest, EntityRequest, JointRequest, ObjectRequest)
+    from gui.core.build import (CompositeRequest, EntityRequest, JointRequest, ObjectRequest)
     bodies, joints = [], []
 
     def body(req, entity: Optional[str]):
@@ -74,8 +74,8 @@ def describe(plan) -> dict:
 
 def _kinematic_axis(step) -> list:
     """The joint's axis as the robot model states it (Kautham's sign): a robot's hinges and
-    sliders are sent to the world with the axis reversed (see gui.build)."""
-    from gui.build import JOINT_HINGE, JOINT_SLIDER
+    sliders are sent to the world with the axis reversed (see gui.core.build)."""
+    from gui.core.build import JOINT_HINGE, JOINT_SLIDER
     if step.type in (JOINT_HINGE, JOINT_SLIDER) and step.body1:
         return [-v for v in step.axis1]
     return list(step.axis1)
@@ -88,8 +88,8 @@ def problem_info_main(argv: Optional[Sequence[str]] = None) -> int:
     parser.add_argument("problem", help="problem XML file")
     parser.add_argument("--indent", type=int, default=1, help="JSON indentation (0: compact)")
     args = parser.parse_args(argv)
-    from gui.build import plan_problem
-    from gui.kautham.problem import load_problem
+    from gui.core.build import plan_problem
+    from gui.core.kautham.problem import load_problem
     try:
         plan = plan_problem(load_problem(args.problem))
     except GuiError as error:
@@ -100,7 +100,7 @@ def problem_info_main(argv: Optional[Sequence[str]] = None) -> int:
 
 
 def _step_label(step) -> str:
-    from gui.build import (CompositeRequest, EntityRequest, JointRequest, MotorRequest,
+    from gui.core.build import (CompositeRequest, EntityRequest, JointRequest, MotorRequest,
                            ObjectRequest)
     if isinstance(step, EntityRequest):
         members = step.objects + step.composites
@@ -126,8 +126,8 @@ def load_problem_main(argv: Optional[Sequence[str]] = None) -> int:
     parser.add_argument("--timeout", type=float, default=10.0,
                         help="seconds to wait for the world's services")
     args = parser.parse_args(argv)
-    from gui.build import plan_problem
-    from gui.kautham.problem import load_problem
+    from gui.core.build import plan_problem
+    from gui.core.kautham.problem import load_problem
     started = time.monotonic()
     try:
         plan = plan_problem(load_problem(args.problem))
@@ -137,7 +137,7 @@ def load_problem_main(argv: Optional[Sequence[str]] = None) -> int:
     print(f"loaded {args.problem} in {time.monotonic() - started:.2f} s: {total} requests",
           flush=True)
     try:
-        from gui.client import WorldClient
+        from gui.ros.client import WorldClient
         client = WorldClient(timeout=args.timeout)
         if not args.keep:
             client.new_scene()
@@ -172,9 +172,9 @@ def run_path_main(argv: Optional[Sequence[str]] = None) -> int:
                         help="rows per second (default: the world's publication rate)")
     parser.add_argument("--timeout", type=float, default=10.0)
     args = parser.parse_args(argv)
-    from gui.build import plan_problem
-    from gui.kautham.problem import load_problem
-    from gui.paths import DEGREES, RADIANS, load_robot_path, refine
+    from gui.core.build import plan_problem
+    from gui.core.kautham.problem import load_problem
+    from gui.core.paths import DEGREES, RADIANS, load_robot_path, refine
     try:
         plan = plan_problem(load_problem(args.problem))
         handles = [h for h in plan.robots if args.robot in (None, h.name)]
@@ -188,7 +188,7 @@ def run_path_main(argv: Optional[Sequence[str]] = None) -> int:
         rows = load_robot_path(file, handle, unit)
         if args.position and args.double:
             rows = refine(rows, args.double)
-        from gui.client import WorldClient, run_position_path, run_velocity_path
+        from gui.ros.client import WorldClient, run_position_path, run_velocity_path
         client = WorldClient(timeout=args.timeout)
         if args.initial:
             client.set_position(handle.situations(rows[0]), reset_velocity=True)

@@ -1,7 +1,5 @@
 """Odin's Viewer: renders the world's scene off-screen (OSMesa) and publishes the frames.
 
-Modules: ``geometry`` (shapes, poses, the one (w, x, y, z) quaternion conversion), ``camera``,
-``scene`` (the ROS-free Core), ``renderer`` (OSMesa + fixed-function OpenGL), ``loop`` (the
-render thread that owns the GL context), ``snapshots`` (PNG files inside ``~snapshot_dir``) and
-``portal`` (the ROS node; ``main()``).
+``viewer.core`` is ROS-free (shapes and poses, camera, scene, OSMesa renderer, the render
+thread, PNG snapshots); ``viewer.portal`` is the ROS node over it (``main()``).
 """

@@ -3,14 +3,14 @@
 Each is raised *before* any call into ODE (ODE ends the process on bad input), so a raised
 error means nothing in the simulation changed. Messages name the offending value.
 """
-from odin_common import OdinError
+from odin_common import errors as common
 
 
-class CoreError(OdinError):
+class CoreError(common.OdinError):
     """Root of the VirtualWorld Core's errors."""
 
 
-class InvalidArgument(CoreError, ValueError):
+class InvalidArgument(CoreError, common.InvalidArgument):
     """A value is malformed: non-finite, out of range, wrong count, bad quaternion, ..."""
 
 

@@ -23,12 +23,13 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     from PyQt5.QtCore import QTimer
     from PyQt5.QtWidgets import QApplication
 
+    from gui.ros.parameters import DEFAULTS
     from gui.window.main_window import MainWindow
     args = rospy.myargv(list(argv) if argv is not None else sys.argv)
     app = QApplication(args)
     rospy.init_node("gui", anonymous=False, disable_signals=True)
-    window = MainWindow(world=rospy.get_param("~world", "/virtual_world"),
-                        viewer=rospy.get_param("~viewer", "/viewer"))
+    window = MainWindow(world=rospy.get_param("~world", DEFAULTS["world"]),
+                        viewer=rospy.get_param("~viewer", DEFAULTS["viewer"]))
     window.show()
     signal.signal(signal.SIGINT, lambda *_: app.quit())
     tick = QTimer()

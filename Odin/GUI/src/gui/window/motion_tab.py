@@ -5,7 +5,7 @@ velocity; vectors and points in the world or the body frame. Forces and torques 
 deleted: their IDs (the world's answers) are listed for deletion. Velocities act once.
 Move joint: a force / torque per joint axis (as many magnitudes as the joint type takes), with
 the list of joint forces. Move motor: goal speeds. Move robot: initial position, velocity
-path and position path files (``gui.paths``), optionally refined by double path precision; a
+path and position path files (``gui.core.paths``), optionally refined by double path precision; a
 path runs on a worker of its own (Stop ends it) so the other tabs stay usable meanwhile.
 """
 from __future__ import annotations
@@ -285,7 +285,7 @@ class MotionTab(QWidget):
 
     def run_path(self, kind: str, path: str) -> None:
         """``kind``: "initial", "velocity" or "position"; runs on the path worker."""
-        from gui.paths import DEGREES, RADIANS, load_robot_path, refine
+        from gui.core.paths import DEGREES, RADIANS, load_robot_path, refine
         handle = self.window.scene.robots.get(self.robot.currentText())
         if handle is None:
             self.window.show_error("Move robot: open a problem with a robot first")
@@ -308,7 +308,7 @@ class MotionTab(QWidget):
         name = pathlib.Path(path).name
 
         def work(client, job):
-            from gui.client import run_position_path, run_velocity_path
+            from gui.ros.client import run_position_path, run_velocity_path
             runner = run_position_path if kind == "position" else run_velocity_path
             from gui.window.worker import Cancelled
             try:

@@ -3,8 +3,8 @@
 Create: a free name, a shape from the chooser (sphere, cylinder, box, mesh from a file) whose
 parameter page comes up in a stacked widget with presets, mass (> 0), fixed or static flags,
 position and orientation (a non-zero quaternion, normalised before sending). A mesh file is read
-on the worker: STL/OBJ/PLY through trimesh, .wrl/.iv through Coin (``gui.shapes.read_shape``);
-a file holding primitives too becomes a composite (``gui.build.shape_to_body``).
+on the worker: STL/OBJ/PLY through trimesh, .wrl/.iv through Coin (``gui.core.shapes.read_shape``);
+a file holding primitives too becomes a composite (``gui.core.build.shape_to_body``).
 The list below shows every object in the world (from ``world_update``).
 """
 from __future__ import annotations
@@ -161,7 +161,7 @@ class ObjectsTab(QWidget):
     # -- create -------------------------------------------------------------------------------
     def object_request(self):
         """The (kind, request) to send, or ``InputError`` saying what is missing."""
-        from gui.build import ObjectRequest
+        from gui.core.build import ObjectRequest
         name = self.name.text().strip()
         if not name:
             raise InputError("Create object: type a name for the object")
@@ -262,14 +262,14 @@ class ObjectsTab(QWidget):
 
 def _build_mesh(client, name: str, path: str, scale: float, common: dict):
     """Reads a mesh file and builds it (worker thread); returns (ID, part names or None)."""
-    from gui.build import CompositeRequest, shape_to_body
-    from gui.kinematics import matrix_from_quaternion
-    from gui.shapes import read_shape
+    from gui.core.build import CompositeRequest, shape_to_body
+    from odin_common.rotations import quaternion_to_matrix
+    from gui.core.shapes import read_shape
     shape = read_shape(path, scale)
     if shape.is_empty:
         raise InputError(f"{path}: holds no geometry")
     pose = np.eye(4)
-    pose[:3, :3] = matrix_from_quaternion(common["orientation"])
+    pose[:3, :3] = quaternion_to_matrix(common["orientation"])
     pose[:3, 3] = common["position"]
     request, _ = shape_to_body(name, shape, pose, common["mass"], common["geometry_only"])
     if isinstance(request, CompositeRequest):

@@ -36,7 +36,7 @@ class SceneModel(QObject):
         self.motors: dict = {}          # motor ID -> number of axes
         self.forces: list = []          # external force / torque IDs
         self.joint_forces: list = []    # joint force IDs
-        self.robots: dict = {}          # robot name -> gui.build.RobotHandle
+        self.robots: dict = {}          # robot name -> gui.core.build.RobotHandle
         self.problem_format: Optional[str] = None
 
     # -- from the world's topics -------------------------------------------------------------

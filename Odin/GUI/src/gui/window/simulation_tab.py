@@ -1,7 +1,7 @@
 """First tab (thesis 7.1): open a Kautham problem, New Scene, the tree of what was built and
 the Simulate / Pause button.
 
-Opening runs on the worker: the problem is read and planned (``gui.build.plan_problem``) and
+Opening runs on the worker: the problem is read and planned (``gui.core.build.plan_problem``) and
 sent request by request (``WorldClient.execute``); each answer adds its element to the tree as
 it comes, under its robot (Links, Joints, Motors) or under "Scene objects".
 
@@ -87,8 +87,8 @@ class SimulationTab(QWidget):
         self.status.setText(f"Reading {pathlib.Path(path).name} ...")
 
         def work(client, job):
-            from gui.build import plan_problem
-            from gui.kautham.problem import load_problem
+            from gui.core.build import plan_problem
+            from gui.core.kautham.problem import load_problem
             plan = plan_problem(load_problem(path))
             job.progress(("plan", plan))
             if replace:
@@ -131,7 +131,7 @@ class SimulationTab(QWidget):
                                   progress)
 
     def _start_plan(self, plan, replace: bool) -> None:
-        from gui.build import CompositeRequest, EntityRequest
+        from gui.core.build import CompositeRequest, EntityRequest
         self._plan = plan
         if replace:
             self._clear()
@@ -164,7 +164,7 @@ class SimulationTab(QWidget):
         return item
 
     def _add_step(self, step, answer) -> None:
-        from gui.build import (CompositeRequest, EntityRequest, JointRequest, MotorRequest,
+        from gui.core.build import (CompositeRequest, EntityRequest, JointRequest, MotorRequest,
                                ObjectRequest)
         owner = self._owner_of.get(id(step))
         if isinstance(step, EntityRequest):

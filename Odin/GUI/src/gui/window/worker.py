@@ -1,6 +1,6 @@
 """The Qt side of the world client: service calls on a thread of their own, never the GUI's.
 
-``WorldWorker`` is a ``QThread`` that owns one ``gui.client.WorldClient`` (persistent service
+``WorldWorker`` is a ``QThread`` that owns one ``gui.ros.client.WorldClient`` (persistent service
 proxies are not shared between threads) and runs *jobs* from a queue one at a time. A job is a
 callable ``fn(client, job) -> result``; its result or the error's message comes back to the GUI
 thread through Qt signals (queued connections), where the ``on_done`` / ``on_error``
@@ -215,7 +215,7 @@ class WorldWorker(QThread):
             self._set_connected(False, f"VirtualWorld absent: waiting for {self.namespace}")
             return
         if self._client is None:
-            from gui.client import WorldClient
+            from gui.ros.client import WorldClient
             try:
                 self._client = WorldClient(self.namespace, timeout=2.0)
             except (WorldError, Exception) as error:  # a world coming up or going down

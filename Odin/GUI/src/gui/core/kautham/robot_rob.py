@@ -1,0 +1,145 @@
+"""Kautham's DH robot files: 2012 ``.rob`` (mm, degrees) and 2017-2021 ``.dh`` (m, radians).
+
+    <Robot name DHType="Standard|Modified" robType="Chain|Tree|Freeflying">
+      <Joints size><Joint name ivFile>
+          <DHPars alpha a theta d/> <PreTrans X Y Z WX WY WZ TH/>
+          <Description rotational movable/> <Limits Hi Low/> <Weight weight/> <Parent name/>
+      </Joint>...</Joints>
+      <ControlSet>...</ControlSet>        (optional; see gui.core.kautham.controls)
+    </Robot>
+
+Lengths (a, d, PreTrans X/Y/Z, prismatic limits) and the link geometry are multiplied by the
+problem's ``scale`` and the file's length unit; angles are converted to radians. A missing
+``<Parent>`` means the previous joint (a chain); ``<Parent name="">`` the robot's base.
+``<WeightSE3>`` (planner weights) is read past.
+"""
+from __future__ import annotations
+
+import math
+import pathlib
+
+import numpy as np
+
+from gui.errors import ProblemError
+from gui.core.kautham.controls import parse_control_set
+from gui.core.kautham.units import LEGACY, SI, Units
+from gui.core.kautham.xmlfile import Node, read_xml
+from gui.core.kinematics import pose_from_axis_angle, rot_x, rot_z, translation
+from gui.core.model import FIXED, PRISMATIC, REVOLUTE, LinkModel, RobotModel
+from gui.core.shapes import read_shape
+
+DH_TYPES = ("Standard", "Modified")
+
+
+def units_of(path: pathlib.Path) -> Units:
+    return SI if path.suffix.lower() == ".dh" else LEGACY
+
+
+def read_dh_robot(path: pathlib.Path, scale: float = 1.0) -> RobotModel:
+    """Reads a .rob/.dh file with its link geometry; everything in SI."""
+    units = units_of(path)
+    root = read_xml(path, "robot file")
+    if root.tag != "Robot":
+        raise root.error(f"expected a <Robot> element, found <{root.tag}>")
+    name = root.get("name") or path.stem
+    dh_raw = root.get("DHType", "Standard").strip()
+    matches = [t for t in DH_TYPES if t.lower() == dh_raw.lower()]
+    if not matches:
+        raise root.error(f"unknown DHType=\"{dh_raw}\" (expected Standard or Modified)")
+    dh_type = matches[0]
+    joints_node = root.find("Joints")
+    joints = list(joints_node.findall("Joint")) if joints_node is not None else []
+    if not joints:
+        raise root.error("has no <Joints> with <Joint> elements")
+    length = units.length * scale
+    links: list[LinkModel] = []
+    index: dict[str, int] = {}
+    for k, joint in enumerate(joints):
+        link = _read_link(joint, k, links, index, dh_type, units, length, path)
+        if link.name in index:
+            raise joint.error(f"a second joint named \"{link.name}\"")
+        index[link.name] = len(links)
+        links.append(link)
+    controls = None
+    cs = root.find("ControlSet")
+    if cs is not None:
+        controls = parse_control_set(cs)
+    return RobotModel(name=name, links=links, source=str(path), kind="rob", dh_type=dh_type,
+                      controls=controls)
+
+
+def _read_link(joint: Node, k: int, links: list, index: dict, dh_type: str, units: Units,
+               length: float, path: pathlib.Path) -> LinkModel:
+    name = joint.require("name")
+    desc = joint.find("Description")
+    rotational = desc.flag("rotational", True) if desc is not None else True
+    movable = desc.flag("movable", True) if desc is not None else True
+    kind = FIXED if not movable else (REVOLUTE if rotational else PRISMATIC)
+    dh = joint.find("DHPars")
+    if dh is not None:
+        alpha = dh.number("alpha", 0.0) * units.angle
+        a = dh.number("a", 0.0) * length
+        theta = dh.number("theta", 0.0) * units.angle
+        d = dh.number("d", 0.0) * length
+    else:
+        alpha = a = theta = d = 0.0
+    pre_trans = np.eye(4)
+    pt = joint.find("PreTrans")
+    if pt is not None:
+        pre_trans = pose_from_axis_angle(
+            [pt.number(c, 0.0) * length for c in ("X", "Y", "Z")],
+            [pt.number(c, 0.0) for c in ("WX", "WY", "WZ")],
+            pt.number("TH", 0.0) * units.angle)
+    if dh_type == "Standard":
+        pre = pre_trans @ rot_z(theta)
+        post = translation(0, 0, d) @ translation(a, 0, 0) @ rot_x(alpha)
+        if kind == PRISMATIC:
+            pre, post = pre @ translation(0, 0, d), translation(a, 0, 0) @ rot_x(alpha)
+    else:
+        pre = pre_trans @ rot_x(alpha) @ translation(a, 0, 0) @ rot_z(theta)
+        post = translation(0, 0, d)
+        if kind == PRISMATIC:
+            pre, post = pre @ translation(0, 0, d), np.eye(4)
+    limits = None
+    lim = joint.find("Limits")
+    if lim is not None and kind != FIXED:
+        factor = units.angle if kind == REVOLUTE else length
+        low, high = lim.number("Low") * factor, lim.number("Hi") * factor
+        if low > high:
+            raise lim.error(f"Low={lim.get('Low')} is above Hi={lim.get('Hi')}")
+        limits = (low, high)
+    mass = None
+    weight = joint.find("Weight")
+    if weight is not None and weight.get("weight") is not None:
+        mass = weight.number("weight")
+        if mass <= 0:
+            raise weight.error(f"weight=\"{weight.get('weight')}\" must be positive")
+    parent_node = joint.find("Parent")
+    if parent_node is None:
+        parent = len(links) - 1 if links else None
+    else:
+        pname = (parent_node.get("name") or "").strip()
+        if not pname:
+            parent = None
+            if links:
+                raise parent_node.error(f"joint \"{name}\" has an empty parent but is not "
+                                        "the first joint")
+        elif pname not in index:
+            raise parent_node.error(f"parent \"{pname}\" of joint \"{name}\" is not a joint "
+                                    "defined before it")
+        else:
+            parent = index[pname]
+    iv = joint.get("ivFile")
+    shape = None
+    if iv:
+        shape = read_shape(path.parent / iv, length)
+    return LinkModel(name=name, parent=parent, pre=pre, post=post, joint=kind,
+                     limits=limits, mass=mass, shape=shape, source=str(path), line=joint.line)
+
+
+def read_shape_robot(path: pathlib.Path, scale: float, units: Units) -> RobotModel:
+    """A robot or obstacle given as a bare geometry file: one free link."""
+    shape = read_shape(path, units.length * scale)
+    link = LinkModel(name=path.stem, parent=None, pre=np.eye(4), post=np.eye(4),
+                     shape=shape, source=str(path))
+    return RobotModel(name=path.stem, links=[link], source=str(path), kind="shape")

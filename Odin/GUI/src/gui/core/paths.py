@@ -1,0 +1,117 @@
+"""Path files (thesis 7.4.3) and what they become: Set Position and Set Velocity data.
+
+A path file is plain text, one configuration per line: the values of the robot's movable
+joints in the robot file's order, separated by spaces, tabs or commas. Blank lines and lines
+starting with '#' are skipped. Units: 2012 Kautham files are in degrees (and mm for prismatic
+joints), current ones in radians (and m); ``read_path(..., units=...)`` converts to SI. A Kautham
+task file (``<Conf>`` elements, current format, radians) is read too. Velocity paths hold one
+motor-speed row per publication cycle (deg/s or rad/s; mm/s or m/s).
+
+- Initial position: one row -> forward kinematics -> one Set Position with every link.
+- Position path: each row -> one Set Position per cycle.
+- Velocity path: each row -> one Set Velocity (all motors) per cycle.
+- "Double path precision": ``double_precision(rows)`` inserts the midpoint between consecutive
+  rows (linear interpolation, thesis 8.3); apply it n times for 2^n finer paths.
+"""
+from __future__ import annotations
+
+import math
+import os
+import pathlib
+import re
+from typing import Optional
+
+import numpy as np
+
+from gui.errors import PathFileError
+from gui.core.kautham.xmlfile import read_xml
+from gui.core.model import PRISMATIC
+
+DEGREES, RADIANS = "degrees", "radians"
+_SPLIT = re.compile(r"[\s,;]+")
+
+
+def read_path(path: os.PathLike | str, n_values: Optional[int] = None) -> np.ndarray:
+    """Rows of numbers as written in the file (no unit conversion): (rows, n_values).
+
+    Every row must have ``n_values`` numbers (or as many as the first row)."""
+    p = pathlib.Path(path)
+    if not p.is_file():
+        raise PathFileError("path file not found", p)
+    text = p.read_text(errors="replace")
+    if text.lstrip().startswith("<"):
+        root = read_xml(p, "task file")
+        lines = [(c.line, c.text) for c in _iter(root) if c.tag == "Conf"]
+    else:
+        lines = list(enumerate(text.splitlines(), start=1))
+    rows = []
+    for number, line in lines:
+        line = line.strip()
+        if not line or line.startswith("#"):
+            continue
+        parts = [t for t in _SPLIT.split(line) if t]
+        try:
+            row = [float(t) for t in parts]
+        except ValueError:
+            bad = next(t for t in parts if not _is_number(t))
+            raise PathFileError(f"{bad!r} is not a number", p, number) from None
+        if not all(math.isfinite(v) for v in row):
+            raise PathFileError("a value is not finite", p, number)
+        expected = n_values if n_values is not None else (len(rows[0]) if rows else len(row))
+        if len(row) != expected:
+            raise PathFileError(f"{len(row)} values, expected {expected} (one per movable "
+                                "joint)", p, number)
+        rows.append(row)
+    if not rows:
+        raise PathFileError("holds no configuration", p)
+    return np.array(rows, dtype=float)
+
+
+def _is_number(token: str) -> bool:
+    try:
+        float(token)
+        return True
+    except ValueError:
+        return False
+
+
+def _iter(node):
+    yield node
+    for child in node.children:
+        yield from _iter(child)
+
+
+def to_si(rows: np.ndarray, joint_kinds: list, units: str) -> np.ndarray:
+    """Converts rows in ``units`` (DEGREES: deg and mm; RADIANS: rad and m) to rad and m."""
+    if units == RADIANS:
+        return np.asarray(rows, dtype=float)
+    if units != DEGREES:
+        raise ValueError(f"units must be {DEGREES!r} or {RADIANS!r}, not {units!r}")
+    factors = np.array([0.001 if kind == PRISMATIC else math.pi / 180.0
+                        for kind in joint_kinds])
+    return np.asarray(rows, dtype=float) * factors
+
+
+def double_precision(rows: np.ndarray) -> np.ndarray:
+    """Inserts the midpoint between every two consecutive rows: n rows -> 2n - 1."""
+    rows = np.asarray(rows, dtype=float)
+    if len(rows) < 2:
+        return rows.copy()
+    out = np.empty((2 * len(rows) - 1, rows.shape[1]))
+    out[0::2] = rows
+    out[1::2] = 0.5 * (rows[:-1] + rows[1:])
+    return out
+
+
+def refine(rows: np.ndarray, times: int) -> np.ndarray:
+    for _ in range(times):
+        rows = double_precision(rows)
+    return rows
+
+
+def load_robot_path(path: os.PathLike | str, handle, units: str) -> np.ndarray:
+    """Reads a path file for the robot ``handle`` (gui.core.build.RobotHandle) in SI units."""
+    model = handle.instance.model
+    kinds = [model.links[i].joint for i in model.movable_links()]
+    rows = read_path(path, len(kinds))
+    return to_si(rows, kinds, units)

@@ -1,0 +1,356 @@
+"""Geometry files -> Odin shapes: triangle meshes and primitives, in metres.
+
+Readers:
+- VRML 1.0 / 2.0 and Inventor 2.x (every dialect in Kautham's corpus, including "VRML 1.0"
+  headers over Coin's VRML node names and .wrl files that are Inventor) through Coin3D (pivy):
+  ``SoDB.readAll`` then a ``SoCallbackAction`` whose triangle callback receives each shape's
+  triangles in that shape's *object* space (contrary to what one might expect); the shape's
+  model matrix, taken in a pre-callback, is applied afterwards with numpy, one shape at a time. Spheres, cylinders and cubes are *not* triangulated: Coin tessellates them as open
+  meshes, so they stay ODE primitives (a pre-callback records them with their model matrix and
+  prunes them).
+- STL, OBJ, PLY, OFF, GLB... through trimesh (imported only when such a file is read).
+
+Mapping a file to Odin (``Shape``):
+- Triangles of every non-primitive node, in the file's frame, become one ``Mesh``; duplicate
+  vertices are merged within ``ShapeDefaults.merge_tolerance`` (vectorised: vertices are
+  snapped to a grid of that pitch and made unique with numpy, O(n log n) instead of the thesis's
+  quadratic loop) and triangles that collapse are dropped.
+- Each primitive becomes a ``Primitive`` with Odin's parameters (sphere: radius; cylinder:
+  radius, length along z -- Inventor's cylinders are along y, so the part's frame is rotated by
+  -90 degrees about x; box: x, y, z sides) and its pose in the file's frame.
+- ``gui.core.build`` turns a shape made only of a mesh into a mesh object, one made of a single
+  primitive into a primitive object whose body sits at the primitive's pose, and anything mixed
+  into a composite (one body, one part per primitive plus one for the mesh).
+- Colour: the diffuse colour (and 1 - transparency as alpha) of the first shape node; a mesh
+  takes the colour of the node that gave it the most triangles.
+"""
+from __future__ import annotations
+
+import contextlib
+import os
+import pathlib
+import re
+import tempfile
+from dataclasses import dataclass, field, replace
+from typing import Optional
+
+import numpy as np
+
+from gui.errors import ShapeError
+from gui.core.kinematics import rot_x
+
+COIN_SUFFIXES = (".wrl", ".iv", ".vrml")
+TRIMESH_SUFFIXES = (".stl", ".obj", ".ply", ".off", ".glb", ".gltf", ".dae")
+
+
+@dataclass(frozen=True)
+class ShapeDefaults:
+    """Tunables of shape reading."""
+    merge_tolerance: float = 1e-6   # m: vertices closer than about this are merged
+    default_color: tuple = (0.0, 0.0, 0.0, 0.0)  # all zero: the Viewer's default colour
+
+
+DEFAULTS = ShapeDefaults()
+
+
+@dataclass(frozen=True, eq=False)
+class Mesh:
+    """A triangle mesh: ``vertices`` (N, 3) float64, m; ``triangles`` (M, 3) uint32,
+    counter-clockwise seen from outside as the file gives them."""
+    vertices: np.ndarray
+    triangles: np.ndarray
+    color: tuple = DEFAULTS.default_color
+
+
+@dataclass(frozen=True, eq=False)
+class Primitive:
+    """A sphere, cylinder (along its frame's z) or box; ``parameters`` as in Object.msg (m);
+    ``pose`` (4, 4): the primitive's frame in the shape's frame."""
+    kind: str
+    parameters: tuple
+    pose: np.ndarray
+    color: tuple = DEFAULTS.default_color
+
+
+@dataclass(frozen=True, eq=False)
+class Shape:
+    """What one geometry file holds, in metres, in the file's (link's) frame."""
+    source: str
+    mesh: Optional[Mesh] = None
+    primitives: tuple = field(default_factory=tuple)
+
+    @property
+    def triangle_count(self) -> int:
+        return 0 if self.mesh is None else int(len(self.mesh.triangles))
+
+    @property
+    def is_empty(self) -> bool:
+        return self.mesh is None and not self.primitives
+
+    def transformed(self, T: np.ndarray) -> "Shape":
+        """The same shape with every coordinate mapped through the rigid pose ``T``."""
+        mesh = self.mesh
+        if mesh is not None:
+            v = mesh.vertices @ T[:3, :3].T + T[:3, 3]
+            mesh = replace(mesh, vertices=v)
+        prims = tuple(replace(p, pose=T @ p.pose) for p in self.primitives)
+        return replace(self, mesh=mesh, primitives=prims)
+
+    def with_color(self, color: tuple) -> "Shape":
+        mesh = None if self.mesh is None else replace(self.mesh, color=tuple(color))
+        prims = tuple(replace(p, color=tuple(color)) for p in self.primitives)
+        return replace(self, mesh=mesh, primitives=prims)
+
+    def merged(self, other: "Shape") -> "Shape":
+        """Both shapes in one (meshes concatenated, primitives appended)."""
+        mesh = self.mesh
+        if other.mesh is not None:
+            if mesh is None:
+                mesh = other.mesh
+            else:
+                tri = np.vstack([mesh.triangles, other.mesh.triangles + len(mesh.vertices)])
+                mesh = Mesh(np.vstack([mesh.vertices, other.mesh.vertices]),
+                            tri.astype(np.uint32), mesh.color)
+        return Shape(self.source, mesh, self.primitives + other.primitives)
+
+
+def merge_vertices(corners: np.ndarray, tolerance: float = DEFAULTS.merge_tolerance
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """Merges duplicate vertices of a triangle soup.
+
+    corners: (M, 3, 3) or (3M, 3) float, the three corners of each triangle.
+    Returns (vertices (N, 3), triangles (K, 3) uint32), K <= M: triangles whose corners merged
+    into fewer than three vertices are dropped. Vertices are snapped to a grid of pitch
+    ``tolerance`` (so points closer than half of it always merge, points farther than it never
+    do); each merged vertex is the mean of the points that merged into it.
+    """
+    pts = np.asarray(corners, dtype=np.float64).reshape(-1, 3)
+    if len(pts) == 0:
+        return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.uint32)
+    if len(pts) % 3:
+        raise ValueError("corners must come three per triangle")
+    keys = np.round(pts / tolerance).astype(np.int64)
+    keys = np.ascontiguousarray(keys)
+    view = keys.view(np.dtype((np.void, keys.dtype.itemsize * 3))).ravel()
+    _, first, inverse = np.unique(view, return_index=True, return_inverse=True)
+    counts = np.bincount(inverse)
+    vertices = np.zeros((len(first), 3))
+    for axis in range(3):
+        vertices[:, axis] = np.bincount(inverse, weights=pts[:, axis]) / counts
+    tri = inverse.reshape(-1, 3)
+    keep = (tri[:, 0] != tri[:, 1]) & (tri[:, 1] != tri[:, 2]) & (tri[:, 0] != tri[:, 2])
+    tri = tri[keep]
+    # Renumber so that only used vertices remain.
+    used = np.unique(tri)
+    if len(used) != len(vertices):
+        remap = np.full(len(vertices), -1, dtype=np.int64)
+        remap[used] = np.arange(len(used))
+        vertices = vertices[used]
+        tri = remap[tri]
+    return vertices, tri.astype(np.uint32)
+
+
+# -- reading ----------------------------------------------------------------------------------
+
+_CACHE: dict = {}
+
+
+def read_shape(path: os.PathLike | str, scale: float = 1.0,
+               defaults: ShapeDefaults = DEFAULTS) -> Shape:
+    """Reads a geometry file and returns its ``Shape`` with coordinates multiplied by
+    ``scale`` (the file unit in metres times the problem's scale: 0.001 for a millimetre file
+    at scale 1). Reading is cached in this process by (file, scale): the SAH hand uses each
+    finger file four times."""
+    p = pathlib.Path(path)
+    key = (str(p.resolve()) if p.exists() else str(p), float(scale), defaults)
+    shape = _CACHE.get(key)
+    if shape is None:
+        raw = _read_raw(p)
+        shape = _finish(raw, scale, defaults, str(p))
+        _CACHE[key] = shape
+    return shape
+
+
+@dataclass
+class _Raw:
+    corners: np.ndarray                  # (M, 3, 3) file units
+    tri_colors: list                     # [(count, color)]
+    primitives: list                     # [(kind, dims (file units), pose 4x4 file units, color)]
+
+
+def _finish(raw: _Raw, scale: float, defaults: ShapeDefaults, source: str) -> Shape:
+    mesh = None
+    if len(raw.corners):
+        vertices, triangles = merge_vertices(raw.corners * scale, defaults.merge_tolerance)
+        if len(triangles):
+            color = max(raw.tri_colors, key=lambda c: c[0])[1] if raw.tri_colors else \
+                defaults.default_color
+            mesh = Mesh(vertices, triangles, color)
+    prims = []
+    for kind, dims, pose, color in raw.primitives:
+        T = pose.copy()
+        T[:3, 3] *= scale
+        prims.append(Primitive(kind, tuple(float(d) * scale for d in dims), T, color))
+    shape = Shape(source, mesh, tuple(prims))
+    if shape.is_empty:
+        raise ShapeError("holds no geometry (no triangles and no sphere, cylinder or cube)",
+                         source)
+    return shape
+
+
+def _read_raw(p: pathlib.Path) -> _Raw:
+    if not p.is_file():
+        raise ShapeError("geometry file not found", p)
+    suffix = p.suffix.lower()
+    if suffix in TRIMESH_SUFFIXES:
+        return _read_trimesh(p)
+    return _read_coin(p)
+
+
+def _read_trimesh(p: pathlib.Path) -> _Raw:
+    import trimesh  # slow to import: only when such a file is read
+    try:
+        loaded = trimesh.load(str(p), force="mesh", process=False)
+    except Exception as error:  # trimesh raises many kinds; all mean "does not parse"
+        raise ShapeError(f"does not parse as a mesh: {error}", p) from None
+    corners = np.asarray(loaded.triangles, dtype=np.float64) if len(loaded.faces) else \
+        np.zeros((0, 3, 3))
+    color = DEFAULTS.default_color
+    try:
+        rgba = np.asarray(loaded.visual.main_color, dtype=float) / 255.0
+        color = tuple(float(c) for c in rgba)
+    except Exception:  # no colour information: keep the default
+        pass
+    return _Raw(corners, [(len(corners), color)], [])
+
+
+_coin = None
+
+
+def _coin_module():
+    global _coin
+    if _coin is None:
+        from pivy import coin
+        coin.SoDB.init()
+        _coin = coin
+    return _coin
+
+
+@contextlib.contextmanager
+def _captured_stderr():
+    """Coin prints read errors on the C stderr; capture them to name the line."""
+    captured = {"text": ""}
+    with tempfile.TemporaryFile() as tmp:
+        try:
+            saved = os.dup(2)
+        except OSError:
+            yield captured
+            return
+        os.dup2(tmp.fileno(), 2)
+        try:
+            yield captured
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            tmp.seek(0)
+            captured["text"] = tmp.read().decode(errors="replace")
+
+
+def _read_coin(p: pathlib.Path) -> _Raw:
+    coin = _coin_module()
+    inp = coin.SoInput()
+    with _captured_stderr() as err:
+        opened = inp.openFile(str(p))
+        root = coin.SoDB.readAll(inp) if opened else None
+        if opened:
+            inp.closeFile()
+    if root is None:
+        text = err["text"]
+        match = re.search(r"line\s+(\d+)", text)
+        first = text.strip().splitlines()[0] if text.strip() else "unknown error"
+        first = first.replace("Coin read error: ", "")
+        raise ShapeError(f"does not parse as VRML/Inventor: {first}", p,
+                         int(match.group(1)) if match else None)
+    root.ref()
+    try:
+        return _collect(coin, root)
+    finally:
+        root.unref()
+
+
+_PRIMITIVE_TYPES = ("SoSphere", "SoCylinder", "SoCube")
+
+
+def _collect(coin, root) -> _Raw:
+    tris: list = []
+    tri_colors: list = []
+    prims: list = []
+    current = {"color": DEFAULTS.default_color, "start": 0, "pose": np.eye(4)}
+    lazy = coin.SoLazyElement
+
+    def color_of(action):
+        state = action.getState()
+        d = lazy.getDiffuse(state, 0).getValue()
+        t = lazy.getTransparency(state, 0)
+        return (float(d[0]), float(d[1]), float(d[2]), float(1.0 - t))
+
+    def model_pose(action):
+        m = action.getModelMatrix()
+        rows = np.array(m.getValue(), dtype=np.float64)
+        return rows.T  # Coin's matrices act on row vectors
+
+    def on_primitive(_data, action, node):
+        T = model_pose(action)
+        R = T[:3, :3]
+        s = np.linalg.norm(R, axis=0)
+        s[s == 0] = 1.0
+        T[:3, :3] = R / s
+        name = node.getTypeId().getName().getString()
+        color = color_of(action)
+        if name == "Sphere":
+            dims = (node.radius.getValue() * float(np.mean(s)),)
+            prims.append(("sphere", dims, T, color))
+        elif name == "Cylinder":
+            dims = (node.radius.getValue() * float((s[0] + s[2]) / 2),
+                    node.height.getValue() * float(s[1]))
+            prims.append(("cylinder", dims, T @ rot_x(-np.pi / 2), color))
+        else:
+            dims = (node.width.getValue() * float(s[0]), node.height.getValue() * float(s[1]),
+                    node.depth.getValue() * float(s[2]))
+            prims.append(("box", dims, T, color))
+        return coin.SoCallbackAction.PRUNE
+
+    runs: list = []   # (first triangle, end, model pose (4, 4), colour) per shape node
+
+    def on_shape(_data, action, node):
+        _close_run()
+        current["color"] = color_of(action)
+        current["pose"] = model_pose(action)
+        current["start"] = len(tris)
+        return coin.SoCallbackAction.CONTINUE
+
+    def _close_run():
+        n = len(tris) - current["start"]
+        if n:
+            runs.append((current["start"], len(tris), current["pose"], current["color"]))
+            tri_colors.append((n, current["color"]))
+        current["start"] = len(tris)
+
+    def on_triangle(_data, _action, v1, v2, v3):
+        # SoCallbackAction gives the corners in the shape's object space.
+        tris.append((v1.getPoint().getValue(), v2.getPoint().getValue(),
+                     v3.getPoint().getValue()))
+
+    action = coin.SoCallbackAction()
+    for type_name in _PRIMITIVE_TYPES:
+        action.addPreCallback(getattr(coin, type_name).getClassTypeId(), on_primitive, None)
+    action.addPreCallback(coin.SoShape.getClassTypeId(), on_shape, None)
+    action.addTriangleCallback(coin.SoShape.getClassTypeId(), on_triangle, None)
+    action.apply(root)
+    _close_run()
+    corners = np.array(tris, dtype=np.float64).reshape(-1, 3, 3)
+    for start, end, pose, _color in runs:
+        if not np.allclose(pose, np.eye(4)):
+            block = corners[start:end]
+            corners[start:end] = block @ pose[:3, :3].T + pose[:3, 3]
+    return _Raw(corners, tri_colors, prims)

@@ -1,0 +1,249 @@
+"""The facts of Odin's ROS interface, written once, for every node and tool (ROS-free).
+
+The constants of the .msg and .srv files as ``IntEnum``s (a test pins each one to the
+generated message classes), what each joint type takes, the thesis's shape-by-parameter-count
+rule, the composite-ID rule, and the services each node offers with their types.
+"""
+from __future__ import annotations
+
+from enum import IntEnum
+from typing import Any, Dict, NamedTuple, Sequence, Tuple
+
+from odin_common.errors import InvalidArgument
+
+
+class JointType(IntEnum):
+    """Messages/Joint: the joint types of Set Joint, JointData and joint IDs."""
+    BALL = 0
+    HINGE = 1
+    SLIDER = 2
+    PISTON = 3
+    UNIVERSAL = 4
+    HINGE2 = 5
+    PR = 6
+    PU = 7
+    FIXED = 8
+    PLANE2D = 9
+
+    @property
+    def label(self) -> str:
+        """Lower-case name for messages ("hinge2", "plane2d")."""
+        return self.name.lower()
+
+
+class JointParameter(IntEnum):
+    """Messages/JointParameter: ODE joint (and motor) parameters, set per axis 1..3."""
+    LO_STOP = 0          # rad or m
+    HI_STOP = 1          # rad or m
+    BOUNCE = 2           # restitution of the stops, [0, 1]
+    CFM = 3              # >= 0
+    ERP = 4              # [0, 1]
+    STOP_ERP = 5         # [0, 1]
+    STOP_CFM = 6         # >= 0
+    SUSPENSION_ERP = 7   # hinge2 only, [0, 1]
+    SUSPENSION_CFM = 8   # hinge2 only, >= 0
+    FUDGE_FACTOR = 9     # [0, 1]
+    VELOCITY = 10        # motor goal: rad/s or m/s
+    MAX_FORCE = 11       # motor limit: N m or N; negative means infinite
+
+    @property
+    def label(self) -> str:
+        return self.name.lower()
+
+
+class SetJointAction(IntEnum):
+    """Services/SetJoint ``action``."""
+    CREATE = 0
+    SET_PARAMETERS = 1
+    REMOVE = 2
+
+
+class MotorKind(IntEnum):
+    """Services/SetMotor ``kind``: dAMotor (rad/s, N m) or dLMotor (m/s, N)."""
+    ANGULAR = 0
+    LINEAR = 1
+
+
+class AxisFrame(IntEnum):
+    """Services/SetMotor ``axis_frames``: the frame a motor axis stays fixed in."""
+    GLOBAL = 0
+    FIRST_BODY = 1
+    SECOND_BODY = 2
+
+
+class ForceKind(IntEnum):
+    """Services/SetExternalForce ``kind``."""
+    FORCE = 0            # N
+    TORQUE = 1           # N m
+
+
+class Solver(IntEnum):
+    """Services/SetWorld ``solver``."""
+    QUICKSTEP = 0        # dWorldQuickStep: iterative, handles piles
+    WORLDSTEP = 1        # dWorldStep: the thesis's exact "big matrix" solver
+
+
+# ---------------------------------------------------------------------------------- joints
+
+JOINT_AXES_USED: Dict[JointType, Tuple[str, ...]] = {
+    JointType.BALL: (), JointType.HINGE: ("axis1",), JointType.SLIDER: ("axis1",),
+    JointType.PISTON: ("axis1",), JointType.UNIVERSAL: ("axis1", "axis2"),
+    JointType.HINGE2: ("axis1", "axis2"), JointType.PR: ("axis1", "axis2"),
+    JointType.PU: ("axis1", "axis2", "axis3"), JointType.FIXED: (), JointType.PLANE2D: (),
+}
+"""Which of Set Joint's axis1..axis3 each joint type reads (world frame)."""
+
+JOINT_USES_ANCHOR = frozenset(set(JointType) - {JointType.SLIDER, JointType.FIXED,
+                                                JointType.PLANE2D})
+"""Joint types whose ``anchor`` (m, world) is used."""
+
+JOINT_FORCE_MAGNITUDES: Dict[JointType, Tuple[str, ...]] = {
+    JointType.HINGE: ("torque",), JointType.SLIDER: ("force",),
+    JointType.PISTON: ("force",), JointType.UNIVERSAL: ("torque1", "torque2"),
+    JointType.HINGE2: ("torque1", "torque2"),
+    JointType.PR: ("force along axis1", "torque about axis2"),
+    JointType.PU: ("torque about axis1", "torque about axis2"),
+    JointType.BALL: ("torque x (world)", "torque y (world)", "torque z (world)"),
+}
+"""The magnitudes Set Joint Force takes per joint type, in order (N for forces, N m for
+torques). ODE's sign convention: a positive magnitude acts on body1 along (about) +axis and the
+reaction on body2. Fixed and plane-2D joints take none."""
+
+JOINT_STATE_AXES: Dict[JointType, Tuple[str, ...]] = {
+    JointType.HINGE: ("angle",), JointType.SLIDER: ("position",),
+    JointType.PISTON: ("position", "angle"), JointType.UNIVERSAL: ("angle1", "angle2"),
+    JointType.HINGE2: ("angle1", "angle2"), JointType.PR: ("position", "angle"),
+    JointType.PU: ("position", "angle1", "angle2"),
+}
+"""What JointData's positions/rates hold per joint type (rad or m; rad/s or m/s); ball, fixed
+and plane-2D joints report none."""
+
+_LIMIT_PARAMETERS = frozenset({JointParameter.LO_STOP, JointParameter.HI_STOP,
+                               JointParameter.BOUNCE, JointParameter.CFM, JointParameter.ERP,
+                               JointParameter.STOP_ERP, JointParameter.STOP_CFM,
+                               JointParameter.FUDGE_FACTOR, JointParameter.VELOCITY,
+                               JointParameter.MAX_FORCE})
+MOTOR_PARAMETERS = _LIMIT_PARAMETERS
+"""Parameters a motor takes on each of its axes."""
+
+JOINT_PARAMETERS: Dict[JointType, frozenset] = {
+    JointType.BALL: frozenset({JointParameter.CFM, JointParameter.ERP}),
+    JointType.FIXED: frozenset({JointParameter.CFM, JointParameter.ERP}),
+    JointType.HINGE: _LIMIT_PARAMETERS, JointType.SLIDER: _LIMIT_PARAMETERS,
+    JointType.PISTON: _LIMIT_PARAMETERS, JointType.UNIVERSAL: _LIMIT_PARAMETERS,
+    JointType.PR: _LIMIT_PARAMETERS, JointType.PU: _LIMIT_PARAMETERS,
+    JointType.HINGE2: _LIMIT_PARAMETERS | {JointParameter.SUSPENSION_ERP,
+                                           JointParameter.SUSPENSION_CFM},
+}
+"""Parameters each joint type takes (plane-2D takes none)."""
+
+JOINT_PARAMETER_AXES: Dict[JointType, int] = {
+    JointType.BALL: 1, JointType.HINGE: 1, JointType.SLIDER: 1, JointType.PISTON: 2,
+    JointType.UNIVERSAL: 2, JointType.HINGE2: 2, JointType.PR: 2, JointType.PU: 3,
+    JointType.FIXED: 1,
+}
+"""Parameter groups (axes 1..n) each joint type has."""
+
+UNIT_PARAMETERS = frozenset({JointParameter.ERP, JointParameter.STOP_ERP,
+                             JointParameter.SUSPENSION_ERP, JointParameter.BOUNCE,
+                             JointParameter.FUDGE_FACTOR})
+"""Parameters whose values lie in [0, 1]."""
+NON_NEGATIVE_PARAMETERS = frozenset({JointParameter.CFM, JointParameter.STOP_CFM,
+                                     JointParameter.SUSPENSION_CFM})
+"""Parameters whose values are >= 0."""
+
+
+def joint_type(value) -> JointType:
+    """The JointType of ``value`` (an int 0..9); InvalidArgument otherwise."""
+    if isinstance(value, bool):
+        raise InvalidArgument(f"joint type {value!r} is not one of 0..9")
+    try:
+        return JointType(value)
+    except (ValueError, TypeError):
+        raise InvalidArgument(f"joint type {value!r} is not one of 0..9") from None
+
+
+def default_joint_id(kind: int, body1: str, body2: str) -> str:
+    """The thesis's joint ID: "<type>:<body1>&<body2>" (a body "" is the static world)."""
+    return f"{int(kind)}:{body1}&{body2}"
+
+
+def default_motor_id(joint_id: str = "", body1: str = "", body2: str = "") -> str:
+    """A motor's default ID: "motor:<joint id>", or "motor:<body1>&<body2>" without a joint."""
+    return f"motor:{joint_id}" if joint_id else f"motor:{body1}&{body2}"
+
+
+# ---------------------------------------------------------------------------------- shapes
+
+SHAPE_BY_PARAMETER_COUNT = {1: "sphere", 2: "cylinder", 3: "box"}
+"""The thesis's rule: Object/Part ``parameters`` decide the shape by their number (sphere
+radius; cylinder radius and length along z; box sides x, y, z); a multiple of 3 that is at
+least 9 is a triangle mesh's vertices (with ``indices``)."""
+
+
+def shape_kind(parameter_count: int) -> str:
+    """"sphere", "cylinder", "box" or "mesh" for a number of parameters; InvalidArgument for a
+    count that fits no shape."""
+    kind = SHAPE_BY_PARAMETER_COUNT.get(parameter_count)
+    if kind is not None:
+        return kind
+    if parameter_count >= 9 and parameter_count % 3 == 0:
+        return "mesh"
+    raise InvalidArgument(f"{parameter_count} parameters fit no shape (1 sphere, 2 cylinder, "
+                          "3 box, a multiple of 3 >= 9 mesh vertices)")
+
+
+# ---------------------------------------------------------------------------------- IDs
+
+COMPOSITE_MARK = ">"
+"""Starts a composite's ID and separates its parts' names; no other name may hold it."""
+
+
+def composite_id(part_names: Sequence[str]) -> str:
+    """A composite's ID: ">part1>part2..." (thesis 4.2.1)."""
+    return COMPOSITE_MARK + COMPOSITE_MARK.join(part_names)
+
+
+def is_composite_id(object_id: str) -> bool:
+    return object_id.startswith(COMPOSITE_MARK)
+
+
+# ---------------------------------------------------------------------------------- services
+
+WORLD_NAMESPACE = "/virtual_world"
+VIEWER_NAMESPACE = "/viewer"
+
+WORLD_SERVICES: Dict[str, str] = {
+    "new_scene": "NewScene", "set_world": "SetWorld", "set_step": "SetStep",
+    "step_once": "StepOnce", "start": "Start", "build_object": "BuildObject",
+    "build_composite": "BuildComposite", "build_entity": "BuildEntity",
+    "remove_object": "RemoveObject", "set_joint": "SetJoint", "set_motor": "SetMotor",
+    "set_position": "SetPosition", "set_velocity": "SetVelocity",
+    "set_external_force": "SetExternalForce", "set_joint_force": "SetJointForce",
+}
+"""The VirtualWorld's services: name under ``~`` -> type in the Services package."""
+
+VIEWER_SERVICES: Dict[str, str] = {
+    "view_object": "ViewObject", "remove_object": "ViewerRemoveObject",
+    "new_scene": "ViewerNewScene", "save_snapshot": "SaveSnapshot", "set_camera": "SetCamera",
+}
+"""The Viewer's services: the three the world calls, then the Viewer's own extras."""
+
+
+class NodeParameter(NamedTuple):
+    """One ``~parameter`` a node reads at start: its default, unit and meaning (each node's
+    table of them is what it reads and what docs/parameters.md shows)."""
+    name: str
+    default: Any
+    unit: str
+    what: str
+
+
+__all__ = ["NodeParameter", "JointType", "JointParameter", "SetJointAction", "MotorKind", "AxisFrame",
+           "ForceKind", "Solver", "JOINT_AXES_USED", "JOINT_USES_ANCHOR",
+           "JOINT_FORCE_MAGNITUDES", "JOINT_STATE_AXES", "JOINT_PARAMETERS",
+           "JOINT_PARAMETER_AXES", "MOTOR_PARAMETERS", "UNIT_PARAMETERS",
+           "NON_NEGATIVE_PARAMETERS", "joint_type", "default_joint_id", "default_motor_id",
+           "SHAPE_BY_PARAMETER_COUNT", "shape_kind", "COMPOSITE_MARK", "composite_id",
+           "is_composite_id", "WORLD_NAMESPACE", "VIEWER_NAMESPACE", "WORLD_SERVICES",
+           "VIEWER_SERVICES"]

@@ -1,0 +1,248 @@
+"""Shapes and poses as the Viewer receives them, checked and turned into renderable geometry.
+
+ROS-free and GL-free. Quaternions (w, x, y, z) become rotation matrices through
+odin_common.rotations, like everywhere in Odin (:func:`rotation_from_wxyz`).
+
+Shapes follow Messages/Object: the number of parameters decides the shape
+(1 sphere radius, 2 cylinder radius and length along the local z axis, centred on the origin,
+3 box side lengths x, y, z centred, 9 or more and a multiple of 3: triangle-mesh vertices with
+3 indices per triangle). Lengths in metres, in the object's own (body) frame.
+"""
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass, field
+from typing import Sequence
+
+import numpy as np
+
+from odin_common.errors import InvalidArgument
+from odin_common.meshes import cluster_vertices
+from odin_common.rotations import quaternion_to_matrix, unit_quaternion
+from viewer.errors import ViewerError
+
+_keys = itertools.count(1)
+
+
+def rotation_from_wxyz(quaternion_wxyz: Sequence[float], where: str = "orientation") -> np.ndarray:
+    """Rotation matrix R_WB (3, 3) from a unit quaternion in ODE's order (w, x, y, z).
+
+    A quaternion whose norm is within odin_common.rotations.QUATERNION_TOLERANCE of 1 is
+    normalised; one that is not finite, not of length 4 or farther from unit length raises
+    :class:`ViewerError`.
+    """
+    try:
+        return quaternion_to_matrix(unit_quaternion(quaternion_wxyz, where))
+    except InvalidArgument as error:
+        raise ViewerError(str(error)) from None
+
+
+def check_position(position_W: Sequence[float], where: str = "position") -> np.ndarray:
+    """(3,) float, metres; raises :class:`ViewerError` unless three finite numbers."""
+    p = np.asarray(position_W, dtype=float).reshape(-1)
+    if p.shape != (3,) or not np.all(np.isfinite(p)):
+        raise ViewerError(f"{where}: expected 3 finite numbers (m), got {list(p)}")
+    return p
+
+
+def pose_matrix(position_W: Sequence[float], quaternion_wxyz: Sequence[float],
+                where: str = "pose") -> np.ndarray:
+    """Homogeneous transform T_WB (4, 4) from a position (m) and a (w, x, y, z) quaternion."""
+    T = np.eye(4)
+    T[:3, :3] = rotation_from_wxyz(quaternion_wxyz, where=f"{where} orientation")
+    T[:3, 3] = check_position(position_W, where=f"{where} position")
+    return T
+
+
+@dataclass(frozen=True, eq=False)
+class Geometry:
+    """A shape ready to draw.
+
+    kind: "sphere", "cylinder", "box" or "mesh".
+    scale_B: (3,) factors applied to the kind's unit primitive (sphere radius 1, cylinder radius 1
+        and length 1 along z, box of side 1, all centred); (1, 1, 1) for meshes.
+    vertices_B, normals_B: (n, 3) float32, body frame, metres, and indices_B (3 m,) uint32, three
+        per triangle; meshes only, empty for primitives.
+    radius: m, radius of a sphere about the body origin that holds the whole shape.
+    closed: the surface is closed and its triangles face outwards (counter-clockwise), so back
+        faces are never seen: the renderer culls them and lights one side only.
+    key: unique per Geometry, so that a renderer can cache GPU buffers by it.
+    """
+    kind: str
+    scale_B: tuple
+    radius: float
+    vertices_B: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.float32))
+    normals_B: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.float32))
+    indices_B: np.ndarray = field(default_factory=lambda: np.zeros(0, np.uint32))
+    closed: bool = True
+    key: int = field(default_factory=lambda: next(_keys))
+
+    @property
+    def triangle_count(self) -> int:
+        return len(self.indices_B) // 3
+
+
+def _positive(values: Sequence[float], names: Sequence[str], shape: str) -> list:
+    out = []
+    for value, name in zip(values, names):
+        if not math.isfinite(value) or value <= 0:
+            raise ViewerError(f"{shape} {name} must be a finite number > 0 (m), got {value}")
+        out.append(float(value))
+    return out
+
+
+def geometry_from_parameters(parameters: Sequence[float], indices: Sequence[int] = ()) -> Geometry:
+    """The shape that ``parameters`` (and, for meshes, ``indices``) describe; see the module doc.
+
+    Raises :class:`ViewerError` for a wrong parameter count, non-positive or non-finite sizes,
+    an empty mesh, an index count that is not a multiple of 3 or an index out of range.
+    """
+    params = np.asarray(parameters, dtype=float).reshape(-1)
+    n = params.size
+    if n == 1:
+        (r,) = _positive(params, ["radius"], "sphere")
+        return Geometry("sphere", (r, r, r), r)
+    if n == 2:
+        r, length = _positive(params, ["radius", "length"], "cylinder")
+        return Geometry("cylinder", (r, r, length), math.hypot(r, length / 2))
+    if n == 3:
+        sides = _positive(params, ["side x", "side y", "side z"], "box")
+        return Geometry("box", tuple(sides), 0.5 * math.sqrt(sum(s * s for s in sides)))
+    if n < 9 or n % 3:
+        raise ViewerError(f"{n} parameters describe no shape: 1 sphere, 2 cylinder, 3 box, "
+                          f"9 or more (a multiple of 3) mesh vertices")
+    return mesh_geometry(params.reshape(-1, 3), indices)
+
+
+#: corners whose face turns more than this from the smoothed vertex normal get a vertex of
+#: their own with the face's normal (hard edges stay hard, curved surfaces look smooth)
+CREASE_ANGLE = math.radians(40.0)
+
+
+#: m: meshes of more than DISPLAY_DETAIL_TRIANGLES triangles are drawn with their vertices
+#: clustered on a grid of this size (detail finer than a millimetre is below a pixel at the
+#: distances a robot scene is watched from, and CAD meshes of hands carry a lot of it: the SAH
+#: hand's 150k triangles become about half; :func:`odin_common.meshes.cluster_vertices`). The
+#: world's collision mesh has a tolerance of its own (the world parameter
+#: collision_mesh_tolerance).
+DISPLAY_TOLERANCE = 0.001
+DISPLAY_DETAIL_TRIANGLES = 2000
+
+
+def mesh_geometry(vertices_B: np.ndarray, indices: Sequence[int]) -> Geometry:
+    """An indexed mesh from vertices (n, 3) m and triangle indices (3 per triangle), with
+    area-weighted vertex normals split at creases sharper than ``CREASE_ANGLE``; large meshes
+    are simplified for display (clustered at ``DISPLAY_TOLERANCE``)."""
+    vertices = np.asarray(vertices_B, dtype=float)
+    if not np.all(np.isfinite(vertices)):
+        raise ViewerError("mesh vertices must be finite numbers (m)")
+    idx = np.asarray(indices, dtype=np.int64).reshape(-1)
+    if idx.size == 0:
+        raise ViewerError(f"mesh with {len(vertices)} vertices has no triangles (empty indices)")
+    if idx.size % 3:
+        raise ViewerError(f"mesh indices come 3 per triangle; got {idx.size}")
+    bad = (idx < 0) | (idx >= len(vertices))
+    if np.any(bad):
+        raise ViewerError(f"mesh index {int(idx[bad][0])} out of range: the mesh has "
+                          f"{len(vertices)} vertices")
+    closed = _closed_and_outward(idx.reshape(-1, 3), vertices[idx].reshape(-1, 3, 3))
+    if idx.size > 3 * DISPLAY_DETAIL_TRIANGLES:
+        simple_vertices, simple_idx = cluster_vertices(vertices, idx, DISPLAY_TOLERANCE)
+        if simple_idx.size:  # a mesh smaller than the tolerance keeps its triangles
+            vertices, idx = simple_vertices, simple_idx
+    corners = vertices[idx].reshape(-1, 3, 3)
+    area_normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    lengths = np.linalg.norm(area_normals, axis=1, keepdims=True)
+    face_normals = np.where(lengths > 1e-20, area_normals / np.maximum(lengths, 1e-300),
+                            [0.0, 0.0, 1.0])
+    vertex_normals = np.zeros_like(vertices)
+    np.add.at(vertex_normals, idx, np.repeat(area_normals, 3, axis=0))
+    norms = np.linalg.norm(vertex_normals, axis=1, keepdims=True)
+    vertex_normals = vertex_normals / np.maximum(norms, 1e-300)
+    corner_face = np.repeat(face_normals, 3, axis=0)
+    sharp = np.einsum("ij,ij->i", vertex_normals[idx], corner_face) < math.cos(CREASE_ANGLE)
+    out_idx = idx.copy()
+    out_idx[sharp] = len(vertices) + np.arange(int(sharp.sum()))
+    radius = float(np.max(np.linalg.norm(vertices[np.unique(idx)], axis=1)))
+    return Geometry("mesh", (1.0, 1.0, 1.0), radius,
+                    vertices_B=np.concatenate([vertices, vertices[idx[sharp]]]).astype(np.float32),
+                    normals_B=np.concatenate([vertex_normals, corner_face[sharp]]).astype(np.float32),
+                    indices_B=out_idx.astype(np.uint32),
+                    closed=closed)
+
+
+def _closed_and_outward(triangles: np.ndarray, corners: np.ndarray) -> bool:
+    """Every directed edge appears once and its reverse once, and the signed volume is > 0."""
+    edges = np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]])
+    n = int(triangles.max()) + 1
+    forward = np.sort(edges[:, 0] * n + edges[:, 1])
+    backward = np.sort(edges[:, 1] * n + edges[:, 0])
+    if np.any(forward[1:] == forward[:-1]) or not np.array_equal(forward, backward):
+        return False
+    volume = np.einsum("ij,ij->i", corners[:, 0], np.cross(corners[:, 1], corners[:, 2])).sum()
+    return bool(volume > 0)
+
+
+# -- unit primitives, tessellated once ------------------------------------------------------
+
+def unit_sphere(slices: int = 32, stacks: int = 16) -> tuple:
+    """Radius-1 sphere: (vertices (n, 3), normals (n, 3), triangle indices (m,)), smooth."""
+    theta = np.linspace(0.0, math.pi, stacks + 1)          # from +z down to -z
+    phi = np.linspace(0.0, 2 * math.pi, slices + 1)
+    t, p = np.meshgrid(theta, phi, indexing="ij")
+    vertices = np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], -1)
+    vertices = vertices.reshape(-1, 3)
+    indices = []
+    row = slices + 1
+    for i in range(stacks):
+        for j in range(slices):
+            a, b = i * row + j, (i + 1) * row + j
+            indices += [a, b, b + 1, a, b + 1, a + 1]
+    return vertices.astype(np.float32), vertices.astype(np.float32), np.array(indices, np.uint32)
+
+
+def unit_cylinder(slices: int = 32) -> tuple:
+    """Radius 1, length 1 along z, centred: smooth side, flat caps."""
+    phi = np.linspace(0.0, 2 * math.pi, slices + 1)
+    ring = np.stack([np.cos(phi), np.sin(phi), np.zeros_like(phi)], -1)
+    verts, norms, idx = [], [], []
+    # side: rings at z = -1/2 and +1/2
+    for z in (-0.5, 0.5):
+        verts.append(ring + [0, 0, z])
+        norms.append(ring)
+    n = slices + 1
+    for j in range(slices):
+        a, b = j, n + j
+        idx += [a, a + 1, b + 1, a, b + 1, b]
+    base = 2 * n
+    for z, sign in ((0.5, 1.0), (-0.5, -1.0)):
+        centre = base
+        verts.append(np.array([[0.0, 0.0, z]]))
+        verts.append(ring + [0, 0, z])
+        norms.append(np.tile([0.0, 0.0, sign], (n + 1, 1)))
+        for j in range(slices):
+            a, b = centre + 1 + j, centre + 2 + j
+            idx += [centre, a, b] if sign > 0 else [centre, b, a]
+        base += n + 1
+    return (np.concatenate(verts).astype(np.float32), np.concatenate(norms).astype(np.float32),
+            np.array(idx, np.uint32))
+
+
+def unit_box() -> tuple:
+    """Side 1, centred: 6 flat faces, outward normals, counter-clockwise."""
+    verts, norms, idx = [], [], []
+    for axis in range(3):
+        for sign in (1.0, -1.0):
+            normal = np.zeros(3)
+            normal[axis] = sign
+            u = np.zeros(3)
+            u[(axis + 1) % 3] = 1.0
+            v = np.cross(normal, u)
+            centre = normal * 0.5
+            start = len(verts)
+            for du, dv in ((-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)):
+                verts.append(centre + du * u + dv * v)
+                norms.append(normal)
+            idx += [start, start + 1, start + 2, start, start + 2, start + 3]
+    return np.array(verts, np.float32), np.array(norms, np.float32), np.array(idx, np.uint32)

@@ -1,0 +1,260 @@
+"""The Viewer's Core: the scene of objects keyed by ID, without ROS and without OpenGL
+(thesis chapter 6.4).
+
+Each object has a pose (world frame, REP 103), a colour and a shape. Its original colour is
+remembered: an object that a Collided message lists is drawn in ``COLLIDING_COLOR`` at once, and
+stays so until the second scene update after that message, i.e. after every update an object is
+grey exactly when some Collided message listed it since the previous update (thesis 6.4.2: the
+colliding status is cleared each cycle). New Scene replaces the whole scene. Adding an object
+re-fits the camera to the whole scene unless the user fixed the camera.
+
+The scene is not thread-safe: one thread (the Portal's render thread) owns it.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Iterable, Optional, Sequence
+
+import numpy as np
+
+from viewer.core.camera import Camera
+from viewer.errors import ViewerError
+from viewer.core.geometry import Geometry, geometry_from_parameters, pose_matrix
+
+#: colour (r, g, b, a) of an object that was sent with an all-zero colour
+DEFAULT_COLOR = (0.62, 0.70, 0.82, 1.0)
+#: colour of an object while reported as colliding (thesis 6.4.1: "dark gray")
+COLLIDING_COLOR = (0.35, 0.35, 0.35, 1.0)
+#: default background (r, g, b)
+DEFAULT_BACKGROUND = (0.93, 0.94, 0.96)
+
+
+def check_color(color: Sequence[float], where: str = "color") -> tuple:
+    """(r, g, b, a) in [0, 1]; all zero means ``DEFAULT_COLOR``; 3 numbers mean a = 1."""
+    c = np.asarray(color, dtype=float).reshape(-1)
+    if c.size == 3:
+        c = np.r_[c, 1.0]
+    if c.shape != (4,) or not np.all(np.isfinite(c)) or np.any((c < 0) | (c > 1)):
+        raise ViewerError(f"{where}: expected r, g, b, a in [0, 1], got {list(c)}")
+    if not np.any(c):
+        return DEFAULT_COLOR
+    return tuple(float(v) for v in c)
+
+
+def check_id(object_id: str) -> str:
+    if not isinstance(object_id, str) or not object_id:
+        raise ViewerError(f"object ID must be a non-empty string, got {object_id!r}")
+    return object_id
+
+
+@dataclass(frozen=True)
+class ViewRequest:
+    """A checked View Object request: id, shape, pose T_WB (4, 4) and colour (r, g, b, a)."""
+    id: str
+    geometry: Geometry
+    pose_W: np.ndarray
+    color: tuple
+
+
+def prepare_view(object_id: str, parameters: Sequence[float], indices: Sequence[int],
+                 position_W: Sequence[float], orientation_wxyz: Sequence[float],
+                 color: Sequence[float]) -> ViewRequest:
+    """Checks a View Object request and builds its geometry (no scene needed, so a service
+    callback can do it on its own thread). Raises :class:`ViewerError` if anything is wrong."""
+    object_id = check_id(object_id)
+    where = f"object {object_id!r}"
+    try:
+        geometry = geometry_from_parameters(parameters, indices)
+    except ViewerError as error:
+        raise ViewerError(f"{where}: {error}") from None
+    return ViewRequest(object_id, geometry, pose_matrix(position_W, orientation_wxyz, where),
+                       check_color(color, f"{where} color"))
+
+
+@dataclass
+class SceneObject:
+    id: str
+    geometry: Geometry
+    pose_W: np.ndarray          # T_WB (4, 4)
+    color: tuple                # original colour (r, g, b, a)
+
+
+@dataclass(frozen=True)
+class DrawItem:
+    """One object to draw: geometry, model matrix (4, 4) body->world including the primitive's
+    scale, and the colour to draw it in now."""
+    id: str
+    geometry: Geometry
+    model_W: np.ndarray
+    color: tuple
+
+
+@dataclass(frozen=True)
+class Grid:
+    """A floor grid on the world's z = 0 plane: centre (x, y) m, half size m, line spacing m."""
+    centre_xy: tuple
+    half_size: float
+    spacing: float
+
+
+class Scene:
+    """Objects keyed by ID, the collision colouring and the camera."""
+
+    def __init__(self, camera: Optional[Camera] = None, camera_fixed: bool = False,
+                 background: Sequence[float] = DEFAULT_BACKGROUND) -> None:
+        self._objects: dict = {}
+        self._listed_since_update: set = set()   # named by Collided since the last update
+        self._grey: set = set()
+        self._camera = camera or Camera()
+        self.camera_fixed = camera_fixed
+        bg = np.asarray(background, dtype=float).reshape(-1)
+        if bg.shape != (3,) or not np.all((bg >= 0) & (bg <= 1)):
+            raise ViewerError(f"background: expected r, g, b in [0, 1], got {list(bg)}")
+        self.background = tuple(float(v) for v in bg)
+
+    # -- objects ---------------------------------------------------------------------------
+    def __len__(self) -> int:
+        return len(self._objects)
+
+    def __contains__(self, object_id: str) -> bool:
+        return object_id in self._objects
+
+    @property
+    def ids(self) -> list:
+        return list(self._objects)
+
+    def view(self, request: ViewRequest) -> bool:
+        """Adds the object, or replaces the one with the same ID (the world may re-send its scene
+        to a Viewer that started late). Returns True if it replaced one. Re-fits the camera."""
+        replaced = request.id in self._objects
+        self._objects[request.id] = SceneObject(request.id, request.geometry,
+                                                np.array(request.pose_W, dtype=float),
+                                                request.color)
+        if not self.camera_fixed:
+            self.fit_camera()
+        return replaced
+
+    def view_object(self, object_id: str, parameters: Sequence[float], indices: Sequence[int] = (),
+                    position_W: Sequence[float] = (0, 0, 0),
+                    orientation_wxyz: Sequence[float] = (1, 0, 0, 0),
+                    color: Sequence[float] = (0, 0, 0, 0)) -> bool:
+        """:func:`prepare_view` and :meth:`view` in one call."""
+        return self.view(prepare_view(object_id, parameters, indices, position_W,
+                                      orientation_wxyz, color))
+
+    def remove_object(self, object_id: str) -> None:
+        if object_id not in self._objects:
+            raise ViewerError(f"no object {object_id!r} in the Viewer's scene "
+                              f"({len(self._objects)} objects)")
+        del self._objects[object_id]
+        self._grey.discard(object_id)
+        self._listed_since_update.discard(object_id)
+
+    def new_scene(self) -> None:
+        """Replaces the scene by an empty one (the camera stays where it is)."""
+        self._objects = {}
+        self._grey = set()
+        self._listed_since_update = set()
+
+    # -- the world's topics ----------------------------------------------------------------
+    def update(self, situations: Iterable) -> int:
+        """Applies poses ``(name, position (3,) m, orientation (w, x, y, z))``; names the scene
+        does not hold and entries with a non-finite or bad pose are skipped. Ends a colouring
+        cycle (see the module doc). Returns the number of poses applied."""
+        applied = 0
+        for name, position, orientation in situations:
+            obj = self._objects.get(name)
+            if obj is None:
+                continue
+            try:
+                obj.pose_W = pose_matrix(position, orientation, name)
+            except ViewerError:
+                continue
+            applied += 1
+        self._grey = self._listed_since_update & self._objects.keys()
+        self._listed_since_update = set()
+        return applied
+
+    def collided(self, names: Iterable[str]) -> None:
+        """Objects a Collided message lists: grey now and through the next update."""
+        names = set(names) & self._objects.keys()
+        self._listed_since_update |= names
+        self._grey |= names
+
+    def color_of(self, object_id: str) -> tuple:
+        """The colour the object is drawn in now."""
+        if object_id not in self._objects:
+            raise ViewerError(f"no object {object_id!r} in the Viewer's scene")
+        return COLLIDING_COLOR if object_id in self._grey else self._objects[object_id].color
+
+    def pose_of(self, object_id: str) -> np.ndarray:
+        return self._objects[object_id].pose_W.copy()
+
+    def draw_list(self) -> list:
+        items = []
+        for obj in self._objects.values():
+            model = obj.pose_W @ np.diag([*obj.geometry.scale_B, 1.0])
+            items.append(DrawItem(obj.id, obj.geometry, model, self.color_of(obj.id)))
+        return items
+
+    # -- bounds and camera -----------------------------------------------------------------
+    def bounds(self) -> Optional[tuple]:
+        """(centre (3,) m, radius m) of a sphere holding every object, or None if empty."""
+        if not self._objects:
+            return None
+        centres = np.array([o.pose_W[:3, 3] for o in self._objects.values()])
+        radii = np.array([o.geometry.radius for o in self._objects.values()])
+        low = (centres - radii[:, None]).min(axis=0)
+        high = (centres + radii[:, None]).max(axis=0)
+        centre = (low + high) / 2
+        radius = float(np.max(np.linalg.norm(centres - centre, axis=1) + radii))
+        return centre, radius
+
+    @property
+    def camera(self) -> Camera:
+        return self._camera
+
+    @property
+    def fitting(self) -> bool:
+        return not self.camera_fixed
+
+    def fit_camera(self) -> None:
+        """Moves the camera to show the whole scene (nothing to do for an empty scene)."""
+        bounds = self.bounds()
+        if bounds is not None:
+            self._camera = self._camera.fitted(*bounds)
+
+    def set_camera(self, camera: Camera, fixed: Optional[bool] = None) -> None:
+        """Uses ``camera``; ``fixed`` True stops re-fitting, False re-fits now and on adds."""
+        self._camera = camera
+        if fixed is not None:
+            self.camera_fixed = fixed
+        if not self.camera_fixed:
+            self.fit_camera()
+
+    def grid(self) -> Grid:
+        """The floor grid under the scene: about 3 scene radii across, 10-25 lines a side."""
+        bounds = self.bounds()
+        centre, radius = bounds if bounds is not None else (np.zeros(3), 1.0)
+        half = max(1.5 * radius, 0.5)
+        raw = half / 8
+        exponent = math.floor(math.log10(raw))
+        spacing = min((m * 10 ** exponent for m in (1, 2, 5, 10)), key=lambda s: abs(s - raw))
+        cx, cy = (round(c / spacing) * spacing for c in centre[:2])
+        half = math.ceil(half / spacing) * spacing
+        return Grid((cx, cy), half, spacing)
+
+    def clip_planes(self) -> tuple:
+        """(near, far) m for the current camera, holding the scene and its grid."""
+        bounds = self.bounds()
+        centre, radius = bounds if bounds is not None else (np.zeros(3), 1.0)
+        grid = self.grid()
+        grid_corner = np.array([grid.centre_xy[0] + grid.half_size,
+                                grid.centre_xy[1] + grid.half_size, 0.0])
+        radius = max(radius, float(np.linalg.norm(grid_corner - centre)))
+        distance = float(np.linalg.norm(np.subtract(self._camera.eye_W, centre)))
+        far = distance + radius
+        near = max(distance - radius, far / 2000.0)
+        return near, far
+

@@ -1,0 +1,119 @@
+"""Persistent forces (thesis 5.4.2, 5.4.3): forces and torques on bodies and along joints,
+re-applied by the C step loop before every step until removed.
+
+Units: N and N m. Body forces: the vector in the world or the object's frame, acting at the
+centre of mass or at a point (world or object frame; ODE's body frame is the object's frame
+shifted to the centre of mass). Joint forces follow ODE's convention: a positive magnitude
+acts on body1 along (about) +axis and the reaction on body2.
+"""
+from __future__ import annotations
+
+from typing import Iterable, List, Sequence
+
+from odin_common.interface import JOINT_FORCE_MAGNITUDES, ForceKind
+from virtual_world.core import validation as check
+from virtual_world.core.records import BodyForceRecord, JointForceRecord
+from virtual_world.core.scene import Scene
+from virtual_world.errors import InvalidArgument, UnknownName, Unsupported
+from virtual_world.ode.joints import ODE_JOINT_TYPE
+
+
+def add_body_force(scene: Scene, object_id: str, kind: int, vector,
+                   vector_in_body_frame: bool = False, at_point: bool = False,
+                   point=(0.0, 0.0, 0.0), point_in_body_frame: bool = False) -> str:
+    """Adds a persistent force or torque; returns "force:<object>:<n>" or
+    "torque:<object>:<n>", n the first free number."""
+    if isinstance(kind, bool) or kind not in set(ForceKind):
+        raise InvalidArgument(f"force kind {kind!r} is not FORCE (0) or TORQUE (1)")
+    kind = ForceKind(kind)
+    obj = scene.body_object(object_id, "force")
+    vector = check.vector("force vector", vector)
+    vector_in_body_frame = check.flag("vector_in_body_frame", vector_in_body_frame)
+    at_point = check.flag("at_point", at_point)
+    point = check.vector("force point", point)
+    point_in_body_frame = check.flag("point_in_body_frame", point_in_body_frame)
+    if kind == ForceKind.TORQUE and at_point:
+        raise InvalidArgument("a torque has no point of application (at_point=True)")
+    if at_point and point_in_body_frame:
+        point = point - obj.com  # object frame -> ODE body frame (centre of mass)
+    force_id = _free_id(scene.body_forces, f"{kind.name.lower()}:{object_id}")
+    scene.body_forces[force_id] = BodyForceRecord(object_id, kind, vector_in_body_frame,
+                                                  at_point, point_in_body_frame, vector, point)
+    obj.forces.add(force_id)
+    _rebuild_body_forces(scene)
+    return force_id
+
+
+def remove_body_force(scene: Scene, force_id: str) -> None:
+    if force_id not in scene.body_forces:
+        raise UnknownName(f"no body force {force_id!r}")
+    scene.objects[scene.body_forces[force_id].object_id].forces.discard(force_id)
+    drop_body_forces(scene, [force_id])
+
+
+def drop_body_forces(scene: Scene, force_ids: Iterable[str]) -> None:
+    """Forgets body forces (their object is going) and hands C the rest."""
+    for force_id in list(force_ids):
+        del scene.body_forces[force_id]
+    _rebuild_body_forces(scene)
+
+
+def _rebuild_body_forces(scene: Scene) -> None:
+    scene.c.set_body_forces([
+        (scene.objects[f.object_id].body.ptr, f.kind, f.vector_in_body_frame, f.at_point,
+         f.point_in_body_frame, f.vector.tolist(), f.point.tolist())
+        for f in scene.body_forces.values()])
+
+
+def add_joint_force(scene: Scene, joint_id: str, magnitudes: Sequence[float]) -> str:
+    """Adds a persistent force/torque along a joint's axes (interface.JOINT_FORCE_MAGNITUDES
+    says which per type); returns "jointforce:<joint>:<n>"."""
+    joint = scene.joint(joint_id)
+    if joint.type not in JOINT_FORCE_MAGNITUDES:
+        raise Unsupported(f"ODE has no force or torque for {joint.type.label} joint "
+                          f"{joint_id!r}")
+    count = len(JOINT_FORCE_MAGNITUDES[joint.type])
+    try:
+        n_values = len(magnitudes)
+    except TypeError:
+        raise InvalidArgument(f"magnitudes {magnitudes!r} is not a sequence") from None
+    if n_values != count:
+        raise InvalidArgument(f"a {joint.type.label} joint force takes {count} magnitude(s); "
+                              f"got {list(magnitudes)!r}")
+    values = check.vector("joint force magnitudes", magnitudes, count)
+    force_id = _free_id(scene.joint_forces, f"jointforce:{joint_id}")
+    scene.joint_forces[force_id] = JointForceRecord(joint_id, values)
+    joint.forces.add(force_id)
+    _rebuild_joint_forces(scene)
+    return force_id
+
+
+def remove_joint_force(scene: Scene, force_id: str) -> None:
+    if force_id not in scene.joint_forces:
+        raise UnknownName(f"no joint force {force_id!r}")
+    scene.joints[scene.joint_forces[force_id].joint_id].forces.discard(force_id)
+    drop_joint_forces(scene, [force_id])
+
+
+def drop_joint_forces(scene: Scene, force_ids: Iterable[str]) -> None:
+    """Forgets joint forces (their joint is going) and hands C the rest."""
+    for force_id in list(force_ids):
+        del scene.joint_forces[force_id]
+    _rebuild_joint_forces(scene)
+
+
+def _rebuild_joint_forces(scene: Scene) -> None:
+    scene.c.set_joint_forces([
+        (scene.joints[f.joint_id].owner.ptr, ODE_JOINT_TYPE[scene.joints[f.joint_id].type],
+         f.magnitudes.tolist()) for f in scene.joint_forces.values()])
+
+
+def _free_id(taken, prefix: str) -> str:
+    n = 0
+    while f"{prefix}:{n}" in taken:
+        n += 1
+    return f"{prefix}:{n}"
+
+
+def body_force_ids(scene: Scene) -> List[str]:
+    return list(scene.body_forces)

@@ -1,0 +1,105 @@
+"""Mass properties of shapes: primitives by ODE's formulas, triangle meshes from trimesh (never
+ODE's dMassSetTrimesh, which is wrong for meshes whose origin is not their centre of mass),
+and the checks that keep ODE from seeing mass no rigid body has.
+
+Meshes:
+  * closed mesh (``is_watertight``): normals repaired (``trimesh.repair.fix_normals``), an
+    inverted mesh turned outside-out, density = mass / |volume|; the exact centre of mass and
+    inertia about it follow (trimesh's surface-integral formulas);
+  * open mesh (or one that stays non-volumetric after the repair; a third of Kautham's link
+    meshes are open or hold several bodies): the mesh's axis-aligned bounding box as a solid
+    box of the given mass, centred on the box. (The convex hull would be tighter but needs
+    scipy, which Odin does not depend on.) A mesh flat in one direction gets a flat box's
+    inertia; one flat in two directions is an error.
+The result is expressed in the mesh's own frame.
+"""
+from __future__ import annotations
+
+from typing import Dict, NamedTuple, Tuple
+
+import numpy as np
+import trimesh
+
+from virtual_world.core.shapes import Shape
+from virtual_world.errors import InvalidArgument
+from virtual_world.ode import bodies
+from virtual_world.ode.runtime import drain_messages, log
+
+
+class MeshMass(NamedTuple):
+    """mass: kg; center: (3,) m, mesh frame; inertia: (3,3) kg m^2 about `center`, mesh axes;
+    rule: "closed" or "bounding box" (which rule gave the figures)."""
+    mass: float
+    center: np.ndarray
+    inertia: np.ndarray
+    rule: str
+
+
+def _solid(mesh: trimesh.Trimesh, mass: float):
+    if mesh.volume < 0:
+        mesh.invert()
+    volume = float(mesh.volume)
+    if not np.isfinite(volume) or volume <= 1e-15 * max(mesh.scale, 1e-12) ** 3:
+        return None
+    mesh.density = mass / volume
+    return np.asarray(mesh.center_mass, float), np.asarray(mesh.moment_inertia, float)
+
+
+def mesh_mass(vertices: np.ndarray, triangles: np.ndarray, mass: float) -> MeshMass:
+    """Mass properties of a mesh: vertices (n,3) m, triangles (m,3) indices, mass kg > 0."""
+    mesh = trimesh.Trimesh(np.asarray(vertices, float), np.asarray(triangles, np.int64),
+                           process=True, validate=False)
+    if mesh.is_watertight:
+        trimesh.repair.fix_normals(mesh)
+        if mesh.is_volume:
+            solid = _solid(mesh, mass)
+            if solid is not None:
+                return MeshMass(mass, solid[0], solid[1], "closed")
+    low, high = np.asarray(vertices, float).min(axis=0), np.asarray(vertices, float).max(axis=0)
+    x, y, z = high - low
+    if sum(side > 0 for side in (x, y, z)) < 2:
+        raise InvalidArgument(f"mesh is degenerate (bounding box sides {x}, {y}, {z})")
+    inertia = mass / 12.0 * np.diag([y * y + z * z, x * x + z * z, x * x + y * y])
+    return MeshMass(mass, (low + high) / 2.0, inertia, "bounding box")
+
+
+_MESH_MASS_CACHE: Dict[Tuple[bytes, bytes], MeshMass] = {}
+"""LRU of unit-mass mesh properties (the same robot's meshes come back on every New Scene)."""
+_MESH_MASS_CACHE_SIZE = 256
+
+
+def _unit_mesh_mass(what: str, shape: Shape) -> MeshMass:
+    key = (shape.vertices.tobytes(), shape.triangles.tobytes())
+    unit = _MESH_MASS_CACHE.pop(key, None)
+    if unit is None:  # mass properties of a unit mass scale linearly with the mass
+        unit = mesh_mass(shape.vertices, shape.triangles, 1.0)
+        if unit.rule != "closed":
+            log.info("%s: open mesh, inertia from its %s", what, unit.rule)
+    _MESH_MASS_CACHE[key] = unit  # most recently used last
+    while len(_MESH_MASS_CACHE) > _MESH_MASS_CACHE_SIZE:
+        del _MESH_MASS_CACHE[next(iter(_MESH_MASS_CACHE))]
+    return unit
+
+
+def shape_mass(what: str, shape: Shape, mass: float):
+    """dMass of ``shape`` with total ``mass`` kg, in the shape's frame (its centre of mass may
+    be off the origin)."""
+    if shape.kind != "mesh":
+        return bodies.primitive_mass(shape.kind, shape.dims, mass)
+    unit = _unit_mesh_mass(what, shape)
+    return bodies.mass_from_parameters(mass, unit.center.tolist(), unit.inertia * mass)
+
+
+def check_mass(what: str, dmass) -> None:
+    """InvalidArgument unless the (centred) dMass is one a rigid body can have: inertia
+    positive definite, principal moments meeting the triangle inequality, and ODE agreeing."""
+    matrix = bodies.inertia_matrix(dmass)
+    if not np.all(np.isfinite(matrix)) or np.min(np.linalg.eigvalsh(matrix)) <= 0:
+        raise InvalidArgument(f"{what}: inertia {matrix.tolist()} is not positive definite")
+    principal = np.linalg.eigvalsh(matrix)
+    if principal[0] + principal[1] < principal[2] * (1 - 1e-9):
+        raise InvalidArgument(f"{what}: principal moments {principal.tolist()} break the "
+                              "triangle inequality (no rigid body has them)")
+    if not bodies.mass_is_valid(dmass):
+        drain_messages()
+        raise InvalidArgument(f"{what}: ODE rejects the mass parameters (dMassCheck)")

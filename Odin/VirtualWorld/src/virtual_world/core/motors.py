@@ -1,0 +1,161 @@
+"""Motors (thesis 5.3.1): angular (dAMotor) and linear (dLMotor) motors on a joint or between
+two bodies, and their goal speeds, which the C step loop sets before every step.
+
+A motor starts with zero goal speed and infinite maximum force unless told otherwise, so a
+robot held by its motors keeps its pose. Goal speeds: rad/s (angular) or m/s (linear).
+"""
+from __future__ import annotations
+
+from typing import List, Mapping, Sequence
+
+import numpy as np
+
+from odin_common.interface import AxisFrame, JointParameter, MotorKind
+from odin_common.specs import MotorSpec
+from virtual_world.core import validation as check
+from virtual_world.core.records import MotorRecord
+from virtual_world.core.scene import Scene
+from virtual_world.errors import DuplicateName, InvalidArgument, Unsupported
+from virtual_world.ode import handles
+from virtual_world.ode import joints as ode_joints
+from virtual_world.ode.runtime import drain_messages
+
+
+def create_motor(scene: Scene, spec: MotorSpec) -> str:
+    """Creates the motor of ``spec`` (see MotorSpec); returns its id."""
+    kind = spec.kind
+    if isinstance(kind, bool) or kind not in set(MotorKind):
+        raise InvalidArgument(f"motor kind {kind!r} is not ANGULAR (0) or LINEAR (1)")
+    kind = MotorKind(kind)
+    motor_id, joint_id, body1, body2 = (check.text(what, value) for what, value in (
+        ("motor_id", spec.id), ("joint", spec.joint), ("body1", spec.body1),
+        ("body2", spec.body2)))
+    axes_values = check.flat_vector("axes", spec.axes) if len(spec.axes) else np.zeros(0)
+    joint = None
+    if joint_id:
+        joint = scene.joint(joint_id)
+        if (body1 or body2) and (body1, body2) != joint.bodies:
+            raise InvalidArgument(f"bodies {body1!r}, {body2!r} differ from joint "
+                                  f"{joint_id!r}'s {joint.bodies}")
+        body1, body2 = joint.bodies
+        if axes_values.size == 0:
+            found = ode_joints.joint_axes(joint.owner.ptr, joint.type, kind)
+            if not found:
+                raise Unsupported(f"joint {joint_id!r} ({joint.type.label}) has no "
+                                  f"{kind.name.lower()} axis; give axes")
+            axes_values = np.concatenate(found)
+    if not body1 and not body2:
+        raise InvalidArgument("a motor needs a joint or at least one body")
+    if body1 == body2:
+        raise InvalidArgument(f"a motor cannot join {body1!r} to itself")
+    objects = [scene.body_object(b, "motor") if b else None for b in (body1, body2)]
+    if axes_values.size % 3 or not 3 <= axes_values.size <= 9:
+        raise InvalidArgument(f"axes {list(spec.axes)!r}: need 1..3 axes of 3 numbers each")
+    naxes = axes_values.size // 3
+    unit_axes = [check.axis(f"motor axis {i + 1}", axes_values[3 * i:3 * i + 3])
+                 for i in range(naxes)]
+    frames = _axis_frames(spec.axis_frames, naxes, objects)
+    max_forces = [check.number("max force", f, allow_inf=True) for f in spec.max_forces] \
+        if len(spec.max_forces) else [-1.0] * naxes
+    if len(max_forces) != naxes:
+        raise InvalidArgument(f"max_forces {list(spec.max_forces)!r}: need one per axis "
+                              f"({naxes})")
+    motor_id = motor_id or spec.default_id
+    if motor_id in scene.motors or motor_id in scene.joints:
+        raise DuplicateName(f"motor id {motor_id!r} is already taken")
+    # ---- ODE
+    owner = handles.new_motor(scene.c.world, kind, [o.body for o in objects if o is not None])
+    if objects[0] is None:  # the body is ODE's body 1 (handles._attached): swap body frames
+        frames = [{AxisFrame.GLOBAL: 0, AxisFrame.FIRST_BODY: 2,
+                   AxisFrame.SECOND_BODY: 1}[f] for f in frames]
+    ode_joints.configure_motor(owner.ptr, kind, unit_axes, frames, max_forces)
+    motor = MotorRecord(motor_id, owner, kind, naxes, joint_id or None, (body1, body2))
+    scene.motors[motor_id] = motor
+    if joint is not None:
+        joint.motors.add(motor_id)
+    for o in objects:
+        if o is not None:
+            o.motors.add(motor_id)
+    rebuild_goals(scene)
+    drain_messages()
+    return motor_id
+
+
+def _axis_frames(given: Sequence[int], naxes: int, objects) -> List[AxisFrame]:
+    """Per axis: the frame it stays fixed in (default: the first body, or the second when the
+    first is the world)."""
+    default = AxisFrame.FIRST_BODY if objects[0] is not None else AxisFrame.SECOND_BODY
+    frames = list(given) if len(given) else [default] * naxes
+    if len(frames) != naxes:
+        raise InvalidArgument(f"axis_frames {list(given)!r}: need one per axis ({naxes})")
+    for frame in frames:
+        if isinstance(frame, bool) or frame not in set(AxisFrame):
+            raise InvalidArgument(f"axis frame {frame!r} is not 0 (world), 1 or 2")
+        if frame and objects[frame - 1] is None:
+            raise InvalidArgument(f"axis frame {frame} names the world ('' body)")
+    return [AxisFrame(f) for f in frames]
+
+
+def remove_motor(scene: Scene, motor_id: str) -> None:
+    motor = scene.motor(motor_id)
+    del scene.motors[motor_id]
+    if motor.joint and motor.joint in scene.joints:
+        scene.joints[motor.joint].motors.discard(motor_id)
+    for body in motor.bodies:
+        if body:
+            scene.objects[body].motors.discard(motor_id)
+    rebuild_goals(scene)  # before the handle goes: C must never see a freed motor
+    motor.owner.close()
+
+
+def axis_counts(scene: Scene, motor_ids: Sequence[str]) -> List[int]:
+    """Number of axes of each motor (how many goal speeds it takes); unknown ids raise."""
+    return [scene.motor(motor_id).naxes for motor_id in motor_ids]
+
+
+def set_velocities(scene: Scene, velocities: Mapping[str, Sequence[float]]) -> None:
+    """Goal speeds (rad/s or m/s) per motor axis; all checked before any is set."""
+    checked = []
+    for motor_id, values in dict(velocities).items():
+        motor = scene.motor(motor_id)
+        vector = check.flat_vector(f"velocities of {motor_id!r}", values) \
+            if hasattr(values, "__len__") else None
+        if vector is None or vector.size != motor.naxes:
+            raise InvalidArgument(f"motor {motor_id!r} has {motor.naxes} axes; got "
+                                  f"{values!r}")
+        checked.append((motor, vector.tolist()))
+    for motor, values in checked:
+        motor.velocity = values
+        scene.c.update_motor_goal(scene.motor_slots[motor.id], values)
+
+
+def split_velocities(scene: Scene, motor_ids: Sequence[str],
+                     velocities: Sequence[float]) -> dict:
+    """{motor id: its goal speeds} from one flat list, each motor taking as many values as it
+    has axes, in order (Set Velocity's request)."""
+    counts = axis_counts(scene, motor_ids)
+    if sum(counts) != len(velocities):
+        raise InvalidArgument(f"{len(velocities)} velocities for motors with {sum(counts)} "
+                              "axes in all")
+    goals, cursor = {}, 0
+    for motor_id, count in zip(motor_ids, counts):
+        goals[motor_id] = tuple(velocities[cursor:cursor + count])
+        cursor += count
+    return goals
+
+
+def set_parameters(scene: Scene, motor: MotorRecord, checked: list) -> None:
+    """Checked (JointParameter, axis, value) triples on a motor; VELOCITY is its goal."""
+    for parameter, axis, value in checked:
+        ode_joints.set_motor_parameter(motor.owner.ptr, motor.kind, parameter, axis, value)
+        if parameter == JointParameter.VELOCITY:
+            motor.velocity[axis - 1] = value
+    scene.c.update_motor_goal(scene.motor_slots[motor.id], motor.velocity)
+    drain_messages()
+
+
+def rebuild_goals(scene: Scene) -> None:
+    """Hands C the goal array of every motor, in creation order."""
+    motors = list(scene.motors.values())
+    scene.motor_slots = {m.id: i for i, m in enumerate(motors)}
+    scene.c.set_motor_goals([(m.owner.ptr, m.kind, m.velocity) for m in motors])

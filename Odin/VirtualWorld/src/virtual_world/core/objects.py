@@ -1,0 +1,339 @@
+"""Objects, composites and entities: checked, built, moved and removed (thesis 4.2.1, 5.1).
+
+An object is a body with one geometry; a composite is one body with several geometries
+(parts placed in the composite's frame, their masses rotated, moved and added); either may be
+geometry only (static, no body) or fixed (a kinematic body). An entity builds several at once,
+all or nothing, optionally without collisions among its members. Every argument is checked
+before the first ODE call.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Dict, List, Sequence, Set, Tuple
+
+import numpy as np
+
+from odin_common.interface import composite_id
+from odin_common.rotations import quaternion_multiply, quaternion_to_matrix
+from odin_common.specs import CompositeSpec, EntitySpec, ObjectSpec, PartSpec
+from virtual_world.core import forces, joints, motors, readout, validation as check
+from virtual_world.core.mass import check_mass, shape_mass
+from virtual_world.core.records import (Built, BuiltEntity, BuiltGeometry, GeometryRecord,
+                                        ObjectRecord, Removed)
+from virtual_world.core.scene import Scene
+from virtual_world.core.shapes import Shape, collision_mesh, prepare_shape
+from virtual_world.errors import DuplicateName, InvalidArgument
+from virtual_world.ode import bodies, handles
+from virtual_world.ode.bindings import ffi
+from virtual_world.ode.runtime import drain_messages
+from virtual_world.ode.world import PoseReader
+
+IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
+
+
+@dataclass(eq=False)
+class _Part:
+    """A checked geometry: shape and mass, pose in the object's frame, what was given."""
+    name: str
+    shape: Shape
+    mass: float
+    position: np.ndarray
+    orientation: np.ndarray
+    color: Tuple[float, ...]
+    parameters: Sequence[float]
+    indices: Sequence[int]
+
+
+@dataclass(eq=False)
+class _Prepared:
+    """A checked object or composite, ready for ODE: its parts and mass (centred)."""
+    spec: object
+    object_id: str
+    parts: List[_Part]
+    position: np.ndarray
+    orientation: np.ndarray
+    fixed: bool
+    geometry_only: bool
+    no_collisions: bool
+    dmass: object               # dMass about the centre of mass, or None (geometry only)
+    com: np.ndarray             # (3,) centre of mass in the object frame
+
+
+# ---------------------------------------------------------------------------------- checks
+
+def _part(what: str, name: str, parameters, indices, mass: float, position, orientation,
+          color) -> _Part:
+    return _Part(name, prepare_shape(what, parameters, indices), mass,
+                 check.vector(f"{what}: position", position),
+                 check.quaternion(f"{what}: orientation", orientation),
+                 tuple(check.vector(f"{what}: color", color, 4).tolist()), parameters, indices)
+
+
+def _centred(what: str, dmass) -> np.ndarray:
+    """Moves ``dmass`` to its centre of mass, checks it; returns the centre (object frame)."""
+    com = bodies.mass_center(dmass)
+    bodies.center_mass(dmass)
+    check_mass(what, dmass)
+    return com
+
+
+def prepare_object(spec: ObjectSpec) -> _Prepared:
+    if not isinstance(spec, ObjectSpec):
+        raise InvalidArgument(f"{spec!r} is not an ObjectSpec")
+    name = check.name("object name", spec.name)
+    what = f"object {name!r}"
+    geometry_only = check.flag(f"{what}: geometry_only", spec.geometry_only)
+    no_collisions = check.flag(f"{what}: no_collisions", spec.no_collisions)
+    mass = check.number(f"{what}: mass", spec.mass)
+    if mass <= 0 and not geometry_only:  # a body-less geometry has no mass to check
+        raise InvalidArgument(f"{what}: mass {spec.mass!r} must be positive")
+    part = _part(what, name, spec.parameters, spec.indices, mass, (0.0, 0.0, 0.0), IDENTITY,
+                 spec.color)
+    position = check.vector(f"{what}: position", spec.position)
+    orientation = check.quaternion(f"{what}: orientation", spec.orientation)
+    fixed = check.flag(f"{what}: fixed", spec.fixed)
+    inertia = check.vector(f"{what}: inertia", spec.inertia, 6) if len(spec.inertia) else None
+    dmass, com = None, np.zeros(3)
+    if not geometry_only:
+        if inertia is not None:   # about the object's origin: the centre of mass is there
+            i = inertia
+            matrix = np.array([[i[0], i[3], i[4]], [i[3], i[1], i[5]], [i[4], i[5], i[2]]])
+            dmass = bodies.mass_from_parameters(mass, (0.0, 0.0, 0.0), matrix)
+        else:
+            dmass = shape_mass(what, part.shape, mass)
+        com = _centred(what, dmass)
+    return _Prepared(spec, name, [part], position, orientation, fixed, geometry_only,
+                     no_collisions, dmass, com)
+
+
+def prepare_composite(spec: CompositeSpec) -> _Prepared:
+    if not isinstance(spec, CompositeSpec):
+        raise InvalidArgument(f"{spec!r} is not a CompositeSpec")
+    if len(spec.parts) == 0:
+        raise InvalidArgument("a composite needs at least one part")
+    parts = []
+    for given in spec.parts:
+        if not isinstance(given, PartSpec):
+            raise InvalidArgument(f"{given!r} is not a PartSpec")
+        name = check.name("part name", given.name)
+        what = f"part {name!r}"
+        mass = check.number(f"{what}: mass", given.mass)
+        if mass <= 0:
+            raise InvalidArgument(f"{what}: mass {given.mass!r} must be positive")
+        parts.append(_part(what, name, given.parameters, given.indices, mass, given.position,
+                           given.orientation, given.color))
+    object_id = composite_id([p.name for p in parts])
+    what = f"composite {object_id!r}"
+    position = check.vector(f"{what}: position", spec.position)
+    orientation = check.quaternion(f"{what}: orientation", spec.orientation)
+    fixed = check.flag("composite fixed", spec.fixed)
+    geometry_only = check.flag("composite geometry_only", spec.geometry_only)
+    no_collisions = check.flag("composite no_collisions", spec.no_collisions)
+    dmass, com = None, np.zeros(3)
+    if not geometry_only:
+        dmass = bodies.zero_mass()
+        for part in parts:
+            bodies.add_mass(dmass, shape_mass(f"part {part.name!r}", part.shape, part.mass),
+                            part.position.tolist(), part.orientation.tolist())
+        com = _centred(f"object {object_id!r}", dmass)
+    return _Prepared(spec, object_id, parts, position, orientation, fixed, geometry_only,
+                     no_collisions, dmass, com)
+
+
+def check_new_names(scene: Scene, prepared: Sequence[_Prepared]) -> None:
+    """DuplicateName if an object id or geometry name is taken (or given twice)."""
+    seen: Set[str] = set()
+    for name in (part.name for p in prepared for part in p.parts):
+        if name in scene.geometries or name in seen:
+            raise DuplicateName(f"geometry name {name!r} is already taken")
+        seen.add(name)
+    seen = set()
+    for p in prepared:
+        if p.object_id in scene.objects or p.object_id in seen:
+            raise DuplicateName(f"object id {p.object_id!r} is already taken")
+        seen.add(p.object_id)
+
+
+# ---------------------------------------------------------------------------------- building
+
+def build(scene: Scene, prepared: _Prepared, tag: int = 0) -> Built:
+    """Creates the checked object in ODE: its body (at the centre of mass), its geoms."""
+    p = prepared
+    body = None
+    if not p.geometry_only:
+        body = handles.new_body(scene.c.world)
+        com_W = p.position + quaternion_to_matrix(p.orientation) @ p.com
+        bodies.configure_body(body.ptr, p.dmass, com_W.tolist(), p.orientation.tolist(),
+                              kinematic=p.fixed)
+    obj = ObjectRecord(p.object_id, p.spec, body, p.com, p.fixed)
+    for part in p.parts:
+        obj.geometries.append(_build_geometry(scene, p, part, body, tag))
+    scene.objects[p.object_id] = obj
+    drain_messages()
+    return Built(p.object_id, _built_geometries(obj.geometries))
+
+
+def _build_geometry(scene: Scene, p: _Prepared, part: _Part, body, tag: int) -> GeometryRecord:
+    shape = part.shape
+    if shape.kind == "mesh":
+        vertices, triangles = collision_mesh(shape, scene.parameters.collision_mesh_tolerance)
+        geom = handles.new_trimesh(scene.c.space,
+                                   ffi.new("double[]", vertices.reshape(-1).tolist()),
+                                   ffi.new("dTriIndex[]", triangles.reshape(-1).tolist()), body)
+    else:
+        geom = handles.new_primitive(scene.c.space, shape.kind, shape.dims, body)
+    if body is not None:
+        bodies.set_geom_offset(geom.ptr, (part.position - p.com).tolist(),
+                               part.orientation.tolist())
+    else:
+        place_static(geom.ptr, p.position, p.orientation, part.position, part.orientation)
+    bodies.set_geom_tag(geom.ptr, tag)
+    if p.no_collisions:
+        bodies.exclude_from_collisions(geom.ptr)
+    record = GeometryRecord(part.name, geom, p.object_id, part.position, part.orientation,
+                            shape, part.parameters, part.indices, part.color)
+    scene.add_geometry(record)
+    return record
+
+
+def _built_geometries(records: Sequence[GeometryRecord]) -> Tuple[BuiltGeometry, ...]:
+    positions, quaternions = PoseReader([r.owner for r in records]).read()
+    return tuple(BuiltGeometry(r.name, tuple(np.asarray(r.parameters, float).tolist()),
+                               tuple(int(i) for i in np.asarray(r.indices).reshape(-1)),
+                               r.color, tuple(positions[k].tolist()),
+                               tuple(quaternions[k].tolist()))
+                 for k, r in enumerate(records))
+
+
+def place_static(geom, position: np.ndarray, orientation: np.ndarray,
+                 part_position: np.ndarray, part_orientation: np.ndarray) -> None:
+    """A static geom at the object's pose composed with its pose in the object frame."""
+    bodies.set_geom_pose(geom, (position + quaternion_to_matrix(orientation) @ part_position)
+                         .tolist(), quaternion_multiply(orientation, part_orientation).tolist())
+
+
+def build_object(scene: Scene, spec: ObjectSpec) -> Built:
+    prepared = prepare_object(spec)
+    check_new_names(scene, [prepared])
+    return build(scene, prepared)
+
+
+def build_composite(scene: Scene, spec: CompositeSpec) -> Built:
+    prepared = prepare_composite(spec)
+    check_new_names(scene, [prepared])
+    return build(scene, prepared)
+
+
+def build_entity(scene: Scene, spec: EntitySpec) -> BuiltEntity:
+    """Builds an entity's members all or nothing; name "" gives "entity<n>"."""
+    if not isinstance(spec, EntitySpec):
+        raise InvalidArgument(f"{spec!r} is not an EntitySpec")
+    internal = check.flag("internal_collisions", spec.internal_collisions)
+    name = check.text("entity name", spec.name) or _free_entity_name(scene)
+    if name in scene.entities:
+        raise DuplicateName(f"entity {name!r} already exists")
+    prepared = [prepare_object(s) for s in spec.objects]
+    prepared += [prepare_composite(s) for s in spec.composites]
+    if not prepared:
+        raise InvalidArgument(f"entity {name!r} has no objects")
+    check_new_names(scene, prepared)
+    tag = 0
+    if not internal:
+        tag = scene.next_tag
+        scene.next_tag += 1
+    members: List[Built] = []
+    try:
+        for p in prepared:
+            members.append(build(scene, p, tag))
+    except Exception:
+        for member in members:
+            remove_object(scene, member.id)
+        raise
+    for member in members:
+        scene.objects[member.id].entity = name
+    scene.entities[name] = [member.id for member in members]
+    return BuiltEntity(name, tuple(members))
+
+
+def _free_entity_name(scene: Scene) -> str:
+    scene.entity_counter += 1
+    while f"entity{scene.entity_counter}" in scene.entities:
+        scene.entity_counter += 1
+    return f"entity{scene.entity_counter}"
+
+
+# ---------------------------------------------------------------------------------- removal
+
+def remove_object(scene: Scene, object_id: str) -> Removed:
+    """Removes an object with its joints, motors and forces; returns every removed id."""
+    obj = scene.object(object_id)
+    removed = Removed()
+    for joint_id in sorted(obj.joints):
+        removed += joints.remove_joint(scene, joint_id)
+    for motor_id in sorted(obj.motors):
+        motors.remove_motor(scene, motor_id)
+        removed += Removed(motors=(motor_id,))
+    if obj.forces:
+        removed += Removed(forces=tuple(sorted(obj.forces)))
+        forces.drop_body_forces(scene, obj.forces)
+    names = tuple(g.name for g in obj.geometries)
+    readout.carry_collisions(scene, set(names))
+    for geometry in obj.geometries:
+        scene.drop_geometry(geometry)
+        geometry.owner.close()
+    if obj.body is not None:
+        obj.body.close()
+    del scene.objects[object_id]
+    if obj.entity is not None:
+        members = scene.entities[obj.entity]
+        members.remove(object_id)
+        if not members:
+            del scene.entities[obj.entity]
+    drain_messages()
+    return removed + Removed(geometries=names)
+
+
+# ---------------------------------------------------------------------------------- moving
+
+def set_poses(scene: Scene, poses: Sequence[Tuple[str, Sequence[float], Sequence[float]]],
+              reset_velocity: bool = False) -> None:
+    """Moves objects: (object id, position m world, orientation wxyz) each, all or nothing."""
+    reset_velocity = check.flag("reset_velocity", reset_velocity)
+    checked = []
+    for item in poses:
+        try:
+            object_id, position, orientation = item
+        except (TypeError, ValueError):
+            raise InvalidArgument(f"{item!r} is not (id, position, orientation)") from None
+        obj = scene.object(object_id)
+        checked.append((obj, check.vector(f"position of {object_id!r}", position),
+                        check.quaternion(f"orientation of {object_id!r}", orientation)))
+    for obj, position, orientation in checked:
+        if obj.body is not None:
+            com_W = position + quaternion_to_matrix(orientation) @ obj.com
+            bodies.set_body_pose(obj.body.ptr, com_W.tolist(), orientation.tolist())
+            if reset_velocity:
+                bodies.set_body_velocity(obj.body.ptr, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+        else:
+            for g in obj.geometries:
+                place_static(g.owner.ptr, position, orientation, g.position, g.orientation)
+
+
+def set_velocity(scene: Scene, object_id: str, linear=None, angular=None) -> None:
+    """Linear velocity of the centre of mass (m/s) and/or angular velocity (rad/s), world
+    frame; None keeps the current one. A fixed (kinematic) body then moves at it."""
+    obj = scene.body_object(object_id, "set_velocity")
+    linear = None if linear is None else check.vector("linear velocity", linear)
+    angular = None if angular is None else check.vector("angular velocity", angular)
+    bodies.set_body_velocity(obj.body.ptr, None if linear is None else linear.tolist(),
+                             None if angular is None else angular.tolist())
+
+
+def entity_members(scene: Scene) -> Dict[str, List[str]]:
+    """Entity name -> ids of its objects still alive."""
+    return {name: list(ids) for name, ids in scene.entities.items()}
+
+
+__all__ = ["prepare_object", "prepare_composite", "build_object", "build_composite",
+           "build_entity", "remove_object", "set_poses", "set_velocity", "place_static",
+           "entity_members"]

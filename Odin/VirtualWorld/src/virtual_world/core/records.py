@@ -1,0 +1,160 @@
+"""What the Core keeps about each thing it built (records, private to the Core) and what it
+answers (results, frozen).
+
+Frames: an object's frame is the pose its spec gives (its geometry's origin); ODE's body sits
+at the centre of mass ``com`` (in the object frame), with the object's axes.
+"""
+from __future__ import annotations
+
+from typing import List, NamedTuple, Optional, Set, Tuple
+
+import numpy as np
+
+from odin_common.interface import JointType, MotorKind
+from virtual_world.core.shapes import Shape
+from virtual_world.ode.handles import Owner
+
+
+# ---------------------------------------------------------------------------------- results
+
+class BuiltGeometry(NamedTuple):
+    """One geometry as built: name, the shape's Object/Part parameters and indices (m, its
+    own frame), colour (RGBA), and its world pose (m; quaternion (w, x, y, z)) right after
+    the build. What a Viewer needs to show it."""
+    name: str
+    parameters: Tuple[float, ...]
+    indices: Tuple[int, ...]
+    color: Tuple[float, ...]
+    position: Tuple[float, float, float]
+    orientation: Tuple[float, float, float, float]
+
+
+class Built(NamedTuple):
+    """What one build made: the object's id and its geometries."""
+    id: str
+    geometries: Tuple[BuiltGeometry, ...]
+
+
+class BuiltEntity(NamedTuple):
+    """What Build Entity made: the entity's name and its members, objects first."""
+    name: str
+    members: Tuple[Built, ...]
+
+    @property
+    def ids(self) -> List[str]:
+        return [member.id for member in self.members]
+
+    @property
+    def geometries(self) -> Tuple[BuiltGeometry, ...]:
+        return tuple(g for member in self.members for g in member.geometries)
+
+
+class Removed(NamedTuple):
+    """Every id that went away with a removal (the Viewer drops the geometry names)."""
+    joints: Tuple[str, ...] = ()
+    motors: Tuple[str, ...] = ()
+    forces: Tuple[str, ...] = ()
+    geometries: Tuple[str, ...] = ()
+
+    def __add__(self, other: "Removed") -> "Removed":
+        return Removed(*(a + b for a, b in zip(self, other)))
+
+
+class JointState(NamedTuple):
+    """positions (rad or m) and rates (rad/s or m/s) per joint axis, as
+    odin_common.interface.JOINT_STATE_AXES lists them; none for ball/fixed/plane2d."""
+    id: str
+    type: int
+    positions: Tuple[float, ...]
+    rates: Tuple[float, ...]
+
+
+class Collision(NamedTuple):
+    """Two colliding geometries (names, sorted), the deepest penetration depth (m) and up to 8
+    contact points (world, m)."""
+    first: str
+    second: str
+    depth: float
+    points: Tuple[Tuple[float, float, float], ...]
+
+
+# ---------------------------------------------------------------------------------- records
+
+class GeometryRecord:
+    """One ODE geom: its owner, the object it belongs to and its pose in the object frame."""
+    __slots__ = ("name", "owner", "object_id", "position", "orientation", "shape",
+                 "parameters", "indices", "color")
+
+    def __init__(self, name: str, owner: Owner, object_id: str, position: np.ndarray,
+                 orientation: np.ndarray, shape: Shape, parameters, indices, color):
+        self.name = name
+        self.owner = owner
+        self.object_id = object_id
+        self.position = position        # (3,) m, object frame
+        self.orientation = orientation  # (4,) wxyz, object frame
+        self.shape = shape
+        self.parameters = parameters    # as given (the Viewer draws the given mesh)
+        self.indices = indices
+        self.color = color
+
+
+class ObjectRecord:
+    """One object: its body (None for geometry only), geometries and what hangs on it."""
+    __slots__ = ("id", "spec", "body", "geometries", "com", "fixed", "joints", "motors",
+                 "forces", "entity")
+
+    def __init__(self, object_id: str, spec, body: Optional[Owner], com: np.ndarray,
+                 fixed: bool):
+        self.id = object_id
+        self.spec = spec
+        self.body = body
+        self.geometries: List[GeometryRecord] = []
+        self.com = com                    # (3,) m, centre of mass in the object frame
+        self.fixed = fixed
+        self.joints: Set[str] = set()
+        self.motors: Set[str] = set()
+        self.forces: Set[str] = set()
+        self.entity: Optional[str] = None
+
+
+class JointRecord:
+    __slots__ = ("id", "type", "owner", "bodies", "motors", "forces")
+
+    def __init__(self, joint_id: str, joint_type: JointType, owner: Owner,
+                 bodies: Tuple[str, str]):
+        self.id = joint_id
+        self.type = joint_type
+        self.owner = owner
+        self.bodies = bodies              # (body1 id or "", body2 id or "")
+        self.motors: Set[str] = set()
+        self.forces: Set[str] = set()
+
+
+class MotorRecord:
+    __slots__ = ("id", "owner", "kind", "naxes", "joint", "bodies", "velocity")
+
+    def __init__(self, motor_id: str, owner: Owner, kind: MotorKind, naxes: int,
+                 joint: Optional[str], bodies: Tuple[str, str]):
+        self.id = motor_id
+        self.owner = owner
+        self.kind = kind
+        self.naxes = naxes
+        self.joint = joint
+        self.bodies = bodies
+        self.velocity: List[float] = [0.0] * naxes   # goal speeds, rad/s or m/s
+
+
+class BodyForceRecord(NamedTuple):
+    """A persistent force or torque on an object's body (see forces.add_body_force)."""
+    object_id: str
+    kind: int
+    vector_in_body_frame: bool
+    at_point: bool
+    point_in_body_frame: bool
+    vector: np.ndarray
+    point: np.ndarray               # ODE body frame (centre of mass) when point_in_body_frame
+
+
+class JointForceRecord(NamedTuple):
+    joint_id: str
+    magnitudes: np.ndarray

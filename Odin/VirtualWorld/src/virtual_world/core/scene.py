@@ -1,0 +1,96 @@
+"""A scene: one ODE world and the records that name what is in it.
+
+The topic modules (objects, joints, motors, forces, readout) work on a Scene; the Core (world.py)
+holds one, behind its lock, and replaces it on New Scene. Dictionaries keep insertion order,
+which is the order of every listing the Core gives.
+"""
+from __future__ import annotations
+
+from typing import Dict, FrozenSet, List, Optional, Tuple
+
+from odin_common.world_parameters import WorldParameters
+from virtual_world.core.records import (BodyForceRecord, Collision, GeometryRecord,
+                                        JointForceRecord, JointRecord, MotorRecord, ObjectRecord)
+from virtual_world.errors import Unsupported, UnknownName
+from virtual_world.ode.runtime import drain_messages
+from virtual_world.ode.world import CWorld, PoseReader
+
+
+class Scene:
+    """The ODE world (``c``) and every record of what it holds."""
+
+    def __init__(self, parameters: WorldParameters):
+        self.parameters = parameters
+        self.c = CWorld(parameters)
+        self.objects: Dict[str, ObjectRecord] = {}
+        self.geometries: Dict[str, GeometryRecord] = {}
+        self.geometry_names: Dict[int, str] = {}        # geom C address -> geometry name
+        self.joints: Dict[str, JointRecord] = {}
+        self.pairs: Dict[FrozenSet[str], str] = {}       # {body1, body2} -> joint id
+        self.motors: Dict[str, MotorRecord] = {}
+        self.motor_slots: Dict[str, int] = {}           # motor id -> slot in C's goal array
+        self.body_forces: Dict[str, BodyForceRecord] = {}
+        self.joint_forces: Dict[str, JointForceRecord] = {}
+        self.entities: Dict[str, List[str]] = {}
+        self.next_tag = 1                               # geom tag of the next entity
+        self.entity_counter = 0                         # n of the last "entity<n>"
+        self.carried: Dict[Tuple[str, str], Collision] = {}   # collisions kept in Python
+        self.sim_time = 0.0                             # s since the scene began
+        self._pose_reader: Optional[PoseReader] = None
+        self._pose_names: List[str] = []
+
+    def close(self) -> None:
+        """Frees every ODE handle of the scene; idempotent."""
+        self.c.close()
+        self._pose_reader = None
+        drain_messages()
+
+    # -- look-ups that refuse unknown names --------------------------------------------------
+    def object(self, object_id: str) -> ObjectRecord:
+        try:
+            return self.objects[object_id]
+        except (KeyError, TypeError):
+            raise UnknownName(f"no object {object_id!r}") from None
+
+    def body_object(self, object_id: str, what: str) -> ObjectRecord:
+        """The object, which must have a body (``what`` names the request)."""
+        obj = self.object(object_id)
+        if obj.body is None:
+            raise Unsupported(f"{what}: object {object_id!r} is geometry only (no body)")
+        return obj
+
+    def joint(self, joint_id: str) -> JointRecord:
+        try:
+            return self.joints[joint_id]
+        except (KeyError, TypeError):
+            raise UnknownName(f"no joint {joint_id!r}") from None
+
+    def motor(self, motor_id: str) -> MotorRecord:
+        try:
+            return self.motors[motor_id]
+        except (KeyError, TypeError):
+            raise UnknownName(f"no motor {motor_id!r}") from None
+
+    def geometry(self, name: str) -> GeometryRecord:
+        try:
+            return self.geometries[name]
+        except (KeyError, TypeError):
+            raise UnknownName(f"no geometry named {name!r}") from None
+
+    # -- geometries, in one C array for pose read-out ---------------------------------------
+    def add_geometry(self, record: GeometryRecord) -> None:
+        self.geometries[record.name] = record
+        self.geometry_names[record.owner.address] = record.name
+        self._pose_reader = None
+
+    def drop_geometry(self, record: GeometryRecord) -> None:
+        del self.geometry_names[record.owner.address]
+        del self.geometries[record.name]
+        self._pose_reader = None
+
+    def pose_reader(self) -> Tuple[List[str], PoseReader]:
+        """(geometry names, a reader of their poses), rebuilt after a build or a removal."""
+        if self._pose_reader is None:
+            self._pose_names = list(self.geometries)
+            self._pose_reader = PoseReader([self.geometries[n].owner for n in self._pose_names])
+        return self._pose_names, self._pose_reader

@@ -1,0 +1,370 @@
+"""The Core: the virtual world of the thesis's chapter 5, ROS-free.
+
+``Core`` holds one Scene behind one re-entrant lock (rospy serves calls on threads of its
+own) and forwards each request to the module of its topic: objects, joints, motors, forces,
+readout. It owns the world parameters and the step. Every argument is checked before any ODE
+call, so an error raised here means nothing changed; the rules that span topics (Set
+Velocity's all-or-nothing, a joint with its parameters) live here, never in a Portal.
+
+Conventions: SI units; world frame unless said; quaternions (w, x, y, z). An object's frame is
+the one its spec's pose gives; "body frame" in this API means the object's frame (ODE's body
+sits at the centre of mass with the same axes). Fixed bodies are ODE kinematic bodies: never
+moved by forces or contacts, infinite mass for them.
+"""
+from __future__ import annotations
+
+import functools
+import threading
+from typing import Dict, List, Mapping, Optional, Sequence, Tuple
+
+import numpy as np
+
+from odin_common.interface import ForceKind, JointType, MotorKind
+from odin_common.specs import CompositeSpec, EntitySpec, JointSpec, MotorSpec, ObjectSpec
+from odin_common.world_parameters import WorldParameters
+from virtual_world.core import forces, joints, motors, objects, readout, validation as check
+from virtual_world.core.records import (Built, BuiltEntity, Collision, JointState, Removed)
+from virtual_world.core.scene import Scene
+from virtual_world.errors import Closed, InvalidArgument
+from virtual_world.ode import bodies
+from virtual_world.ode.runtime import drain_messages, init_ode
+
+
+def _locked(method):
+    @functools.wraps(method)
+    def wrapper(self, *args, **kwargs):
+        with self._lock:
+            if self._scene is None:
+                raise Closed(f"Core is closed ({method.__name__})")
+            return method(self, *args, **kwargs)
+    return wrapper
+
+
+class Core:
+    """The virtual world: objects, joints, motors, forces, collisions and the step."""
+
+    def __init__(self, parameters: Optional[WorldParameters] = None):
+        init_ode()
+        parameters = WorldParameters() if parameters is None else parameters
+        if not isinstance(parameters, WorldParameters):
+            raise InvalidArgument(f"parameters={parameters!r} is not a WorldParameters")
+        check.shared(parameters.validate)
+        self._lock = threading.RLock()
+        self._scene: Optional[Scene] = Scene(parameters)
+
+    # ------------------------------------------------------------------ lifetime
+
+    @_locked
+    def new_scene(self) -> None:
+        """Frees every object, joint, motor and force and starts an empty world with the
+        same world parameters; sim_time restarts at 0."""
+        parameters = self._scene.parameters
+        self._scene.close()
+        self._scene = Scene(parameters)
+
+    def close(self) -> None:
+        """Frees everything; idempotent. Any later call but close() raises Closed."""
+        with self._lock:
+            if self._scene is not None:
+                self._scene.close()
+                self._scene = None
+
+    def __enter__(self) -> "Core":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:  # interpreter shutdown: modules may be gone
+            pass
+
+    # ------------------------------------------------------------------ world parameters
+
+    @property
+    def world_parameters(self) -> WorldParameters:
+        """The values in force (an immutable snapshot, safe to read from any thread)."""
+        return self._parameters
+
+    @property
+    def _parameters(self) -> WorldParameters:
+        scene = self._scene
+        if scene is None:
+            raise Closed("Core is closed (world_parameters)")
+        return scene.parameters
+
+    @_locked
+    def set_world_parameters(self, **changes) -> WorldParameters:
+        """Checks every change, then applies them all; returns the values in force.
+        At least one change; switching the collision policy forgets recorded collisions."""
+        if not changes:
+            raise InvalidArgument("no world parameter given (Set World: set at least one "
+                                  "set_* flag)")
+        scene = self._scene
+        new = check.shared(scene.parameters.replace, **changes)
+        if new.contact_less != scene.parameters.contact_less:
+            readout.forget_collisions(scene)
+        scene.c.apply(new)
+        scene.parameters = new
+        return new
+
+    # ------------------------------------------------------------------ objects
+
+    @_locked
+    def build_object(self, spec: ObjectSpec) -> Built:
+        """Creates one object (see ObjectSpec); returns its id and geometries as built."""
+        return objects.build_object(self._scene, spec)
+
+    @_locked
+    def build_composite(self, spec: CompositeSpec) -> Built:
+        """Creates a composite: its parts are geometries on one body placed at the centre of
+        mass (part masses rotated, translated and added); its id is ">part1>part2..."."""
+        return objects.build_composite(self._scene, spec)
+
+    @_locked
+    def build_entity(self, spec: EntitySpec) -> BuiltEntity:
+        """Builds objects and composites as one entity, all or nothing (see EntitySpec)."""
+        return objects.build_entity(self._scene, spec)
+
+    @_locked
+    def entities(self) -> Dict[str, List[str]]:
+        """Entity name -> ids of its objects still alive."""
+        return objects.entity_members(self._scene)
+
+    @_locked
+    def remove_object(self, object_id: str) -> Removed:
+        """Removes an object with its joints, motors and forces; returns every removed id."""
+        return objects.remove_object(self._scene, object_id)
+
+    @_locked
+    def object_ids(self) -> List[str]:
+        return list(self._scene.objects)
+
+    @_locked
+    def object_spec(self, object_id: str):
+        """The ObjectSpec or CompositeSpec the object was built from."""
+        return self._scene.object(object_id).spec
+
+    @_locked
+    def geometry_names(self, object_id: str) -> List[str]:
+        """Names of the object's geometries (one, or a composite's parts)."""
+        return [g.name for g in self._scene.object(object_id).geometries]
+
+    @_locked
+    def collision_triangle_count(self, geometry_name: str) -> int:
+        """Triangles ODE collides with for a mesh geometry (fewer than given when it was built
+        under a collision_mesh_tolerance); 0 for a primitive."""
+        geometry = self._scene.geometry(geometry_name)
+        if geometry.shape.kind != "mesh":
+            return 0
+        return bodies.triangle_count(geometry.owner.ptr)
+
+    @_locked
+    def set_poses(self, poses: Sequence[Tuple[str, Sequence[float], Sequence[float]]],
+                  reset_velocity: bool = False) -> None:
+        """Moves objects: (object id, position m world, orientation wxyz) each, all or
+        nothing. reset_velocity zeroes the bodies' linear and angular velocities."""
+        objects.set_poses(self._scene, poses, reset_velocity)
+
+    @_locked
+    def set_velocity(self, object_id: str, linear=None, angular=None) -> None:
+        """Sets the linear velocity of the centre of mass (m/s, world) and/or the angular
+        velocity (rad/s, world) of a body; None keeps the current one."""
+        objects.set_velocity(self._scene, object_id, linear, angular)
+
+    @_locked
+    def set_velocities(self, object_id: str = "", linear=None, angular=None,
+                       motor_ids: Sequence[str] = (), velocities: Sequence[float] = ()) -> None:
+        """Set Velocity: an object's velocities and/or motor goal speeds (one flat list, each
+        motor taking as many values as it has axes), all checked before any is set."""
+        if len(motor_ids) == 0 and not object_id:
+            raise InvalidArgument("nothing to set: give an object or motors")
+        if object_id and linear is None and angular is None:
+            raise InvalidArgument(f"object {object_id!r} given without set_linear or "
+                                  "set_angular")
+        scene = self._scene
+        if object_id:
+            scene.body_object(object_id, "set_velocity")
+            linear = None if linear is None else check.vector("linear", linear)
+            angular = None if angular is None else check.vector("angular", angular)
+        goals = motors.split_velocities(scene, motor_ids, velocities) if len(motor_ids) else {}
+        motors.set_velocities(scene, goals)
+        if object_id:
+            objects.set_velocity(scene, object_id, linear, angular)
+
+    # ------------------------------------------------------------------ joints and motors
+
+    @_locked
+    def add_joint(self, spec: JointSpec) -> str:
+        """Creates a joint and sets its parameters, all or nothing (see JointSpec); returns
+        its id."""
+        return joints.create_joint(self._scene, spec)
+
+    def create_joint(self, joint_type: int, body1: str, body2: str, anchor=(0.0, 0.0, 0.0),
+                     axis1=(0.0, 0.0, 1.0), axis2=(1.0, 0.0, 0.0), axis3=(0.0, 1.0, 0.0),
+                     joint_id: str = "", parameters: Sequence = ()) -> str:
+        """add_joint with the fields of JointSpec as arguments. Joint types: JointType;
+        PLANE2D keeps body1 in the plane z = 0 (body2 must be ""); FIXED keeps the bodies'
+        present relative pose; one joint per pair of bodies."""
+        return self.add_joint(JointSpec(joint_type, body1, body2, anchor, axis1, axis2, axis3,
+                                        parameters, joint_id))
+
+    @_locked
+    def joint_ids(self) -> List[str]:
+        return list(self._scene.joints)
+
+    @_locked
+    def set_joint_parameters(self, joint_id: str,
+                             parameters: Sequence[Tuple[int, int, float]]) -> None:
+        """(parameter, axis 1..3, value) triples on a joint or a motor, all or nothing (see
+        joints.set_joint_parameters for the ranges); at least one."""
+        if len(parameters) == 0:
+            raise InvalidArgument(f"no parameter to set on {joint_id!r}")
+        joints.set_joint_parameters(self._scene, joint_id, parameters)
+
+    @_locked
+    def remove_joint(self, joint_id: str) -> Removed:
+        """Removes a joint with its motors and joint forces."""
+        return joints.remove_joint(self._scene, joint_id)
+
+    @_locked
+    def joint_states(self) -> List[JointState]:
+        """Positions and rates of every joint, per axis (see JointState)."""
+        return joints.joint_states(self._scene)
+
+    @_locked
+    def add_motor(self, spec: MotorSpec) -> str:
+        """Creates a motor (see MotorSpec) at zero goal speed; returns its id."""
+        return motors.create_motor(self._scene, spec)
+
+    def create_motor(self, motor_id: str = "", joint: str = "", body1: str = "",
+                     body2: str = "", kind: int = MotorKind.ANGULAR, axes: Sequence[float] = (),
+                     axis_frames: Sequence[int] = (), max_forces: Sequence[float] = ()) -> str:
+        """add_motor with the fields of MotorSpec as arguments."""
+        return self.add_motor(MotorSpec(joint, kind, body1, body2, axes, axis_frames,
+                                        max_forces, motor_id))
+
+    @_locked
+    def motor_ids(self) -> List[str]:
+        return list(self._scene.motors)
+
+    @_locked
+    def motor_axis_counts(self, motor_ids: Sequence[str]) -> List[int]:
+        """Number of axes of each motor (how many goal speeds it takes); unknown ids raise."""
+        return motors.axis_counts(self._scene, motor_ids)
+
+    @_locked
+    def motor_goals(self) -> Dict[str, List[float]]:
+        """Every motor's goal speeds per axis (rad/s or m/s)."""
+        return {motor_id: list(m.velocity) for motor_id, m in self._scene.motors.items()}
+
+    @_locked
+    def remove_motor(self, motor_id: str) -> None:
+        motors.remove_motor(self._scene, motor_id)
+
+    @_locked
+    def set_motor_velocities(self, velocities: Mapping[str, Sequence[float]]) -> None:
+        """Goal speeds (rad/s or m/s) per motor axis; all checked before any is set."""
+        motors.set_velocities(self._scene, velocities)
+
+    # ------------------------------------------------------------------ forces
+
+    @_locked
+    def add_body_force(self, object_id: str, kind: int, vector,
+                       vector_in_body_frame: bool = False, at_point: bool = False,
+                       point=(0.0, 0.0, 0.0), point_in_body_frame: bool = False) -> str:
+        """A persistent force (N) or torque (N m) on an object's body, re-applied before every
+        step until removed: the vector in the world or the object's frame; a force acts at
+        the centre of mass or at ``point`` (m, world or object frame). Returns
+        "force:<object>:<n>" or "torque:<object>:<n>"."""
+        return forces.add_body_force(self._scene, object_id, kind, vector,
+                                     vector_in_body_frame, at_point, point, point_in_body_frame)
+
+    @_locked
+    def remove_body_force(self, force_id: str) -> None:
+        forces.remove_body_force(self._scene, force_id)
+
+    @_locked
+    def body_force_ids(self) -> List[str]:
+        return list(self._scene.body_forces)
+
+    @_locked
+    def add_joint_force(self, joint_id: str, magnitudes: Sequence[float]) -> str:
+        """A persistent force/torque along a joint's axes, applied before every step until
+        removed (odin_common.interface.JOINT_FORCE_MAGNITUDES). Returns
+        "jointforce:<joint>:<n>"."""
+        return forces.add_joint_force(self._scene, joint_id, magnitudes)
+
+    @_locked
+    def remove_joint_force(self, force_id: str) -> None:
+        forces.remove_joint_force(self._scene, force_id)
+
+    @_locked
+    def joint_force_ids(self) -> List[str]:
+        return list(self._scene.joint_forces)
+
+    # ------------------------------------------------------------------ step and read-out
+
+    @_locked
+    def step(self, step_size: float, count: int = 1) -> None:
+        """Runs ``count`` steps of ``step_size`` s, all in one C call: collide (contacts or
+        recording), body forces, joint forces and motor goals, (Quick)Step, empty contacts."""
+        step_size = check.number("step_size", step_size)
+        if step_size <= 0:
+            raise InvalidArgument(f"step_size={step_size!r} must be positive")
+        if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
+            raise InvalidArgument(f"count={count!r} must be a positive integer")
+        scene = self._scene
+        if not scene.parameters.contact_less:
+            scene.carried = {}
+        scene.c.step(step_size, int(count))
+        scene.sim_time += step_size * int(count)
+        drain_messages()
+
+    @_locked
+    def detect_collisions(self) -> None:
+        """Contact-less policy: collision detection on the present poses without a step, so
+        that read_collisions() reports what touches now in a paused world whose objects were
+        moved (Set Position). Does nothing under the contact policy."""
+        self._scene.c.detect()
+        drain_messages()
+
+    @property
+    def sim_time(self) -> float:
+        """Simulated seconds since the scene began."""
+        return self._scene.sim_time
+
+    @property
+    def last_step_contacts(self) -> int:
+        """Contact joints created in the last step."""
+        return self._scene.c.last_step_contacts
+
+    @_locked
+    def poses(self) -> Tuple[List[str], np.ndarray, np.ndarray]:
+        """Every geometry (composite parts one by one, static ones too): names, positions
+        (n, 3) m and quaternions (n, 4) wxyz, world frame; read in one C call."""
+        return readout.poses(self._scene)
+
+    @_locked
+    def body_state(self, object_id: str) -> Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(position of the object origin m, orientation wxyz, linear velocity of the centre of
+        mass m/s, angular velocity rad/s), world frame."""
+        return readout.body_state(self._scene, object_id)
+
+    @_locked
+    def mass_properties(self, object_id: str) -> Tuple[float, np.ndarray, np.ndarray]:
+        """(mass kg, centre of mass (3,) m in the object frame, inertia (3,3) kg m^2 about the
+        centre of mass, object axes) as ODE holds them."""
+        return readout.mass_properties(self._scene, object_id)
+
+    @_locked
+    def read_collisions(self) -> List[Collision]:
+        """Colliding geometry pairs (names sorted within a pair), deepest depth and points.
+        Contact-less policy: every pair seen since the last read; reading clears the set.
+        Contact policy: the pairs that had contacts in the last step."""
+        return readout.read_collisions(self._scene)
+
+
+__all__ = ["Core", "ForceKind", "JointType", "MotorKind"]

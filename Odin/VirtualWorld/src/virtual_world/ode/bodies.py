@@ -1,0 +1,152 @@
+"""ODE's bodies, geoms and mass records, as the Core uses them: poses, velocities, kinematic
+bodies, geom offsets and collision bits, and dMass arithmetic.
+
+Frames: an ODE body sits at its centre of mass with the object's axes; positions and velocities
+here are ODE's (centre of mass, world frame), quaternions (w, x, y, z). The Core converts
+between an object's frame and its centre of mass. Arguments are already checked.
+"""
+from __future__ import annotations
+
+from typing import Sequence, Tuple
+
+import numpy as np
+
+from virtual_world.ode.bindings import ffi, lib
+
+IDENTITY = (1.0, 0.0, 0.0, 0.0)
+
+
+# ---------------------------------------------------------------------------------- bodies
+
+def configure_body(body, dmass, com_position: Sequence[float], quaternion: Sequence[float],
+                   kinematic: bool) -> None:
+    """Sets a new body's mass (centred: its centre of mass at the body origin), pose, and makes
+    it kinematic (infinite mass for contacts and joints, moved only by its velocity)."""
+    lib.dBodySetMass(body, dmass)
+    set_body_pose(body, com_position, quaternion)
+    if kinematic:
+        lib.dBodySetKinematic(body)
+
+
+def set_body_pose(body, com_position: Sequence[float], quaternion: Sequence[float]) -> None:
+    lib.dBodySetPosition(body, *com_position)
+    lib.dBodySetQuaternion(body, list(quaternion))
+
+
+def set_body_velocity(body, linear: Sequence[float] = None,
+                      angular: Sequence[float] = None) -> None:
+    """Linear velocity of the centre of mass (m/s) and/or angular velocity (rad/s), world;
+    None keeps the current one."""
+    if linear is not None:
+        lib.dBodySetLinearVel(body, *linear)
+    if angular is not None:
+        lib.dBodySetAngularVel(body, *angular)
+
+
+def body_state(body) -> Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(centre of mass (3,) m, quaternion (4,), linear velocity (3,) m/s, angular velocity
+    (3,) rad/s), world frame."""
+    p, q = lib.dBodyGetPosition(body), lib.dBodyGetQuaternion(body)
+    v, w = lib.dBodyGetLinearVel(body), lib.dBodyGetAngularVel(body)
+    return (np.array([p[0], p[1], p[2]]), np.array([q[0], q[1], q[2], q[3]]),
+            np.array([v[0], v[1], v[2]]), np.array([w[0], w[1], w[2]]))
+
+
+def body_mass(body) -> Tuple[float, np.ndarray]:
+    """(mass kg, inertia (3, 3) kg m^2 about the centre of mass, body axes)."""
+    m = ffi.new("dMass *")
+    lib.dBodyGetMass(body, m)
+    return float(m.mass), inertia_matrix(m)
+
+
+# ---------------------------------------------------------------------------------- geoms
+
+def set_geom_offset(geom, position: Sequence[float], quaternion: Sequence[float]) -> None:
+    """Places a geom attached to a body relative to the body (centre of mass, body axes)."""
+    if any(v != 0 for v in position):
+        lib.dGeomSetOffsetPosition(geom, *position)
+    if tuple(quaternion) != IDENTITY:
+        lib.dGeomSetOffsetQuaternion(geom, list(quaternion))
+
+
+def set_geom_pose(geom, position: Sequence[float], quaternion: Sequence[float]) -> None:
+    """Places a static (body-less) geom, world frame."""
+    lib.dGeomSetPosition(geom, *position)
+    lib.dGeomSetQuaternion(geom, list(quaternion))
+
+
+def set_geom_tag(geom, tag: int) -> None:
+    """Two geoms with the same non-zero tag never collide (an entity without internal
+    collisions; odin_step.c's near-callback reads it)."""
+    lib.odin_set_geom_tag(geom, tag)
+
+
+def exclude_from_collisions(geom) -> None:
+    """The hash space never pairs a geom whose category and collide bits are all clear."""
+    lib.dGeomSetCategoryBits(geom, 0)
+    lib.dGeomSetCollideBits(geom, 0)
+
+
+def triangle_count(geom) -> int:
+    return int(lib.dGeomTriMeshGetTriangleCount(geom))
+
+
+# ---------------------------------------------------------------------------------- mass
+
+def primitive_mass(kind: str, dims: Sequence[float], mass: float):
+    """dMass of a sphere, cylinder (along z) or box of total ``mass`` kg about its centre."""
+    m = ffi.new("dMass *")
+    if kind == "sphere":
+        lib.dMassSetSphereTotal(m, mass, dims[0])
+    elif kind == "cylinder":
+        lib.dMassSetCylinderTotal(m, mass, 3, dims[0], dims[1])
+    elif kind == "box":
+        lib.dMassSetBoxTotal(m, mass, *dims)
+    else:
+        raise ValueError(f"no primitive mass for {kind!r}")
+    return m
+
+
+def mass_from_parameters(mass: float, center: Sequence[float], inertia: np.ndarray):
+    """dMass of ``mass`` kg with ``inertia`` (3, 3) kg m^2 about ``center`` (m), which is
+    then where the dMass's centre lies."""
+    m = ffi.new("dMass *")
+    i = inertia
+    lib.dMassSetParameters(m, mass, 0.0, 0.0, 0.0, i[0, 0], i[1, 1], i[2, 2], i[0, 1], i[0, 2],
+                           i[1, 2])
+    lib.dMassTranslate(m, *center)
+    return m
+
+
+def zero_mass():
+    m = ffi.new("dMass *")
+    lib.dMassSetZero(m)
+    return m
+
+
+def add_mass(total, part, position: Sequence[float], quaternion: Sequence[float]) -> None:
+    """Adds ``part`` (a dMass in the part's frame), rotated by ``quaternion`` and moved to
+    ``position``, to ``total``."""
+    R = ffi.new("dMatrix3")
+    lib.dRfromQ(R, list(quaternion))
+    lib.dMassRotate(part, R)
+    lib.dMassTranslate(part, *position)
+    lib.dMassAdd(total, part)
+
+
+def mass_center(m) -> np.ndarray:
+    return np.array([m.c[0], m.c[1], m.c[2]])
+
+
+def center_mass(m) -> None:
+    """Moves a dMass so that its centre of mass is its origin (ODE's bodies need that)."""
+    lib.dMassTranslate(m, *(-mass_center(m)).tolist())
+
+
+def inertia_matrix(m) -> np.ndarray:
+    return np.array([[m.I[4 * r + c] for c in range(3)] for r in range(3)])
+
+
+def mass_is_valid(m) -> bool:
+    """ODE's own check (dMassCheck); it reports through ODE's message handler when false."""
+    return bool(lib.dMassCheck(m))

@@ -1,0 +1,188 @@
+"""One Python owner per ODE handle: every world, space, joint group, body, geom, trimesh data
+and joint is created here and freed by its owner.
+
+Rules (dm_control / pymunk style):
+  * every owner frees its handle exactly once: ``close()`` is idempotent and a
+    ``weakref.finalize`` frees a forgotten owner when it is collected (never twice);
+  * a child holds its parents strongly, so no parent is freed under a living child;
+  * a parent holds its children weakly and closes them first when it closes (ODE's
+    dWorldDestroy would otherwise destroy bodies and joints behind their owners' backs, and
+    dBodyDestroy would turn attached geoms into static ones); spaces are created with
+    cleanup off, so geoms are only ever destroyed by their owners;
+  * a trimesh geom keeps its vertex and index arrays (ODE does not copy them) and its trimesh
+    data owner alive, and frees that data after the geom.
+
+Arguments are the Core's, already checked: ODE ends the process on bad input.
+The destroy functions are looked up in ``DESTROYERS`` at call time so tests can spy on them.
+"""
+from __future__ import annotations
+
+import weakref
+from typing import Any, Callable, Dict, Iterable, Optional, Sequence, Tuple
+
+from odin_common.interface import JointType, MotorKind
+from virtual_world.ode.bindings import ffi, lib
+
+DESTROYERS: Dict[str, Callable[[Any], None]] = {
+    "world": lambda p: lib.dWorldDestroy(p),
+    "space": lambda p: lib.dSpaceDestroy(p),
+    "jointgroup": lambda p: lib.dJointGroupDestroy(p),
+    "body": lambda p: lib.dBodyDestroy(p),
+    "geom": lambda p: lib.dGeomDestroy(p),
+    "trimeshdata": lambda p: lib.dGeomTriMeshDataDestroy(p),
+    "joint": lambda p: lib.dJointDestroy(p),
+}
+
+
+def _free(kind: str, ptr: Any, keep: Tuple[Any, ...]) -> None:
+    DESTROYERS[kind](ptr)
+    for item in keep:  # owners kept by this handle (a trimesh's data) go right after it
+        if isinstance(item, Owner):
+            item.close()
+
+
+class Owner:
+    """Owns one ODE handle `ptr` of `kind` (a key of DESTROYERS).
+
+    parents: owners that must outlive this one (held strongly); they close this one first.
+    keep:    Python objects (cffi arrays, other owners) kept alive until the handle is freed.
+    """
+
+    __slots__ = ("kind", "_ptr", "_parents", "_children", "_finalizer", "__weakref__")
+
+    def __init__(self, kind: str, ptr: Any, parents: Iterable["Owner"] = (),
+                 keep: Tuple[Any, ...] = ()):
+        if ptr == ffi.NULL:
+            raise MemoryError(f"ODE returned NULL for a new {kind}")
+        self.kind = kind
+        self._ptr = ptr
+        self._parents = tuple(parents)
+        self._children: "weakref.WeakSet[Owner]" = weakref.WeakSet()
+        for parent in self._parents:
+            parent._children.add(self)
+        self._finalizer = weakref.finalize(self, _free, kind, ptr, tuple(keep))
+        self._finalizer.atexit = False  # ODE may already be closed at interpreter exit
+
+    @property
+    def ptr(self) -> Any:
+        """The live C handle; raises if closed."""
+        if self._ptr is None:
+            raise ValueError(f"{self.kind} handle already freed")
+        return self._ptr
+
+    @property
+    def closed(self) -> bool:
+        return self._ptr is None
+
+    @property
+    def address(self) -> int:
+        """The handle's C address (how C code names it back to Python)."""
+        return int(ffi.cast("uintptr_t", self.ptr))
+
+    def close(self) -> None:
+        """Frees children first, then the handle; a second call does nothing."""
+        if self._ptr is None:
+            return
+        for child in list(self._children):
+            child.close()
+        self._ptr = None
+        self._finalizer()
+        for parent in self._parents:
+            parent._children.discard(self)
+
+
+# ---------------------------------------------------------------------------------- world
+
+def new_world() -> Owner:
+    return Owner("world", lib.dWorldCreate())
+
+
+def new_space() -> Owner:
+    """A hash space that never destroys its geoms (their owners do)."""
+    space = lib.dHashSpaceCreate(ffi.NULL)
+    if space != ffi.NULL:
+        lib.dSpaceSetCleanup(space, 0)
+    return Owner("space", space)
+
+
+def new_joint_group(world: Owner) -> Owner:
+    return Owner("jointgroup", lib.dJointGroupCreate(0), parents=(world,))
+
+
+# ---------------------------------------------------------------------------------- bodies
+
+def new_body(world: Owner) -> Owner:
+    return Owner("body", lib.dBodyCreate(world.ptr), parents=(world,))
+
+
+# ---------------------------------------------------------------------------------- geoms
+
+def new_geom(ptr: Any, space: Owner, body: Optional[Owner] = None,
+             keep: Tuple[Any, ...] = ()) -> Owner:
+    """Adopts a freshly created geom in `space`, attached to `body` if any."""
+    parents = (space,) if body is None else (space, body)
+    owner = Owner("geom", ptr, parents=parents, keep=keep)
+    if body is not None:
+        lib.dGeomSetBody(ptr, body.ptr)
+    return owner
+
+
+def new_primitive(space: Owner, kind: str, dims: Sequence[float],
+                  body: Optional[Owner] = None) -> Owner:
+    """A sphere (radius), cylinder (radius, length along z) or box (sides x, y, z), m."""
+    if kind == "sphere":
+        ptr = lib.dCreateSphere(space.ptr, dims[0])
+    elif kind == "cylinder":
+        ptr = lib.dCreateCylinder(space.ptr, dims[0], dims[1])
+    elif kind == "box":
+        ptr = lib.dCreateBox(space.ptr, dims[0], dims[1], dims[2])
+    else:
+        raise ValueError(f"no ODE primitive {kind!r}")
+    return new_geom(ptr, space, body)
+
+
+def new_trimesh(space: Owner, vertices: Any, indices: Any, body: Optional[Owner] = None) -> Owner:
+    """A trimesh geom over cffi arrays `vertices` (double[3n]) and `indices` (dTriIndex[3m]).
+
+    The geom's owner keeps both arrays and the trimesh data owner alive; the data is freed
+    right after the geom."""
+    data = Owner("trimeshdata", lib.dGeomTriMeshDataCreate(), keep=(vertices, indices))
+    lib.dGeomTriMeshDataBuildDouble(data.ptr, vertices, 3 * ffi.sizeof("double"),
+                                    len(vertices) // 3, indices, len(indices),
+                                    3 * ffi.sizeof("dTriIndex"))
+    ptr = lib.dCreateTriMesh(space.ptr, data.ptr, ffi.NULL, ffi.NULL, ffi.NULL)
+    if ptr == ffi.NULL:
+        data.close()
+        raise MemoryError("ODE returned NULL for a new trimesh")
+    return new_geom(ptr, space, body, keep=(vertices, indices, data))  # data freed after geom
+
+
+# ---------------------------------------------------------------------------------- joints
+
+_CREATE_JOINT = {
+    JointType.BALL: lib.dJointCreateBall, JointType.HINGE: lib.dJointCreateHinge,
+    JointType.SLIDER: lib.dJointCreateSlider, JointType.PISTON: lib.dJointCreatePiston,
+    JointType.UNIVERSAL: lib.dJointCreateUniversal, JointType.HINGE2: lib.dJointCreateHinge2,
+    JointType.PR: lib.dJointCreatePR, JointType.PU: lib.dJointCreatePU,
+    JointType.FIXED: lib.dJointCreateFixed, JointType.PLANE2D: lib.dJointCreatePlane2D,
+}
+_CREATE_MOTOR = {MotorKind.ANGULAR: lib.dJointCreateAMotor,
+                 MotorKind.LINEAR: lib.dJointCreateLMotor}
+
+
+def _attached(ptr: Any, world: Owner, bodies: Sequence[Owner]) -> Owner:
+    """Adopts a new joint and attaches it: bodies[0] is ODE's body 1; with one body, body 2 is
+    the static world (NULL)."""
+    owner = Owner("joint", ptr, parents=(world, *bodies))
+    lib.dJointAttach(ptr, bodies[0].ptr, bodies[1].ptr if len(bodies) > 1 else ffi.NULL)
+    return owner
+
+
+def new_joint(world: Owner, kind: JointType, bodies: Sequence[Owner]) -> Owner:
+    """A joint of ``kind`` attached to one or two bodies (see _attached)."""
+    return _attached(_CREATE_JOINT[kind](world.ptr, ffi.NULL), world, bodies)
+
+
+def new_motor(world: Owner, kind: MotorKind, bodies: Sequence[Owner]) -> Owner:
+    """An angular (dAMotor) or linear (dLMotor) motor attached like a joint."""
+    return _attached(_CREATE_MOTOR[kind](world.ptr, ffi.NULL), world, bodies)

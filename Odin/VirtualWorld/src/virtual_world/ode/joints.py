@@ -1,0 +1,164 @@
+"""ODE's joints and motors, by type: setting anchors and axes, parameters, reading positions,
+rates and axes. The per-type tables of ODE's C functions live here and nowhere else.
+
+Conventions: world frame; a body joined to the static world is ODE's body 1 (body 2 NULL), so
+angles, rates, joint forces and motors describe that body's motion about (along) the axes as
+given. Arguments are already checked.
+"""
+from __future__ import annotations
+
+from typing import List, Sequence, Tuple
+
+import numpy as np
+
+from odin_common.interface import JointParameter, JointType, MotorKind
+from virtual_world.ode.bindings import ffi, lib
+
+T = JointType
+
+ODE_JOINT_TYPE = {
+    T.BALL: lib.dJointTypeBall, T.HINGE: lib.dJointTypeHinge, T.SLIDER: lib.dJointTypeSlider,
+    T.PISTON: lib.dJointTypePiston, T.UNIVERSAL: lib.dJointTypeUniversal,
+    T.HINGE2: lib.dJointTypeHinge2, T.PR: lib.dJointTypePR, T.PU: lib.dJointTypePU,
+    T.FIXED: lib.dJointTypeFixed, T.PLANE2D: lib.dJointTypePlane2D,
+}
+"""Odin's joint type -> ODE's dJointType (what odin_step.c switches on)."""
+
+_ODE_PARAMETER = {
+    JointParameter.LO_STOP: lib.dParamLoStop, JointParameter.HI_STOP: lib.dParamHiStop,
+    JointParameter.BOUNCE: lib.dParamBounce, JointParameter.CFM: lib.dParamCFM,
+    JointParameter.ERP: lib.dParamERP, JointParameter.STOP_ERP: lib.dParamStopERP,
+    JointParameter.STOP_CFM: lib.dParamStopCFM,
+    JointParameter.SUSPENSION_ERP: lib.dParamSuspensionERP,
+    JointParameter.SUSPENSION_CFM: lib.dParamSuspensionCFM,
+    JointParameter.FUDGE_FACTOR: lib.dParamFudgeFactor, JointParameter.VELOCITY: lib.dParamVel,
+    JointParameter.MAX_FORCE: lib.dParamFMax,
+}
+
+_SET_PARAMETER = {
+    T.BALL: lib.dJointSetBallParam, T.HINGE: lib.dJointSetHingeParam,
+    T.SLIDER: lib.dJointSetSliderParam, T.PISTON: lib.dJointSetPistonParam,
+    T.UNIVERSAL: lib.dJointSetUniversalParam, T.HINGE2: lib.dJointSetHinge2Param,
+    T.PR: lib.dJointSetPRParam, T.PU: lib.dJointSetPUParam, T.FIXED: lib.dJointSetFixedParam,
+}
+_SET_MOTOR_PARAMETER = {MotorKind.ANGULAR: lib.dJointSetAMotorParam,
+                        MotorKind.LINEAR: lib.dJointSetLMotorParam}
+
+_STATE = {  # per joint type: (position getters, rate getters), one per reported axis
+    T.HINGE: ((lib.dJointGetHingeAngle,), (lib.dJointGetHingeAngleRate,)),
+    T.SLIDER: ((lib.dJointGetSliderPosition,), (lib.dJointGetSliderPositionRate,)),
+    T.PISTON: ((lib.dJointGetPistonPosition, lib.dJointGetPistonAngle),
+               (lib.dJointGetPistonPositionRate, lib.dJointGetPistonAngleRate)),
+    T.UNIVERSAL: ((lib.dJointGetUniversalAngle1, lib.dJointGetUniversalAngle2),
+                  (lib.dJointGetUniversalAngle1Rate, lib.dJointGetUniversalAngle2Rate)),
+    T.HINGE2: ((lib.dJointGetHinge2Angle1, lib.dJointGetHinge2Angle2),
+               (lib.dJointGetHinge2Angle1Rate, lib.dJointGetHinge2Angle2Rate)),
+    T.PR: ((lib.dJointGetPRPosition, lib.dJointGetPRAngle),
+           (lib.dJointGetPRPositionRate, lib.dJointGetPRAngleRate)),
+    T.PU: ((lib.dJointGetPUPosition, lib.dJointGetPUAngle1, lib.dJointGetPUAngle2),
+           (lib.dJointGetPUPositionRate, lib.dJointGetPUAngle1Rate,
+            lib.dJointGetPUAngle2Rate)),
+}
+
+_AXES = {  # the axes a motor on a joint of this type drives, by motor kind
+    MotorKind.ANGULAR: {
+        T.HINGE: (lib.dJointGetHingeAxis,), T.PISTON: (lib.dJointGetPistonAxis,),
+        T.UNIVERSAL: (lib.dJointGetUniversalAxis1, lib.dJointGetUniversalAxis2),
+        T.HINGE2: (lib.dJointGetHinge2Axis1, lib.dJointGetHinge2Axis2),
+        T.PR: (lib.dJointGetPRAxis2,),
+        T.PU: (lib.dJointGetPUAxis1, lib.dJointGetPUAxis2)},
+    MotorKind.LINEAR: {
+        T.SLIDER: (lib.dJointGetSliderAxis,), T.PISTON: (lib.dJointGetPistonAxis,),
+        T.PR: (lib.dJointGetPRAxis1,), T.PU: (lib.dJointGetPUAxis3,)},
+}
+
+
+def configure_joint(joint, kind: JointType, anchor: Sequence[float], axis1: Sequence[float],
+                    axis2: Sequence[float], axis3: Sequence[float]) -> None:
+    """Sets the anchor (m, world) and the axes (unit, world) ``kind`` uses; a fixed joint
+    keeps the bodies' present relative pose."""
+    a = list(anchor)
+    if kind == T.BALL:
+        lib.dJointSetBallAnchor(joint, *a)
+    elif kind == T.HINGE:
+        lib.dJointSetHingeAnchor(joint, *a)
+        lib.dJointSetHingeAxis(joint, *axis1)
+    elif kind == T.SLIDER:
+        lib.dJointSetSliderAxis(joint, *axis1)
+    elif kind == T.PISTON:
+        lib.dJointSetPistonAnchor(joint, *a)
+        lib.dJointSetPistonAxis(joint, *axis1)
+    elif kind == T.UNIVERSAL:
+        lib.dJointSetUniversalAnchor(joint, *a)
+        lib.dJointSetUniversalAxis1(joint, *axis1)
+        lib.dJointSetUniversalAxis2(joint, *axis2)
+    elif kind == T.HINGE2:
+        lib.dJointSetHinge2Anchor(joint, *a)
+        lib.dJointSetHinge2Axes(joint, list(axis1) + [0.0], list(axis2) + [0.0])
+    elif kind == T.PR:
+        lib.dJointSetPRAnchor(joint, *a)
+        lib.dJointSetPRAxis1(joint, *axis1)
+        lib.dJointSetPRAxis2(joint, *axis2)
+    elif kind == T.PU:
+        lib.dJointSetPUAnchor(joint, *a)
+        lib.dJointSetPUAxis1(joint, *axis1)
+        lib.dJointSetPUAxis2(joint, *axis2)
+        lib.dJointSetPUAxis3(joint, *axis3)
+    elif kind == T.FIXED:
+        lib.dJointSetFixed(joint)
+
+
+def ode_parameter(parameter: JointParameter, axis: int) -> int:
+    """ODE's parameter number for ``parameter`` on axis 1..3 (dParamX, dParamX2, dParamX3)."""
+    return _ODE_PARAMETER[parameter] + (axis - 1) * lib.dParamGroup
+
+
+def set_joint_parameter(joint, kind: JointType, parameter: JointParameter, axis: int,
+                        value: float) -> None:
+    _SET_PARAMETER[kind](joint, ode_parameter(parameter, axis), value)
+
+
+def set_motor_parameter(motor, kind: MotorKind, parameter: JointParameter, axis: int,
+                        value: float) -> None:
+    _SET_MOTOR_PARAMETER[kind](motor, ode_parameter(parameter, axis), value)
+
+
+def joint_state(joint, kind: JointType) -> Tuple[Tuple[float, ...], Tuple[float, ...]]:
+    """(positions, rates) per reported axis (interface.JOINT_STATE_AXES); () for ball, fixed
+    and plane-2D joints."""
+    getters = _STATE.get(kind)
+    if getters is None:
+        return (), ()
+    return (tuple(get(joint) for get in getters[0]), tuple(get(joint) for get in getters[1]))
+
+
+def joint_axes(joint, kind: JointType, motor_kind: MotorKind) -> List[np.ndarray]:
+    """The joint's rotational (ANGULAR) or sliding (LINEAR) axes now, world frame."""
+    v = ffi.new("dVector3")
+    axes = []
+    for get in _AXES[motor_kind].get(kind, ()):
+        get(joint, v)
+        axes.append(np.array([v[0], v[1], v[2]]))
+    return axes
+
+
+def configure_motor(motor, kind: MotorKind, axes: Sequence[np.ndarray], frames: Sequence[int],
+                    max_forces: Sequence[float]) -> None:
+    """Sets a motor's axes (unit, world) anchored in ODE's frames (0 world, 1 ODE's body 1,
+    2 body 2), each with its maximum force (negative: infinite) and a zero goal speed."""
+    if kind == MotorKind.ANGULAR:
+        lib.dJointSetAMotorMode(motor, lib.dAMotorUser)
+        lib.dJointSetAMotorNumAxes(motor, len(axes))
+        set_axis = lib.dJointSetAMotorAxis
+    else:
+        lib.dJointSetLMotorNumAxes(motor, len(axes))
+        set_axis = lib.dJointSetLMotorAxis
+    for i, (axis, frame, force) in enumerate(zip(axes, frames, max_forces)):
+        set_axis(motor, i, frame, *axis.tolist())
+        set_motor_parameter(motor, kind, JointParameter.MAX_FORCE, i + 1,
+                            lib.dInfinity if force < 0 else force)
+        set_motor_parameter(motor, kind, JointParameter.VELOCITY, i + 1, 0.0)
+
+
+INFINITY = lib.dInfinity
+"""ODE's infinity (a motor's unlimited force, an open stop)."""

@@ -1,0 +1,165 @@
+"""One ODE world as odin_step.c runs it: the world, its hash space and contact group, the
+contact settings, and the arrays of persistent actions the C step loop applies.
+
+``CWorld`` owns an ``OdinWorld`` struct (memory Python's, allocated with ffi.new) and the three
+scene handles; the arrays of body forces, joint forces and motor goals are rebuilt from plain
+tuples whenever they change, and always before a handle they point at is freed (C must never
+see a freed handle). Collision records come back as geom addresses, which the Core names.
+"""
+from __future__ import annotations
+
+from typing import List, Sequence, Tuple
+
+import numpy as np
+
+from odin_common.world_parameters import WorldParameters
+from virtual_world.ode import handles
+from virtual_world.ode.bindings import ffi, lib
+
+BodyForce = Tuple  # (body ptr, torque, vector_in_body, at_point, point_in_body, vector, point)
+JointForce = Tuple  # (joint ptr, ODE joint type, magnitudes)
+MotorGoal = Tuple  # (motor ptr, MotorKind, velocities)
+Record = Tuple  # (geom address 1, geom address 2, depth m, points ((x, y, z), ...) m)
+
+
+class CWorld:
+    """The C side of one scene; ``close()`` frees every handle in it (idempotent)."""
+
+    def __init__(self, parameters: WorldParameters):
+        self.world = handles.new_world()
+        self.space = handles.new_space()
+        self.contacts = handles.new_joint_group(self.world)
+        self.struct = ffi.new("OdinWorld *")
+        s = self.struct
+        s.world, s.space, s.contact_group = self.world.ptr, self.space.ptr, self.contacts.ptr
+        self._arrays = {}          # keeps the action arrays alive while C points at them
+        self.apply(parameters)
+
+    def apply(self, p: WorldParameters) -> None:
+        """The world parameters in ODE's world and the contact settings."""
+        world, inf = self.world.ptr, lib.dInfinity
+        lib.dWorldSetGravity(world, *p.gravity)
+        lib.dWorldSetERP(world, p.erp)
+        lib.dWorldSetCFM(world, p.cfm)
+        lib.dWorldSetMaxAngularSpeed(world, p.max_angular_speed or inf)
+        lib.dWorldSetContactMaxCorrectingVel(world, p.contact_max_correcting_velocity or inf)
+        lib.dWorldSetContactSurfaceLayer(world, p.contact_surface_layer)
+        lib.dWorldSetLinearDamping(world, p.linear_damping)
+        lib.dWorldSetLinearDampingThreshold(world, p.linear_damping_threshold)
+        lib.dWorldSetAngularDamping(world, p.angular_damping)
+        lib.dWorldSetAngularDampingThreshold(world, p.angular_damping_threshold)
+        lib.dWorldSetQuickStepNumIterations(world, p.quickstep_iterations)
+        s = self.struct
+        s.max_contacts = p.max_contacts
+        s.mu = inf if p.friction < 0 else p.friction
+        s.bounce = p.bounce
+        s.bounce_vel = p.bounce_velocity
+        s.contact_less = int(p.contact_less)
+        s.solver = int(p.solver)
+
+    @property
+    def max_contacts(self) -> int:
+        return int(self.struct.max_contacts)
+
+    # -- persistent actions ------------------------------------------------------------------
+    def set_body_forces(self, forces: Sequence[BodyForce]) -> None:
+        array = ffi.new("OdinBodyForce[]", max(len(forces), 1))
+        for f, (body, torque, v_body, at_point, p_body, vector, point) in zip(array, forces):
+            f.body = body
+            f.torque, f.vector_in_body, f.at_point, f.point_in_body = (
+                int(torque), int(v_body), int(at_point), int(p_body))
+            f.vector = list(vector)
+            f.point = list(point)
+        self._install("forces", array, len(forces))
+
+    def set_joint_forces(self, forces: Sequence[JointForce]) -> None:
+        array = ffi.new("OdinJointForce[]", max(len(forces), 1))
+        for f, (joint, ode_type, magnitudes) in zip(array, forces):
+            f.joint = joint
+            f.type = ode_type
+            for k, value in enumerate(magnitudes):
+                f.magnitude[k] = value
+        self._install("joint_forces", array, len(forces))
+
+    def set_motor_goals(self, goals: Sequence[MotorGoal]) -> None:
+        """Every motor's goal speeds, in slots 0..n-1 (update_motor_goal(slot, ...) later)."""
+        array = ffi.new("OdinMotorGoal[]", max(len(goals), 1))
+        for g, (motor, kind, velocities) in zip(array, goals):
+            g.motor = motor
+            g.kind = int(kind)
+            g.naxes = len(velocities)
+            for k, value in enumerate(velocities):
+                g.velocity[k] = value
+        self._install("motors", array, len(goals))
+
+    def update_motor_goal(self, slot: int, velocities: Sequence[float]) -> None:
+        goal = self._arrays["motors"][slot]
+        for k, value in enumerate(velocities):
+            goal.velocity[k] = value
+
+    def _install(self, field: str, array, count: int) -> None:
+        setattr(self.struct, field, array)
+        setattr(self.struct, "n_" + field, count)
+        self._arrays[field] = array
+
+    # -- stepping and read-out ---------------------------------------------------------------
+    def step(self, step_size: float, count: int) -> None:
+        """``count`` steps in one C call (odin_step.c: collide, actions, step, empty)."""
+        lib.odin_world_step(self.struct, step_size, count)
+
+    def detect(self) -> None:
+        """Contact-less policy: records what touches now, without stepping."""
+        lib.odin_world_detect(self.struct)
+
+    @property
+    def last_step_contacts(self) -> int:
+        return int(self.struct.last_step_contacts)
+
+    def records(self) -> List[Record]:
+        """The collision records of the C loop (pairs of geom addresses)."""
+        s = self.struct
+        out = []
+        for i in range(s.n_records):
+            r = s.records[i]
+            points = tuple((r.points[k][0], r.points[k][1], r.points[k][2])
+                           for k in range(r.npoints))
+            out.append((int(ffi.cast("uintptr_t", r.g1)), int(ffi.cast("uintptr_t", r.g2)),
+                        float(r.depth), points))
+        return out
+
+    def clear_records(self) -> None:
+        lib.odin_world_clear_records(self.struct)
+
+    def close(self) -> None:
+        """Frees every handle of the scene and the record buffers; idempotent."""
+        if self.world.closed:
+            return
+        s = self.struct
+        for field in ("forces", "joint_forces", "motors"):
+            setattr(s, field, ffi.NULL)
+            setattr(s, "n_" + field, 0)
+        self._arrays.clear()
+        lib.odin_world_clear_records(s)
+        lib.odin_world_free_buffers(s)
+        self.space.close()        # every geom (children first)
+        self.contacts.close()
+        self.world.close()        # every body, joint and motor left
+        s.world = s.space = s.contact_group = ffi.NULL
+
+
+class PoseReader:
+    """Reads the world poses of a fixed list of geoms in one C call."""
+
+    def __init__(self, geoms: Sequence):
+        self.count = len(geoms)
+        self._array = ffi.new("dGeomID[]", [g.ptr for g in geoms] or 1)
+
+    def read(self) -> Tuple[np.ndarray, np.ndarray]:
+        """(positions (n, 3) m, quaternions (n, 4) (w, x, y, z)), world frame."""
+        positions = np.empty((self.count, 3))
+        quaternions = np.empty((self.count, 4))
+        if self.count:
+            lib.odin_read_poses(self._array, self.count,
+                                ffi.cast("double *", ffi.from_buffer(positions)),
+                                ffi.cast("double *", ffi.from_buffer(quaternions)))
+        return positions, quaternions

@@ -1,0 +1,115 @@
+"""Between the world's ROS messages and the Core's plain values; no rospy, only the generated
+classes (specs to Object/Composite messages and back: odin_common.messages).
+
+Units and frames pass through unchanged (SI, world frame, quaternions (w, x, y, z) on both
+sides), so these functions only reshape.
+"""
+from __future__ import annotations
+
+import struct
+from typing import Sequence
+
+import numpy as np
+
+from Messages.msg import Collided, CollisionPair, JointData, SpaceDistribution
+from geometry_msgs.msg import Point
+from sensor_msgs.msg import JointState
+from Services.srv import ViewObjectRequest
+
+
+def view_requests(geometries) -> list:
+    """View Object requests for geometries as the Core built them (core.BuiltGeometry), or
+    as they are now (at their present poses)."""
+    return [ViewObjectRequest(g.name, list(g.parameters), list(g.indices), list(g.position),
+                              list(g.orientation), list(g.color)) for g in geometries]
+
+
+def collided_message(collisions, stamp) -> Collided:
+    """Core collisions (first, second, depth, points) -> Messages/Collided."""
+    message = Collided()
+    message.header.stamp = stamp
+    message.header.frame_id = "world"
+    names = {}
+    for collision in collisions:
+        names.setdefault(collision.first, None)
+        names.setdefault(collision.second, None)
+        message.pairs.append(CollisionPair(
+            collision.first, collision.second, collision.depth,
+            [Point(*point) for point in collision.points]))
+    message.names = list(names)
+    return message
+
+
+def joint_data(states) -> list:
+    return [JointData(state.id, state.type, list(state.positions), list(state.rates))
+            for state in states]
+
+
+def joint_state_message(states, stamp) -> JointState:
+    """Core joint states -> sensor_msgs/JointState, one name per joint axis: ``<joint id>``
+    for one-axis joints, ``<joint id>/<axis>`` otherwise."""
+    message = JointState()
+    message.header.stamp = stamp
+    for state in states:
+        for axis, (position, rate) in enumerate(zip(state.positions, state.rates), start=1):
+            message.name.append(state.id if len(state.positions) == 1 else f"{state.id}/{axis}")
+            message.position.append(position)
+            message.velocity.append(rate)
+    return message
+
+
+class SpaceDistributionWriter:
+    """Serialises SpaceDistribution from the Core's pose arrays without one Python object per
+    geometry: the names are encoded once per scene and the 7 doubles of every geometry are
+    scattered into that template with one vectorised copy. Subscribers receive an ordinary
+    Messages/SpaceDistribution (the wire format is the same)."""
+
+    _POSE_BYTES = 7 * 8
+
+    def __init__(self):
+        self._layout(())
+
+    def message(self, names: Sequence[str], positions: np.ndarray, quaternions: np.ndarray,
+                stamp) -> SpaceDistribution:
+        if tuple(names) != self._names:
+            self._layout(names)
+        poses = np.ascontiguousarray(np.hstack([positions, quaternions]), dtype="<f8")
+        body = np.frombuffer(self._template, dtype=np.uint8).copy()
+        body[self._scatter] = poses.view(np.uint8).ravel()
+        return _PreSerialised(stamp, body.tobytes())
+
+    def _layout(self, names: Sequence[str]) -> None:
+        chunks, offsets, cursor = [struct.pack("<I", len(names))], [], 4
+        for name in names:
+            encoded = name.encode("utf-8")
+            chunk = struct.pack("<I", len(encoded)) + encoded
+            chunks.append(chunk + bytes(self._POSE_BYTES))
+            offsets.append(cursor + len(chunk))
+            cursor += len(chunk) + self._POSE_BYTES
+        self._names = tuple(names)
+        self._template = bytearray(b"".join(chunks))
+        starts = np.asarray(offsets, dtype=np.intp)
+        self._scatter = (starts[:, None] + np.arange(self._POSE_BYTES)).ravel()
+
+
+class _PreSerialised(SpaceDistribution):
+    """A SpaceDistribution whose situations are already serialised (see the writer)."""
+
+    __slots__ = ("_body",)
+
+    def __init__(self, stamp, body: bytes):
+        super().__init__()
+        self.header.stamp = stamp
+        self.header.frame_id = "world"
+        self._body = body
+
+    def serialize(self, buff) -> None:
+        header = self.header
+        frame = header.frame_id.encode("utf-8")
+        buff.write(struct.pack("<3I", header.seq, header.stamp.secs, header.stamp.nsecs))
+        buff.write(struct.pack("<I", len(frame)) + frame)
+        buff.write(self._body)
+
+
+__all__ = ["view_requests", "collided_message", "joint_data", "joint_state_message",
+           "SpaceDistributionWriter"]

@@ -1,0 +1,28 @@
+"""The world node's own ``~parameters`` (read once at start), as data: the Portal reads them
+and tools/interface_doc.py writes docs/parameters.md from them. ROS-free.
+
+Besides these, every world parameter (odin_common.world_parameters) is a ``~parameter`` of the
+same name.
+"""
+from __future__ import annotations
+
+from typing import Tuple
+
+from odin_common.interface import VIEWER_NAMESPACE, NodeParameter
+from virtual_world.core.step_values import StepValues
+
+_STEP = StepValues()
+
+NODE_PARAMETERS: Tuple[NodeParameter, ...] = (
+    NodeParameter("rate", _STEP.rate, "Hz", "Portal cycles (publications) per wall-clock second"),
+    NodeParameter("step", _STEP.step, "s", "simulated time of one ODE step"),
+    NodeParameter("steps_per_cycle", _STEP.steps_per_cycle, "-",
+                  "ODE steps per cycle (cycle time = step x steps)"),
+    NodeParameter("simulate", False, "-", "start simulating at once"),
+    NodeParameter("free_run", False, "-",
+                  "cycles back to back (batch work); publications still at `~rate`"),
+    NodeParameter("viewer", VIEWER_NAMESPACE, "-", "namespace of the Viewer's services"),
+)
+"""The world node's parameters besides the world parameters, in documentation order."""
+
+DEFAULTS = {p.name: p.default for p in NODE_PARAMETERS}
