@@ -58,7 +58,7 @@ def can_request(position, mass: float, color):
     return replace(request, color=tuple(color))
 
 
-def run(quick: bool = False, frames: bool = True) -> dict:
+def run(frames: bool = True) -> dict:
     p = dict(PARAMETERS)
     problem, plan = common.load_plan(common.EXAMPLES / PROBLEM)
     with common.Session("contactless", WORLD, CAMERA, track={CAN, TIP},

@@ -88,7 +88,7 @@ def motor_of(handle, link_name: str) -> str:
     return handle.motor_ids[handle.joint_keys.index(key)]
 
 
-def run(quick: bool = False, frames: bool = True, out_root=None) -> dict:
+def run(frames: bool = True, out_root=None) -> dict:
     from gui.paths import RADIANS, load_robot_path, refine
     p = dict(PARAMETERS)
     problem, plan = common.load_plan(common.EXAMPLES / PROBLEM)

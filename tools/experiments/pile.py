@@ -83,7 +83,7 @@ def starting_pose(handle, can_xy, p) -> np.ndarray:
     return q
 
 
-def run(quick: bool = False, frames: bool = True) -> dict:
+def run(frames: bool = True) -> dict:
     p = dict(PARAMETERS)
     problem, plan = common.load_plan(common.EXAMPLES / PROBLEM)
     for name in CANS:
