@@ -50,13 +50,29 @@ def test_contactless_pair_greys_exactly_while_touching():
 def test_pile_cans_knocked_down_fall_and_bounce():
     import pile
     facts = pile.run(frames=False)
-    cans = facts["outcome"]["cans"]
+    o = facts["outcome"]
+    cans = o["cans"]
+    # the base turns from 0.04 s at 0.1 rad/s; the geometry (the arm's meshes turned about the
+    # Shoulder axis into the cans' cylinders) puts the first touch at 1.04277 s; the first
+    # hand-can contact is reported at 1.08 s (Ring-Med & can_2), 37 ms later
+    low, high = pile.CONTACT_WINDOW_S
+    assert o["hand_contact_when_the_arm_reaches_the_pile"], (
+        f"first hand-can contact at {o['first_hand_contact_s']} s "
+        f"({o['first_hand_contact_pairs']}), the arm reaches the pile at "
+        f"{o['arm_reaches_pile_at_s']} s: {o['first_hand_contact_lag_s']} s apart, not in "
+        f"[{low}, {high}] s")
     for name, can in cans.items():
-        assert can["moved_m"] > 0.2, name
-        assert can["knocked_off_the_table"], name
-    assert all(can["hit_ground"] and can["bounced"] and not can["fell_past_the_floor_edge"]
-               for can in cans.values())
-    assert facts["contacts"]["cycles_with_contacts"] > 0
+        # the top can falls at 1.40 s, the bottom one at 1.52 s
+        assert can["falls_after_the_hand_touches_the_pile"], (
+            f"{name} fell at {can['falls_at_s']} s, the hand first touched the pile at "
+            f"{o['first_hand_contact_s']} s")
+        assert can["moved_m"] > 0.2, f"{name} moved {can['moved_m']} m"
+        assert can["knocked_off_the_table"], f"{name} stayed on the table: {can['end_m']}"
+        # on the floor at 3.04 s (top can) and 2.48 s (bottom can), both bounce
+        assert can["hit_ground"] and can["bounced"] and not can["fell_past_the_floor_edge"], (
+            f"{name}: hit the floor {can['hit_ground']} (at {can['hit_ground_at_s']} s), "
+            f"bounced {can['bounced']}, fell past the floor's edge "
+            f"{can['fell_past_the_floor_edge']}, ends at {can['end_m']}")
 
 
 @pytest.mark.forked
