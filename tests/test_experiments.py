@@ -2,7 +2,8 @@
 world and Viewer nodes by rosrun and this process as the GUI (tools/experiments), and its
 outcome is asserted on what the nodes published and what the Viewer drew.
 
-Each test runs in a forked child (rospy.init_node works once per process).
+Each test runs in a forked child (rospy.init_node works once per process). The world is
+deterministic for the same calls: two runs of each experiment recorded the same figures.
 """
 import pathlib
 import sys
@@ -80,18 +81,34 @@ def test_grasp_carries_the_can_and_releases_it_when_the_hand_opens(tmp_path):
     import grasp
     facts = grasp.run(frames=False, out_root=tmp_path)  # out/experiments/grasp keeps its frames
     o = facts["outcome"]
-    assert o["can_height_above_table_while_carried_m"]["min"] > 0.1
-    assert o["can_moved_while_carried_m"] > 0.5
-    # held from the lift until the opening: within millimetres of its place in the palm's frame,
-    # and not sinking through the grip
-    # (16 mm and 4 mm with the 4 mm collision meshes, the same in every run; 13 mm and 5 mm
-    # with the meshes as given)
-    assert o["max_slip_in_hand_before_opening_m"] < 0.02
-    assert o["max_slip_in_hand_while_carried_m"] < 0.015
-    assert o["can_sank_in_hand_before_opening_m"] < 0.003
-    assert o["released_only_when_hand_opens"]
-    assert o["can_released_at_s"] >= o["hand_opens_at_s"]
-    assert o["can_on_floor_at_end"]
+    h = o["can_height_above_table_while_carried_m"]
+    assert h["min"] > 0.1, f"carried as low as {h['min']} m above the table"
+    assert o["can_moved_while_carried_m"] > 0.5, f"carried {o['can_moved_while_carried_m']} m"
+    # held from the lift until the opening: within millimetres of its place in the palm's
+    # frame, and not sinking through the grip (13.6 mm from the lift's start, 3.0 mm during
+    # the carry, 0 mm sunk)
+    assert o["max_slip_in_hand_before_opening_m"] < 0.02, \
+        f"slipped {o['max_slip_in_hand_before_opening_m']} m in the hand from the lift"
+    assert o["max_slip_in_hand_while_carried_m"] < 0.015, \
+        f"slipped {o['max_slip_in_hand_while_carried_m']} m in the hand while carried"
+    assert o["can_sank_in_hand_before_opening_m"] < 0.003, \
+        f"sank {o['can_sank_in_hand_before_opening_m']} m in the hand"
+    # the release, searched over the whole run: in the hand (within 15 mm of its place in the
+    # palm's frame) from 0.92 s; the hand opens at 7.44 s, still touches the can at 7.48 s,
+    # the can leaves the hand at 7.52 s (80 ms after the opening; a can let go at the opening
+    # could not leave before 49.5 ms) and is on the floor at 7.84 s (free fall: by 7.897 s)
+    checks = grasp.release_checks(o)
+    failed = [name for name, held in checks.items() if not held]
+    assert not failed, (
+        f"{', '.join(failed)}: hand opens at {o['hand_opens_at_s']} s; the can in the hand from "
+        f"{o.get('in_hand_from_s')} s, leaves it at {o.get('left_hand_at_s')} s "
+        f"({o.get('left_hand_after_opening_s')} s after the opening, free fall allows "
+        f"{o.get('earliest_free_fall_exit_s')} s), hand last touches it at "
+        f"{o.get('hand_last_touches_can_at_s')} s, on the floor at {o.get('on_floor_at_s')} s "
+        f"({o.get('on_floor_after_opening_s')} s after the opening, free fall by "
+        f"{o.get('latest_on_floor_after_opening_s')} s), never rising: "
+        f"{o.get('falls_without_rising')}")
+    assert o["can_on_floor_at_end"], f"the can ends at {o['can_final_position_m']}"
 
 
 def test_one_command_runs_several_experiments():
