@@ -186,7 +186,10 @@ def run(frames: bool = True, out_root=None) -> dict:
 #: offset (m) in a frame turning with the arm: along the radius from the base's axis, along
 #: the tangent (anticlockwise seen from above), up
 CLOSEUP_OFFSET = (0.39, 0.20, 0.24)
-BASE_AXIS_XY = (0.05, 0.05)  # m, where the TX90's Shoulder axis stands in the scene
+#: m, the point the close-ups' radial direction starts from: 5 cm off the TX90's Shoulder axis,
+#: which stands at the origin (forward kinematics, as pile.arm_reaches_pile finds it); kept so
+#: that the close-ups look from where they always did
+BASE_AXIS_XY = (0.05, 0.05)
 
 
 def take_closeup(s: "common.Session", label: str, subject: str):
