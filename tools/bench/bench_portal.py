@@ -8,8 +8,13 @@ Figures:
                                    1,000 objects published at 25 Hz to a subscriber (goal <= 0.1).
   portal_rtf_spheres100            real-time factor of the 100-sphere scene of bench_core run
                                    back to back (~free_run), divided by the native C program's
-                                   steps per second times the step size, measured alternately,
+                                   steps per second times the step size, measured alternately
+                                   (native first in even rounds, the node first in odd ones),
                                    median of the rounds' ratios (goal >= 0.90).
+Same work: after each round's window the node is paused and its step count and final poses
+read (world_update); one native run at the end steps as far as the longest of them and prints
+its poses at each round's step count. The figure is given only if they are bit-identical in
+every round (measured so on 2026-11-22), else refused (report.Refused) with the difference.
 """
 from __future__ import annotations
 
@@ -27,13 +32,15 @@ sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(HERE))
 
 from forked import in_child  # noqa: E402
+from report import Refused  # noqa: E402
 from ros_harness import RosMaster  # noqa: E402
 
 CLIENTS = 4
 CALLS = 10_000
 CPU_WINDOW = 10.0
 RTF_WINDOW = 8.0
-RTF_ROUNDS = 5
+RTF_ROUNDS = int(os.environ.get("ODIN_BENCH_ROUNDS", "5"))
+STEP = 0.001    # the node's default step (s), the native program's
 NATIVE_STEPS = 20_000
 
 
@@ -167,12 +174,14 @@ def publish_1000_cpu() -> dict:
 
 # -- real-time factor against native C ----------------------------------------------------------
 def world_rtf_spheres100() -> dict:
-    """Simulated seconds per wall-clock second of the 100-sphere scene, free running."""
+    """Simulated seconds per wall-clock second of the 100-sphere scene, free running; then,
+    paused, the steps taken and the final poses (x y z qw qx qy qz of s0..s99)."""
     with RosMaster() as master:
         master.apply_to_this_process()
         _start_world(master, "_free_run:=true")
         import rospy
         from rosgraph_msgs.msg import Clock
+        from Messages.msg import SpaceDistribution
         from world_client import WorldClient, sphere, box
         rospy.init_node("bench_portal_rtf", anonymous=True, disable_signals=True)
         client = WorldClient()
@@ -188,24 +197,67 @@ def world_rtf_spheres100() -> dict:
         time.sleep(RTF_WINDOW)
         sim1 = rospy.wait_for_message("/clock", Clock, timeout=5).clock.to_sec()
         wall1 = time.monotonic()
+        client.ok("start", simulate=False)
+        time.sleep(0.2)         # a cycle under way when the pause came is published by now
+        update = rospy.wait_for_message("/virtual_world/world_update", SpaceDistribution,
+                                        timeout=5)
         client.close()
-    return {"rtf": (sim1 - sim0) / (wall1 - wall0)}
+    poses = {s.name: tuple(s.position) + tuple(s.orientation) for s in update.situations}
+    return {"rtf": (sim1 - sim0) / (wall1 - wall0),
+            "steps": round(update.header.stamp.to_sec() / STEP),
+            "poses": [poses.get(f"s{i}") for i in range(100)]}
+
+
+def _native_rtf(exe: pathlib.Path) -> float:
+    # long enough that, like the node's window, it is mostly spheres at rest on the plane
+    output = subprocess.run([str(exe), "0", str(NATIVE_STEPS), "0", "0"], check=True,
+                            capture_output=True, text=True).stdout.split()
+    return NATIVE_STEPS * STEP / float(output[0])   # simulated s per wall s
+
+
+def native_poses_at(exe: pathlib.Path, steps: list) -> dict:
+    """{step count: the 100 poses} of one native run of the 100-sphere scene."""
+    import bench_core
+    output = subprocess.run([str(exe), "0", str(max(steps)), "0", "0", *map(str, steps)],
+                            check=True, capture_output=True, text=True).stdout
+    return {count: run.poses for count, run in bench_core.parse_checkpoints(output).items()}
+
+
+def pose_difference(native: list, node: list) -> str | None:
+    """None if the node's poses are the native ones to the bit, else the largest difference."""
+    if any(pose is None or len(pose) != 7 for pose in node):
+        return "the node's world_update lacks some of s0..s99"
+    import bench_core
+    return bench_core.pose_difference(native, node)
 
 
 def rtf_spheres100(out_dir: pathlib.Path) -> dict:
-    """Alternates the node and the native program; the ratio of their medians."""
+    """Alternates the node and the native program; the median of the rounds' ratios; refused
+    unless the node's final poses are the native program's after as many steps."""
     import bench_core
     exe = bench_core._compile(out_dir)
     world, native = [], []
-    for _ in range(RTF_ROUNDS):
-        # long enough that, like the node's window, it is mostly spheres at rest on the plane
-        output = subprocess.run([str(exe), "0", str(NATIVE_STEPS), "0", "0"], check=True,
-                                capture_output=True, text=True).stdout.split()
-        native.append(NATIVE_STEPS * 0.001 / float(output[0]))   # simulated s per wall s
-        world.append(in_child(world_rtf_spheres100)["rtf"])
+    for k in range(RTF_ROUNDS):
+        if k % 2 == 0:
+            native.append(_native_rtf(exe))
+            world.append(in_child(world_rtf_spheres100))
+        else:
+            world.append(in_child(world_rtf_spheres100))
+            native.append(_native_rtf(exe))
+    steps = [w["steps"] for w in world]
+    reference = native_poses_at(exe, steps)
+    differences = [(k, d) for k, d in enumerate(
+        pose_difference(reference[w["steps"]], w["poses"]) for w in world) if d]
     # the median of the rounds' ratios: a round's two runs share the load of a shared machine
-    ratio = statistics.median(w / n for w, n in zip(world, native))
-    print(f"  world rtf {world}, native {native}")
+    ratio = statistics.median(w["rtf"] / n for w, n in zip(world, native))
+    print(f"  world rtf {[w['rtf'] for w in world]}, native {native}, node steps {steps}, "
+          f"same poses as native: {differences[0][1] if differences else 'yes'}")
+    if differences:
+        k, difference = differences[0]
+        return {"portal_rtf_spheres100": Refused(
+            f"the node's poses differ from native C's after as many steps in "
+            f"{len(differences)} of {len(world)} rounds (round {k}, {steps[k]} steps: "
+            f"{difference})")}
     return {"portal_rtf_spheres100": ratio}
 
 

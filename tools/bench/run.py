@@ -1,11 +1,22 @@
-"""Runs every benchmark module ``bench_*.py`` beside this file and writes the figures.
+"""Runs every benchmark module ``bench_*.py`` beside this file, writes the figures and checks
+them against tools/bench/goals.json.
 
 Each module defines ``run(out_dir: pathlib.Path) -> dict[str, float]`` (figure name -> number)
-and may write details of its own under ``out_dir``. The figures of all modules are merged into
-``out/bench/results.json``. ``python run.py core viewer`` runs only ``bench_core``/``bench_viewer``.
-Figures are ratios measured side by side in one run wherever a baseline exists, because this
-machine is shared and noisy.
+and may write details of its own under ``out_dir``. A figure's value may instead be a
+``report.Refused(reason)``: the module could not measure it honestly (e.g. native C and Odin did
+not do the same work); it is left out of the results and the run fails.
+
+Every run starts a fresh ``out/bench/results.json`` (figure -> number; a module that fails
+leaves its figures out and makes the run fail) and ``out/bench/run.json`` (what ran, what
+failed, what was refused and why). At the end of a whole run, report.py prints every missed
+goal, rewrites the README's figure table and the exit status is 1 if a goal was missed, a goal's
+figure is missing, a figure was refused or a module failed.
+
+``python run.py core viewer`` runs only ``bench_core``/``bench_viewer`` (a partial run: the
+README is left alone and only the figures measured are checked). ``ODIN_BENCH_ROUNDS=3`` runs
+fewer rounds in the modules that repeat rounds (for development on a shared machine).
 """
+import datetime
 import importlib.util
 import json
 import pathlib
@@ -15,6 +26,9 @@ import traceback
 
 HERE = pathlib.Path(__file__).resolve().parent
 ROOT = HERE.parent.parent
+sys.path.insert(0, str(HERE))
+
+import report  # noqa: E402
 
 
 def _load(path: pathlib.Path):
@@ -24,35 +38,58 @@ def _load(path: pathlib.Path):
     return module
 
 
+def _write(path: pathlib.Path, data: dict) -> None:
+    path.write_text(json.dumps(data, indent=2, sort_keys=path.name == "results.json") + "\n")
+
+
 def main(argv: list) -> int:
+    started = time.monotonic()
     out_dir = ROOT / "out" / "bench"
     out_dir.mkdir(parents=True, exist_ok=True)
-    results_path = out_dir / "results.json"
-    results = json.loads(results_path.read_text()) if results_path.exists() else {}
-    wanted = set(argv)
-    failed = []
-    for path in sorted(HERE.glob("bench_*.py")):
-        name = path.stem[len("bench_"):]
-        if wanted and name not in wanted:
-            continue
-        started = time.monotonic()
+    goals = report.load_goals()     # a malformed goals.json fails before minutes of benchmarks
+    modules = {path.stem[len("bench_"):]: path for path in sorted(HERE.glob("bench_*.py"))}
+    unknown = [name for name in argv if name not in modules]
+    if unknown:
+        print(f"no benchmark module {unknown}; there are {sorted(modules)}", file=sys.stderr)
+        return 2
+    wanted = [name for name in modules if not argv or name in argv]
+    results: dict = {}
+    run = {"modules": wanted, "partial": bool(argv), "failed_modules": [], "refused": {}}
+    _write(out_dir / "results.json", results)
+    _write(out_dir / "run.json", run)
+    for name in wanted:
+        module_started = time.monotonic()
         print(f"bench {name} ...", flush=True)
         try:
-            figures = _load(path).run(out_dir)
+            figures = _load(modules[name]).run(out_dir)
         except Exception:  # one broken benchmark must not hide the others' figures
             traceback.print_exc()
-            failed.append(name)
+            run["failed_modules"].append(name)
+            print(f"bench {name}: FAILED after {time.monotonic() - module_started:.1f} s",
+                  flush=True)
+            _write(out_dir / "run.json", run)
             continue
         for key, value in figures.items():
-            print(f"  {key} = {value}")
-        results.update(figures)
-        results_path.write_text(json.dumps(results, indent=2, sort_keys=True) + "\n")
-        print(f"bench {name}: {time.monotonic() - started:.1f} s", flush=True)
-    print(f"figures in {results_path}")
-    if failed:
-        print(f"failed benchmarks: {', '.join(failed)}", file=sys.stderr)
-        return 1
-    return 0
+            if isinstance(value, report.Refused):
+                run["refused"][key] = value.reason
+                print(f"  {key} REFUSED: {value.reason}")
+            else:
+                print(f"  {key} = {value}")
+                results[key] = value
+        _write(out_dir / "results.json", results)
+        _write(out_dir / "run.json", run)
+        print(f"bench {name}: {time.monotonic() - module_started:.1f} s", flush=True)
+    run["seconds"] = round(time.monotonic() - started, 1)
+    run["finished"] = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    _write(out_dir / "run.json", run)
+    print(f"figures in {out_dir / 'results.json'} ({run['seconds']:.0f} s)")
+    status = report.report(results, goals, run, None if argv else report.README_PATH,
+                           only_present=bool(argv))
+    for figure, reason in run["refused"].items():
+        print(f"REFUSED {figure}: {reason}", file=sys.stderr)
+    if run["failed_modules"]:
+        print(f"failed benchmark modules: {', '.join(run['failed_modules'])}", file=sys.stderr)
+    return 1 if (status or run["refused"] or run["failed_modules"]) else 0
 
 
 if __name__ == "__main__":

@@ -50,6 +50,11 @@ PATHS_DIR = ROOT / "Odin" / "GUI" / "paths"
 #: The Viewer's colour for a colliding object (viewer.core.scene.COLLIDING_COLOR), 0..255.
 COLLIDING_RGB = (89, 89, 89)
 
+#: The ICRA09 scene of the TX90 problems (pile, grasp): the table is a 0.5 m cube on the floor,
+#: the floor a 10 mm slab centred at z = -0.011 m (its top at -0.006 m).
+TABLE_TOP = 0.5
+FLOOR_TOP = -0.006
+
 
 class ExperimentError(RuntimeError):
     """An experiment could not run (a node died, a service refused, a message never came)."""
@@ -377,6 +382,43 @@ def cylinder_can(name: str, position, mass: float, color, radius: float, length:
     return ObjectRequest(name=name, parameters=(float(radius), float(length)), indices=(),
                          mass=float(mass), position=tuple(float(v) for v in position),
                          orientation=(1.0, 0.0, 0.0, 0.0), color=tuple(color))
+
+
+# -- geometry, computed from the meshes the GUI sends (not from the collision engine) ------------
+def mesh_bodies(plan) -> dict:
+    """{object ID: (vertices (n, 3) in the object's frame, triangles (m, 3))} of every mesh the
+    plan builds as a single object (robot links are the objects of an EntityRequest)."""
+    from gui.core.build import EntityRequest, ObjectRequest
+    objects = []
+    for step in plan.steps:
+        if isinstance(step, EntityRequest):
+            objects.extend(step.objects)
+        elif isinstance(step, ObjectRequest):
+            objects.append(step)
+    return {o.id: (np.asarray(o.parameters, float).reshape(-1, 3),
+                   np.asarray(o.indices, np.int64).reshape(-1, 3))
+            for o in objects if len(o.indices)}
+
+
+def in_world(vertices: np.ndarray, position, quaternion) -> np.ndarray:
+    """Vertices (n, 3) of an object's frame placed at ``position``, ``quaternion`` (wxyz)."""
+    from odin_common.rotations import quaternion_to_matrix
+    return vertices @ quaternion_to_matrix(quaternion).T + np.asarray(position, float)
+
+
+def surface_points(vertices: np.ndarray, triangles: np.ndarray, spacing: float) -> np.ndarray:
+    """Points on a triangle mesh's surface no further than about ``spacing`` apart along every
+    edge: each triangle's barycentric grid of n x n cells, n = its longest edge / spacing."""
+    corners = vertices[triangles]                                   # (m, 3, 3)
+    edges = np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=2).max(axis=1)
+    counts = np.maximum(1, np.ceil(edges / spacing).astype(int))
+    out = [vertices]
+    for n in np.unique(counts):
+        i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
+        keep = i + j <= n
+        weights = np.stack([i[keep], j[keep], n - i[keep] - j[keep]], axis=1) / n   # (k, 3)
+        out.append(np.einsum("kb,tbc->tkc", weights, corners[counts == n]).reshape(-1, 3))
+    return np.concatenate(out)
 
 
 # -- pictures ---------------------------------------------------------------------------------

@@ -13,9 +13,11 @@ World parameters of table 10.1: contact-less policy, 1 step per cycle, 10 fps, s
 gravity (0, 0, 0), contact surface layer 0.
 
 Outcome (summary.json): the only pair ever reported is (can, KukaLWR/Link7); it is reported
-on one unbroken run of cycles, with its start and stop times and its maximum depth; the
-Viewer's frames show the can and the link grey exactly while they touch (pixels are read:
-the can's red pixels vanish and the link's pixels turn the Viewer's collision grey).
+on one unbroken run of cycles, with its start and stop times and its maximum depth; the start
+and stop are where the geometry puts them (``geometric_contact``: the two meshes and the can's
+prescribed motion, without the collision engine), within LAG_WINDOW_S; the Viewer's frames
+show the can and the link grey exactly while they touch (pixels are read: the can's red pixels
+vanish and the link's pixels turn the Viewer's collision grey).
 """
 from __future__ import annotations
 
@@ -58,9 +60,10 @@ def can_request(position, mass: float, color):
     return replace(request, color=tuple(color))
 
 
-def run(quick: bool = False, frames: bool = True) -> dict:
+def run(frames: bool = True) -> dict:
     p = dict(PARAMETERS)
     problem, plan = common.load_plan(common.EXAMPLES / PROBLEM)
+    geometry = geometric_contact(plan, p)
     with common.Session("contactless", WORLD, CAMERA, track={CAN, TIP},
                         frames=frames) as s:
         s.client.execute(plan)
@@ -77,12 +80,108 @@ def run(quick: bool = False, frames: bool = True) -> dict:
             else:
                 s.cycle(1)
         s.finish()
-        facts = analyse(s)
+        facts = analyse(s, geometry)
         common.write_summary(s, facts, p)
     return facts
 
 
-def analyse(s: "common.Session") -> dict:
+#: grid of the vertical columns in which the two meshes are compared (m): 0.05 mm, a tenth of
+#: the can's travel in one 1 ms step
+COLUMN_GRID_M = 0.00005
+
+
+def column_extents(vertices: np.ndarray, triangles: np.ndarray, xs: np.ndarray,
+                   ys: np.ndarray) -> tuple:
+    """For every vertical line (xs[i], ys[j]), the lowest and highest z at which it crosses the
+    mesh's triangles ((len(xs), len(ys)) arrays; +inf / -inf where it misses the mesh)."""
+    X, Y = np.meshgrid(xs, ys, indexing="ij")
+    low = np.full(X.shape, np.inf)
+    high = np.full(X.shape, -np.inf)
+    for a, b, c in vertices[triangles]:
+        i0, i1 = np.searchsorted(xs, min(a[0], b[0], c[0])), \
+            np.searchsorted(xs, max(a[0], b[0], c[0]), "right")
+        j0, j1 = np.searchsorted(ys, min(a[1], b[1], c[1])), \
+            np.searchsorted(ys, max(a[1], b[1], c[1]), "right")
+        det = (b[1] - c[1]) * (a[0] - c[0]) + (c[0] - b[0]) * (a[1] - c[1])
+        if i0 >= i1 or j0 >= j1 or abs(det) < 1e-18:
+            continue                      # no grid line inside, or a vertical triangle
+        px, py = X[i0:i1, j0:j1] - c[0], Y[i0:i1, j0:j1] - c[1]
+        l1 = ((b[1] - c[1]) * px + (c[0] - b[0]) * py) / det
+        l2 = ((c[1] - a[1]) * px + (a[0] - c[0]) * py) / det
+        inside = (l1 >= 0) & (l2 >= 0) & (l1 + l2 <= 1)
+        z = l1 * a[2] + l2 * b[2] + (1 - l1 - l2) * c[2]
+        np.minimum(low[i0:i1, j0:j1], np.where(inside, z, np.inf), out=low[i0:i1, j0:j1])
+        np.maximum(high[i0:i1, j0:j1], np.where(inside, z, -np.inf), out=high[i0:i1, j0:j1])
+    return low, high
+
+
+def geometric_contact(plan, p: dict) -> dict:
+    """When the moving can's mesh first and last overlaps the tip link's mesh, from the two
+    meshes as the GUI sends them and the can's prescribed motion, without the collision engine.
+
+    The link's mesh is placed by forward kinematics of ``robot_configuration_rad``, the can's
+    at ``can_start_m`` and moved by ``can_velocity_m_s`` (straight down: no gravity, no
+    contacts, so its motion is exactly the one set). In every vertical line through both
+    meshes' footprints the link's solid spans [a_low, a_high] and the can's, at time 0,
+    [b_low, b_high]; moving down at speed v the can overlaps the link in that line from
+    (b_low - a_high) / v to (b_high - a_low) / v. The first and last of these over all lines
+    are the times. The can's own mesh matters: can.wrl is a drinks can, bevelled at both ends
+    (at the grazing line its bottom is 5.8 mm above its lowest point); a cylinder of its size
+    would overlap the link from 0.217 s to 0.584 s instead of 0.228 s to 0.563 s."""
+    velocity = np.asarray(p["can_velocity_m_s"], float)
+    if velocity[0] != 0.0 or velocity[1] != 0.0 or velocity[2] >= 0.0:
+        raise common.ExperimentError(f"geometric_contact handles a can moving straight down, "
+                                     f"not {velocity.tolist()} m/s")
+    speed = -velocity[2]
+    meshes = common.mesh_bodies(plan)
+    robot = plan.robots[0]
+    pose = {body: (position, quaternion) for body, position, quaternion
+            in robot.situations(np.array(p["robot_configuration_rad"]))}[TIP]
+    link_v, link_t = meshes[TIP]
+    link_v = common.in_world(link_v, *pose)
+    can = can_request(p["can_start_m"], p["can_mass_kg"], p["can_color"])
+    can_v = common.in_world(np.asarray(can.parameters, float).reshape(-1, 3), can.position,
+                            can.orientation)
+    can_t = np.asarray(can.indices, np.int64).reshape(-1, 3)
+    low_xy = np.maximum(link_v[:, :2].min(0), can_v[:, :2].min(0))
+    high_xy = np.minimum(link_v[:, :2].max(0), can_v[:, :2].max(0))
+    if np.any(low_xy > high_xy):
+        raise common.ExperimentError("the can's path never crosses the tip link's footprint")
+    h = COLUMN_GRID_M
+    xs = np.arange(low_xy[0], high_xy[0] + h / 2, h)
+    ys = np.arange(low_xy[1], high_xy[1] + h / 2, h)
+    a_low, a_high = column_extents(link_v, link_t, xs, ys)
+    b_low, b_high = column_extents(can_v, can_t, xs, ys)
+    both = np.isfinite(a_low) & np.isfinite(b_low)
+    if not both.any():
+        raise common.ExperimentError("no vertical line crosses both the can and the tip link")
+    axis_xy = np.asarray(p["can_start_m"][:2], float)
+    X, Y = np.meshgrid(xs, ys, indexing="ij")
+    reach = np.hypot(X - axis_xy[0], Y - axis_xy[1])
+    return {
+        "start_s": round(float((b_low - a_high)[both].min() / speed), 6),
+        "stop_s": round(float((b_high - a_low)[both].max() / speed), 6),
+        # how far the link reaches into the can's outline, seen from above
+        "depth_m": round(float(np.hypot(*(can_v[:, :2] - axis_xy).T).max()
+                               - reach[both].min()), 6),
+        "columns": int(both.sum()),
+        "grid_m": h,
+    }
+
+
+#: how much later than the geometry the Collided messages may show the start and the stop: one
+#: Portal cycle is one 1 ms step, and the cycle stamped t collides the poses at its step's
+#: start (t - 1 ms), so a pair that starts (stops) touching at time g is first reported (first
+#: missing) in the cycle stamped between g + 1 ms and g + 2 ms (measured: 1.547 and 1.586 ms).
+#: The window is [0, 2 ms]: between Step Once calls the paused world also publishes at its
+#: ~rate, colliding the poses after the step under the stamp t, so a start can show 0 to 1 ms
+#: after g when such a publication falls between the first two cycles of the contact; plus
+#: 0.1 ms for the column grid (0.05 mm of the can's travel).
+LAG_WINDOW_S = (0.0, 2 * WORLD["step"])
+LAG_SLACK_S = 0.0001
+
+
+def analyse(s: "common.Session", geometry: dict) -> dict:
     with s.record.lock:
         collided = dict(s.record.collided)
     times = sorted(collided)
@@ -100,6 +199,9 @@ def analyse(s: "common.Session") -> dict:
     reports = sum(len(collided[t]) for t in times)
     start = touching[0] if touching else None
     stop = round(touching[-1] + step, 6) if touching else None   # first cycle without the pair
+    start_lag = round(start - geometry["start_s"], 6) if touching else None
+    stop_lag = round(stop - geometry["stop_s"], 6) if touching else None
+    low, high = LAG_WINDOW_S[0] - LAG_SLACK_S, LAG_WINDOW_S[1] + LAG_SLACK_S
     facts = {
         "outcome": {
             "pairs_reported": [list(p) for p in pairs_seen],
@@ -107,7 +209,15 @@ def analyse(s: "common.Session") -> dict:
             "collision_start_s": start,
             "collision_stop_s": stop,
             "collision_runs": runs,
+            "geometric_start_s": geometry["start_s"],
+            "geometric_stop_s": geometry["stop_s"],
+            "start_lag_s": start_lag,
+            "stop_lag_s": stop_lag,
+            "lag_window_s": [LAG_WINDOW_S[0], LAG_WINDOW_S[1]],
+            "start_and_stop_as_the_geometry_says": bool(
+                touching and low <= start_lag <= high and low <= stop_lag <= high),
             "max_depth_m": round(depth, 6),
+            "geometric_depth_m": geometry["depth_m"],
             "collided_messages": len(times),
             "cycles": s.cycles,
             "collision_reports_per_sim_s": round(reports / s.sim_time, 3) if s.sim_time else 0,
@@ -180,10 +290,14 @@ def verdict(facts: dict) -> tuple:
     """(outcome held, one line per fact) for run.py and the tests."""
     o = facts["outcome"]
     ok = (o["only_the_can_and_tip"] and o["collision_runs"] == 1 and o["max_depth_m"] > 0
-          and o["collided_messages"] >= o["cycles"])
+          and o["collided_messages"] >= o["cycles"] and o["start_and_stop_as_the_geometry_says"])
     lines = [f"pairs reported: {o['pairs_reported']}",
              f"pair collides from {o['collision_start_s']} s to {o['collision_stop_s']} s "
              f"({o['collision_runs']} run), max depth {o['max_depth_m'] * 1000:.2f} mm",
+             f"the meshes overlap from {o['geometric_start_s']} s to {o['geometric_stop_s']} s "
+             f"(geometry): reported {o['start_lag_s']} s and {o['stop_lag_s']} s later (window "
+             f"{o['lag_window_s']} s), reach {o['geometric_depth_m'] * 1000:.2f} mm into the "
+             f"can's outline",
              f"{o['collided_messages']} Collided messages for {o['cycles']} cycles"]
     frames = facts.get("frames")
     if frames:

@@ -28,8 +28,11 @@ and the Viewer's picture keep the given meshes); the finger motors' torque is li
 
 Outcome (summary.json): the can's height above the table while carried (its lowest point, tilt
 included); how far it moves in the palm's frame from the lift's start (the hand has closed) and
-from the carry's start until the hand opens, how much it sinks and tilts; it is released only
-after the opening starts, and it ends on the floor. With frames, ``closeups.png``: six close-up
+from the carry's start until the hand opens, how much it sinks and tilts; when it leaves the
+hand, searched over the whole run (``release``: its centre in the palm's frame more than
+LEFT_HAND_M from where the carry started, for good), against free-fall bounds from the
+opening; when the hand last touches it; when it reaches the floor, and that it ends there.
+With frames, ``closeups.png``: six close-up
 snapshots of the hand (approach done, closed, lifted, carried, opened, dropped), taken with
 the Viewer's Set Camera and not counted among the numbered frames.
 """
@@ -47,7 +50,8 @@ PROBLEM = "TX90_RHand_ICRA10_5PMD_TwoCan.xml"
 ROBOT = "TX90 SAHand Right"
 CAN = "can"
 PALM = f"{ROBOT}/Palm"
-TABLE_TOP = 0.5  # m, the ICRA09 scene's table (a 0.5 m cube on the floor)
+TABLE_TOP = common.TABLE_TOP
+FLOOR_TOP = common.FLOOR_TOP
 
 PARAMETERS = {
     "can_mass_kg": 0.35,
@@ -88,7 +92,7 @@ def motor_of(handle, link_name: str) -> str:
     return handle.motor_ids[handle.joint_keys.index(key)]
 
 
-def run(quick: bool = False, frames: bool = True, out_root=None) -> dict:
+def run(frames: bool = True, out_root=None) -> dict:
     from gui.core.paths import RADIANS, load_robot_path, refine
     p = dict(PARAMETERS)
     problem, plan = common.load_plan(common.EXAMPLES / PROBLEM)
@@ -182,7 +186,10 @@ def run(quick: bool = False, frames: bool = True, out_root=None) -> dict:
 #: offset (m) in a frame turning with the arm: along the radius from the base's axis, along
 #: the tangent (anticlockwise seen from above), up
 CLOSEUP_OFFSET = (0.39, 0.20, 0.24)
-BASE_AXIS_XY = (0.05, 0.05)  # m, where the TX90's Shoulder axis stands in the scene
+#: m, the point the close-ups' radial direction starts from: 5 cm off the TX90's Shoulder axis,
+#: which stands at the origin (forward kinematics, as pile.arm_reaches_pile finds it); kept so
+#: that the close-ups look from where they always did
+BASE_AXIS_XY = (0.05, 0.05)
 
 
 def take_closeup(s: "common.Session", label: str, subject: str):
@@ -227,6 +234,62 @@ def closeup_sheet(closeups, out: pathlib.Path, columns: int = 3, width: int = 32
     return out
 
 
+#: the can has left the hand once its centre, in the palm's frame, is further than this (m) from
+#: where it was held when the carry started: 15 mm is above the most it moves there while the
+#: hand holds it (10.7 mm from the lift's start on, 3.0 mm during the carry) and under half
+#: the can's radius (31.7 mm)
+LEFT_HAND_M = 0.015
+GRAVITY = 9.81
+#: how much later than free fall from the opening (s) the can may leave the hand and reach the
+#: floor: both are seen at cycle ends (up to one 40 ms cycle late) and the hand still touches
+#: the can in the first cycle of the opening (one more)
+FALL_SLACK_S = 2 * WORLD["steps_per_cycle"] * WORLD["step"]
+
+
+def release(t: np.ndarray, drift: np.ndarray, can_z: np.ndarray, bottom: np.ndarray,
+            opens_at: float) -> dict:
+    """When the can leaves the hand, searched over the whole run: the sample after the last one
+    at which its centre is within LEFT_HAND_M of its held place in the palm's frame (``drift``
+    per sample); since when it had been there without a break; when its lowest point reaches
+    the floor. A can that slipped out while carried leaves before the opening; one that stays
+    in the hand has no release.
+
+    Bounds, from free fall (the can starts from rest in the palm's frame when the opening
+    starts): it cannot leave the LEFT_HAND_M ball before sqrt(2 (LEFT_HAND_M - drift) / g)
+    (drift: how far from its held place it already is), unless it is thrown or already loose;
+    its centre reaches the height of a can lying on the floor (one radius above it) no later
+    than sqrt(2 (z - floor - radius) / g) after the opening if nothing holds it, and the can's
+    lowest point reaches the floor before its centre gets that low."""
+    inside = np.nonzero(drift <= LEFT_HAND_M)[0]
+    if not len(inside) or inside[-1] == len(t) - 1:
+        return {"left_hand_at_s": None}
+    last = int(inside[-1])
+    first = last
+    while first > 0 and drift[first - 1] <= LEFT_HAND_M:
+        first -= 1                                     # the start of that unbroken hold
+    k_open = int(np.searchsorted(t, opens_at))
+    earliest = float(np.sqrt(2 * max(LEFT_HAND_M - drift[k_open], 0.0) / GRAVITY))
+    radius = PARAMETERS["can_radius_m"]
+    latest_floor = float(np.sqrt(2 * max(can_z[k_open] - FLOOR_TOP - radius, 0.0) / GRAVITY)) \
+        + FALL_SLACK_S
+    after = np.arange(last + 1, len(t))
+    on_floor = after[bottom[after] <= FLOOR_TOP + 0.005]
+    floor_k = int(on_floor[0]) if len(on_floor) else None
+    falling = can_z[last + 1:(floor_k if floor_k is not None else len(t)) + 1]
+    return {
+        "in_hand_from_s": float(t[first]),
+        "left_hand_at_s": float(t[last + 1]),
+        "left_hand_after_opening_s": round(float(t[last + 1] - opens_at), 6),
+        "earliest_free_fall_exit_s": round(earliest, 4),
+        "on_floor_at_s": float(t[floor_k]) if floor_k is not None else None,
+        "on_floor_after_opening_s": round(float(t[floor_k] - opens_at), 6)
+        if floor_k is not None else None,
+        "latest_on_floor_after_opening_s": round(latest_floor, 4),
+        # from leaving the hand to the floor its centre never rises (by more than 1 mm)
+        "falls_without_rising": bool(np.all(np.diff(falling) <= 0.001)),
+    }
+
+
 def analyse(s: "common.Session", phases: dict) -> dict:
     from odin_common.rotations import quaternion_to_matrix
     t, can, can_q = s.trajectory(CAN)
@@ -250,16 +313,19 @@ def analyse(s: "common.Session", phases: dict) -> dict:
     # started (gravity pulling it down through the grip)
     dz = (can[:, 2] - palm[:, 2]) - (can[:, 2] - palm[:, 2])[np.searchsorted(t, phases["lift"])]
     sank = float(max(0.0, -dz[held].min()))
-    in_hand = drift < 0.02
-    after_open = t >= phases["open"]
-    left = np.nonzero(after_open & ~in_hand)[0]
-    released_at = float(t[left[0]]) if len(left) else None
     # the can's lowest point (its tilt counts: a cylinder's lowest rim point is h/2 cos(tilt)
     # + r sin(tilt) below its centre)
     up = np.array([quaternion_to_matrix(q)[2, 2] for q in can_q])
     tilt = np.arccos(np.clip(np.abs(up), 0.0, 1.0))
     radius, half_length = PARAMETERS["can_radius_m"], PARAMETERS["can_length_m"] / 2
     bottom = can[:, 2] - (half_length * np.cos(tilt) + radius * np.sin(tilt))
+    left = release(t, drift_from("carry"), can[:, 2], bottom, phases["open"])
+    with s.record.lock:
+        pairs = dict(s.record.contact_pairs)
+    hand = f"{ROBOT}/"
+    touched = [tc for tc, listed in pairs.items() if any(
+        CAN in (a, b) and hand in a + b for a, b in listed)]
+    last_touch = max(touched) if touched else None
     samples = {}
     for name, at in phases.items():
         k = min(int(np.searchsorted(t, at)), n - 1)
@@ -279,10 +345,10 @@ def analyse(s: "common.Session", phases: dict) -> dict:
             "max_slip_in_hand_while_carried_m": round(slip_carried, 4),
             "can_sank_in_hand_before_opening_m": round(sank, 4),
             "can_max_tilt_while_held_deg": round(float(np.degrees(tilt[held].max())), 1),
+            "lift_starts_at_s": phases["lift"],
             "hand_opens_at_s": phases["open"],
-            "can_released_at_s": released_at,
-            "released_only_when_hand_opens": bool(released_at is not None
-                                                  and slip_held < 0.02),
+            **left,
+            "hand_last_touches_can_at_s": last_touch,
             "can_final_position_m": [round(float(v), 4) for v in can[-1]],
             "can_on_floor_at_end": bool(can[-1, 2] < 0.1),
         },
@@ -293,10 +359,34 @@ def analyse(s: "common.Session", phases: dict) -> dict:
     return facts
 
 
+def release_checks(o: dict) -> dict:
+    """What the release must show, each true or false (the test asserts them one by one)."""
+    left = o.get("left_hand_at_s")
+    if left is None:
+        return {"the can leaves the hand": False}
+    return {
+        "the can leaves the hand": True,
+        "it is in the hand from before the lift on": o["in_hand_from_s"] <= o["lift_starts_at_s"],
+        "it leaves no sooner than a can dropped at the opening could":
+            o["left_hand_after_opening_s"] >= o["earliest_free_fall_exit_s"],
+        "it leaves within two cycles of that":
+            o["left_hand_after_opening_s"] <= o["earliest_free_fall_exit_s"] + FALL_SLACK_S,
+        "the hand still touches it after the opening starts, not after it left":
+            o["hand_last_touches_can_at_s"] is not None
+            and o["hand_opens_at_s"] < o["hand_last_touches_can_at_s"] <= left,
+        "it only goes down until it reaches the floor": o["falls_without_rising"]
+            and o["on_floor_at_s"] is not None,
+        "it reaches the floor no later than free fall allows":
+            o["on_floor_at_s"] is not None
+            and o["on_floor_after_opening_s"] <= o["latest_on_floor_after_opening_s"],
+    }
+
+
 def verdict(facts: dict) -> tuple:
     o = facts["outcome"]
     h = o["can_height_above_table_while_carried_m"]
-    ok = (o["released_only_when_hand_opens"] and h["min"] > 0.02 and o["can_on_floor_at_end"]
+    checks = release_checks(o)
+    ok = (all(checks.values()) and h["min"] > 0.02 and o["can_on_floor_at_end"]
           and o["can_moved_while_carried_m"] > 0.3)
     lines = [f"can carried {h['min']:.3f}..{h['max']:.3f} m above the table, moved "
              f"{o['can_moved_while_carried_m']:.2f} m; slip in hand from the lift to the "
@@ -304,7 +394,14 @@ def verdict(facts: dict) -> tuple:
              f"{o['max_slip_in_hand_while_carried_m'] * 1000:.1f} mm), sank "
              f"{o['can_sank_in_hand_before_opening_m'] * 1000:.1f} mm, tilted up to "
              f"{o['can_max_tilt_while_held_deg']} deg",
-             f"hand opens at {o['hand_opens_at_s']} s, can released at "
-             f"{o['can_released_at_s']} s, final position {o['can_final_position_m']}",
+             f"hand opens at {o['hand_opens_at_s']} s; the can, in the hand from "
+             f"{o.get('in_hand_from_s')} s, leaves the hand at {o.get('left_hand_at_s')} s "
+             f"({o.get('left_hand_after_opening_s')} s after the opening; free fall: no sooner "
+             f"than {o.get('earliest_free_fall_exit_s')} s), the hand last touches it at "
+             f"{o.get('hand_last_touches_can_at_s')} s, it is on the floor at "
+             f"{o.get('on_floor_at_s')} s ({o.get('on_floor_after_opening_s')} s after the "
+             f"opening; free fall: by {o.get('latest_on_floor_after_opening_s')} s); final "
+             f"position {o['can_final_position_m']}",
+             "release: " + ", ".join(f"{k}: {v}" for k, v in checks.items()),
              f"contacts: {facts['contacts']}"]
     return ok, lines

@@ -1,8 +1,8 @@
 """Runs the thesis's three experiments (chapter 10) end to end, headless.
 
-    python tools/experiments/run.py                 # all three
-    python tools/experiments/run.py grasp           # one (contactless, pile, grasp)
-    python tools/experiments/run.py --quick pile    # a shorter run with the same outcome checks
+    python tools/experiments/run.py                   # all three
+    python tools/experiments/run.py grasp             # one (contactless, pile, grasp)
+    python tools/experiments/run.py --no-frames pile  # no Viewer frames (the same simulation)
 
 Each experiment starts its own roscore, ``rosrun VirtualWorld virtualWorld`` and ``rosrun
 Viewer viewer``, acts as the GUI, and writes ``out/experiments/<name>/``: numbered Viewer frames
@@ -33,7 +33,6 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("names", nargs="*", metavar="name",
                         help="contactless, pile or grasp (default: all three)")
-    parser.add_argument("--quick", action="store_true", help="shorter runs, same outcome checks")
     parser.add_argument("--no-frames", action="store_true", help="no Viewer frames")
     args = parser.parse_args(argv)
     unknown = [n for n in args.names if n not in NAMES]
@@ -45,7 +44,7 @@ def main(argv=None) -> int:
         started = time.monotonic()
         print(f"experiment {name} ...", flush=True)
         try:
-            code = _run_in_child(name, quick=args.quick, frames=not args.no_frames)
+            code = _run_in_child(name, frames=not args.no_frames)
         except KeyboardInterrupt:
             print("interrupted; every process started was stopped", file=sys.stderr)
             return 130
@@ -64,7 +63,7 @@ def main(argv=None) -> int:
     return 0
 
 
-def _run_in_child(name: str, quick: bool, frames: bool) -> int:
+def _run_in_child(name: str, frames: bool) -> int:
     """Runs one experiment in a child process and returns its exit code: 0 the outcome held,
     1 it did not, 2 the run failed, 130 interrupted. Each experiment has a roscore of its own,
     and rospy binds a process to the first master it registers with (init_node works once per
@@ -75,7 +74,7 @@ def _run_in_child(name: str, quick: bool, frames: bool) -> int:
         code = 2
         try:
             module = importlib.import_module(name)
-            facts = module.run(quick=quick, frames=frames)
+            facts = module.run(frames=frames)
             ok, lines = module.verdict(facts)
             for line in lines:
                 print(f"  {line}")

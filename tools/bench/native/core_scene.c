@@ -1,6 +1,11 @@
 /* Native baseline for bench_core.py: the same scene and step loop as the Odin Core, in plain C
- * over libode. Usage: core_scene MODE STEPS NFORCES NMOTORS (MODE 0 spheres on a plane, 1 pile
- * inside four walls). Prints the seconds spent in the step loop and the last step's contacts. */
+ * over libode. Usage: core_scene MODE STEPS NFORCES NMOTORS [CHECKPOINT...] (MODE 0 spheres on a
+ * plane, 1 pile inside four walls). Prints the seconds spent in the step loop and the last
+ * step's contacts on one line, then the final pose of each of the 100 bodies, one a line:
+ * x y z qw qx qy qz (%.17g, which reads back as the same double), for bench_core.py and
+ * bench_portal.py to compare with Odin's. Before that, after each CHECKPOINT-th step, a line
+ * "after CHECKPOINT CONTACTS" and the 100 poses of that moment (the loop's time then includes
+ * the printing: for checks, not timing). */
 #include <ode/ode.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -30,13 +35,20 @@ static void near_cb(void *data, dGeomID o1, dGeomID o2) {
     contacts_last += n > 0 ? n : 0;
 }
 
+static void print_poses(dBodyID *bodies) {
+    for (int i = 0; i < 100; ++i) {
+        const dReal *p = dBodyGetPosition(bodies[i]), *q = dBodyGetQuaternion(bodies[i]);
+        printf("%.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", p[0], p[1], p[2], q[0], q[1], q[2], q[3]);
+    }
+}
+
 static void wall(dSpaceID space, double x, double y, double z, double lx, double ly, double lz) {
     dGeomID g = dCreateBox(space, lx, ly, lz);
     dGeomSetPosition(g, x, y, z);
 }
 
 int main(int argc, char **argv) {
-    if (argc != 5) { fprintf(stderr, "usage: core_scene MODE STEPS NFORCES NMOTORS\n"); return 2; }
+    if (argc < 5) { fprintf(stderr, "usage: core_scene MODE STEPS NFORCES NMOTORS [CHECKPOINT...]\n"); return 2; }
     int mode = atoi(argv[1]), steps = atoi(argv[2]), nforces = atoi(argv[3]), nmotors = atoi(argv[4]);
     dInitODE2(0);
     world = dWorldCreate();
@@ -89,9 +101,12 @@ int main(int argc, char **argv) {
         for (int i = 0; i < nmotors; ++i) dJointSetAMotorParam(motors[i], dParamVel, 0.5);
         dWorldQuickStep(world, 0.001);
         dJointGroupEmpty(group);
+        for (int k = 5; k < argc; ++k)
+            if (atoi(argv[k]) == s + 1) { printf("after %d %d\n", s + 1, contacts_last); print_poses(bodies); }
     }
     clock_gettime(CLOCK_MONOTONIC, &t1);
     printf("%.6f %d\n", (t1.tv_sec - t0.tv_sec) + 1e-9 * (t1.tv_nsec - t0.tv_nsec), contacts_last);
+    print_poses(bodies);
     dCloseODE();
     return 0;
 }
