@@ -77,8 +77,8 @@ def test_forgotten_owner_is_freed_once_by_gc(spy):
 
 def test_trimesh_owner_keeps_arrays_and_frees_data_after_geom(spy):
     space = handles.new_space()
-    vertices = ffi.new("double[]", BOX_V)
-    indices = ffi.new("dTriIndex[]", BOX_I)
+    vertices = np.array(BOX_V, dtype=float).reshape(-1, 3)
+    indices = np.array(BOX_I, dtype=np.uint32).reshape(-1, 3)
     geom = handles.new_trimesh(space, vertices, indices)
     order = []
     spy_keys = list(spy)

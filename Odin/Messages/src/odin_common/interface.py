@@ -97,6 +97,13 @@ JOINT_USES_ANCHOR = frozenset(set(JointType) - {JointType.SLIDER, JointType.FIXE
                                                 JointType.PLANE2D})
 """Joint types whose ``anchor`` (m, world) is used."""
 
+JOINT_NEEDS_TWO_BODIES = frozenset({JointType.HINGE2})
+"""Joint types ODE cannot attach to one body and the static world (it aborts)."""
+
+JOINT_AXIS2_ON_BODY2 = frozenset({JointType.UNIVERSAL, JointType.HINGE2, JointType.PU})
+"""Joint types whose second rotation axis is fixed in body2 (or the world), not in body1:
+a motor on their two rotation axes anchors its second axis there."""
+
 JOINT_FORCE_MAGNITUDES: Dict[JointType, Tuple[str, ...]] = {
     JointType.HINGE: ("torque",), JointType.SLIDER: ("force",),
     JointType.PISTON: ("force",), JointType.UNIVERSAL: ("torque1", "torque2"),
@@ -241,7 +248,7 @@ class NodeParameter(NamedTuple):
 
 __all__ = ["NodeParameter", "JointType", "JointParameter", "SetJointAction", "MotorKind", "AxisFrame",
            "ForceKind", "Solver", "JOINT_AXES_USED", "JOINT_USES_ANCHOR",
-           "JOINT_FORCE_MAGNITUDES", "JOINT_STATE_AXES", "JOINT_PARAMETERS",
+           "JOINT_NEEDS_TWO_BODIES", "JOINT_AXIS2_ON_BODY2", "JOINT_FORCE_MAGNITUDES", "JOINT_STATE_AXES", "JOINT_PARAMETERS",
            "JOINT_PARAMETER_AXES", "MOTOR_PARAMETERS", "UNIT_PARAMETERS",
            "NON_NEGATIVE_PARAMETERS", "joint_type", "default_joint_id", "default_motor_id",
            "SHAPE_BY_PARAMETER_COUNT", "shape_kind", "COMPOSITE_MARK", "composite_id",

@@ -9,7 +9,8 @@ from __future__ import annotations
 
 from typing import List, Sequence, Tuple
 
-from odin_common.interface import (JOINT_AXES_USED, JOINT_PARAMETER_AXES, JOINT_PARAMETERS,
+from odin_common.interface import (JOINT_AXES_USED, JOINT_NEEDS_TWO_BODIES,
+                                   JOINT_PARAMETER_AXES, JOINT_PARAMETERS,
                                    MOTOR_PARAMETERS, NON_NEGATIVE_PARAMETERS, UNIT_PARAMETERS,
                                    JointParameter, JointType, joint_type)
 from odin_common.specs import JointSpec
@@ -36,6 +37,9 @@ def create_joint(scene: Scene, spec: JointSpec) -> str:
     if body1 == body2:
         raise InvalidArgument(f"a joint cannot join {body1!r} to itself")
     objects = [scene.body_object(b, "joint") if b else None for b in (body1, body2)]
+    if kind in JOINT_NEEDS_TWO_BODIES and not (body1 and body2):
+        raise Unsupported(f"a {kind.label} joint needs two bodies (ODE cannot attach it to "
+                          "the static world)")
     if kind == JointType.PLANE2D and (not body1 or body2):
         raise Unsupported("a plane-2D joint takes body1 only (body2 must be '')")
     pair = frozenset((body1, body2))

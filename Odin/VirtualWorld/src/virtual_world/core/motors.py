@@ -10,7 +10,7 @@ from typing import List, Mapping, Sequence
 
 import numpy as np
 
-from odin_common.interface import AxisFrame, JointParameter, MotorKind
+from odin_common.interface import JOINT_AXIS2_ON_BODY2, AxisFrame, JointParameter, MotorKind
 from odin_common.specs import MotorSpec
 from virtual_world.core import validation as check
 from virtual_world.core.records import MotorRecord
@@ -32,6 +32,7 @@ def create_motor(scene: Scene, spec: MotorSpec) -> str:
         ("body2", spec.body2)))
     axes_values = check.flat_vector("axes", spec.axes) if len(spec.axes) else np.zeros(0)
     joint = None
+    ode_frames = None   # frames in ODE's terms, when the joint decides them
     if joint_id:
         joint = scene.joint(joint_id)
         if (body1 or body2) and (body1, body2) != joint.bodies:
@@ -44,6 +45,11 @@ def create_motor(scene: Scene, spec: MotorSpec) -> str:
                 raise Unsupported(f"joint {joint_id!r} ({joint.type.label}) has no "
                                   f"{kind.name.lower()} axis; give axes")
             axes_values = np.concatenate(found)
+            if len(found) == 2 and joint.type in JOINT_AXIS2_ON_BODY2 and \
+                    not len(spec.axis_frames):
+                # axis 1 turns with ODE's body 1, axis 2 with body 2 (or the world): as the
+                # joint holds them, so the goals stay the joint's rates
+                ode_frames = [1, 2 if body1 and body2 else 0]
     if not body1 and not body2:
         raise InvalidArgument("a motor needs a joint or at least one body")
     if body1 == body2:
@@ -65,7 +71,9 @@ def create_motor(scene: Scene, spec: MotorSpec) -> str:
         raise DuplicateName(f"motor id {motor_id!r} is already taken")
     # ---- ODE
     owner = handles.new_motor(scene.c.world, kind, [o.body for o in objects if o is not None])
-    if objects[0] is None:  # the body is ODE's body 1 (handles._attached): swap body frames
+    if ode_frames is not None:
+        frames = ode_frames
+    elif objects[0] is None:  # the body is ODE's body 1 (handles._attached): swap body frames
         frames = [{AxisFrame.GLOBAL: 0, AxisFrame.FIRST_BODY: 2,
                    AxisFrame.SECOND_BODY: 1}[f] for f in frames]
     ode_joints.configure_motor(owner.ptr, kind, unit_axes, frames, max_forces)

@@ -24,7 +24,6 @@ from virtual_world.core.scene import Scene
 from virtual_world.core.shapes import Shape, collision_mesh, prepare_shape
 from virtual_world.errors import DuplicateName, InvalidArgument
 from virtual_world.ode import bodies, handles
-from virtual_world.ode.bindings import ffi
 from virtual_world.ode.runtime import drain_messages
 from virtual_world.ode.world import PoseReader
 
@@ -177,9 +176,7 @@ def _build_geometry(scene: Scene, p: _Prepared, part: _Part, body, tag: int) -> 
     shape = part.shape
     if shape.kind == "mesh":
         vertices, triangles = collision_mesh(shape, scene.parameters.collision_mesh_tolerance)
-        geom = handles.new_trimesh(scene.c.space,
-                                   ffi.new("double[]", vertices.reshape(-1).tolist()),
-                                   ffi.new("dTriIndex[]", triangles.reshape(-1).tolist()), body)
+        geom = handles.new_trimesh(scene.c.space, vertices, triangles, body)
     else:
         geom = handles.new_primitive(scene.c.space, shape.kind, shape.dims, body)
     if body is not None:

@@ -20,6 +20,8 @@ from __future__ import annotations
 import weakref
 from typing import Any, Callable, Dict, Iterable, Optional, Sequence, Tuple
 
+import numpy as np
+
 from odin_common.interface import JointType, MotorKind
 from virtual_world.ode.bindings import ffi, lib
 
@@ -141,11 +143,15 @@ def new_primitive(space: Owner, kind: str, dims: Sequence[float],
     return new_geom(ptr, space, body)
 
 
-def new_trimesh(space: Owner, vertices: Any, indices: Any, body: Optional[Owner] = None) -> Owner:
-    """A trimesh geom over cffi arrays `vertices` (double[3n]) and `indices` (dTriIndex[3m]).
+def new_trimesh(space: Owner, vertices: np.ndarray, triangles: np.ndarray,
+                body: Optional[Owner] = None) -> Owner:
+    """A trimesh geom over ``vertices`` (n, 3) m and ``triangles`` (m, 3) indices.
 
-    The geom's owner keeps both arrays and the trimesh data owner alive; the data is freed
-    right after the geom."""
+    ODE keeps pointers to the arrays without copying them: they are copied into cffi arrays
+    that the geom's owner keeps alive with the trimesh data owner; the data is freed right
+    after the geom."""
+    vertices = ffi.new("double[]", np.asarray(vertices, dtype=float).reshape(-1).tolist())
+    indices = ffi.new("dTriIndex[]", np.asarray(triangles).reshape(-1).tolist())
     data = Owner("trimeshdata", lib.dGeomTriMeshDataCreate(), keep=(vertices, indices))
     lib.dGeomTriMeshDataBuildDouble(data.ptr, vertices, 3 * ffi.sizeof("double"),
                                     len(vertices) // 3, indices, len(indices),

@@ -1,0 +1,84 @@
+"""The layers of docs/ARCHITECTURE.md hold: every module of the stack imports only what its
+layer may (read from the source with ast, lazy imports inside functions included)."""
+import ast
+import pathlib
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+SOURCES = ROOT / "Odin"
+
+ROS = ("rospy", "rosgraph", "roslib", "rospkg", "genpy", "tf2_ros", "interactive_markers",
+       "rosbag")
+MESSAGES = ("Messages.msg", "Services", "std_msgs", "sensor_msgs", "geometry_msgs",
+            "rosgraph_msgs", "visualization_msgs", "diagnostic_msgs", "tf2_msgs")
+QT = ("PyQt5",)
+
+# layer (module prefix) -> prefixes it must never import
+RULES = {
+    "odin_common": ROS + QT + ("Services", "virtual_world", "viewer", "gui"),
+    "virtual_world.core": ROS + MESSAGES + QT + ("virtual_world.portal", "virtual_world.ode"
+                                                  ".bindings", "viewer", "gui",
+                                                  "odin_common.messages"),
+    "virtual_world.ode": ROS + MESSAGES + QT + ("virtual_world.core", "virtual_world.portal",
+                                                "viewer", "gui"),
+    "viewer.core": ROS + MESSAGES + QT + ("viewer.portal", "virtual_world", "gui",
+                                          "odin_common.messages"),
+    "gui.core": ROS + MESSAGES + QT + ("gui.ros", "gui.window", "virtual_world", "viewer",
+                                       "odin_common.messages"),
+    "gui.ros": QT + ("gui.window", "virtual_world", "viewer"),
+    "virtual_world.portal": QT + ("viewer", "gui", "virtual_world.ode"),
+    "viewer.portal": QT + ("virtual_world", "gui"),
+}
+# the generated message classes are allowed in odin_common.messages only
+EXCEPTIONS = {"odin_common.messages": ("Messages.msg",)}
+# Qt tabs talk to the world through gui.ros' typed client only
+TAB_RULE = ROS + MESSAGES
+
+
+def _modules():
+    for path in sorted(SOURCES.glob("*/src/**/*.py")):
+        src = next(p for p in path.parents if p.name == "src")
+        parts = path.relative_to(src).with_suffix("").parts
+        yield ".".join(p for p in parts if p != "__init__"), path
+
+
+def _imports(path: pathlib.Path):
+    tree = ast.parse(path.read_text(), str(path))
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            for alias in node.names:
+                yield alias.name, node.lineno
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            yield node.module, node.lineno
+            for alias in node.names:   # "from Messages import msg" imports Messages.msg
+                yield f"{node.module}.{alias.name}", node.lineno
+
+
+def _matches(imported: str, prefix: str) -> bool:
+    return imported == prefix or imported.startswith(prefix + ".")
+
+
+MODULES = list(_modules())
+
+
+def test_every_source_module_is_in_a_layer():
+    layered = [name for name, _ in MODULES
+               if any(_matches(name, layer) for layer in RULES)
+               or name.startswith(("gui.window", "gui.cli", "gui.errors", "virtual_world.errors",
+                                   "viewer.errors"))
+               or name in ("virtual_world", "viewer", "gui")]
+    assert sorted(layered) == sorted(name for name, _ in MODULES)
+
+
+@pytest.mark.parametrize("name,path", MODULES, ids=[name for name, _ in MODULES])
+def test_module_imports_only_what_its_layer_may(name, path):
+    forbidden = [prefix for layer, prefixes in RULES.items() if _matches(name, layer)
+                 for prefix in prefixes]
+    if name.startswith("gui.window.") and name.endswith("_tab"):
+        forbidden += TAB_RULE
+    allowed = EXCEPTIONS.get(name, ())
+    wrong = [(imported, line) for imported, line in _imports(path)
+             if any(_matches(imported, prefix) for prefix in forbidden)
+             and not any(_matches(imported, ok) for ok in allowed)]
+    assert not wrong, f"{path.relative_to(ROOT)} imports {wrong}"
