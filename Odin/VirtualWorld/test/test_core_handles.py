@@ -79,7 +79,7 @@ def test_trimesh_owner_keeps_arrays_and_frees_data_after_geom(spy):
     space = handles.new_space()
     vertices = np.array(BOX_V, dtype=float).reshape(-1, 3)
     indices = np.array(BOX_I, dtype=np.uint32).reshape(-1, 3)
-    geom = handles.new_trimesh(space, vertices, indices)
+    geom = handles.new_trimesh(space, vertices, indices, serial=1)
     order = []
     spy_keys = list(spy)
     del vertices, indices

@@ -8,7 +8,7 @@ acts on body1 along (about) +axis and the reaction on body2.
 """
 from __future__ import annotations
 
-from typing import Iterable, List, Sequence
+from typing import Dict, Iterable, Sequence
 
 from odin_common.interface import JOINT_FORCE_MAGNITUDES, ForceKind
 from virtual_world.core import validation as check
@@ -108,12 +108,22 @@ def _rebuild_joint_forces(scene: Scene) -> None:
          f.magnitudes.tolist()) for f in scene.joint_forces.values()])
 
 
+def replace_all(scene: Scene, body_forces: Dict[str, BodyForceRecord],
+                joint_forces: Dict[str, JointForceRecord]) -> None:
+    """Every persistent force becomes one of these (a snapshot put back): the records, the
+    ids on their objects and joints, and C's arrays."""
+    scene.body_forces = dict(body_forces)
+    scene.joint_forces = dict(joint_forces)
+    for obj in scene.objects.values():
+        obj.forces = {i for i, f in body_forces.items() if f.object_id == obj.id}
+    for joint in scene.joints.values():
+        joint.forces = {i for i, f in joint_forces.items() if f.joint_id == joint.id}
+    _rebuild_body_forces(scene)
+    _rebuild_joint_forces(scene)
+
+
 def _free_id(taken, prefix: str) -> str:
     n = 0
     while f"{prefix}:{n}" in taken:
         n += 1
     return f"{prefix}:{n}"
-
-
-def body_force_ids(scene: Scene) -> List[str]:
-    return list(scene.body_forces)

@@ -176,15 +176,17 @@ def _build_geometry(scene: Scene, p: _Prepared, part: _Part, body, tag: int) -> 
     shape = part.shape
     if shape.kind == "mesh":
         vertices, triangles = collision_mesh(shape, scene.parameters.collision_mesh_tolerance)
-        geom = handles.new_trimesh(scene.c.space, vertices, triangles, body)
+        geom = handles.new_trimesh(scene.c.space, vertices, triangles, scene.take_serial(),
+                                   body)
     else:
-        geom = handles.new_primitive(scene.c.space, shape.kind, shape.dims, body)
+        geom = handles.new_primitive(scene.c.space, shape.kind, shape.dims,
+                                     scene.take_serial(), body)
     if body is not None:
         bodies.set_geom_offset(geom.ptr, (part.position - p.com).tolist(),
                                part.orientation.tolist())
     else:
         place_static(geom.ptr, p.position, p.orientation, part.position, part.orientation)
-    bodies.set_geom_tag(geom.ptr, tag)
+    bodies.set_geom_tag(geom, tag)
     if p.no_collisions:
         bodies.exclude_from_collisions(geom.ptr)
     record = GeometryRecord(part.name, geom, p.object_id, part.position, part.orientation,
@@ -292,10 +294,9 @@ def remove_object(scene: Scene, object_id: str) -> Removed:
 
 # ---------------------------------------------------------------------------------- moving
 
-def set_poses(scene: Scene, poses: Sequence[Tuple[str, Sequence[float], Sequence[float]]],
-              reset_velocity: bool = False) -> None:
-    """Moves objects: (object id, position m world, orientation wxyz) each, all or nothing."""
-    reset_velocity = check.flag("reset_velocity", reset_velocity)
+def check_poses(scene: Scene, poses) -> list:
+    """[(object record, position (3,), orientation (4,))] of (object id, position m world,
+    orientation wxyz) items, each checked."""
     checked = []
     for item in poses:
         try:
@@ -305,7 +306,14 @@ def set_poses(scene: Scene, poses: Sequence[Tuple[str, Sequence[float], Sequence
         obj = scene.object(object_id)
         checked.append((obj, check.vector(f"position of {object_id!r}", position),
                         check.quaternion(f"orientation of {object_id!r}", orientation)))
-    for obj, position, orientation in checked:
+    return checked
+
+
+def set_poses(scene: Scene, poses: Sequence[Tuple[str, Sequence[float], Sequence[float]]],
+              reset_velocity: bool = False) -> None:
+    """Moves objects: (object id, position m world, orientation wxyz) each, all or nothing."""
+    reset_velocity = check.flag("reset_velocity", reset_velocity)
+    for obj, position, orientation in check_poses(scene, poses):
         if obj.body is not None:
             com_W = position + quaternion_to_matrix(orientation) @ obj.com
             bodies.set_body_pose(obj.body.ptr, com_W.tolist(), orientation.tolist())

@@ -44,21 +44,23 @@ def mass_properties(scene: Scene, object_id: str) -> Tuple[float, np.ndarray, np
     return mass, obj.com.copy(), inertia
 
 
-def _named_records(scene: Scene) -> List[Collision]:
+def named_records(scene: Scene) -> List[Tuple[Collision, int]]:
+    """C's collision records under geometry names (sorted within a pair), each with the step
+    count when it was first seen."""
     result = []
-    for address1, address2, depth, points in scene.c.records():
+    for address1, address2, depth, points, first_step in scene.c.records():
         first = scene.geometry_names[address1]
         second = scene.geometry_names[address2]
         if second < first:
             first, second = second, first
-        result.append(Collision(first, second, depth, points))
+        result.append((Collision(first, second, depth, points), first_step))
     return result
 
 
 def carry_collisions(scene: Scene, removed_names: Set[str]) -> None:
     """Moves the C records into Python (deepest occurrence per pair), dropping the pairs of
     ``removed_names`` (geometries about to be freed)."""
-    for c in _named_records(scene):
+    for c, _ in named_records(scene):
         key = (c.first, c.second)
         old = scene.carried.get(key)
         if old is None or c.depth > old.depth:

@@ -70,12 +70,38 @@ class JointState(NamedTuple):
 
 
 class Collision(NamedTuple):
-    """Two colliding geometries (names, sorted), the deepest penetration depth (m) and up to 8
-    contact points (world, m)."""
+    """Two colliding geometries (names, sorted), the deepest penetration depth (m), up to 8
+    contact points (world, m) of the deepest occurrence and, where the Core knows it, the
+    simulated time (s) the pair was first seen (NaN otherwise)."""
     first: str
     second: str
     depth: float
     points: Tuple[Tuple[float, float, float], ...]
+    first_time: float = float("nan")
+
+
+class BodyState(NamedTuple):
+    """An object's state: position of its frame's origin (m), orientation (w, x, y, z),
+    linear velocity of its centre of mass (m/s), angular velocity (rad/s); world frame."""
+    id: str
+    position: Tuple[float, float, float]
+    orientation: Tuple[float, float, float, float]
+    linear: Tuple[float, float, float]
+    angular: Tuple[float, float, float]
+
+
+class Propagation(NamedTuple):
+    """What a propagation did: it ran ``steps`` steps of ``step_size`` s from ``start_time``
+    (simulated s), ended in ``states`` (every object with a body), met ``collisions`` (each
+    pair once, deepest, with the time first seen), in ``wall_time`` s of this machine; ``kept``
+    says whether the world stayed in the final state."""
+    start_time: float
+    step_size: float
+    steps: int
+    states: Tuple[BodyState, ...]
+    collisions: Tuple[Collision, ...]
+    wall_time: float
+    kept: bool
 
 
 # ---------------------------------------------------------------------------------- records

@@ -33,9 +33,13 @@ class Scene:
         self.joint_forces: Dict[str, JointForceRecord] = {}
         self.entities: Dict[str, List[str]] = {}
         self.next_tag = 1                               # geom tag of the next entity
+        self.next_serial = 1                            # serial of the next geom
         self.entity_counter = 0                         # n of the last "entity<n>"
         self.carried: Dict[Tuple[str, str], Collision] = {}   # collisions kept in Python
         self.sim_time = 0.0                             # s since the scene began
+        self.snapshots: Dict[str, object] = {}          # name -> snapshots.Snapshot
+        self.reset_point: Optional[object] = None       # the state right after the last build
+        self.contents_changed = True                    # a build or removal since reset_point
         self._pose_reader: Optional[PoseReader] = None
         self._pose_names: List[str] = []
 
@@ -78,6 +82,13 @@ class Scene:
             raise UnknownName(f"no geometry named {name!r}") from None
 
     # -- geometries, in one C array for pose read-out ---------------------------------------
+    def take_serial(self) -> int:
+        """The next geom's serial: geoms are numbered in creation order, so the same calls
+        give the same numbers (odin_step.c orders contacts by them)."""
+        serial = self.next_serial
+        self.next_serial += 1
+        return serial
+
     def add_geometry(self, record: GeometryRecord) -> None:
         self.geometries[record.name] = record
         self.geometry_names[record.owner.address] = record.name

@@ -14,7 +14,9 @@ moved by forces or contacts, infinite mass for them.
 from __future__ import annotations
 
 import functools
+import math
 import threading
+import time
 from typing import Dict, List, Mapping, Optional, Sequence, Tuple
 
 import numpy as np
@@ -22,10 +24,12 @@ import numpy as np
 from odin_common.interface import ForceKind, JointType, MotorKind
 from odin_common.specs import CompositeSpec, EntitySpec, JointSpec, MotorSpec, ObjectSpec
 from odin_common.world_parameters import WorldParameters
-from virtual_world.core import forces, joints, motors, objects, readout, validation as check
-from virtual_world.core.records import (Built, BuiltEntity, Collision, JointState, Removed)
+from virtual_world.core import (forces, joints, motors, objects, readout, snapshots,
+                                validation as check)
+from virtual_world.core.records import (BodyState, Built, BuiltEntity, Collision, JointState,
+                                        Propagation, Removed)
 from virtual_world.core.scene import Scene
-from virtual_world.errors import Closed, InvalidArgument
+from virtual_world.errors import Closed, InvalidArgument, UnknownName
 from virtual_world.ode import bodies
 from virtual_world.ode.runtime import drain_messages, init_ode
 
@@ -38,6 +42,30 @@ def _locked(method):
                 raise Closed(f"Core is closed ({method.__name__})")
             return method(self, *args, **kwargs)
     return wrapper
+
+
+def _changes_contents(method):
+    """A call that may add or remove objects, joints or motors: the next change of state takes
+    a new reset point."""
+    @functools.wraps(method)
+    def wrapper(self, *args, **kwargs):
+        result = method(self, *args, **kwargs)
+        self._scene.contents_changed = True
+        return result
+    return _locked(wrapper)
+
+
+def _changes_state(method):
+    """A call that changes the dynamic state: first, if the contents changed since the reset
+    point was taken, the state as the last build left it becomes the reset point."""
+    @functools.wraps(method)
+    def wrapper(self, *args, **kwargs):
+        scene = self._scene
+        if scene.contents_changed:
+            scene.reset_point = snapshots.take(scene)
+            scene.contents_changed = False
+        return method(self, *args, **kwargs)
+    return _locked(wrapper)
 
 
 class Core:
@@ -112,18 +140,18 @@ class Core:
 
     # ------------------------------------------------------------------ objects
 
-    @_locked
+    @_changes_contents
     def build_object(self, spec: ObjectSpec) -> Built:
         """Creates one object (see ObjectSpec); returns its id and geometries as built."""
         return objects.build_object(self._scene, spec)
 
-    @_locked
+    @_changes_contents
     def build_composite(self, spec: CompositeSpec) -> Built:
         """Creates a composite: its parts are geometries on one body placed at the centre of
         mass (part masses rotated, translated and added); its id is ">part1>part2..."."""
         return objects.build_composite(self._scene, spec)
 
-    @_locked
+    @_changes_contents
     def build_entity(self, spec: EntitySpec) -> BuiltEntity:
         """Builds objects and composites as one entity, all or nothing (see EntitySpec)."""
         return objects.build_entity(self._scene, spec)
@@ -133,7 +161,7 @@ class Core:
         """Entity name -> ids of its objects still alive."""
         return objects.entity_members(self._scene)
 
-    @_locked
+    @_changes_contents
     def remove_object(self, object_id: str) -> Removed:
         """Removes an object with its joints, motors and forces; returns every removed id."""
         return objects.remove_object(self._scene, object_id)
@@ -161,20 +189,20 @@ class Core:
             return 0
         return bodies.triangle_count(geometry.owner.ptr)
 
-    @_locked
+    @_changes_state
     def set_poses(self, poses: Sequence[Tuple[str, Sequence[float], Sequence[float]]],
                   reset_velocity: bool = False) -> None:
         """Moves objects: (object id, position m world, orientation wxyz) each, all or
         nothing. reset_velocity zeroes the bodies' linear and angular velocities."""
         objects.set_poses(self._scene, poses, reset_velocity)
 
-    @_locked
+    @_changes_state
     def set_velocity(self, object_id: str, linear=None, angular=None) -> None:
         """Sets the linear velocity of the centre of mass (m/s, world) and/or the angular
         velocity (rad/s, world) of a body; None keeps the current one."""
         objects.set_velocity(self._scene, object_id, linear, angular)
 
-    @_locked
+    @_changes_state
     def set_velocities(self, object_id: str = "", linear=None, angular=None,
                        motor_ids: Sequence[str] = (), velocities: Sequence[float] = ()) -> None:
         """Set Velocity: an object's velocities and/or motor goal speeds (one flat list, each
@@ -196,7 +224,7 @@ class Core:
 
     # ------------------------------------------------------------------ joints and motors
 
-    @_locked
+    @_changes_contents
     def add_joint(self, spec: JointSpec) -> str:
         """Creates a joint and sets its parameters, all or nothing (see JointSpec); returns
         its id."""
@@ -215,7 +243,7 @@ class Core:
     def joint_ids(self) -> List[str]:
         return list(self._scene.joints)
 
-    @_locked
+    @_changes_state
     def set_joint_parameters(self, joint_id: str,
                              parameters: Sequence[Tuple[int, int, float]]) -> None:
         """(parameter, axis 1..3, value) triples on a joint or a motor, all or nothing (see
@@ -224,7 +252,7 @@ class Core:
             raise InvalidArgument(f"no parameter to set on {joint_id!r}")
         joints.set_joint_parameters(self._scene, joint_id, parameters)
 
-    @_locked
+    @_changes_contents
     def remove_joint(self, joint_id: str) -> Removed:
         """Removes a joint with its motors and joint forces."""
         return joints.remove_joint(self._scene, joint_id)
@@ -234,7 +262,7 @@ class Core:
         """Positions and rates of every joint, per axis (see JointState)."""
         return joints.joint_states(self._scene)
 
-    @_locked
+    @_changes_contents
     def add_motor(self, spec: MotorSpec) -> str:
         """Creates a motor (see MotorSpec) at zero goal speed; returns its id."""
         return motors.create_motor(self._scene, spec)
@@ -260,18 +288,18 @@ class Core:
         """Every motor's goal speeds per axis (rad/s or m/s)."""
         return {motor_id: list(m.velocity) for motor_id, m in self._scene.motors.items()}
 
-    @_locked
+    @_changes_contents
     def remove_motor(self, motor_id: str) -> None:
         motors.remove_motor(self._scene, motor_id)
 
-    @_locked
+    @_changes_state
     def set_motor_velocities(self, velocities: Mapping[str, Sequence[float]]) -> None:
         """Goal speeds (rad/s or m/s) per motor axis; all checked before any is set."""
         motors.set_velocities(self._scene, velocities)
 
     # ------------------------------------------------------------------ forces
 
-    @_locked
+    @_changes_state
     def add_body_force(self, object_id: str, kind: int, vector,
                        vector_in_body_frame: bool = False, at_point: bool = False,
                        point=(0.0, 0.0, 0.0), point_in_body_frame: bool = False) -> str:
@@ -282,7 +310,7 @@ class Core:
         return forces.add_body_force(self._scene, object_id, kind, vector,
                                      vector_in_body_frame, at_point, point, point_in_body_frame)
 
-    @_locked
+    @_changes_state
     def remove_body_force(self, force_id: str) -> None:
         forces.remove_body_force(self._scene, force_id)
 
@@ -290,14 +318,14 @@ class Core:
     def body_force_ids(self) -> List[str]:
         return list(self._scene.body_forces)
 
-    @_locked
+    @_changes_state
     def add_joint_force(self, joint_id: str, magnitudes: Sequence[float]) -> str:
         """A persistent force/torque along a joint's axes, applied before every step until
         removed (odin_common.interface.JOINT_FORCE_MAGNITUDES). Returns
         "jointforce:<joint>:<n>"."""
         return forces.add_joint_force(self._scene, joint_id, magnitudes)
 
-    @_locked
+    @_changes_state
     def remove_joint_force(self, force_id: str) -> None:
         forces.remove_joint_force(self._scene, force_id)
 
@@ -305,9 +333,139 @@ class Core:
     def joint_force_ids(self) -> List[str]:
         return list(self._scene.joint_forces)
 
-    # ------------------------------------------------------------------ step and read-out
+    # ------------------------------------------------------------------ snapshots
 
     @_locked
+    def save_state(self, name: str) -> None:
+        """Keeps the whole dynamic state under ``name`` (replacing a snapshot of that name):
+        poses, velocities, joint and motor parameters, motor goals, persistent forces,
+        simulated time (core.snapshots). New Scene forgets every snapshot."""
+        name = check.name("snapshot name", name, allow_marker=True)
+        self._scene.snapshots[name] = snapshots.take(self._scene)
+
+    @_changes_state
+    def restore_state(self, name: str) -> None:
+        """Puts back the state saved under ``name``: stepping on from it gives bit-identical
+        results to stepping on from when it was saved. Refused when the scene's objects,
+        joints or motors are no longer those it was saved with."""
+        snapshot = self._snapshot(name)
+        snapshots.check_fits(self._scene, snapshot, f"snapshot {name!r}")
+        snapshots.put_back(self._scene, snapshot)
+
+    @_locked
+    def snapshot_names(self) -> List[str]:
+        return list(self._scene.snapshots)
+
+    @_locked
+    def remove_state(self, name: str) -> None:
+        self._snapshot(name)
+        del self._scene.snapshots[name]
+
+    def _snapshot(self, name: str):
+        snapshot = self._scene.snapshots.get(name) if isinstance(name, str) else None
+        if snapshot is None:
+            raise UnknownName(f"no snapshot {name!r} (saved: {sorted(self._scene.snapshots)})")
+        return snapshot
+
+    @_locked
+    def reset(self) -> None:
+        """Back to the state right after the last build or removal (of an object, joint or
+        motor): the poses, velocities, parameters, goals, forces and simulated time the world
+        had then."""
+        scene = self._scene
+        if scene.contents_changed or scene.reset_point is None:
+            return   # nothing has changed the state since the last build
+        snapshots.put_back(scene, scene.reset_point)
+
+    @_changes_state
+    def propagate(self, duration: float, step_size: float,
+                  motor_goals: Optional[Mapping[str, Sequence[float]]] = None,
+                  body_forces: Sequence[Mapping] = (), start: str = "",
+                  keep: bool = False) -> Propagation:
+        """Runs the world for ``duration`` s in steps of ``step_size`` s, as fast as it goes:
+        from the snapshot ``start`` (or from now), under ``motor_goals`` ({motor id: goal
+        speeds}) and ``body_forces`` (each the keyword arguments of add_body_force), recording
+        every pair that collides on the way. Then the world goes back to the state it had
+        before the call, unless ``keep``; the forces act during the propagation only.
+        Everything is checked before anything changes."""
+        scene = self._scene
+        duration = check.number("duration", duration)
+        step_size = check.number("step_size", step_size)
+        if duration <= 0 or step_size <= 0:
+            raise InvalidArgument(f"duration={duration!r} and step_size={step_size!r} must be "
+                                  "positive")
+        steps = max(1, round(duration / step_size))
+        keep = check.flag("keep", keep)
+        start_snapshot = self._snapshot(start) if start else None
+        if start_snapshot is not None:
+            snapshots.check_fits(scene, start_snapshot, f"snapshot {start!r}")
+        before = snapshots.take(scene)
+        started = time.perf_counter()
+        try:
+            if start_snapshot is not None:
+                snapshots.put_back(scene, start_snapshot)
+            if motor_goals:
+                motors.set_velocities(scene, motor_goals)
+            added = [forces.add_body_force(scene, **dict(f)) for f in body_forces]
+            result = self._run(steps, step_size)
+            for force_id in added:
+                forces.remove_body_force(scene, force_id)
+        except Exception:
+            snapshots.put_back(scene, before)   # a refused control changes nothing
+            raise
+        if not keep:
+            snapshots.put_back(scene, before)
+        return result._replace(wall_time=time.perf_counter() - started, kept=keep)
+
+    def _run(self, steps: int, step_size: float) -> Propagation:
+        """Steps with every step's collisions recorded; what a propagation answers."""
+        scene = self._scene
+        readout.carry_collisions(scene, set())
+        carried, scene.carried = scene.carried, {}
+        start_time, start_step = scene.sim_time, scene.c.step_count
+        scene.c.record_every_step = True
+        try:
+            scene.c.step(step_size, steps)
+        finally:
+            scene.c.record_every_step = False
+        scene.sim_time += step_size * steps
+        drain_messages()
+        collisions = tuple(sorted(
+            c._replace(first_time=start_time + (step - start_step) * step_size)
+            for c, step in readout.named_records(scene)))
+        scene.c.clear_records()
+        scene.carried = carried
+        states = tuple(BodyState(i, *(tuple(v.tolist()) for v in readout.body_state(scene, i)))
+                       for i, o in scene.objects.items() if o.body is not None)
+        return Propagation(start_time, step_size, steps, states, collisions, 0.0, False)
+
+    @_locked
+    def check_collision(self, poses: Sequence[Tuple[str, Sequence[float], Sequence[float]]]
+                        ) -> List[Collision]:
+        """The pairs that collide with the objects at ``poses`` ((object id, position m,
+        orientation wxyz) each; the others where they are), without stepping and whatever the
+        collision policy: names, deepest depth and points. The world is left as it was."""
+        scene = self._scene
+        moved = list(dict.fromkeys(obj for obj, _, _ in objects.check_poses(scene, poses)))
+        bodies_moved = [o for o in moved if o.body is not None]
+        statics = [g for o in moved if o.body is None for g in o.geometries]
+        saved_bodies = bodies.read_states([o.body.ptr for o in bodies_moved])
+        saved_statics = [bodies.static_geom_pose(g.owner.ptr) for g in statics]
+        readout.carry_collisions(scene, set())
+        try:
+            objects.set_poses(scene, poses)
+            scene.c.detect(any_policy=True)
+            found = sorted(c for c, _ in readout.named_records(scene))
+        finally:
+            scene.c.clear_records()
+            bodies.write_states([o.body.ptr for o in bodies_moved], saved_bodies)
+            for g, pose in zip(statics, saved_statics):
+                bodies.set_static_geom_pose(g.owner.ptr, pose)
+        return found
+
+    # ------------------------------------------------------------------ step and read-out
+
+    @_changes_state
     def step(self, step_size: float, count: int = 1) -> None:
         """Runs ``count`` steps of ``step_size`` s, all in one C call: collide (contacts or
         recording), body forces, joint forces and motor goals, (Quick)Step, empty contacts."""

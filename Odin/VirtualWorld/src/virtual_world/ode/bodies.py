@@ -59,6 +59,29 @@ def body_mass(body) -> Tuple[float, np.ndarray]:
     return float(m.mass), inertia_matrix(m)
 
 
+BODY_STATE_SIZE = lib.ODIN_BODY_STATE_SIZE
+"""Doubles per body in read_states/write_states (odin_step.h: position, quaternion, rotation
+matrix, linear and angular velocity, enabled)."""
+
+
+def read_states(bodies: Sequence) -> np.ndarray:
+    """(n, BODY_STATE_SIZE) float64: the dynamic state of each body, bit for bit."""
+    out = np.empty((len(bodies), BODY_STATE_SIZE))
+    if len(bodies):
+        array = ffi.new("dBodyID[]", list(bodies))
+        lib.odin_read_body_states(array, len(bodies), ffi.cast("double *", ffi.from_buffer(out)))
+    return out
+
+
+def write_states(bodies: Sequence, states: np.ndarray) -> None:
+    """Puts back states read by read_states, bit for bit (odin_state.c says how)."""
+    if len(bodies):
+        states = np.ascontiguousarray(states, dtype=np.float64)
+        array = ffi.new("dBodyID[]", list(bodies))
+        lib.odin_write_body_states(array, len(bodies),
+                                   ffi.cast("double *", ffi.from_buffer(states)))
+
+
 # ---------------------------------------------------------------------------------- geoms
 
 def set_geom_offset(geom, position: Sequence[float], quaternion: Sequence[float]) -> None:
@@ -75,10 +98,22 @@ def set_geom_pose(geom, position: Sequence[float], quaternion: Sequence[float]) 
     lib.dGeomSetQuaternion(geom, list(quaternion))
 
 
-def set_geom_tag(geom, tag: int) -> None:
+def static_geom_pose(geom) -> np.ndarray:
+    """(15,) a static geom's position (3) and rotation matrix (12), bit for bit."""
+    p, R = lib.dGeomGetPosition(geom), lib.dGeomGetRotation(geom)
+    return np.array([p[0], p[1], p[2]] + [R[k] for k in range(12)])
+
+
+def set_static_geom_pose(geom, pose: np.ndarray) -> None:
+    """Puts back a pose read by static_geom_pose (ODE copies both as given)."""
+    lib.dGeomSetPosition(geom, *pose[:3].tolist())
+    lib.dGeomSetRotation(geom, pose[3:].tolist())
+
+
+def set_geom_tag(geom_owner, tag: int) -> None:
     """Two geoms with the same non-zero tag never collide (an entity without internal
-    collisions; odin_step.c's near-callback reads it)."""
-    lib.odin_set_geom_tag(geom, tag)
+    collisions; odin_step.c's near-callback reads it from the geom's OdinGeomInfo)."""
+    geom_owner.data.tag = tag
 
 
 def exclude_from_collisions(geom) -> None:

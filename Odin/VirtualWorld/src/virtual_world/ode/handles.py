@@ -50,10 +50,10 @@ class Owner:
     keep:    Python objects (cffi arrays, other owners) kept alive until the handle is freed.
     """
 
-    __slots__ = ("kind", "_ptr", "_parents", "_children", "_finalizer", "__weakref__")
+    __slots__ = ("kind", "_ptr", "_parents", "_children", "_finalizer", "data", "__weakref__")
 
     def __init__(self, kind: str, ptr: Any, parents: Iterable["Owner"] = (),
-                 keep: Tuple[Any, ...] = ()):
+                 keep: Tuple[Any, ...] = (), data: Any = None):
         if ptr == ffi.NULL:
             raise MemoryError(f"ODE returned NULL for a new {kind}")
         self.kind = kind
@@ -62,7 +62,8 @@ class Owner:
         self._children: "weakref.WeakSet[Owner]" = weakref.WeakSet()
         for parent in self._parents:
             parent._children.add(self)
-        self._finalizer = weakref.finalize(self, _free, kind, ptr, tuple(keep))
+        self.data = data  # C memory the handle points at (a geom's OdinGeomInfo), kept alive
+        self._finalizer = weakref.finalize(self, _free, kind, ptr, (*keep, data))
         self._finalizer.atexit = False  # ODE may already be closed at interpreter exit
 
     @property
@@ -119,17 +120,21 @@ def new_body(world: Owner) -> Owner:
 
 # ---------------------------------------------------------------------------------- geoms
 
-def new_geom(ptr: Any, space: Owner, body: Optional[Owner] = None,
+def new_geom(ptr: Any, space: Owner, serial: int, body: Optional[Owner] = None,
              keep: Tuple[Any, ...] = ()) -> Owner:
-    """Adopts a freshly created geom in `space`, attached to `body` if any."""
+    """Adopts a freshly created geom in `space`, attached to `body` if any, with its
+    OdinGeomInfo (``serial``: its number in the scene, in creation order; tag 0) as its data;
+    ``owner.data`` is that info."""
     parents = (space,) if body is None else (space, body)
-    owner = Owner("geom", ptr, parents=parents, keep=keep)
+    info = ffi.new("OdinGeomInfo *", {"serial": serial, "tag": 0})
+    owner = Owner("geom", ptr, parents=parents, keep=keep, data=info)
+    lib.dGeomSetData(ptr, info)
     if body is not None:
         lib.dGeomSetBody(ptr, body.ptr)
     return owner
 
 
-def new_primitive(space: Owner, kind: str, dims: Sequence[float],
+def new_primitive(space: Owner, kind: str, dims: Sequence[float], serial: int,
                   body: Optional[Owner] = None) -> Owner:
     """A sphere (radius), cylinder (radius, length along z) or box (sides x, y, z), m."""
     if kind == "sphere":
@@ -140,10 +145,10 @@ def new_primitive(space: Owner, kind: str, dims: Sequence[float],
         ptr = lib.dCreateBox(space.ptr, dims[0], dims[1], dims[2])
     else:
         raise ValueError(f"no ODE primitive {kind!r}")
-    return new_geom(ptr, space, body)
+    return new_geom(ptr, space, serial, body)
 
 
-def new_trimesh(space: Owner, vertices: np.ndarray, triangles: np.ndarray,
+def new_trimesh(space: Owner, vertices: np.ndarray, triangles: np.ndarray, serial: int,
                 body: Optional[Owner] = None) -> Owner:
     """A trimesh geom over ``vertices`` (n, 3) m and ``triangles`` (m, 3) indices.
 
@@ -160,7 +165,7 @@ def new_trimesh(space: Owner, vertices: np.ndarray, triangles: np.ndarray,
     if ptr == ffi.NULL:
         data.close()
         raise MemoryError("ODE returned NULL for a new trimesh")
-    return new_geom(ptr, space, body, keep=(vertices, indices, data))  # data freed after geom
+    return new_geom(ptr, space, serial, body, keep=(vertices, indices, data))  # data after geom
 
 
 # ---------------------------------------------------------------------------------- joints

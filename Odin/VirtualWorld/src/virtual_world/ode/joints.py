@@ -43,6 +43,14 @@ _SET_PARAMETER = {
 }
 _SET_MOTOR_PARAMETER = {MotorKind.ANGULAR: lib.dJointSetAMotorParam,
                         MotorKind.LINEAR: lib.dJointSetLMotorParam}
+_GET_PARAMETER = {
+    T.BALL: lib.dJointGetBallParam, T.HINGE: lib.dJointGetHingeParam,
+    T.SLIDER: lib.dJointGetSliderParam, T.PISTON: lib.dJointGetPistonParam,
+    T.UNIVERSAL: lib.dJointGetUniversalParam, T.HINGE2: lib.dJointGetHinge2Param,
+    T.PR: lib.dJointGetPRParam, T.PU: lib.dJointGetPUParam, T.FIXED: lib.dJointGetFixedParam,
+}
+_GET_MOTOR_PARAMETER = {MotorKind.ANGULAR: lib.dJointGetAMotorParam,
+                        MotorKind.LINEAR: lib.dJointGetLMotorParam}
 
 _STATE = {  # per joint type: (position getters, rate getters), one per reported axis
     T.HINGE: ((lib.dJointGetHingeAngle,), (lib.dJointGetHingeAngleRate,)),
@@ -121,6 +129,14 @@ def set_joint_parameter(joint, kind: JointType, parameter: JointParameter, axis:
 def set_motor_parameter(motor, kind: MotorKind, parameter: JointParameter, axis: int,
                         value: float) -> None:
     _SET_MOTOR_PARAMETER[kind](motor, ode_parameter(parameter, axis), value)
+
+
+def joint_parameter(joint, kind: JointType, parameter: JointParameter, axis: int) -> float:
+    return float(_GET_PARAMETER[kind](joint, ode_parameter(parameter, axis)))
+
+
+def motor_parameter(motor, kind: MotorKind, parameter: JointParameter, axis: int) -> float:
+    return float(_GET_MOTOR_PARAMETER[kind](motor, ode_parameter(parameter, axis)))
 
 
 def joint_state(joint, kind: JointType) -> Tuple[Tuple[float, ...], Tuple[float, ...]]:

@@ -16,6 +16,7 @@ typedef struct dxJointGroup *dJointGroupID;
 typedef struct dxTriMeshData *dTriMeshDataID;
 
 typedef struct dMass { dReal mass; dVector3 c; dMatrix3 I; } dMass;
+typedef struct dContactGeom dContactGeom;   /* opaque here: only C code reads contacts */
 
 static const double dInfinity;
 
@@ -77,6 +78,10 @@ const dReal *dBodyGetTorque(dBodyID);
 void dBodySetMass(dBodyID, const dMass *mass);
 void dBodyGetMass(dBodyID, dMass *mass);
 void dBodySetKinematic(dBodyID);
+const dReal *dBodyGetRotation(dBodyID);
+int dBodyIsEnabled(dBodyID);
+void dBodyEnable(dBodyID);
+void dBodyDisable(dBodyID);
 int dBodyIsKinematic(dBodyID);
 void dBodyGetRelPointPos(dBodyID, dReal px, dReal py, dReal pz, dVector3 result);
 void dBodyVectorToWorld(dBodyID, dReal px, dReal py, dReal pz, dVector3 result);
@@ -93,15 +98,22 @@ void dMassRotate(dMass *, const dMatrix3 R);
 void dMassAdd(dMass *a, const dMass *b);
 int dMassCheck(const dMass *m);
 
+/* ODE's random generator (QuickStep reorders constraints with it) */
+unsigned long dRandGetSeed(void);
+void dRandSetSeed(unsigned long s);
+
 /* rotation */
 void dRfromQ(dMatrix3 R, const dQuaternion q);
 
 /* geoms */
 void dGeomDestroy(dGeomID geom);
+void dGeomSetData(dGeomID geom, void *data);
 void dGeomSetBody(dGeomID geom, dBodyID body);
 dBodyID dGeomGetBody(dGeomID geom);
 void dGeomSetPosition(dGeomID geom, dReal x, dReal y, dReal z);
 void dGeomSetQuaternion(dGeomID geom, const dQuaternion Q);
+void dGeomSetRotation(dGeomID geom, const dMatrix3 R);
+const dReal *dGeomGetRotation(dGeomID geom);
 const dReal *dGeomGetPosition(dGeomID geom);
 void dGeomGetQuaternion(dGeomID geom, dQuaternion result);
 void dGeomSetOffsetPosition(dGeomID geom, dReal x, dReal y, dReal z);
@@ -198,14 +210,23 @@ dReal dJointGetPUAngle1Rate(dJointID);
 dReal dJointGetPUAngle2Rate(dJointID);
 
 void dJointSetHingeParam(dJointID, int parameter, dReal value);
+dReal dJointGetHingeParam(dJointID, int parameter);
 void dJointSetSliderParam(dJointID, int parameter, dReal value);
+dReal dJointGetSliderParam(dJointID, int parameter);
 void dJointSetPistonParam(dJointID, int parameter, dReal value);
+dReal dJointGetPistonParam(dJointID, int parameter);
 void dJointSetUniversalParam(dJointID, int parameter, dReal value);
+dReal dJointGetUniversalParam(dJointID, int parameter);
 void dJointSetHinge2Param(dJointID, int parameter, dReal value);
+dReal dJointGetHinge2Param(dJointID, int parameter);
 void dJointSetPRParam(dJointID, int parameter, dReal value);
+dReal dJointGetPRParam(dJointID, int parameter);
 void dJointSetPUParam(dJointID, int parameter, dReal value);
+dReal dJointGetPUParam(dJointID, int parameter);
 void dJointSetBallParam(dJointID, int parameter, dReal value);
+dReal dJointGetBallParam(dJointID, int parameter);
 void dJointSetFixedParam(dJointID, int parameter, dReal value);
+dReal dJointGetFixedParam(dJointID, int parameter);
 void dJointSetAMotorParam(dJointID, int parameter, dReal value);
 void dJointSetLMotorParam(dJointID, int parameter, dReal value);
 dReal dJointGetAMotorParam(dJointID, int parameter);

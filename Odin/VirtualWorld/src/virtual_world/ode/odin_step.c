@@ -9,11 +9,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* ---------------------------------------------------------------- geom tags */
+/* ---------------------------------------------------------------- geom identity */
 
-void odin_set_geom_tag(dGeomID g, long tag) { dGeomSetData(g, (void *)(intptr_t)tag); }
-
-long odin_get_geom_tag(dGeomID g) { return (long)(intptr_t)dGeomGetData(g); }
+static const OdinGeomInfo *info_of(dGeomID g) { return (const OdinGeomInfo *)dGeomGetData(g); }
 
 /* ---------------------------------------------------------------- collision records */
 
@@ -66,6 +64,7 @@ static void record_pair(OdinWorld *w, dGeomID o1, dGeomID o2, const dContact *c,
         r = &w->records[w->n_records++];
         r->g1 = a;
         r->g2 = b;
+        r->first_step = w->step_count;
         size_t mask = (size_t)(w->table_cap - 1);
         size_t h = pair_hash(a, b) & mask;
         while (w->table[h]) h = (h + 1) & mask;
@@ -85,17 +84,85 @@ void odin_world_clear_records(OdinWorld *w) {
 void odin_world_free_buffers(OdinWorld *w) {
     free(w->records);
     free(w->table);
+    free(w->pairs);
+    free(w->contacts);
     w->records = NULL;
     w->table = NULL;
+    w->pairs = NULL;
+    w->contacts = NULL;
     w->n_records = w->cap_records = w->table_cap = 0;
+    w->n_pairs = w->cap_pairs = w->n_contacts = w->cap_contacts = 0;
+}
+
+/* ---------------------------------------------------------------- a pass's pairs, in order */
+
+/* Keeps a colliding pair's contacts until the pass ends; 0 when memory ran out. */
+static int keep_pair(OdinWorld *w, dGeomID g1, dGeomID g2, long s1, long s2,
+                     const dContact *c, int n) {
+    if (w->n_pairs >= w->cap_pairs) {
+        int cap = w->cap_pairs ? 2 * w->cap_pairs : 256;
+        OdinPair *pairs = realloc(w->pairs, (size_t)cap * sizeof(OdinPair));
+        if (!pairs) return 0;
+        w->pairs = pairs;
+        w->cap_pairs = cap;
+    }
+    if (w->n_contacts + n > w->cap_contacts) {
+        int cap = w->cap_contacts ? 2 * w->cap_contacts : 1024;
+        while (cap < w->n_contacts + n) cap *= 2;
+        dContactGeom *contacts = realloc(w->contacts, (size_t)cap * sizeof(dContactGeom));
+        if (!contacts) return 0;
+        w->contacts = contacts;
+        w->cap_contacts = cap;
+    }
+    OdinPair *p = &w->pairs[w->n_pairs++];
+    p->g1 = g1; p->g2 = g2; p->s1 = s1; p->s2 = s2;
+    p->first = w->n_contacts;
+    p->n = n;
+    for (int i = 0; i < n; ++i) w->contacts[w->n_contacts++] = c[i].geom;
+    return 1;
+}
+
+static int by_serials(const void *a, const void *b) {
+    const OdinPair *p = (const OdinPair *)a, *q = (const OdinPair *)b;
+    if (p->s1 != q->s1) return p->s1 < q->s1 ? -1 : 1;
+    return (p->s2 > q->s2) - (p->s2 < q->s2);
+}
+
+/* Creates the pass's contact joints, pair by pair in serial order: the same scene gives the
+ * same constraints in the same order, whatever order the hash space found the pairs in. */
+static void make_contacts(OdinWorld *w) {
+    if (!w->unordered) qsort(w->pairs, (size_t)w->n_pairs, sizeof(OdinPair), by_serials);
+    int mode = dContactApprox1;
+    if (w->bounce > 0) mode |= dContactBounce;
+    for (int k = 0; k < w->n_pairs; ++k) {
+        const OdinPair *p = &w->pairs[k];
+        dBodyID b1 = dGeomGetBody(p->g1), b2 = dGeomGetBody(p->g2);
+        for (int i = 0; i < p->n; ++i) {
+            dContact contact;
+            memset(&contact, 0, sizeof contact);
+            contact.geom = w->contacts[p->first + i];
+            contact.surface.mode = mode;
+            contact.surface.mu = w->mu;
+            contact.surface.bounce = w->bounce;
+            contact.surface.bounce_vel = w->bounce_vel;
+            dJointID c = dJointCreateContact(w->world, w->contact_group, &contact);
+            dJointAttach(c, b1, b2);
+        }
+        w->last_step_contacts += p->n;
+    }
+    w->n_pairs = w->n_contacts = 0;
 }
 
 /* ---------------------------------------------------------------- near-callback */
 
 static void near_callback(void *data, dGeomID o1, dGeomID o2) {
     OdinWorld *w = (OdinWorld *)data;
-    long t1 = (long)(intptr_t)dGeomGetData(o1);
-    if (t1 && t1 == (long)(intptr_t)dGeomGetData(o2)) return; /* same entity, no internal collisions */
+    const OdinGeomInfo *i1 = info_of(o1), *i2 = info_of(o2);
+    if (i1->tag && i1->tag == i2->tag) return; /* same entity, no internal collisions */
+    if (i1->serial > i2->serial) { /* collide in serial order: the same contacts every time */
+        dGeomID g = o1; o1 = o2; o2 = g;
+        const OdinGeomInfo *i = i1; i1 = i2; i2 = i;
+    }
     dBodyID b1 = dGeomGetBody(o1), b2 = dGeomGetBody(o2);
     if (b1 == b2) return; /* parts of one composite, or two static geoms */
     if (b1 && b2 && dAreConnectedExcluding(b1, b2, dJointTypeContact)) return;
@@ -108,17 +175,7 @@ static void near_callback(void *data, dGeomID o1, dGeomID o2) {
     if (n <= 0) return;
     if (w->recording) record_pair(w, o1, o2, contact, n);
     if (w->contact_less) return;
-    int mode = dContactApprox1;
-    if (w->bounce > 0) mode |= dContactBounce;
-    for (int i = 0; i < n; ++i) {
-        contact[i].surface.mode = mode;
-        contact[i].surface.mu = w->mu;
-        contact[i].surface.bounce = w->bounce;
-        contact[i].surface.bounce_vel = w->bounce_vel;
-        dJointID c = dJointCreateContact(w->world, w->contact_group, &contact[i]);
-        dJointAttach(c, b1, b2);
-    }
-    w->last_step_contacts += n;
+    if (!keep_pair(w, o1, o2, i1->serial, i2->serial, contact, n)) w->buffer_overflow++;
 }
 
 /* ---------------------------------------------------------------- persistent actions */
@@ -203,33 +260,44 @@ int odin_world_step(OdinWorld *w, double h, int count) {
     for (int s = 0; s < count; ++s) {
         w->last_step_contacts = 0;
         /* contact policy: the pairs of the last step; contact-less: every step, kept until read */
-        if (!w->contact_less) {
+        if (w->contact_less || w->record_every_step) {
+            w->recording = 1;
+        } else {
             w->recording = (s == count - 1);
             if (w->recording) odin_world_clear_records(w);
-        } else {
-            w->recording = 1;
         }
-        dSpaceCollide(w->space, w, &near_callback);   /* 1. collisions */
+        dSpaceCollide(w->space, w, &near_callback);   /* 1. collisions, */
+        if (!w->contact_less) make_contacts(w);       /*    contacts in serial order */
         apply_body_forces(w);                         /* 2. forces and torques on bodies */
         apply_joint_forces(w);                        /* 3. joint forces and motor goals */
         apply_motor_goals(w);
-        if (w->solver == 0) dWorldQuickStep(w->world, h); /* 4. step */
-        else dWorldStep(w->world, h);
+        if (w->solver == 0) {                         /* 4. step */
+            dRandSetSeed(w->rand_seed);
+            dWorldQuickStep(w->world, h);
+            w->rand_seed = dRandGetSeed();
+        } else {
+            dWorldStep(w->world, h);
+        }
         /* 5. fixed bodies are kinematic (dBodySetKinematic): nothing to reset */
         dJointGroupEmpty(w->contact_group);           /* 6. contacts last one step */
+        w->step_count++;
     }
     w->recording = 0;
     return 0;
 }
 
-/* Contact-less policy only: collision detection on the present poses, no step. The pairs go
- * into the records like a step's (a paused world whose objects were moved still reports what
- * touches). Under the contact policy it does nothing: contacts exist only inside a step. */
-void odin_world_detect(OdinWorld *w) {
-    if (!w->contact_less) return;
+/* Collision detection on the present poses, no step. The pairs go into the records like a
+ * step's: under the contact-less policy a paused world whose objects were moved still reports
+ * what touches; under the contact policy only a query asks (any_policy), and is answered as the
+ * contact-less policy would, without a contact joint. */
+void odin_world_detect(OdinWorld *w, int any_policy) {
+    if (!w->contact_less && !any_policy) return;
+    int policy = w->contact_less;
+    w->contact_less = 1;
     w->recording = 1;
     dSpaceCollide(w->space, w, &near_callback);
     w->recording = 0;
+    w->contact_less = policy;
 }
 
 /* ---------------------------------------------------------------- read-out */

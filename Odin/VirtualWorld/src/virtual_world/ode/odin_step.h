@@ -40,10 +40,29 @@ typedef struct OdinMotorGoal {
     double velocity[3];
 } OdinMotorGoal;
 
-/* A pair of geoms found colliding; depth is the deepest ODE contact depth seen. */
+/* What every geom's data (dGeomSetData) points at; Python allocates it with the geom and keeps
+ * it alive as long as the geom. serial: the geom's number in its scene, given in creation order,
+ * which orders colliding pairs (and so contact joints) the same way whatever the geoms' memory
+ * addresses are. tag: two geoms with the same non-zero tag never collide (an entity without
+ * internal collisions). */
+typedef struct OdinGeomInfo {
+    long serial;
+    long tag;
+} OdinGeomInfo;
+
+/* A colliding pair found in one collide pass, its contacts at contacts[first .. first + n). */
+typedef struct OdinPair {
+    dGeomID g1, g2;          /* in serial order */
+    long s1, s2;             /* their serials, s1 < s2 */
+    int first, n;
+} OdinPair;
+
+/* A pair of geoms found colliding; depth is the deepest ODE contact depth seen; first_step the
+ * world's step count when it was first seen since the records were cleared. */
 typedef struct OdinCollision {
     dGeomID g1, g2;
     double depth;
+    long first_step;
     int npoints;
     double points[ODIN_RECORD_POINTS][3];
 } OdinCollision;
@@ -59,31 +78,46 @@ typedef struct OdinWorld {
     double bounce_vel;
     int contact_less;        /* 1: record pairs only, never create contacts */
     int solver;              /* 0 QuickStep, 1 dWorldStep */
+    unsigned long rand_seed; /* the world's own state of ODE's random generator, which QuickStep
+                                uses to reorder constraints: set before each QuickStep and read
+                                back after, so no other world (or process history) changes it */
     /* persistent actions (arrays owned by Python) */
     OdinBodyForce *forces; int n_forces;
     OdinJointForce *joint_forces; int n_joint_forces;
     OdinMotorGoal *motors; int n_motors;
     /* outputs */
     int last_step_contacts;
+    int record_every_step;   /* contact policy: record the pairs of every step, not the last */
+    int unordered;           /* benchmarks only: contacts made as the hash space finds them
+                                (not deterministic), to measure what the ordering costs */
+    long step_count;         /* steps taken since the scene began */
     int recording;           /* internal: record pairs during this collide pass */
     int record_overflow;     /* pairs dropped because memory ran out */
     OdinCollision *records; int n_records; int cap_records;
     int *table; int table_cap;   /* open addressing over records (contact-less dedupe) */
+    /* internal: one collide pass's pairs and contacts, sorted before contact joints are made */
+    OdinPair *pairs; int n_pairs; int cap_pairs;
+    dContactGeom *contacts; int n_contacts; int cap_contacts;
+    int buffer_overflow;     /* pairs dropped because memory ran out */
 } OdinWorld;
 
-/* Geom data (dGeomSetData) holds an entity tag as an integer: two geoms with the same non-zero
- * tag never collide (an entity without internal collisions). */
-void odin_set_geom_tag(dGeomID g, long tag);
-long odin_get_geom_tag(dGeomID g);
 
 /* Runs `count` steps of `h` seconds. Returns 0. */
 int odin_world_step(OdinWorld *w, double h, int count);
-/* Contact-less policy: records the pairs touching now, without stepping (no-op otherwise). */
-void odin_world_detect(OdinWorld *w);
+/* Records the pairs touching now, without stepping and without contacts: under the contact-less
+ * policy always; under the contact policy only when any_policy (a collision query). */
+void odin_world_detect(OdinWorld *w, int any_policy);
 /* Forgets the collision records (contact-less: after a read). */
 void odin_world_clear_records(OdinWorld *w);
-/* Frees the record buffer (close/new scene). */
+/* Frees the record and contact buffers (close/new scene). */
 void odin_world_free_buffers(OdinWorld *w);
+
+/* Bodies' dynamic state, ODIN_BODY_STATE_SIZE doubles each: position (3, centre of mass, m),
+ * quaternion (4), rotation matrix (12, ODE's 3x4), linear velocity (3, m/s), angular velocity
+ * (3, rad/s), enabled (1.0 or 0.0). Written back bit for bit (odin_state.c). */
+#define ODIN_BODY_STATE_SIZE 26
+void odin_read_body_states(dBodyID *bodies, int n, double *out);
+void odin_write_body_states(dBodyID *bodies, int n, const double *in);
 
 /* Vectorised read-out of geom world poses: pos (n,3), quat (n,4) wxyz. */
 void odin_read_poses(dGeomID *geoms, int n, double *pos, double *quat);

@@ -19,7 +19,8 @@ from virtual_world.ode.bindings import ffi, lib
 BodyForce = Tuple  # (body ptr, torque, vector_in_body, at_point, point_in_body, vector, point)
 JointForce = Tuple  # (joint ptr, ODE joint type, magnitudes)
 MotorGoal = Tuple  # (motor ptr, MotorKind, velocities)
-Record = Tuple  # (geom address 1, geom address 2, depth m, points ((x, y, z), ...) m)
+Record = Tuple  # (geom address 1, geom address 2, depth m, points ((x, y, z), ...) m,
+#                  the step count when first seen)
 
 
 class CWorld:
@@ -60,6 +61,32 @@ class CWorld:
     @property
     def max_contacts(self) -> int:
         return int(self.struct.max_contacts)
+
+    @property
+    def rand_seed(self) -> int:
+        """The world's state of ODE's random generator (QuickStep's constraint order)."""
+        return int(self.struct.rand_seed)
+
+    @rand_seed.setter
+    def rand_seed(self, value: int) -> None:
+        self.struct.rand_seed = value
+
+    @property
+    def step_count(self) -> int:
+        """Steps taken since the scene began."""
+        return int(self.struct.step_count)
+
+    @step_count.setter
+    def step_count(self, value: int) -> None:
+        self.struct.step_count = value
+
+    @property
+    def record_every_step(self) -> bool:
+        return bool(self.struct.record_every_step)
+
+    @record_every_step.setter
+    def record_every_step(self, value: bool) -> None:
+        self.struct.record_every_step = int(value)
 
     # -- persistent actions ------------------------------------------------------------------
     def set_body_forces(self, forces: Sequence[BodyForce]) -> None:
@@ -107,9 +134,10 @@ class CWorld:
         """``count`` steps in one C call (odin_step.c: collide, actions, step, empty)."""
         lib.odin_world_step(self.struct, step_size, count)
 
-    def detect(self) -> None:
-        """Contact-less policy: records what touches now, without stepping."""
-        lib.odin_world_detect(self.struct)
+    def detect(self, any_policy: bool = False) -> None:
+        """Records what touches now, without stepping or contacts: under the contact-less
+        policy, or under either when ``any_policy`` (a collision query)."""
+        lib.odin_world_detect(self.struct, int(any_policy))
 
     @property
     def last_step_contacts(self) -> int:
@@ -124,7 +152,7 @@ class CWorld:
             points = tuple((r.points[k][0], r.points[k][1], r.points[k][2])
                            for k in range(r.npoints))
             out.append((int(ffi.cast("uintptr_t", r.g1)), int(ffi.cast("uintptr_t", r.g2)),
-                        float(r.depth), points))
+                        float(r.depth), points, int(r.first_step)))
         return out
 
     def clear_records(self) -> None:

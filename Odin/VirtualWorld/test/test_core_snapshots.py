@@ -1,0 +1,304 @@
+"""Determinism, snapshots, reset, propagation and collision queries: the physics a planner
+builds on. "The same" means bit-identical here: poses and velocities are compared as raw
+float64 bytes, never with a tolerance."""
+import hashlib
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from virtual_world.core import (FORCE, HINGE, LO_STOP, MAX_FORCE, Core, ObjectSpec,
+                                WorldParameters)
+from odin_common import OdinError
+from virtual_world.errors import InvalidArgument, UnknownName
+
+H = 0.001
+
+
+def pile(core, n=60):
+    """Spheres dropped into a box of four walls: a chaotic scene, where one bit's difference
+    in one contact spreads to every body within a second."""
+    core.build_object(ObjectSpec("ground", [4, 4, 1], position=(0, 0, -0.5), geometry_only=True))
+    for name, pos, size in (("w1", (0.45, 0, 1), (0.2, 1.1, 2)),
+                            ("w2", (-0.45, 0, 1), (0.2, 1.1, 2)),
+                            ("w3", (0, 0.45, 1), (1.1, 0.2, 2)),
+                            ("w4", (0, -0.45, 1), (1.1, 0.2, 2))):
+        core.build_object(ObjectSpec(name, list(size), position=pos, geometry_only=True))
+    for i in range(n):
+        layer = i // 9
+        core.build_object(ObjectSpec(f"s{i}", [0.1], position=(
+            (i % 3) * 0.21 - 0.21 + 0.01 * (layer % 2), ((i // 3) % 3) * 0.21 - 0.21,
+            0.12 + layer * 0.21)))
+
+
+def state_bytes(core) -> bytes:
+    """Every geometry's pose and every body's velocities, as raw bytes."""
+    names, positions, quaternions = core.poses()
+    velocities = [np.concatenate(core.body_state(i)[2:]) for i in core.object_ids()
+                  if not core.object_spec(i).geometry_only]
+    return positions.tobytes() + quaternions.tobytes() + np.array(velocities).tobytes()
+
+
+def digest(core) -> str:
+    return hashlib.sha256(state_bytes(core)).hexdigest()
+
+
+@pytest.fixture
+def core():
+    c = Core()
+    yield c
+    c.close()
+
+
+# ------------------------------------------------------------------ determinism
+
+def test_the_same_pile_is_bit_identical_after_new_scene_cycles(core):
+    pile(core)
+    core.step(H, 1500)
+    first = state_bytes(core)
+    for k in range(3):   # other scenes in between: other memory, other hash-space order
+        core.new_scene()
+        core.build_object(ObjectSpec(f"junk{k}", [0.3], position=(5, 5, 5)))
+        pile(core, n=20 + k)
+        core.step(H, 7)
+    core.new_scene()
+    pile(core)
+    core.step(H, 1500)
+    assert state_bytes(core) == first
+
+
+def test_the_same_pile_is_bit_identical_in_a_fresh_process(core):
+    script = (f"import sys; sys.path.insert(0, {str(__file__.rsplit('/', 1)[0])!r})\n"
+              "import test_core_snapshots as t\nfrom virtual_world.core import Core\n"
+              "c = Core(); t.pile(c); c.step(t.H, 800); print(t.digest(c))")
+    fresh = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                           check=True).stdout.strip()
+    core.build_object(ObjectSpec("elsewhere", [0.2], position=(9, 9, 9)))   # a history
+    core.new_scene()
+    pile(core)
+    core.step(H, 800)
+    assert digest(core) == fresh
+
+
+def test_another_world_stepping_in_between_changes_nothing():
+    alone, shared, other = Core(), Core(), Core()
+    for c in (alone, shared, other):
+        pile(c)
+    for _ in range(10):
+        alone.step(H, 60)
+        shared.step(H, 60)
+        other.step(H, 13)   # QuickStep's random constraint order is each world's own
+    assert state_bytes(alone) == state_bytes(shared)
+    for c in (alone, shared, other):
+        c.close()
+
+
+# ------------------------------------------------------------------ snapshots
+
+def arm(core):
+    """A three-link arm on hinges with motors, stops, a joint force and a body force, over a
+    ground it can hit."""
+    core.set_world_parameters(solver=1)
+    core.build_object(ObjectSpec("ground", [4, 4, 1], position=(0, 0, -0.5), geometry_only=True))
+    previous = ""
+    for k in range(3):
+        core.build_object(ObjectSpec(f"l{k}", [0.3, 0.05, 0.05], mass=1.0,
+                                     position=(0.15 + 0.3 * k, 0, 0.5)))
+        joint = core.create_joint(HINGE, previous, f"l{k}", anchor=(0.3 * k, 0, 0.5),
+                                  axis1=(0, 1, 0))
+        core.create_motor(joint=joint, max_forces=[8.0])
+        previous = f"l{k}"
+    core.set_joint_parameters("1:&l0", [(LO_STOP, 1, -0.5)])
+    core.add_joint_force("1:l0&l1", [0.3])
+    core.add_body_force("l2", FORCE, (0, 0, -2.0))
+    core.set_motor_velocities({"motor:1:&l0": [0.4], "motor:1:l0&l1": [-0.2]})
+
+
+@pytest.mark.parametrize("build", [pile, arm], ids=["pile", "arm"])
+def test_restoring_a_snapshot_replays_bit_for_bit(core, build):
+    build(core)
+    core.step(H, 300)
+    core.save_state("s")
+    core.step(H, 700)
+    continued = state_bytes(core)
+    time_then = core.sim_time
+    core.restore_state("s")
+    assert core.sim_time == pytest.approx(0.3)
+    core.step(H, 700)
+    assert state_bytes(core) == continued and core.sim_time == time_then
+
+
+def test_a_snapshot_brings_back_goals_parameters_and_forces(core):
+    arm(core)
+    core.step(H, 200)
+    core.save_state("before changes")
+    core.step(H, 500)
+    expected = state_bytes(core)
+    core.restore_state("before changes")
+    # change every kind of state a snapshot holds ...
+    core.set_motor_velocities({"motor:1:&l0": [-1.0], "motor:1:l1&l2": [2.0]})
+    core.set_joint_parameters("1:&l0", [(LO_STOP, 1, -0.1)])
+    core.set_joint_parameters("motor:1:l0&l1", [(MAX_FORCE, 1, 1.0)])
+    core.add_body_force("l0", FORCE, (5, 0, 0))
+    core.remove_joint_force("jointforce:1:l0&l1:0")
+    core.set_velocity("l1", linear=(0, 0, 3))
+    core.step(H, 50)
+    assert state_bytes(core) != expected
+    # ... and put it back
+    core.restore_state("before changes")
+    assert core.body_force_ids() == ["force:l2:0"]
+    assert core.joint_force_ids() == ["jointforce:1:l0&l1:0"]
+    assert core.motor_goals()["motor:1:&l0"] == [0.4]
+    core.step(H, 500)
+    assert state_bytes(core) == expected
+
+
+def test_snapshots_are_listed_replaced_removed_and_forgotten_by_new_scene(core):
+    pile(core, n=5)
+    core.save_state("a")
+    core.save_state("b")
+    core.save_state("a")
+    assert core.snapshot_names() == ["a", "b"]
+    core.remove_state("b")
+    assert core.snapshot_names() == ["a"]
+    core.new_scene()
+    assert core.snapshot_names() == []
+
+
+def test_an_unknown_snapshot_or_a_changed_scene_is_refused_and_changes_nothing(core):
+    pile(core, n=5)
+    core.save_state("s")
+    core.step(H, 100)
+    before = state_bytes(core)
+    with pytest.raises(UnknownName, match="no snapshot 'nope'"):
+        core.restore_state("nope")
+    assert state_bytes(core) == before
+    core.build_object(ObjectSpec("newcomer", [0.1], position=(2, 2, 1)))
+    grown = state_bytes(core)
+    with pytest.raises(InvalidArgument, match="newcomer"):
+        core.restore_state("s")
+    assert state_bytes(core) == grown
+    core.remove_object("newcomer")
+    core.remove_object("s0")
+    shrunk = state_bytes(core)
+    with pytest.raises(InvalidArgument, match="s0"):
+        core.restore_state("s")
+    assert state_bytes(core) == shrunk and core.sim_time == pytest.approx(0.1)
+
+
+# ------------------------------------------------------------------ reset
+
+def test_reset_goes_back_to_the_state_right_after_the_last_build(core):
+    pile(core, n=10)
+    built = state_bytes(core)
+    core.set_poses([("s0", (0, 0, 2.0), (1, 0, 0, 0))])
+    core.step(H, 400)
+    core.reset()
+    assert state_bytes(core) == built and core.sim_time == 0.0
+    core.step(H, 400)
+    once = state_bytes(core)
+    core.reset()
+    core.step(H, 400)
+    assert state_bytes(core) == once
+    core.build_object(ObjectSpec("late", [0.1], position=(1, 1, 1)))   # a new last build
+    core.step(H, 100)
+    after_late = core.body_state("s1")[0].tobytes()
+    core.step(H, 100)
+    core.reset()
+    assert core.body_state("s1")[0].tobytes() != after_late   # the state when "late" came
+    assert core.sim_time == pytest.approx(0.4)
+
+
+# ------------------------------------------------------------------ propagation
+
+def test_propagation_leaves_the_world_as_it_was_and_matches_stepping(core):
+    arm(core)
+    core.step(H, 100)
+    core.save_state("here")
+    before = state_bytes(core)
+    result = core.propagate(0.25, H)
+    assert state_bytes(core) == before and core.sim_time == pytest.approx(0.1)
+    assert result.steps == 250 and result.start_time == pytest.approx(0.1)
+    assert not result.kept and result.wall_time > 0
+    core.step(H, 250)
+    stepped = {s: core.body_state(s) for s in ("l0", "l1", "l2")}
+    for state in result.states:
+        position, orientation, linear, angular = stepped[state.id]
+        assert np.array(state.position).tobytes() == position.tobytes()
+        assert np.array(state.linear).tobytes() == linear.tobytes()
+    assert {s.id for s in result.states} == {"l0", "l1", "l2"}
+
+
+def test_propagation_from_a_snapshot_under_controls_then_kept(core):
+    arm(core)
+    core.save_state("start")
+    core.step(H, 300)
+    goals = {"motor:1:&l0": [-0.8]}
+    push = [dict(object_id="l2", kind=FORCE, vector=(0.0, 0.0, 20.0))]
+    kept = core.propagate(0.2, H, motor_goals=goals, body_forces=push, start="start", keep=True)
+    assert kept.kept and core.sim_time == pytest.approx(0.2)
+    assert core.body_force_ids() == ["force:l2:0"]          # the push acted during it only
+    assert core.motor_goals()["motor:1:&l0"] == [-0.8]      # goals are state: kept
+    after = state_bytes(core)
+    # the same by hand
+    core.restore_state("start")
+    core.set_motor_velocities(goals)
+    pushed = core.add_body_force("l2", FORCE, (0.0, 0.0, 20.0))
+    core.step(H, 200)
+    core.remove_body_force(pushed)
+    assert state_bytes(core) == after
+
+
+def test_propagation_reports_each_collision_once_with_its_first_time(core):
+    core.build_object(ObjectSpec("ground", [4, 4, 1], position=(0, 0, -0.5), geometry_only=True))
+    core.build_object(ObjectSpec("ball", [0.1], position=(0, 0, 0.6)))
+    result = core.propagate(0.6, H)
+    (hit,) = result.collisions
+    assert (hit.first, hit.second) == ("ball", "ground")
+    fall = math.sqrt(2 * 0.5 / 9.81)   # the ball's bottom falls 0.5 m
+    assert abs(hit.first_time - fall) < 0.003 and hit.depth > 0
+    assert core.read_collisions() == [] and core.sim_time == 0.0
+
+
+def test_a_bad_propagation_is_refused_and_changes_nothing(core):
+    arm(core)
+    core.step(H, 50)
+    before = state_bytes(core)
+    for kwargs in (dict(duration=-1.0), dict(step_size=0.0), dict(start="unknown"),
+                   dict(motor_goals={"motor:nope": [1.0]}),
+                   dict(motor_goals={"motor:1:&l0": [1.0, 2.0]}),
+                   dict(body_forces=[dict(object_id="ground", kind=FORCE, vector=(1, 0, 0))]),
+                   dict(body_forces=[dict(object_id="l1", kind=FORCE, vector=(math.nan, 0, 0))])):
+        with pytest.raises(OdinError):
+            core.propagate(**{"duration": 0.1, "step_size": H, **kwargs})
+        assert state_bytes(core) == before, kwargs
+        assert core.body_force_ids() == ["force:l2:0"] and core.motor_goals()["motor:1:&l0"] == [0.4]
+
+
+# ------------------------------------------------------------------ collision queries
+
+@pytest.mark.parametrize("contact_less", [False, True])
+def test_a_collision_query_answers_at_once_and_leaves_the_world_as_it_was(contact_less):
+    core = Core(WorldParameters(contact_less=contact_less, gravity=(0, 0, 0)))
+    core.build_object(ObjectSpec("table", [1, 1, 0.1], position=(0, 0, 0.5), geometry_only=True))
+    core.build_object(ObjectSpec("can", [0.05, 0.2], position=(2, 0, 0.7)))
+    core.build_object(ObjectSpec("a", [0.1], position=(5, 0, 0)))
+    core.build_object(ObjectSpec("b", [0.1], position=(5.15, 0, 0)))   # touching already
+    core.step(H)
+    before = state_bytes(core)
+    hits = core.check_collision([("can", (0, 0, 0.62), (1, 0, 0, 0))])
+    assert [(c.first, c.second) for c in hits] == [("a", "b"), ("can", "table")]
+    depth = {(c.first, c.second): c.depth for c in hits}
+    assert depth[("can", "table")] == pytest.approx(0.03, abs=1e-6)   # 0.62 - 0.1 - 0.55
+    assert core.check_collision([("can", (0, 0, 1.0), (1, 0, 0, 0))]) == \
+        [c for c in hits if c.first == "a"]
+    assert core.check_collision([("table", (2, 0, 0.6), (1, 0, 0, 0))])[1][:2] == \
+        ("can", "table")   # a static object moved for the question only
+    assert state_bytes(core) == before
+    reported = [(c.first, c.second) for c in core.read_collisions()]
+    assert reported == [("a", "b")]   # the query added nothing to what the world reports
+    with pytest.raises(UnknownName):
+        core.check_collision([("ghost", (0, 0, 0), (1, 0, 0, 0))])
+    core.close()
