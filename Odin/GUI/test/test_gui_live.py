@@ -98,7 +98,7 @@ def test_motor_goal_joint_value_and_forward_kinematics_share_one_sign(world):
     client = WorldClient()
     client.call("set_world", set_solver=True, solver=1, quickstep_iterations=20)
     speeds = [0.5 if i == 0 else 0.0 for i in range(len(handle.motor_ids))]
-    client.set_velocity(handle.motor_ids, speeds)
+    client.set_velocities(handle.motor_ids, speeds)
     client.call("step_once", cycles=25)                          # 1 s at 0.5 rad/s
     joints = rospy.wait_for_message("/virtual_world/joint_data", JointsData, timeout=10)
     values = {j.id: j.positions[0] for j in joints.joints if j.positions}
