@@ -369,6 +369,20 @@ def test_problem_info_does_not_import_rospy():
     assert result.returncode == 0, result.stderr
 
 
+def test_the_gui_core_imports_neither_rospy_nor_qt():
+    code = ("import importlib, pkgutil, sys\n"
+            "import gui.core\n"
+            "names = [m.name for m in pkgutil.walk_packages(gui.core.__path__, 'gui.core.')]\n"
+            "for name in names:\n"
+            "    importlib.import_module(name)\n"
+            "print(len(names))\n"
+            "found = [m for m in ('rospy', 'PyQt5') if m in sys.modules]\n"
+            "assert not found, f'gui.core imported {found}'")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    assert int(result.stdout) >= 12     # build, kinematics, model, paths, shapes, kautham.*
+
+
 def test_problem_info_error_is_one_line_with_file_and_line(tmp_path):
     bad = tmp_path / "bad.xml"
     bad.write_text('<?xml version="1.0"?>\n<Problem>\n  <Robot robot="x.rob">\n</Problem>\n')
