@@ -14,9 +14,8 @@ import sys
 import time
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT / "tests"))
 
-from ros_harness import RosMaster  # noqa: E402
+from odin_common.ros_master import RosMaster  # noqa: E402
 
 from odin_common.specs import ObjectSpec  # noqa: E402
 

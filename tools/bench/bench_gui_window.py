@@ -37,8 +37,7 @@ def _kautham_dir() -> pathlib.Path:
 
 
 def run(out_dir: pathlib.Path) -> dict:
-    sys.path.insert(0, str(ROOT / "tests"))
-    from ros_harness import RosMaster
+    from odin_common.ros_master import RosMaster
     out_dir.mkdir(parents=True, exist_ok=True)
     result_path = out_dir / "gui_window_bench.json"
     cold_path = out_dir / "gui_window_cold_open.json"

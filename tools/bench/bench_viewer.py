@@ -123,8 +123,7 @@ _PUBLISHER = textwrap.dedent("""
 
 
 def fps_held(seconds: float = 10.0) -> float:
-    sys.path.insert(0, str(ROOT / "tests"))
-    from ros_harness import RosMaster
+    from odin_common.ros_master import RosMaster
 
     with tempfile.TemporaryDirectory(prefix="odin_bench_viewer_") as home:
         with RosMaster(ros_home=home) as master:

@@ -38,9 +38,8 @@ from typing import Iterable, Optional, Sequence
 import numpy as np
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent.parent
-sys.path.insert(0, str(ROOT / "tests"))
 
-from ros_harness import RosMaster  # noqa: E402
+from odin_common.ros_master import RosMaster  # noqa: E402
 
 OUT_ROOT = ROOT / "out" / "experiments"
 KAUTHAM_DIR = pathlib.Path(os.environ.get("ODIN_KAUTHAM_DIR", ROOT.parent / "shared" / "kautham"))

@@ -19,7 +19,6 @@ importing this module does not import rospy (only the generated message classes)
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
 from typing import Callable, NamedTuple, Optional, Sequence, Tuple
 
 import numpy as np
@@ -31,19 +30,9 @@ from odin_common.interface import WORLD_NAMESPACE, WORLD_SERVICES, ForceKind, Se
 from odin_common.messages import (composite_message, object_message, parameter_messages,
                                   situation_messages)
 from odin_common.specs import CompositeSpec, EntitySpec, JointSpec, MotorSpec, ObjectSpec
+from odin_common.step_values import StepValues
 from odin_common.world_parameters import (PARAMETER_INFO, PARAMETERS, ParameterInfo,
                                           WorldParameters, set_world_flags)
-
-
-@dataclass(frozen=True)
-class StepValues:
-    """The world's step values in force (Set Step's answer): ``step`` s of simulated time per
-    ODE step, ``steps_per_cycle`` ODE steps per Portal cycle, ``cycle_time`` s of simulated time
-    per cycle, ``rate`` Hz, cycles (publications) per wall-clock second."""
-    step: float
-    steps_per_cycle: int
-    cycle_time: float
-    rate: float
 
 
 class BuiltEntity(NamedTuple):
@@ -78,7 +67,7 @@ def _world_parameters(response) -> WorldParameters:
 
 def _step_values(response) -> StepValues:
     return StepValues(step=float(response.step), steps_per_cycle=int(response.steps_per_cycle),
-                      cycle_time=float(response.cycle_time), rate=float(response.rate))
+                      rate=float(response.rate))
 
 
 class WorldClient:

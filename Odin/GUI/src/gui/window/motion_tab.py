@@ -19,6 +19,7 @@ from PyQt5.QtWidgets import (QButtonGroup, QCheckBox, QComboBox, QFileDialog, QG
 from gui.window.fields import VectorRow, int_spin, spin
 from gui.window.scene import JOINT_TYPE_NAMES
 from odin_common.interface import JOINT_FORCE_MAGNITUDES, ForceKind
+from odin_common.step_values import StepValues
 
 ACTIONS = ["force", "torque", "angular velocity", "linear velocity"]
 #: the actions that add a persistent force (by their index in ACTIONS)
@@ -310,7 +311,7 @@ class MotionTab(QWidget):
             return
         if kind == "position" and self.double.value():
             rows = refine(rows, int(self.double.value()))
-        rate = self.window.publication_rate or 25.0
+        rate = self.window.publication_rate or StepValues().rate
         total = len(rows)
         name = pathlib.Path(path).name
 

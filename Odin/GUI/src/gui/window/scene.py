@@ -13,7 +13,7 @@ from typing import Optional
 
 from PyQt5.QtCore import QObject, pyqtSignal
 
-from odin_common.interface import JointType
+from odin_common.interface import JointType, motor_joint
 
 JOINT_TYPE_NAMES = {
     JointType.BALL: "Ball", JointType.HINGE: "Hinge", JointType.SLIDER: "Slider",
@@ -70,8 +70,8 @@ class SceneModel(QObject):
         joints = {j.id: int(j.type) for j in msg.joints}
         if joints != self.joints:
             self.joints = joints
-            motors = {m: n for m, n in self.motors.items() if m[len("motor:"):] in joints
-                      or not m.startswith("motor:")}
+            motors = {m: n for m, n in self.motors.items() if motor_joint(m) in joints
+                      or not motor_joint(m)}
             stale = [f for f in self.joint_forces if f.split(":", 1)[1].rsplit(":", 1)[0]
                      not in joints]
             self.changed.emit("joints")

@@ -16,6 +16,7 @@ from PyQt5.QtWidgets import (QButtonGroup, QCheckBox, QComboBox, QGridLayout, QH
 
 from gui.window.fields import VectorRow, checked_spin, int_spin, spin
 from odin_common.interface import Solver
+from odin_common.step_values import MAX_RATE, MAX_STEP, MAX_STEPS_PER_CYCLE, StepValues
 from odin_common.world_parameters import PARAMETER_INFO, default
 
 #: (parameter, label, decimals, step, bound of the field where the parameter has none) of the
@@ -74,11 +75,15 @@ class SettingsTab(QWidget):
         # -- step page
         page = QWidget()
         grid = QGridLayout(page)
+        first = StepValues()   # shown until the world answers with the values in force
         self.step_fields = {
-            "step": checked_spin("Step", 0.001, 1e-6, 1.0, 6, 0.0005, "s"),
-            "steps_per_cycle": (QCheckBox("Steps per cycle"), int_spin(40, 1, 100000)),
-            "cycle_time": checked_spin("Cycle time", 0.04, 1e-6, 10.0, 5, 0.01, "s"),
-            "rate": checked_spin("Rate (publications / s)", 25.0, 0.01, 1000.0, 2, 1.0, "Hz"),
+            "step": checked_spin("Step", first.step, 1e-6, MAX_STEP, 6, 0.0005, "s"),
+            "steps_per_cycle": (QCheckBox("Steps per cycle"),
+                                int_spin(first.steps_per_cycle, 1, MAX_STEPS_PER_CYCLE)),
+            "cycle_time": checked_spin("Cycle time", first.cycle_time, 1e-6, 10.0, 5, 0.01,
+                                       "s"),
+            "rate": checked_spin("Rate (publications / s)", first.rate, 0.01, MAX_RATE, 2, 1.0,
+                                 "Hz"),
         }
         grid.addWidget(QLabel("<b>send</b>"), 0, 0)
         grid.addWidget(QLabel("<b>in force</b>"), 0, 2)
@@ -206,7 +211,7 @@ class SettingsTab(QWidget):
                          self.show_step)
 
     def show_step(self, values) -> None:
-        """Shows the step values in force (gui.ros.client.StepValues)."""
+        """Shows the step values in force (odin_common.step_values.StepValues)."""
         for key in self.step_fields:
             value = getattr(values, key)
             self.in_force[key] = value

@@ -7,7 +7,7 @@ import sys
 import numpy as np
 from PIL import Image
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 
 def _processes_pointing_at(uri: str) -> list:
