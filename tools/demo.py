@@ -1,23 +1,29 @@
-"""`make demo`: the three-node chain end to end, headless.
+"""`make demo`: the three-node chain end to end, headless, then the thesis's grasp.
 
-Starts a roscore on a free loopback port and the nodes with rosrun (VirtualWorld, Viewer), builds
-a scene through the GUI's world client (gui.ros.client.WorldClient: a sphere above a box on the
-ground), runs it, and writes Viewer snapshots to out/demo/. Every process started here is
-stopped on the way out, also on Ctrl-C, SIGTERM or failure. Exit status 0 only if the sphere was seen to fall.
+First part, on a scene Odin builds itself: starts a roscore on a free loopback port and the
+nodes with rosrun (VirtualWorld, Viewer), builds a scene through the GUI's world client
+(gui.ros.client.WorldClient: a sphere above a box on the ground), runs it, and writes Viewer
+snapshots to out/demo/. Every process started here is stopped on the way out, also on Ctrl-C,
+SIGTERM or failure. Exit status 0 only if the sphere was seen to fall.
+
+Second part, on the Kautham corpus: the grasping experiment (tools/experiments, frames in
+out/experiments/grasp/), in a process of its own. Without the corpus (a bare clone) it prints
+one line saying where the corpus comes from instead.
 """
 from __future__ import annotations
 
 import pathlib
 import shutil
 import signal
+import subprocess
 import sys
 import time
 
+from gui.core.kautham.corpus import corpus_dir, missing_message
+from odin_common.ros_master import RosMaster
+from odin_common.specs import ObjectSpec
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
-
-from odin_common.ros_master import RosMaster  # noqa: E402
-
-from odin_common.specs import ObjectSpec  # noqa: E402
 
 OUT = ROOT / "out" / "demo"
 SNAPSHOTS = 16
@@ -93,9 +99,18 @@ def main() -> int:
     return 0
 
 
+def kautham_part() -> int:
+    """The grasp experiment on the Kautham corpus, or one line saying where it comes from."""
+    if corpus_dir() is None:
+        print(f"demo: the Kautham part is skipped: {missing_message()}")
+        return 0
+    return subprocess.run([sys.executable, str(ROOT / "tools" / "experiments" / "run.py"),
+                           "grasp"]).returncode
+
+
 if __name__ == "__main__":
     try:
-        sys.exit(main())
+        sys.exit(main() or kautham_part())
     except KeyboardInterrupt:
         print("demo: interrupted; every process it started was stopped", file=sys.stderr)
         sys.exit(130)

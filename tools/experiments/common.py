@@ -39,10 +39,11 @@ import numpy as np
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent.parent
 
+from gui.core.kautham.corpus import ENVIRONMENT  # noqa: E402
 from odin_common.ros_master import RosMaster  # noqa: E402
 
 OUT_ROOT = ROOT / "out" / "experiments"
-KAUTHAM_DIR = pathlib.Path(os.environ.get("ODIN_KAUTHAM_DIR", ROOT.parent / "shared" / "kautham"))
+KAUTHAM_DIR = pathlib.Path(os.environ.get(ENVIRONMENT, ROOT.parent / "shared" / "kautham"))
 EXAMPLES = KAUTHAM_DIR / "legacy_2012" / "examples"
 PATHS_DIR = ROOT / "Odin" / "GUI" / "paths"
 
