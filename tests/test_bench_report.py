@@ -83,6 +83,16 @@ def test_a_missing_figure_without_goal_does_not_fail(tmp_path):
     assert "| `latency_p99_ms` | - | **missing** | no goal |" in readme
 
 
+def test_absolute_figures_carry_the_host_probed_around_their_module(tmp_path):
+    run = {"figure_modules": {"frame_ms": "viewer", "band": "experiments"},
+           "host_by_module": {"viewer": 1234, "experiments": 987}}
+    status, printed, readme = _report(_results(), tmp_path, run)
+    assert status == 0, printed
+    assert "| 17.8 ms (host 1,234 steps/s) |" in readme
+    assert "| 1.5 x real time (host 987 steps/s) |" in readme
+    assert "| 5.54 ms (host 2,978 steps/s) |" in readme     # no probe: the run's figure
+
+
 def test_boundaries_nan_and_undescribed_figures():
     goals = {"a": {"min": 1.0, "unit": "ratio", "what": "a"}}
     assert report.check({"a": 1.0}, goals) == []                # goals are inclusive
