@@ -167,6 +167,10 @@ def caption(run: Mapping) -> str:
         parts.append(f"Last run: {run['finished']}")
     if run.get("seconds") is not None:
         parts.append(f"`make bench` took {run['seconds'] / 60:.1f} min")
+    probes = [p["steps_per_s"] for p in run.get("host_probes") or [] if p.get("steps_per_s")]
+    if probes:
+        parts.append(f"host probes {_number(min(probes))}-{_number(max(probes))} native "
+                     f"steps/s over the run")
     if run.get("failed_modules"):
         parts.append("failed modules: " + ", ".join(run["failed_modules"]))
     return ("; ".join(parts) + ".\n\n") if parts else ""
