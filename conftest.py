@@ -1,6 +1,7 @@
-"""pytest configuration for the whole repository: the ROS test harness lives in tests/, and
-tests marked ``forked`` run in a child process of their own (rospy.init_node works once per
-process). The child sends its reports back through pytest's own report serialisation."""
+"""pytest configuration for the whole repository: a private roscore per test that asks for one
+(``ros_master``, odin_common.ros_master), the Kautham corpus (``kautham_dir``), and tests marked
+``forked`` run in a child process of their own (rospy.init_node works once per process). The
+child sends its reports back through pytest's own report serialisation."""
 import json
 import os
 import pathlib
@@ -10,9 +11,8 @@ import tempfile
 import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parent
-sys.path.insert(0, str(ROOT / "tests"))
 
-from ros_harness import RosMaster  # noqa: E402
+from odin_common.ros_master import RosMaster  # noqa: E402
 
 
 @pytest.fixture

@@ -1,22 +1,29 @@
-"""`make demo`: the three-node chain end to end, headless.
+"""`make demo`: the three-node chain end to end, headless, then the thesis's grasp.
 
-Starts a roscore on a free loopback port and the nodes with rosrun (VirtualWorld, Viewer), builds
-a scene through the world's services as the GUI would (a sphere above a box on the ground), runs
-it, and writes Viewer snapshots to out/demo/. Every process started here is stopped on the way
-out, also on Ctrl-C, SIGTERM or failure. Exit status 0 only if the sphere was seen to fall.
+First part, on a scene Odin builds itself: starts a roscore on a free loopback port and the
+nodes with rosrun (VirtualWorld, Viewer), builds a scene through the GUI's world client
+(gui.ros.client.WorldClient: a sphere above a box on the ground), runs it, and writes Viewer
+snapshots to out/demo/. Every process started here is stopped on the way out, also on Ctrl-C,
+SIGTERM or failure. Exit status 0 only if the sphere was seen to fall.
+
+Second part, on the Kautham corpus: the grasping experiment (tools/experiments, frames in
+out/experiments/grasp/), in a process of its own. Without the corpus (a bare clone) it prints
+one line saying where the corpus comes from instead.
 """
 from __future__ import annotations
 
 import pathlib
 import shutil
 import signal
+import subprocess
 import sys
 import time
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT / "tests"))
+from gui.core.kautham.corpus import corpus_dir, missing_message
+from odin_common.ros_master import RosMaster
+from odin_common.specs import ObjectSpec
 
-from ros_harness import RosMaster  # noqa: E402
+ROOT = pathlib.Path(__file__).resolve().parent.parent
 
 OUT = ROOT / "out" / "demo"
 SNAPSHOTS = 16
@@ -27,21 +34,18 @@ def _raise_keyboard_interrupt(signum, frame):
     raise KeyboardInterrupt(f"signal {signum}")
 
 
-def build_scene(srv, msg, call) -> None:
+def build_scene(client) -> None:
     """The walking skeleton's scene: ground, a box on it and a bouncy sphere 2 m above it."""
-    call("/virtual_world/new_scene", srv.NewScene)
-    call("/virtual_world/set_world", srv.SetWorld,
-         srv.SetWorldRequest(set_gravity=True, gravity=[0.0, 0.0, -9.81], set_bounce=True,
-                             bounce=0.6, bounce_velocity=0.1))
-    ground = msg.Object(name="ground", parameters=[4.0, 4.0, 0.1], position=[0, 0, -0.05],
-                        orientation=[1, 0, 0, 0], color=[0.55, 0.6, 0.55, 1],
-                        geometry_only=True)
-    box = msg.Object(name="box", parameters=[0.6, 0.6, 0.4], mass=5.0, position=[0, 0, 0.2],
-                     orientation=[1, 0, 0, 0], color=[0.2, 0.4, 0.9, 1])
-    sphere = msg.Object(name="sphere", parameters=[0.15], mass=1.0, position=[0.05, 0, 2.6],
-                        orientation=[1, 0, 0, 0], color=[0.9, 0.25, 0.2, 1])
+    client.new_scene()
+    client.set_world(gravity=(0.0, 0.0, -9.81), bounce=0.6, bounce_velocity=0.1)
+    ground = ObjectSpec(name="ground", parameters=(4.0, 4.0, 0.1), position=(0, 0, -0.05),
+                        color=(0.55, 0.6, 0.55, 1), geometry_only=True)
+    box = ObjectSpec(name="box", parameters=(0.6, 0.6, 0.4), mass=5.0, position=(0, 0, 0.2),
+                     color=(0.2, 0.4, 0.9, 1))
+    sphere = ObjectSpec(name="sphere", parameters=(0.15,), mass=1.0, position=(0.05, 0, 2.6),
+                        color=(0.9, 0.25, 0.2, 1))
     for body in (ground, box, sphere):
-        call("/virtual_world/build_object", srv.BuildObject, srv.BuildObjectRequest(body))
+        client.build_object(body)
 
 
 def main() -> int:
@@ -68,18 +72,21 @@ def main() -> int:
                                "_eye:=[3.2, -3.2, 1.8]", "_target:=[0, 0, 1.3]")
         master.wait_for_service("/virtual_world/start")
         master.wait_for_service("/viewer/save_snapshot")
-        build_scene(srv, msg, call)
+        from gui.ros.client import WorldClient
+        client = WorldClient(timeout=30)
+        build_scene(client)
         time.sleep(0.5)  # the Viewer receives the scene from the world's queue
         heights = []
         for index in range(SNAPSHOTS):
             if index == 1:
-                call("/virtual_world/start", srv.Start, True)
+                client.start()
             time.sleep(SNAPSHOT_PERIOD)
             update = rospy.wait_for_message("/virtual_world/world_update",
                                             msg.SpaceDistribution, timeout=10)
             heights.extend(s.position[2] for s in update.situations if s.name == "sphere")
             call("/viewer/save_snapshot", srv.SaveSnapshot, f"demo_{index:03d}.png")
-        call("/virtual_world/start", srv.Start, False)
+        client.pause()
+        client.close()
         for process in (world, viewer):
             if process.poll() is not None:
                 raise RuntimeError(f"{process.args} died:\n{master.log_text(process)[-2000:]}")
@@ -92,9 +99,18 @@ def main() -> int:
     return 0
 
 
+def kautham_part() -> int:
+    """The grasp experiment on the Kautham corpus, or one line saying where it comes from."""
+    if corpus_dir() is None:
+        print(f"demo: the Kautham part is skipped: {missing_message()}")
+        return 0
+    return subprocess.run([sys.executable, str(ROOT / "tools" / "experiments" / "run.py"),
+                           "grasp"]).returncode
+
+
 if __name__ == "__main__":
     try:
-        sys.exit(main())
+        sys.exit(main() or kautham_part())
     except KeyboardInterrupt:
         print("demo: interrupted; every process it started was stopped", file=sys.stderr)
         sys.exit(130)

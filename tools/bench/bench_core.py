@@ -8,8 +8,6 @@ machine, native first in even rounds and Odin first in odd ones):
                          native_time / odin_time (goal >= 0.95).
   core_pile_ratio        the same inside four walls so they pile up (~230 contacts a step).
   core_forces_ratio      the pile plus 100 persistent forces and 20 motors (goal >= 0.90).
-  host_native_ode_steps_per_s  the host's speed: the native program's steps per second on the
-                         100-sphere scene (STEPS / the median of its rounds' times).
   core_newscene_leak_kb  resident memory growth (kB) over 1000 New Scene cycles of a
                          100-object scene (50 spheres, 50 box meshes), after 50 warm-up cycles,
                          measured with /proc/self/statm in a subprocess (goal < 5000).
@@ -46,11 +44,17 @@ CASES = {  # figure -> (mode, forces, motors)
 }
 
 
-def _compile(out_dir: pathlib.Path) -> pathlib.Path:
-    exe = out_dir / "core_scene"
+def _compile(out_dir: pathlib.Path, name: str = "core_scene") -> pathlib.Path:
+    exe = out_dir / name
     src = HERE / "native" / "core_scene.c"
     subprocess.run(["gcc", "-O2", "-DdDOUBLE", str(src), "-lode", "-o", str(exe)], check=True)
     return exe
+
+
+def host_steps_per_s(exe: pathlib.Path) -> float:
+    """The host's speed now: the native program's steps per second on the 100-sphere scene
+    (STEPS steps; run.py probes it around every module: host_native_ode_steps_per_s)."""
+    return STEPS / _native(exe, 0, 0, 0).seconds
 
 
 class Run(NamedTuple):
@@ -284,9 +288,6 @@ def run(out_dir: pathlib.Path) -> dict:
         else:
             figures[figure] = round(statistics.median(
                 n.seconds / o.seconds for n, o in zip(native_runs, odin_runs)), 3)
-        if figure == "core_spheres100_ratio":
-            figures["host_native_ode_steps_per_s"] = round(
-                STEPS / statistics.median(n.seconds for n in native_runs))
         details.append(f"{figure}: native {[n.seconds for n in native_runs]} s "
                        f"({native_runs[-1].contacts} contacts), odin "
                        f"{[o.seconds for o in odin_runs]} s ({odin_runs[-1].contacts} contacts), "

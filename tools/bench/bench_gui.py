@@ -41,8 +41,7 @@ def run(out_dir: pathlib.Path) -> dict:
              for _ in range(RUNS)]
     print(f"  problem_info {[round(t, 3) for t in infos]} s")
     figures["gui_info_tx90_hand_s"] = round(statistics.median(infos), 3)
-    sys.path.insert(0, str(ROOT / "tests"))
-    from ros_harness import RosMaster
+    from odin_common.ros_master import RosMaster
     times = []
     with RosMaster() as master:
         master.rosrun("Viewer", "viewer")

@@ -37,8 +37,7 @@ def _kautham_dir() -> pathlib.Path:
 
 
 def run(out_dir: pathlib.Path) -> dict:
-    sys.path.insert(0, str(ROOT / "tests"))
-    from ros_harness import RosMaster
+    from odin_common.ros_master import RosMaster
     out_dir.mkdir(parents=True, exist_ok=True)
     result_path = out_dir / "gui_window_bench.json"
     cold_path = out_dir / "gui_window_cold_open.json"
@@ -83,16 +82,15 @@ def _child(out_dir: pathlib.Path, cold_open_only: bool = False) -> None:
     from PyQt5.QtCore import QEvent, QObject, QTimer
     from PyQt5.QtWidgets import QApplication, QFileDialog
 
-    from gui.core.build import CompositeRequest, EntityRequest, ObjectRequest, plan_problem
+    from gui.core.build import plan_problem
     from gui.core.kautham.problem import load_problem
     from gui.window.main_window import MainWindow
     from gui.window.testing import app, click, pump, wait_for
 
     problem = _kautham_dir() / PROBLEM
     plan = plan_problem(load_problem(problem))     # only to know what "all built" means
-    n_joints = plan.counts()["JointRequest"]
-    n_elements = sum(len(s.objects) + len(s.composites) if hasattr(s, "objects") else 1
-                     for s in plan.steps)
+    n_joints = plan.counts()["JointStep"]
+    n_elements = sum(len(s.entries("")) for s in plan.steps)
     app()
     rospy.init_node("gui", anonymous=False, disable_signals=True)
     window = MainWindow(poll_period=0.2)
@@ -100,12 +98,7 @@ def _child(out_dir: pathlib.Path, cold_open_only: bool = False) -> None:
     wait_for(lambda: window.connected and window.updates > 0, 30, "connection")
     QFileDialog.getOpenFileName = staticmethod(lambda *a, **k: (str(problem), ""))
     tab = window.simulation
-    bodies = set()
-    for step in plan.steps:
-        if isinstance(step, EntityRequest):
-            bodies.update(m.id for m in list(step.objects) + list(step.composites))
-        elif isinstance(step, (ObjectRequest, CompositeRequest)):
-            bodies.add(step.id)
+    bodies = {body.id for body in plan.bodies()}
 
     opens = []
     for _ in range(1 if cold_open_only else 1 + WARM_OPENS):

@@ -28,12 +28,12 @@ import time
 
 HERE = pathlib.Path(__file__).resolve().parent
 ROOT = HERE.parent.parent
-sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(HERE))
+sys.path.insert(0, str(ROOT / "tests" / "nodes"))   # world_client: the node tests' raw client
 
 from forked import in_child  # noqa: E402
 from report import Refused  # noqa: E402
-from ros_harness import RosMaster  # noqa: E402
+from odin_common.ros_master import RosMaster  # noqa: E402
 
 CLIENTS = 4
 CALLS = 10_000

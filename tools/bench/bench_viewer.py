@@ -33,34 +33,29 @@ def _kautham_dir() -> pathlib.Path:
 def grasp_scene():
     """(view requests [(id, parameters, indices, position, orientation wxyz, color)],
     robot handle) for the grasp problem, composites split into parts as the world does."""
-    from gui.core.build import CompositeRequest, EntityRequest, ObjectRequest, plan_problem
+    from gui.core.build import plan_problem
     from gui.core.kautham.problem import load_problem
     from gui.core.kinematics import pose_to_position_quaternion
     from odin_common.rotations import quaternion_to_matrix
+    from odin_common.specs import ObjectSpec
 
     plan = plan_problem(load_problem(_kautham_dir() / PROBLEM))
     views = []
-
-    def add(steps):
-        for step in steps:
-            if isinstance(step, EntityRequest):
-                add(step.objects)
-                add(step.composites)
-            elif isinstance(step, ObjectRequest):
-                views.append((step.name, step.parameters, step.indices, step.position,
-                              step.orientation, step.color))
-            elif isinstance(step, CompositeRequest):
-                T = np.eye(4)
-                T[:3, :3] = quaternion_to_matrix(step.orientation)
-                T[:3, 3] = step.position
-                for part in step.parts:
-                    P = np.eye(4)
-                    P[:3, :3] = quaternion_to_matrix(part.orientation)
-                    P[:3, 3] = part.position
-                    position, quaternion = pose_to_position_quaternion(T @ P)
-                    views.append((part.name, part.parameters, part.indices, position,
-                                  quaternion, part.color))
-    add(plan.steps)
+    for body in plan.bodies():
+        if isinstance(body, ObjectSpec):
+            views.append((body.name, body.parameters, body.indices, body.position,
+                          body.orientation, body.color))
+            continue
+        T = np.eye(4)
+        T[:3, :3] = quaternion_to_matrix(body.orientation)
+        T[:3, 3] = body.position
+        for part in body.parts:
+            P = np.eye(4)
+            P[:3, :3] = quaternion_to_matrix(part.orientation)
+            P[:3, 3] = part.position
+            position, quaternion = pose_to_position_quaternion(T @ P)
+            views.append((part.name, part.parameters, part.indices, position,
+                          quaternion, part.color))
     return views, (plan.robots[0] if plan.robots else None)
 
 
@@ -128,8 +123,7 @@ _PUBLISHER = textwrap.dedent("""
 
 
 def fps_held(seconds: float = 10.0) -> float:
-    sys.path.insert(0, str(ROOT / "tests"))
-    from ros_harness import RosMaster
+    from odin_common.ros_master import RosMaster
 
     with tempfile.TemporaryDirectory(prefix="odin_bench_viewer_") as home:
         with RosMaster(ros_home=home) as master:

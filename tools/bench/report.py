@@ -4,8 +4,9 @@ The goals live in goals.json beside this file, one figure a line:
     "figure": {"min": 0.95, "unit": "ratio", "what": "what it measures"},
 "min" (at least) and/or "max" (at most) are the goal, both inclusive; a figure without either is
 reported, not checked. Keys starting with "_" are notes. Units other than RELATIVE_UNITS depend
-on the host's speed: the table prints the host figure (HOST_FIGURE, measured in the same run)
-beside them, so a reader can tell a slow host from a slow Odin.
+on the host's speed: the table prints the host's speed beside them (the probes run.py took
+around the figure's module, else HOST_FIGURE, the run's median), so a reader can tell a slow
+host from a slow Odin.
 
 ``python report.py`` reads out/bench/results.json (figure -> number) and out/bench/run.json
 (written by run.py: why figures are missing), prints every missed goal and missing figure,
@@ -132,11 +133,13 @@ def host_bound(spec: Mapping) -> bool:
 
 
 def table(results: Mapping[str, float], goals: Mapping[str, dict],
-          reasons: Optional[Mapping[str, str]] = None) -> str:
+          reasons: Optional[Mapping[str, str]] = None, run: Optional[Mapping] = None) -> str:
     """The markdown table: every figure of goals.json in its order, then any figure of the
     results that goals.json does not describe yet."""
     reasons = reasons or {}
-    host = results.get(HOST_FIGURE)
+    run = run or {}
+    by_module = run.get("host_by_module") or {}
+    modules = run.get("figure_modules") or {}
     rows = ["| figure | goal | last run | what |", "|---|---|---|---|"]
     figures = list(goals) + sorted(f for f in results if f not in goals)
     for figure in figures:
@@ -147,6 +150,7 @@ def table(results: Mapping[str, float], goals: Mapping[str, dict],
             if missed(value, spec):
                 cell = f"**{cell} (missed)**"
             if host_bound(spec) and figure != HOST_FIGURE:
+                host = by_module.get(modules.get(figure), results.get(HOST_FIGURE))
                 cell += f" (host {_number(host)} steps/s)" if host is not None else " (host ?)"
         else:
             why = reasons.get(figure)
@@ -163,6 +167,10 @@ def caption(run: Mapping) -> str:
         parts.append(f"Last run: {run['finished']}")
     if run.get("seconds") is not None:
         parts.append(f"`make bench` took {run['seconds'] / 60:.1f} min")
+    probes = [p["steps_per_s"] for p in run.get("host_probes") or [] if p.get("steps_per_s")]
+    if probes:
+        parts.append(f"host probes {_number(min(probes))}-{_number(max(probes))} native "
+                     f"steps/s over the run")
     if run.get("failed_modules"):
         parts.append("failed modules: " + ", ".join(run["failed_modules"]))
     return ("; ".join(parts) + ".\n\n") if parts else ""
@@ -198,7 +206,7 @@ def report(results: Mapping[str, float], goals: Mapping[str, dict], run: Mapping
     problems = check(results, goals, reasons, only_present)
     if readme is not None:
         path = pathlib.Path(readme)
-        block = caption(run) + table(results, goals, reasons)
+        block = caption(run) + table(results, goals, reasons, run)
         path.write_text(rewrite_readme(path.read_text(), block))
         print(f"figure table written to {path}", file=out)
     checked = sum(1 for s in goals.values() if "min" in s or "max" in s)

@@ -38,12 +38,12 @@ from typing import Iterable, Optional, Sequence
 import numpy as np
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent.parent
-sys.path.insert(0, str(ROOT / "tests"))
 
-from ros_harness import RosMaster  # noqa: E402
+from gui.core.kautham.corpus import ENVIRONMENT  # noqa: E402
+from odin_common.ros_master import RosMaster  # noqa: E402
 
 OUT_ROOT = ROOT / "out" / "experiments"
-KAUTHAM_DIR = pathlib.Path(os.environ.get("ODIN_KAUTHAM_DIR", ROOT.parent / "shared" / "kautham"))
+KAUTHAM_DIR = pathlib.Path(os.environ.get(ENVIRONMENT, ROOT.parent / "shared" / "kautham"))
 EXAMPLES = KAUTHAM_DIR / "legacy_2012" / "examples"
 PATHS_DIR = ROOT / "Odin" / "GUI" / "paths"
 
@@ -235,9 +235,9 @@ class Session:
         """Advances ``count`` Portal cycles, one Step Once each; returns the simulated time."""
         for _ in range(count):
             started = time.perf_counter()
-            response = self.client.call("step_once", cycles=1)
+            sim_time = self.client.step_once(1)
             self.stepping_wall += time.perf_counter() - started
-            self.sim_time = float(response.sim_time)
+            self.sim_time = sim_time
             self.cycles += 1
         return self.sim_time
 
@@ -365,39 +365,34 @@ def load_plan(problem_file: pathlib.Path):
     return problem, plan_problem(problem)
 
 
-def replace_step(plan, name: str, new_step) -> None:
-    """Replaces the plan's Build Object request named ``name`` (the GUI's Objects tab would
-    build the object differently; the rest of the plan is sent as loaded)."""
-    from gui.core.build import ObjectRequest
+def replace_step(plan, name: str, spec) -> None:
+    """Replaces the plan's Build Object step named ``name`` by one building ``spec`` (an
+    ObjectSpec: the GUI's Objects tab would build the object differently; the rest of the plan
+    is sent as loaded)."""
+    from gui.core.build import ObjectStep
     for k, step in enumerate(plan.steps):
-        if isinstance(step, ObjectRequest) and step.name == name:
-            plan.steps[k] = new_step
+        if isinstance(step, ObjectStep) and step.spec.name == name:
+            plan.steps[k] = ObjectStep(spec)
             return
     raise ExperimentError(f"the plan has no object named {name!r}")
 
 
 def cylinder_can(name: str, position, mass: float, color, radius: float, length: float):
-    """A can as a cylinder primitive (axis along world z), a movable body."""
-    from gui.core.build import ObjectRequest
-    return ObjectRequest(name=name, parameters=(float(radius), float(length)), indices=(),
-                         mass=float(mass), position=tuple(float(v) for v in position),
-                         orientation=(1.0, 0.0, 0.0, 0.0), color=tuple(color))
+    """A can as a cylinder primitive (axis along world z), a movable body (ObjectSpec)."""
+    from odin_common.specs import ObjectSpec
+    return ObjectSpec(name=name, parameters=(float(radius), float(length)), mass=float(mass),
+                      position=tuple(float(v) for v in position),
+                      orientation=(1.0, 0.0, 0.0, 0.0), color=tuple(color))
 
 
 # -- geometry, computed from the meshes the GUI sends (not from the collision engine) ------------
 def mesh_bodies(plan) -> dict:
     """{object ID: (vertices (n, 3) in the object's frame, triangles (m, 3))} of every mesh the
-    plan builds as a single object (robot links are the objects of an EntityRequest)."""
-    from gui.core.build import EntityRequest, ObjectRequest
-    objects = []
-    for step in plan.steps:
-        if isinstance(step, EntityRequest):
-            objects.extend(step.objects)
-        elif isinstance(step, ObjectRequest):
-            objects.append(step)
+    plan builds as a single object (robot links are the objects of a Build Entity)."""
+    from odin_common.specs import ObjectSpec
     return {o.id: (np.asarray(o.parameters, float).reshape(-1, 3),
                    np.asarray(o.indices, np.int64).reshape(-1, 3))
-            for o in objects if len(o.indices)}
+            for o in plan.bodies() if isinstance(o, ObjectSpec) and len(o.indices)}
 
 
 def in_world(vertices: np.ndarray, position, quaternion) -> np.ndarray:

@@ -49,7 +49,8 @@ CAMERA = common.Camera(eye=(0.62, -0.02, 0.45), target=(0.575, 0.40, 0.32))
 
 
 def can_request(position, mass: float, color):
-    """The can as a movable mesh body, oriented as the TX90 problem places it (axis z)."""
+    """The can as a movable mesh body (ObjectSpec), oriented as the TX90 problem places it
+    (axis z)."""
     from gui.core.build import shape_to_body
     from gui.core.kinematics import pose_from_axis_angle
     from gui.core.shapes import read_shape
@@ -70,8 +71,7 @@ def run(frames: bool = True) -> dict:
         robot = plan.robots[0]
         s.client.set_position(robot.situations(np.array(p["robot_configuration_rad"])))
         s.client.build_object(can_request(p["can_start_m"], p["can_mass_kg"], p["can_color"]))
-        s.client.call("set_velocity", object=CAN, set_linear=True,
-                      linear=p["can_velocity_m_s"])
+        s.client.set_body_velocity(CAN, linear=p["can_velocity_m_s"])
         cycles = int(round(p["duration_s"] / WORLD["step"]))
         s.cycle_and_frame()
         while s.cycles < cycles:

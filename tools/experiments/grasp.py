@@ -110,10 +110,10 @@ def run(frames: bool = True, out_root=None) -> dict:
         s.client.set_position([(CAN, p["can_position_m"], (1.0, 0.0, 0.0, 0.0))])
         s.client.set_position(handle.situations(initial[0]))
         flex = [motor_of(handle, name) for name in FLEX]
-        from Messages.msg import JointParameter
+        from odin_common.interface import JointParameter
         for motor in flex:  # fingers squeeze with a bounded torque
-            s.client.call("set_joint", action=1, id=motor, parameters=[JointParameter(
-                parameter=11, axis=1, value=p["finger_max_torque_N_m"])])
+            s.client.set_joint_parameters(motor, [(JointParameter.MAX_FORCE, 1,
+                                                   p["finger_max_torque_N_m"])])
         every = p["frame_every_cycles"]
         phases = []
 
@@ -145,28 +145,28 @@ def run(frames: bool = True, out_root=None) -> dict:
         advance(len(approach), lambda: s.client.set_position(handle.situations(next(rows))))
         closeup("approach done")
         phase("close")
-        s.client.set_velocity(flex, [p["finger_close_rad_s"]] * len(flex))
+        s.client.set_velocities(flex, [p["finger_close_rad_s"]] * len(flex))
         advance(int(p["close_s"] * per_s))
         closeup("closed")
         phase("lift")
         forearm = motor_of(handle, "ForeArm")
         wrist = motor_of(handle, "Wrist")
-        s.client.set_velocity([forearm, wrist], [p["lift_forearm_rad_s"],
+        s.client.set_velocities([forearm, wrist], [p["lift_forearm_rad_s"],
                                                  -p["lift_forearm_rad_s"]])
         advance(int(p["lift_s"] * per_s))
-        s.client.set_velocity([forearm, wrist], [0.0, 0.0])
+        s.client.set_velocities([forearm, wrist], [0.0, 0.0])
         closeup("lifted")
         phase("carry")
         shoulder = motor_of(handle, "Shoulder")
-        s.client.set_velocity([shoulder], [p["carry_shoulder_rad_s"]])
+        s.client.set_velocities([shoulder], [p["carry_shoulder_rad_s"]])
         advance(int(p["carry_s"] * per_s))
-        s.client.set_velocity([shoulder], [0.0])
+        s.client.set_velocities([shoulder], [0.0])
         advance(int(0.3 * per_s))
         closeup("carried")
         phase("open")
-        s.client.set_velocity(flex, [p["open_rad_s"]] * len(flex))
+        s.client.set_velocities(flex, [p["open_rad_s"]] * len(flex))
         advance(int(p["open_s"] * per_s))
-        s.client.set_velocity(flex, [0.0] * len(flex))
+        s.client.set_velocities(flex, [0.0] * len(flex))
         closeup("opened", PALM)
         phase("fall")
         advance(int(p["fall_s"] * per_s))

@@ -179,13 +179,13 @@ def run(frames: bool = True) -> dict:
         per_s = 1.0 / (WORLD["step"] * WORLD["steps_per_cycle"])
         every = p["frame_every_cycles"]
         s.cycle_and_frame()
-        s.client.set_velocity([shoulder], [p["base_speed_rad_s"]])
+        s.client.set_velocities([shoulder], [p["base_speed_rad_s"]])
         turn_started = s.sim_time                      # 0.04 s: after the first cycle's frame
         total = int(round(p["duration_s"] * per_s))
         stop_at = int(round(p["base_turns_s"] * per_s))
         while s.cycles < total:
             if s.cycles == stop_at:
-                s.client.set_velocity([shoulder], [0.0])
+                s.client.set_velocities([shoulder], [0.0])
             if (s.cycles + 1) % every == 0:
                 s.cycle_and_frame()
             else:

@@ -19,6 +19,8 @@ import signal
 import sys
 import time
 
+from gui.core.kautham.corpus import corpus_dir, missing_message
+
 HERE = pathlib.Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
@@ -38,6 +40,9 @@ def main(argv=None) -> int:
     unknown = [n for n in args.names if n not in NAMES]
     if unknown:
         parser.error(f"unknown experiment(s) {', '.join(unknown)}: choose from {', '.join(NAMES)}")
+    if corpus_dir() is None:
+        print(f"experiments: {missing_message()}", file=sys.stderr)
+        return 2
     signal.signal(signal.SIGTERM, _raise_keyboard_interrupt)
     failed = []
     for name in args.names or NAMES:

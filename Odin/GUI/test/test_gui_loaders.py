@@ -13,7 +13,8 @@ import sys
 import numpy as np
 import pytest
 
-from gui.core.build import CompositeRequest, EntityRequest, JointRequest, ObjectRequest, plan_problem
+from gui.core.build import EntityStep, JointStep, plan_problem
+from odin_common.specs import CompositeSpec
 from gui.errors import GuiError, ProblemError, ShapeError
 from gui.core.kautham.problem import load_problem
 from gui.core.kautham.robot_rob import read_dh_robot
@@ -87,9 +88,7 @@ def test_every_legacy_problem_loads_and_plans(name):
     plan = plan_problem(problem)
     assert plan.robots and plan.steps
     for step in plan.steps:
-        members = step.objects + step.composites if isinstance(step, EntityRequest) else \
-            (step,) if isinstance(step, (ObjectRequest, CompositeRequest)) else ()
-        for m in members:
+        for m in step.bodies:
             assert len(m.orientation) == 4
             assert abs(np.linalg.norm(m.orientation) - 1) < 1e-9
 
@@ -179,11 +178,8 @@ def test_urdf_tx90_follows_its_joint_origins():
 # -- scene placement --------------------------------------------------------------------------
 def _bodies(plan):
     out = {}
-    for step in plan.steps:
-        members = step.objects + step.composites if isinstance(step, EntityRequest) else \
-            (step,) if isinstance(step, (ObjectRequest, CompositeRequest)) else ()
-        for m in members:
-            out[m.id] = m
+    for m in plan.bodies():
+        out[m.id] = m
     return out
 
 
@@ -198,7 +194,7 @@ def test_cans_table_and_columns_land_where_location_says():
         assert bodies[name].geometry_only and bodies[name].triangle_count > 1000
     # The table scene: two Inventor cubes placed by their Transform nodes (mm -> m).
     table = next(b for k, b in bodies.items() if "sceneRevistaICRA09" in k)
-    assert isinstance(table, CompositeRequest) and table.geometry_only
+    assert isinstance(table, CompositeSpec) and table.geometry_only
     top = table.parts[0]
     assert top.parameters == pytest.approx((1.5, 2.5, 0.01), rel=1e-6)
     assert top.position == pytest.approx((-0.75, 1.25, -0.011), abs=1e-9)
@@ -227,7 +223,7 @@ def test_current_format_obstacles_use_home_in_metres():
 
 def test_robot_plan_joints_motors_and_names():
     plan = plan_problem(load_problem(LEGACY / "Staubli_R6_two_columns.xml"))
-    joints = [s for s in plan.steps if isinstance(s, JointRequest)]
+    joints = [s.spec for s in plan.steps if isinstance(s, JointStep)]
     base = _bodies(plan)["TX90/Base"]
     assert base.fixed and all(j.body1 and j.body2 for j in joints)   # no joint to the world
     hinges = [j for j in joints if j.type == 1]
@@ -334,12 +330,12 @@ def test_problem_with_relative_parent_paths_and_free_flying_robot(corpus):
         ' <Scene scene="../robots/2DRR.rob" scale="1"><Location X="0" Y="500" Z="0" WX="0" '
         'WY="0" WZ="1" TH="0"/></Scene>\n</Problem>\n')
     plan = plan_problem(load_problem(corpus / "TRO" / "free.xml"))
-    entity = plan.steps[0]
-    assert isinstance(entity, EntityRequest) and len(entity.objects) == 1
+    entity = plan.steps[0].spec
+    assert isinstance(plan.steps[0], EntityStep) and len(entity.objects) == 1
     assert entity.objects[0].position == pytest.approx((0.1, 0, 0))
     assert plan.robots[0].joint_keys == []
     # the .rob scene: a movable obstacle with joints but no fixed base joint
-    joints = [s for s in plan.steps if isinstance(s, JointRequest)]
+    joints = [s.spec for s in plan.steps if isinstance(s, JointStep)]
     assert joints and all(j.body1 != "" for j in joints)
 
 
@@ -373,6 +369,20 @@ def test_problem_info_does_not_import_rospy():
     assert result.returncode == 0, result.stderr
 
 
+def test_the_gui_core_imports_neither_rospy_nor_qt():
+    code = ("import importlib, pkgutil, sys\n"
+            "import gui.core\n"
+            "names = [m.name for m in pkgutil.walk_packages(gui.core.__path__, 'gui.core.')]\n"
+            "for name in names:\n"
+            "    importlib.import_module(name)\n"
+            "print(len(names))\n"
+            "found = [m for m in ('rospy', 'PyQt5') if m in sys.modules]\n"
+            "assert not found, f'gui.core imported {found}'")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    assert int(result.stdout) >= 12     # build, kinematics, model, paths, shapes, kautham.*
+
+
 def test_problem_info_error_is_one_line_with_file_and_line(tmp_path):
     bad = tmp_path / "bad.xml"
     bad.write_text('<?xml version="1.0"?>\n<Problem>\n  <Robot robot="x.rob">\n</Problem>\n')
@@ -392,5 +402,5 @@ def test_collision_disabled_scene_objects_reach_the_world_as_no_collisions(corpu
     bodies = _bodies(plan_problem(load_problem(corpus / "nocollide.xml")))
     assert bodies["can"].no_collisions
     assert not any(b.no_collisions for name, b in bodies.items() if name != "can")
-    from gui.ros.client import WorldClient
-    assert WorldClient.object_msg(bodies["can"]).no_collisions
+    from odin_common.messages import object_message
+    assert object_message(bodies["can"]).no_collisions

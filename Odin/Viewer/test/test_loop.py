@@ -5,7 +5,7 @@ import time
 
 import pytest
 
-from pixels import is_hue, patch
+from viewer.core.pixels import is_hue, patch
 from viewer.core.camera import Camera
 from viewer.errors import ViewerError
 from viewer.core.loop import RenderLoop

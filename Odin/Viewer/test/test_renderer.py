@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from pixels import is_background, is_grey, is_hue, patch
+from viewer.core.pixels import is_background, is_grey, is_hue, patch
 from viewer.core.camera import Camera
 from viewer.core.renderer import Renderer
 from viewer.core.scene import Scene

@@ -7,17 +7,11 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 import time
 from typing import Optional, Sequence
 
-import numpy as np
-
 from gui.errors import GuiError
-from gui.core.kinematics import pose_to_position_quaternion
-
-_JOINT_NAMES = {1: "hinge", 2: "slider", 8: "fixed"}
 
 
 def _fail(tool: str, error: Exception) -> int:
@@ -28,57 +22,16 @@ def _fail(tool: str, error: Exception) -> int:
 
 def describe(plan) -> dict:
     """The JSON-ready description of a plan: bodies at Home and joints (world frame)."""
-    from gui.core.build import (CompositeRequest, EntityRequest, JointRequest, ObjectRequest)
     bodies, joints = [], []
-
-    def body(req, entity: Optional[str]):
-        if isinstance(req, ObjectRequest):
-            kind = {1: "sphere", 2: "cylinder", 3: "box"}.get(len(req.parameters), "mesh")
-            parameters = list(req.parameters) if kind != "mesh" else []
-            bodies.append(dict(name=req.name, entity=entity, shape=kind,
-                               position=list(req.position), quaternion=list(req.orientation),
-                               triangles=req.triangle_count,
-                               mass=None if req.geometry_only else req.mass,
-                               static=req.geometry_only, parameters=parameters))
-        else:
-            bodies.append(dict(name=req.id, entity=entity, shape="composite",
-                               position=list(req.position), quaternion=list(req.orientation),
-                               triangles=req.triangle_count,
-                               mass=None if req.geometry_only else req.mass,
-                               static=req.geometry_only,
-                               parts=[p.name for p in req.parts]))
-
-    limits = {}
-    for handle in plan.robots:
-        model = handle.instance.model
-        for key, i in zip(handle.joint_keys, model.movable_links()):
-            limits[key] = model.links[i].limits
     for step in plan.steps:
-        if isinstance(step, EntityRequest):
-            for req in step.objects + step.composites:
-                body(req, step.name)
-        elif isinstance(step, (ObjectRequest, CompositeRequest)):
-            body(step, None)
-        elif isinstance(step, JointRequest):
-            lim = limits.get(step.key)
-            joints.append(dict(name=step.key, type=_JOINT_NAMES.get(step.type, str(step.type)),
-                               parent=step.body1 or None, child=step.body2,
-                               anchor=list(step.anchor), axis=_kinematic_axis(step),
-                               limits=None if lim is None else [lim[0], lim[1]]))
+        description = step.describe()
+        bodies.extend(description["bodies"])
+        joints.extend(description["joints"])
     robots = [dict(name=h.name, joints=h.joint_keys, home=[float(v) for v in h.home],
                    motors=h.motor_ids) for h in plan.robots]
     return dict(problem=plan.problem.source, format=plan.problem.format,
                 units=dict(length="m", angle="rad", mass="kg", quaternion="w,x,y,z"),
                 bodies=bodies, joints=joints, robots=robots)
-
-
-def _kinematic_axis(step) -> list:
-    """The joint's axis as the robot model states it (Kautham's sign): a robot's hinges and
-    sliders are sent to the world with the axis reversed (see gui.core.build)."""
-    from gui.core.build import JOINT_HINGE, JOINT_SLIDER
-    if step.type in (JOINT_HINGE, JOINT_SLIDER) and step.body1:
-        return [-v for v in step.axis1]
-    return list(step.axis1)
 
 
 def problem_info_main(argv: Optional[Sequence[str]] = None) -> int:
@@ -97,24 +50,6 @@ def problem_info_main(argv: Optional[Sequence[str]] = None) -> int:
     json.dump(describe(plan), sys.stdout, indent=args.indent or None)
     sys.stdout.write("\n")
     return 0
-
-
-def _step_label(step) -> str:
-    from gui.core.build import (CompositeRequest, EntityRequest, JointRequest, MotorRequest,
-                           ObjectRequest)
-    if isinstance(step, EntityRequest):
-        members = step.objects + step.composites
-        tris = sum(m.triangle_count for m in members)
-        return f"entity {step.name}: {len(members)} bodies, {tris} triangles"
-    if isinstance(step, ObjectRequest):
-        return f"object {step.name} ({step.triangle_count} triangles)"
-    if isinstance(step, CompositeRequest):
-        return f"composite {step.id} ({len(step.parts)} parts)"
-    if isinstance(step, JointRequest):
-        return f"joint {step.key} ({_JOINT_NAMES.get(step.type, step.type)})"
-    if isinstance(step, MotorRequest):
-        return f"motor on {step.joint_key}"
-    return type(step).__name__
 
 
 def load_problem_main(argv: Optional[Sequence[str]] = None) -> int:
@@ -143,7 +78,7 @@ def load_problem_main(argv: Optional[Sequence[str]] = None) -> int:
             client.new_scene()
 
         def progress(k: int, step, answer_id: str) -> None:
-            print(f"[{k}/{total}] {_step_label(step)} -> {answer_id}", flush=True)
+            print(f"[{k}/{total}] {step.label()} -> {answer_id}", flush=True)
 
         client.execute(plan, progress=progress)
     except GuiError as error:

@@ -175,9 +175,18 @@ def default_joint_id(kind: int, body1: str, body2: str) -> str:
     return f"{int(kind)}:{body1}&{body2}"
 
 
+MOTOR_PREFIX = "motor:"
+
+
 def default_motor_id(joint_id: str = "", body1: str = "", body2: str = "") -> str:
     """A motor's default ID: "motor:<joint id>", or "motor:<body1>&<body2>" without a joint."""
-    return f"motor:{joint_id}" if joint_id else f"motor:{body1}&{body2}"
+    return MOTOR_PREFIX + (joint_id if joint_id else f"{body1}&{body2}")
+
+
+def motor_joint(motor_id: str) -> str:
+    """What a default motor ID names after its prefix (its joint's ID for a motor on a joint);
+    "" for an ID of one's own."""
+    return motor_id[len(MOTOR_PREFIX):] if motor_id.startswith(MOTOR_PREFIX) else ""
 
 
 # ---------------------------------------------------------------------------------- shapes
@@ -250,7 +259,7 @@ __all__ = ["NodeParameter", "JointType", "JointParameter", "SetJointAction", "Mo
            "ForceKind", "Solver", "JOINT_AXES_USED", "JOINT_USES_ANCHOR",
            "JOINT_NEEDS_TWO_BODIES", "JOINT_AXIS2_ON_BODY2", "JOINT_FORCE_MAGNITUDES", "JOINT_STATE_AXES", "JOINT_PARAMETERS",
            "JOINT_PARAMETER_AXES", "MOTOR_PARAMETERS", "UNIT_PARAMETERS",
-           "NON_NEGATIVE_PARAMETERS", "joint_type", "default_joint_id", "default_motor_id",
+           "NON_NEGATIVE_PARAMETERS", "joint_type", "default_joint_id", "MOTOR_PREFIX", "default_motor_id", "motor_joint",
            "SHAPE_BY_PARAMETER_COUNT", "shape_kind", "COMPOSITE_MARK", "composite_id",
            "is_composite_id", "WORLD_NAMESPACE", "VIEWER_NAMESPACE", "WORLD_SERVICES",
            "VIEWER_SERVICES"]

@@ -1,18 +1,21 @@
 """A loaded problem -> the VirtualWorld requests that build it, as plain data (ROS-free).
 
-``plan_problem(problem)`` returns a ``BuildPlan``: an ordered list of requests whose fields
-mirror Messages/Object, Messages/Composite and the Set Joint / Set Motor services, plus, per
-robot, what paths need to drive it (``RobotHandle``). ``gui.ros.client.WorldClient.execute`` sends
-a plan; the Qt window can do the same step by step.
+``plan_problem(problem)`` returns a ``BuildPlan``: an ordered list of steps, each wrapping one
+odin_common spec (``EntityStep``: EntitySpec, ``ObjectStep``: ObjectSpec, ``CompositeStep``:
+CompositeSpec, ``JointStep``: JointSpec, ``MotorStep``: MotorSpec), plus, per robot, what paths
+need to drive it (``RobotHandle``). A step knows its one-line ``label()``, its ``describe()``
+(problem_info's JSON), the ``entries(answer)`` it adds to a listing of what was built, and how
+to ``send(client, ids)`` itself through a ``gui.ros.client.WorldClient``;
+``WorldClient.execute(plan)`` sends a whole plan, the Qt window does the same step by step.
 
 How a problem maps to the world:
 - A robot with joints -> one Build Entity (one object or composite per link, internal
   collisions off), then per link one Set Joint: revolute -> HINGE, prismatic -> SLIDER (anchor
   and axis from the joint frame at Home, world frame; LO_STOP/HI_STOP from the limits, relative
   to the Home value the joint is built at), a non-movable link -> FIXED joint to its parent;
-  the base is held by a FIXED joint to the static environment (body1 ""). Then one Set Motor
-  (angular for hinges, linear for sliders; infinite force, zero speed, so the robot holds its
-  pose) per movable joint, id "motor:" + joint id.
+  the base is a fixed (kinematic) body. Then one Set Motor (angular for hinges, linear for
+  sliders; infinite force, zero speed, so the robot holds its pose) per movable joint, id
+  "motor:" + joint id.
 - A robot made of one link (a bare shape or a one-link URDF) is a free-flying body: an entity
   of one object, no joint.
 - A static obstacle -> Build Object/Composite with ``geometry_only``. A movable obstacle (a .rob
@@ -32,20 +35,22 @@ How a problem maps to the world:
 from __future__ import annotations
 
 import dataclasses
-
 from dataclasses import dataclass, field
-from typing import Optional
+from typing import ClassVar, Dict, List, NamedTuple, Optional, Tuple, Union
 
 import numpy as np
 
 from gui.core.kinematics import pose_to_position_quaternion
-from gui.core.model import FIXED, PRISMATIC, REVOLUTE, Instance, Problem
+from gui.core.model import REVOLUTE, Instance, Problem
 from gui.core.shapes import Shape
+from odin_common.interface import JointParameter, JointType, MotorKind, default_motor_id
+from odin_common.specs import (CompositeSpec, EntitySpec, JointSpec, MotorSpec, ObjectSpec,
+                               PartSpec)
 
-# Messages/Joint and Messages/JointParameter constants (kept here so the Core needs no ROS).
-JOINT_HINGE, JOINT_SLIDER, JOINT_FIXED = 1, 2, 8
-PARAM_LO_STOP, PARAM_HI_STOP = 0, 1
-MOTOR_ANGULAR, MOTOR_LINEAR = 0, 1
+BodySpec = Union[ObjectSpec, CompositeSpec]
+
+SCENE_OBJECTS = "Scene objects"
+"""The listing section of objects that belong to no robot (``StepEntry.section``)."""
 
 
 @dataclass(frozen=True)
@@ -54,96 +59,212 @@ class BuildDefaults:
     internal_collisions: bool = False
 
 
-@dataclass(frozen=True, eq=False)
-class ObjectRequest:
-    """Messages/Object. ``parameters`` and ``indices`` are tuples for primitives and flat
-    numpy arrays (float64, uint32) for meshes."""
+@dataclass
+class BuiltIds:
+    """The world's answers so far while a plan is sent: planned body ID -> world ID, joint key
+    ("robot/link") -> world joint ID, joint key -> world motor ID."""
+    bodies: Dict[str, str] = field(default_factory=dict)
+    joints: Dict[str, str] = field(default_factory=dict)
+    motors: Dict[str, str] = field(default_factory=dict)
+
+    def as_dict(self) -> dict:
+        return {"bodies": self.bodies, "joints": self.joints, "motors": self.motors}
+
+
+class StepEntry(NamedTuple):
+    """One line of a listing of what a step built: under its owner's ``section`` ("Links",
+    "Joints", "Motors"; ``SCENE_OBJECTS`` for a step without owner), a short ``name`` and the
+    ``world_id``."""
+    section: str
     name: str
-    parameters: tuple
-    indices: tuple
-    mass: float
-    position: tuple
-    orientation: tuple
-    color: tuple
-    fixed: bool = False
-    geometry_only: bool = False
-    inertia: tuple = ()
-    triangle_count: int = 0
-    no_collisions: bool = False
-
-    @property
-    def id(self) -> str:
-        return self.name
+    world_id: str
 
 
-@dataclass(frozen=True, eq=False)
-class PartRequest:
-    """Messages/Part (pose relative to the composite's frame)."""
-    name: str
-    parameters: tuple
-    indices: tuple
-    mass: float
-    position: tuple
-    orientation: tuple
-    color: tuple
+# ---------------------------------------------------------------------------------- steps
+# Each step wraps one spec. ``send(client, ids)`` calls the client's typed method (a
+# gui.ros.client.WorldClient; only its methods are used, so this module needs no ROS), records
+# the world's IDs in ``ids`` (BuiltIds) and returns the world's answer (an ID).
+
+def _object_description(spec: ObjectSpec, entity: Optional[str]) -> dict:
+    shape = spec.shape
+    return dict(name=spec.name, entity=entity, shape=shape, position=list(spec.position),
+                quaternion=list(spec.orientation), triangles=spec.triangle_count,
+                mass=None if spec.geometry_only else spec.mass, static=spec.geometry_only,
+                parameters=list(spec.parameters) if shape != "mesh" else [])
+
+
+def _composite_description(spec: CompositeSpec, entity: Optional[str]) -> dict:
+    return dict(name=spec.id, entity=entity, shape="composite", position=list(spec.position),
+                quaternion=list(spec.orientation), triangles=spec.triangle_count,
+                mass=None if spec.geometry_only else spec.mass, static=spec.geometry_only,
+                parts=[p.name for p in spec.parts])
+
+
+def _short(name: str, separator: str = "/") -> str:
+    return name.rsplit(separator, 1)[-1]
 
 
 @dataclass(frozen=True, eq=False)
-class CompositeRequest:
-    """Messages/Composite."""
-    parts: tuple
-    position: tuple
-    orientation: tuple
-    fixed: bool = False
-    geometry_only: bool = False
-    no_collisions: bool = False
+class EntityStep:
+    """Build Entity: a robot's (or movable obstacle's) links, all or nothing."""
+    spec: EntitySpec
 
     @property
-    def id(self) -> str:
-        return ">" + ">".join(p.name for p in self.parts)
+    def owner(self) -> Optional[str]:
+        """The robot or obstacle the step belongs to (None: a scene object)."""
+        return self.spec.name
 
     @property
-    def mass(self) -> float:
-        return float(sum(p.mass for p in self.parts))
+    def bodies(self) -> Tuple[BodySpec, ...]:
+        return self.spec.members
 
-    @property
-    def triangle_count(self) -> int:
-        return sum(len(p.indices) // 3 for p in self.parts)
+    def label(self) -> str:
+        members = self.spec.members
+        triangles = sum(m.triangle_count for m in members)
+        return f"entity {self.spec.name}: {len(members)} bodies, {triangles} triangles"
+
+    def describe(self) -> dict:
+        name = self.spec.name
+        return {"bodies": [_object_description(o, name) for o in self.spec.objects]
+                + [_composite_description(c, name) for c in self.spec.composites],
+                "joints": []}
+
+    def entries(self, answer: str) -> List[StepEntry]:
+        return [StepEntry("Links", _short(m.id), m.id) for m in self.spec.members]
+
+    def send(self, client, ids: BuiltIds) -> str:
+        built = client.build_entity(self.spec)
+        for member, world_id in zip(self.spec.members, built.ids):
+            ids.bodies[member.id] = world_id
+        return built.name
 
 
 @dataclass(frozen=True, eq=False)
-class EntityRequest:
-    """Services/BuildEntity."""
-    name: str
-    objects: tuple
-    composites: tuple
-    internal_collisions: bool = False
+class ObjectStep:
+    """Build Object: a scene object."""
+    spec: ObjectSpec
+    owner: ClassVar[Optional[str]] = None
+
+    @property
+    def bodies(self) -> Tuple[BodySpec, ...]:
+        return (self.spec,)
+
+    def label(self) -> str:
+        return f"object {self.spec.name} ({self.spec.triangle_count} triangles)"
+
+    def describe(self) -> dict:
+        return {"bodies": [_object_description(self.spec, None)], "joints": []}
+
+    def entries(self, answer: str) -> List[StepEntry]:
+        return [StepEntry(SCENE_OBJECTS, self.spec.id, str(answer))]
+
+    def send(self, client, ids: BuiltIds) -> str:
+        world_id = ids.bodies[self.spec.id] = client.build_object(self.spec)
+        return world_id
 
 
-@dataclass(frozen=True)
-class JointRequest:
-    """Services/SetJoint, action CREATE. ``key`` names it inside the plan ("robot/link")."""
+@dataclass(frozen=True, eq=False)
+class CompositeStep:
+    """Build Composite: a scene object made of several shapes."""
+    spec: CompositeSpec
+    owner: ClassVar[Optional[str]] = None
+
+    @property
+    def bodies(self) -> Tuple[BodySpec, ...]:
+        return (self.spec,)
+
+    def label(self) -> str:
+        return f"composite {self.spec.id} ({len(self.spec.parts)} parts)"
+
+    def describe(self) -> dict:
+        return {"bodies": [_composite_description(self.spec, None)], "joints": []}
+
+    def entries(self, answer: str) -> List[StepEntry]:
+        parts = self.spec.parts
+        return [StepEntry(SCENE_OBJECTS, f"{_short(parts[0].name, '#')} ({len(parts)} parts)",
+                          str(answer))]
+
+    def send(self, client, ids: BuiltIds) -> str:
+        world_id = ids.bodies[self.spec.id] = client.build_composite(self.spec)
+        return world_id
+
+
+@dataclass(frozen=True, eq=False)
+class JointStep:
+    """Set Joint (create) between two links. ``key`` names it in the plan ("robot/link");
+    the spec's bodies are planned IDs, replaced by the world's when sent. ``limits``: the
+    joint's range as the robot model states it (rad or m; None: unlimited or a fixed joint),
+    for descriptions: the stops sent are relative to the Home value."""
     key: str
-    type: int
-    body1: str
-    body2: str
-    anchor: tuple = (0.0, 0.0, 0.0)
-    axis1: tuple = (0.0, 0.0, 1.0)   # FIXED ignores it (the world refuses a zero axis)
-    axis2: tuple = (1.0, 0.0, 0.0)   # unused by hinge/slider/fixed; non-zero for the same reason
-    axis3: tuple = (0.0, 1.0, 0.0)
-    parameters: tuple = ()           # ((parameter, axis, value), ...)
+    owner: str
+    spec: JointSpec
+    limits: Optional[Tuple[float, float]] = None
 
-    @property
-    def default_id(self) -> str:
-        return f"{self.type}:{self.body1}&{self.body2}"
+    bodies: ClassVar[Tuple[BodySpec, ...]] = ()
+
+    def label(self) -> str:
+        return f"joint {self.key} ({JointType(self.spec.type).label})"
+
+    def kinematic_axis(self) -> list:
+        """The joint's axis as the robot model states it (Kautham's sign): a robot's hinges
+        and sliders are sent to the world with the axis reversed (see ``plan_problem``)."""
+        spec = self.spec
+        if spec.type in (JointType.HINGE, JointType.SLIDER) and spec.body1:
+            return [-v for v in spec.axis1]
+        return list(spec.axis1)
+
+    def describe(self) -> dict:
+        spec, limits = self.spec, self.limits
+        return {"bodies": [], "joints": [dict(
+            name=self.key, type=JointType(spec.type).label, parent=spec.body1 or None,
+            child=spec.body2, anchor=list(spec.anchor), axis=self.kinematic_axis(),
+            limits=None if limits is None else [limits[0], limits[1]])]}
+
+    def entries(self, answer: str) -> List[StepEntry]:
+        return [StepEntry("Joints", _short(self.key), str(answer))]
+
+    def send(self, client, ids: BuiltIds) -> str:
+        spec = self.spec
+        spec = dataclasses.replace(spec, body1=ids.bodies.get(spec.body1, spec.body1),
+                                   body2=ids.bodies.get(spec.body2, spec.body2))
+        world_id = ids.joints[self.key] = client.add_joint(spec)
+        return world_id
 
 
-@dataclass(frozen=True)
-class MotorRequest:
-    """Services/SetMotor driving the joint built by the JointRequest ``joint_key``."""
+@dataclass(frozen=True, eq=False)
+class MotorStep:
+    """Set Motor on the joint of the JointStep ``joint_key``; the spec's ``joint`` is the
+    predicted joint ID, replaced by the world's when sent."""
     joint_key: str
-    kind: int
+    owner: str
+    spec: MotorSpec
 
+    bodies: ClassVar[Tuple[BodySpec, ...]] = ()
+
+    def label(self) -> str:
+        return f"motor on {self.joint_key}"
+
+    def describe(self) -> dict:
+        return {"bodies": [], "joints": []}
+
+    def entries(self, answer: str) -> List[StepEntry]:
+        return [StepEntry("Motors", _short(self.joint_key), str(answer))]
+
+    def send(self, client, ids: BuiltIds) -> str:
+        spec = dataclasses.replace(self.spec, joint=ids.joints[self.joint_key])
+        world_id = ids.motors[self.joint_key] = client.add_motor(spec)
+        return world_id
+
+
+PlanStep = Union[EntityStep, ObjectStep, CompositeStep, JointStep, MotorStep]
+
+
+def body_step(spec: BodySpec) -> PlanStep:
+    """The step that builds one scene object (ObjectStep or CompositeStep)."""
+    return ObjectStep(spec) if isinstance(spec, ObjectSpec) else CompositeStep(spec)
+
+
+# ---------------------------------------------------------------------------------- plans
 
 @dataclass
 class LinkBody:
@@ -178,17 +299,31 @@ class RobotHandle:
 
 @dataclass
 class BuildPlan:
-    """Requests in the order they must be sent: EntityRequest, ObjectRequest,
-    CompositeRequest, JointRequest, MotorRequest."""
+    """Steps in the order they must be sent (EntityStep, ObjectStep, CompositeStep,
+    JointStep, MotorStep)."""
     problem: Problem
     steps: list
     robots: list                     # RobotHandle per robot (and per movable multi-link obstacle)
 
     def counts(self) -> dict:
+        """{step class name: how many}."""
         out: dict = {}
         for step in self.steps:
             out[type(step).__name__] = out.get(type(step).__name__, 0) + 1
         return out
+
+    def bodies(self) -> List[BodySpec]:
+        """Every object and composite the plan builds (entities' members included), in order."""
+        return [body for step in self.steps for body in step.bodies]
+
+    def record_world_ids(self, ids: BuiltIds) -> None:
+        """Puts the world's IDs (answers to the plan's steps) into the robot handles."""
+        for handle in self.robots:
+            for body in handle.bodies:
+                body.body_id = ids.bodies.get(body.body_id, body.body_id)
+            if handle.joint_keys:
+                handle.joint_ids = [ids.joints[k] for k in handle.joint_keys]
+                handle.motor_ids = [ids.motors[k] for k in handle.joint_keys]
 
 
 def _volume(part_kind: str, parameters: tuple, vertices=None, triangles=None) -> float:
@@ -211,8 +346,8 @@ def _flat(a) -> tuple:
 
 
 def shape_to_body(name: str, shape: Shape, link_pose: np.ndarray, mass: float,
-                  static: bool):
-    """The request (object or composite) for a shape whose frame is at ``link_pose``, and the
+                  static: bool) -> Tuple[BodySpec, np.ndarray]:
+    """The spec (object or composite) for a shape whose frame is at ``link_pose``, and the
     body's pose in that frame (identity but for a lone primitive)."""
     pieces = []
     if shape.mesh is not None:
@@ -226,20 +361,20 @@ def shape_to_body(name: str, shape: Shape, link_pose: np.ndarray, mass: float,
     if len(pieces) == 1:
         kind, params, indices, offset, color, _ = pieces[0]
         position, quaternion = pose_to_position_quaternion(link_pose @ offset)
-        request = ObjectRequest(name=name, parameters=params, indices=indices, mass=mass,
-                                position=position, orientation=quaternion, color=tuple(color),
-                                geometry_only=static, triangle_count=len(indices) // 3)
-        return request, offset
+        spec = ObjectSpec(name=name, parameters=params, indices=indices, mass=mass,
+                          position=position, orientation=quaternion, color=tuple(color),
+                          geometry_only=static)
+        return spec, offset
     total = sum(p[5] for p in pieces) or 1.0
     parts = []
     for k, (kind, params, indices, offset, color, volume) in enumerate(pieces):
         position, quaternion = pose_to_position_quaternion(offset)
-        parts.append(PartRequest(name=f"{name}#{k}", parameters=params, indices=indices,
-                                 mass=max(mass * volume / total, mass * 1e-6),
-                                 position=position, orientation=quaternion, color=tuple(color)))
+        parts.append(PartSpec(name=f"{name}#{k}", parameters=params, indices=indices,
+                              mass=max(mass * volume / total, mass * 1e-6),
+                              position=position, orientation=quaternion, color=tuple(color)))
     position, quaternion = pose_to_position_quaternion(link_pose)
-    return CompositeRequest(parts=tuple(parts), position=position, orientation=quaternion,
-                            geometry_only=static), np.eye(4)
+    return CompositeSpec(parts=tuple(parts), position=position, orientation=quaternion,
+                         geometry_only=static), np.eye(4)
 
 
 def plan_problem(problem: Problem, defaults: BuildDefaults = BuildDefaults()) -> BuildPlan:
@@ -250,41 +385,41 @@ def plan_problem(problem: Problem, defaults: BuildDefaults = BuildDefaults()) ->
         poses = model.link_poses(inst.base_pose)
         static = inst.role == "obstacle" and not inst.movable
         single = len(model.links) == 1
-        requests, bodies = [], []
+        specs, bodies = [], []
         for link, pose in zip(model.links, poses):
             name = inst.name if single else f"{inst.name}/{link.name}"
             mass = link.mass if link.mass is not None else defaults.link_mass
-            request, offset = shape_to_body(name, link.shape, pose, mass, static)
-            requests.append(request)
-            bodies.append(LinkBody(request.id, offset))
+            spec, offset = shape_to_body(name, link.shape, pose, mass, static)
+            specs.append(spec)
+            bodies.append(LinkBody(spec.id, offset))
         if not inst.collision:   # <Collision Enable="false">: the world never pairs it
-            requests = [dataclasses.replace(r, no_collisions=True) for r in requests]
+            specs = [dataclasses.replace(s, no_collisions=True) for s in specs]
         if static or (single and inst.role == "obstacle"):
-            steps.extend(requests)
+            steps.extend(body_step(s) for s in specs)
             continue
         if inst.role == "robot" and not single:
             # The base is a fixed (kinematic) body: it never moves, whatever the motors push,
             # where a fixed joint to the environment would give a little under their reaction.
-            requests[0] = dataclasses.replace(requests[0], fixed=True)
-        steps.append(EntityRequest(
+            specs[0] = dataclasses.replace(specs[0], fixed=True)
+        steps.append(EntityStep(EntitySpec(
             name=inst.name,
-            objects=tuple(r for r in requests if isinstance(r, ObjectRequest)),
-            composites=tuple(r for r in requests if isinstance(r, CompositeRequest)),
-            internal_collisions=defaults.internal_collisions))
+            objects=tuple(s for s in specs if isinstance(s, ObjectSpec)),
+            composites=tuple(s for s in specs if isinstance(s, CompositeSpec)),
+            internal_collisions=defaults.internal_collisions)))
         if single:
             if inst.role == "robot":
                 handles.append(RobotHandle(inst, bodies, [], home=model.home()))
             continue
         frames = model.joint_frames(inst.base_pose)
-        joint_keys, motors = [], []
+        joint_keys, joint_ids, motors = [], [], []
         for i, link in enumerate(model.links):
             if link.parent is None:
                 continue
             key = f"{inst.name}/{link.name}"
             parent_id = bodies[link.parent].body_id
             if not link.movable:
-                steps.append(JointRequest(key=key, type=JOINT_FIXED, body1=parent_id,
-                                          body2=bodies[i].body_id))
+                steps.append(JointStep(key, inst.name, JointSpec(
+                    type=JointType.FIXED, body1=parent_id, body2=bodies[i].body_id)))
                 continue
             frame = frames[i]
             # ODE measures a hinge's angle (a slider's position) as body1's motion relative to
@@ -294,19 +429,20 @@ def plan_problem(problem: Problem, defaults: BuildDefaults = BuildDefaults()) ->
             params = ()
             if link.limits is not None:
                 h = link.home_value()
-                params = ((PARAM_LO_STOP, 1, float(link.limits[0] - h)),
-                          (PARAM_HI_STOP, 1, float(link.limits[1] - h)))
-            steps.append(JointRequest(
-                key=key, type=JOINT_HINGE if link.joint == REVOLUTE else JOINT_SLIDER,
-                body1=parent_id, body2=bodies[i].body_id, anchor=_flat(frame[:3, 3]),
-                axis1=_flat(axis), parameters=params))
+                params = ((JointParameter.LO_STOP, 1, float(link.limits[0] - h)),
+                          (JointParameter.HI_STOP, 1, float(link.limits[1] - h)))
+            revolute = link.joint == REVOLUTE
+            joint = JointSpec(type=JointType.HINGE if revolute else JointType.SLIDER,
+                              body1=parent_id, body2=bodies[i].body_id,
+                              anchor=_flat(frame[:3, 3]), axis1=_flat(axis), parameters=params)
+            steps.append(JointStep(key, inst.name, joint, limits=link.limits))
             joint_keys.append(key)
-            motors.append(MotorRequest(joint_key=key, kind=MOTOR_ANGULAR
-                                       if link.joint == REVOLUTE else MOTOR_LINEAR))
+            joint_ids.append(joint.default_id)
+            motors.append(MotorStep(key, inst.name, MotorSpec(
+                joint=joint.default_id,
+                kind=MotorKind.ANGULAR if revolute else MotorKind.LINEAR)))
         steps.extend(motors)
-        by_key = {s.key: s for s in steps if isinstance(s, JointRequest)}
-        joint_ids = [by_key[k].default_id for k in joint_keys]
         handles.append(RobotHandle(inst, bodies, joint_keys, joint_ids=joint_ids,
-                                   motor_ids=["motor:" + j for j in joint_ids],
+                                   motor_ids=[default_motor_id(j) for j in joint_ids],
                                    home=model.home()))
     return BuildPlan(problem=problem, steps=steps, robots=handles)

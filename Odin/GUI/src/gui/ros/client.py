@@ -1,33 +1,79 @@
 """The GUI's client of the VirtualWorld: rospy service proxies, no Qt.
 
-``WorldClient`` keeps one persistent ``rospy.ServiceProxy`` per world service (a round trip is
-~0.05 ms persistent against ~1.2 ms fresh) and turns ``success: false`` (or a broken
-connection) into ``gui.errors.WorldError`` carrying the world's message. ``execute(plan)``
-sends a ``gui.core.build.BuildPlan``; ``run_position_path`` / ``run_velocity_path`` drive a robot.
+``WorldClient`` keeps one persistent ``rospy.ServiceProxy`` per world service
+(``odin_common.interface.WORLD_SERVICES``; a round trip is ~0.05 ms persistent against ~1.2 ms
+fresh) and offers one typed method per thing a tool or the window asks of the world: requests
+go in as odin_common specs, enums and plain values (SI units, world frame, quaternions
+(w, x, y, z)), answers come back as IDs, ``WorldParameters`` or ``StepValues``. A refusal
+(``success: false``) or a broken connection raises ``gui.errors.WorldError`` carrying the
+world's message. ``execute(plan)`` sends a ``gui.core.build.BuildPlan`` (each step sends
+itself); ``run_position_path`` / ``run_velocity_path`` drive a robot. Messages are built only
+by ``odin_common.messages`` and here.
 
 The Qt window must not call these from its GUI thread (each call blocks until the world
-answers): run them in a worker thread and signal the results back.
+answers): run them in a worker thread and signal the results back (gui.window.worker).
 
-Requires ``rospy.init_node`` (done here with ``disable_signals=True`` unless already done).
+Requires ``rospy.init_node`` (done here with ``disable_signals=True`` unless already done);
+importing this module does not import rospy (only the generated message classes).
 """
 from __future__ import annotations
 
 import time
-from typing import Callable, Optional, Sequence
+from typing import Callable, NamedTuple, Optional, Sequence, Tuple
 
 import numpy as np
 
-from gui.core.build import (BuildPlan, CompositeRequest, EntityRequest, JointRequest, MotorRequest,
-                       ObjectRequest, RobotHandle)
+from gui.core.build import BuildPlan, BuiltIds, RobotHandle
 from gui.errors import WorldError
+from odin_common.errors import InvalidArgument
+from odin_common.interface import WORLD_NAMESPACE, WORLD_SERVICES, ForceKind, SetJointAction
+from odin_common.messages import (composite_message, object_message, parameter_messages,
+                                  situation_messages)
+from odin_common.specs import CompositeSpec, EntitySpec, JointSpec, MotorSpec, ObjectSpec
+from odin_common.step_values import StepValues
+from odin_common.world_parameters import (PARAMETER_INFO, PARAMETERS, ParameterInfo,
+                                          WorldParameters, set_world_flags)
 
-SET_JOINT_CREATE = 0
+
+class BuiltEntity(NamedTuple):
+    """Build Entity's answer: the entity's name and its members' IDs (objects first)."""
+    name: str
+    ids: Tuple[str, ...]
+
+
+def _floats(values) -> list:
+    return [float(v) for v in np.asarray(values, dtype=float).reshape(-1)]
+
+
+def _field(info: ParameterInfo, value):
+    """A world parameter as Set World's request field holds it."""
+    if info.kind == "vector":
+        return _floats(value)
+    if info.kind == "int":
+        return int(value)
+    if info.kind == "bool":
+        return bool(value)
+    return float(value)
+
+
+def _world_parameters(response) -> WorldParameters:
+    """Set World's answer -> the WorldParameters in force."""
+    values = {}
+    for info in PARAMETERS:
+        value = _field(info, getattr(response, info.name))
+        values[info.name] = tuple(value) if info.kind == "vector" else value
+    return WorldParameters(**values)
+
+
+def _step_values(response) -> StepValues:
+    return StepValues(step=float(response.step), steps_per_cycle=int(response.steps_per_cycle),
+                      rate=float(response.rate))
 
 
 class WorldClient:
     """Calls ``<namespace>/<service>``; every method raises ``WorldError`` on refusal."""
 
-    def __init__(self, namespace: str = "/virtual_world", timeout: float = 10.0,
+    def __init__(self, namespace: str = WORLD_NAMESPACE, timeout: float = 10.0,
                  node_name: str = "gui"):
         import rospy
         from Services import srv
@@ -43,15 +89,6 @@ class WorldClient:
             raise WorldError(f"{self.namespace}", f"no VirtualWorld answering after {timeout:g} s "
                              "(is `rosrun VirtualWorld virtualWorld` running?)") from None
 
-    _TYPES = {
-        "new_scene": "NewScene", "set_world": "SetWorld", "set_step": "SetStep",
-        "step_once": "StepOnce", "start": "Start", "build_object": "BuildObject",
-        "build_composite": "BuildComposite", "build_entity": "BuildEntity",
-        "remove_object": "RemoveObject", "set_joint": "SetJoint", "set_motor": "SetMotor",
-        "set_position": "SetPosition", "set_velocity": "SetVelocity",
-        "set_external_force": "SetExternalForce", "set_joint_force": "SetJointForce",
-    }
-
     def call(self, service: str, /, **fields):
         """Calls one service with request ``fields``; returns the response or raises."""
         response = self.ask(service, **fields)
@@ -64,7 +101,7 @@ class WorldClient:
         Set World still reports the values in force); raises only if the call fails."""
         proxy = self._proxies.get(service)
         if proxy is None:
-            service_class = getattr(self._srv, self._TYPES[service])
+            service_class = getattr(self._srv, WORLD_SERVICES[service])
             proxy = self._rospy.ServiceProxy(f"{self.namespace}/{service}", service_class,
                                              persistent=True)
             self._proxies[service] = proxy
@@ -80,112 +117,188 @@ class WorldClient:
             proxy.close()
         self._proxies.clear()
 
-    # -- message conversion -------------------------------------------------------------------
-    @staticmethod
-    def object_msg(req: ObjectRequest):
-        from Messages.msg import Object
-        return Object(name=req.name, parameters=list(np.asarray(req.parameters, dtype=float)),
-                      indices=list(np.asarray(req.indices, dtype=np.uint32)), mass=req.mass,
-                      inertia=list(req.inertia), position=list(req.position),
-                      orientation=list(req.orientation), color=list(req.color),
-                      fixed=req.fixed, geometry_only=req.geometry_only,
-                      no_collisions=req.no_collisions)
-
-    @staticmethod
-    def composite_msg(req: CompositeRequest):
-        from Messages.msg import Composite, Part
-        parts = [Part(name=p.name, parameters=list(np.asarray(p.parameters, dtype=float)),
-                      indices=list(np.asarray(p.indices, dtype=np.uint32)), mass=p.mass,
-                      position=list(p.position), orientation=list(p.orientation),
-                      color=list(p.color)) for p in req.parts]
-        return Composite(parts=parts, position=list(req.position),
-                         orientation=list(req.orientation), fixed=req.fixed,
-                         geometry_only=req.geometry_only, no_collisions=req.no_collisions)
-
-    # -- services -----------------------------------------------------------------------------
+    # -- the scene and the simulation ----------------------------------------------------------
     def new_scene(self) -> None:
+        """New Scene: removes every object, joint, motor and force (parameters stay)."""
         self.call("new_scene")
 
-    def build_object(self, req: ObjectRequest) -> str:
-        return self.call("build_object", object=self.object_msg(req)).id
+    def set_world(self, **changes) -> WorldParameters:
+        """Set World with the world parameters ``changes`` (names, units and ranges:
+        odin_common.world_parameters.PARAMETERS, e.g. ``gravity=(0, 0, -1.62), erp=0.1``), all
+        or nothing; returns the parameters in force. Set World applies some parameters in pairs
+        (bounce with bounce_velocity, solver with quickstep_iterations): the one of a pair not
+        given keeps its value in force."""
+        if not changes:
+            raise InvalidArgument("Set World: no world parameter given")
+        unknown = sorted(set(changes) - set(PARAMETER_INFO))
+        if unknown:
+            raise InvalidArgument(f"Set World: unknown world parameter(s) {unknown}; known: "
+                                  f"{[p.name for p in PARAMETERS]}")
+        flags = set_world_flags()
+        partners = {name for given in changes for name in flags[PARAMETER_INFO[given].set_flag]
+                    if name not in changes}
+        values = dict(changes)
+        if partners:
+            in_force = self.world_parameters()
+            values.update({name: getattr(in_force, name) for name in partners})
+        fields = {}
+        for name, value in values.items():
+            info = PARAMETER_INFO[name]
+            fields[info.set_flag] = True
+            fields[name] = _field(info, value)
+        return _world_parameters(self.call("set_world", **fields))
 
-    def build_composite(self, req: CompositeRequest) -> str:
-        return self.call("build_composite", composite=self.composite_msg(req)).id
+    def world_parameters(self) -> WorldParameters:
+        """The world parameters in force (an empty Set World is refused but answers them)."""
+        return _world_parameters(self.ask("set_world"))
 
-    def build_entity(self, req: EntityRequest) -> list:
-        response = self.call("build_entity", name=req.name,
-                             objects=[self.object_msg(o) for o in req.objects],
-                             composites=[self.composite_msg(c) for c in req.composites],
-                             internal_collisions=req.internal_collisions)
-        return list(response.ids)
+    def set_step(self, step: Optional[float] = None, steps_per_cycle: Optional[int] = None,
+                 cycle_time: Optional[float] = None, rate: Optional[float] = None) -> StepValues:
+        """Set Step with the values given (s, steps, s, Hz; None: not given); the world resolves
+        the others (thesis 4.5) and answers the values in force. Nothing given is refused."""
+        fields = {}
+        if step is not None:
+            fields["step"] = float(step)
+        if steps_per_cycle is not None:
+            fields["steps_per_cycle"] = int(steps_per_cycle)
+        if cycle_time is not None:
+            fields["cycle_time"] = float(cycle_time)
+        if rate is not None:
+            fields["rate"] = float(rate)
+        return _step_values(self.call("set_step", **fields))
 
-    def set_joint(self, req: JointRequest, body_ids: Optional[dict] = None) -> str:
-        from Messages.msg import JointParameter
-        ids = body_ids or {}
-        params = [JointParameter(parameter=p, axis=a, value=v) for p, a, v in req.parameters]
-        return self.call("set_joint", action=SET_JOINT_CREATE, type=req.type,
-                         body1=ids.get(req.body1, req.body1), body2=ids.get(req.body2, req.body2),
-                         anchor=list(req.anchor), axis1=list(req.axis1),
-                         axis2=list(req.axis2), axis3=list(req.axis3), parameters=params).id
-
-    def set_motor(self, joint_id: str, kind: int) -> str:
-        return self.call("set_motor", joint=joint_id, kind=kind).id
-
-    def set_position(self, situations: Sequence, reset_velocity: bool = True) -> None:
-        """``situations``: (body ID, position (3,) m, quaternion (w, x, y, z))."""
-        from Messages.msg import Situation
-        self.call("set_position", situations=[
-            Situation(name=n, position=list(p), orientation=list(q)) for n, p, q in situations],
-            reset_velocity=reset_velocity)
-
-    def set_velocity(self, motors: Sequence[str], velocities: Sequence[float]) -> None:
-        self.call("set_velocity", motors=list(motors),
-                  velocities=[float(v) for v in velocities])
+    def step_values(self) -> StepValues:
+        """The step values in force (an empty Set Step is refused but answers them)."""
+        return _step_values(self.ask("set_step"))
 
     def publication_rate(self) -> float:
-        """The world's publications per wall-clock second: an empty Set Step is refused but
-        answers with the step values in force."""
-        return float(self.ask("set_step").rate)
+        """The world's publications per wall-clock second (Hz)."""
+        return self.step_values().rate
+
+    def step_once(self, cycles: int = 1) -> float:
+        """Step Once: advances a paused world ``cycles`` Portal cycles; returns the simulated
+        time after them (s)."""
+        return float(self.call("step_once", cycles=int(cycles)).sim_time)
+
+    def start(self) -> bool:
+        """Start: the simulation advances by itself; returns the state in force (True)."""
+        return bool(self.call("start", simulate=True).simulating)
+
+    def pause(self) -> bool:
+        """Start with simulate false; returns the state in force (False)."""
+        return bool(self.call("start", simulate=False).simulating)
+
+    # -- objects ---------------------------------------------------------------------------
+    def build_object(self, spec: ObjectSpec) -> str:
+        """Build Object; returns its ID."""
+        return self.call("build_object", object=object_message(spec)).id
+
+    def build_composite(self, spec: CompositeSpec) -> str:
+        """Build Composite; returns its ID (">part1>part2...")."""
+        return self.call("build_composite", composite=composite_message(spec)).id
+
+    def build_entity(self, spec: EntitySpec) -> BuiltEntity:
+        """Build Entity (all or nothing); returns its name and its members' IDs."""
+        response = self.call("build_entity", name=spec.name,
+                             objects=[object_message(o) for o in spec.objects],
+                             composites=[composite_message(c) for c in spec.composites],
+                             internal_collisions=bool(spec.internal_collisions))
+        return BuiltEntity(response.id, tuple(response.ids))
+
+    def remove_object(self, object_id: str) -> None:
+        """Remove Object, with its joints, motors and forces."""
+        self.call("remove_object", id=object_id)
+
+    def set_position(self, situations: Sequence, reset_velocity: bool = True) -> None:
+        """Set Position of bodies at once. ``situations``: (body ID, position (3,) m world,
+        quaternion (w, x, y, z)); ``reset_velocity`` also zeroes their velocities."""
+        self.call("set_position", situations=situation_messages(situations),
+                  reset_velocity=bool(reset_velocity))
+
+    def set_body_velocity(self, object_id: str, linear: Optional[Sequence[float]] = None,
+                          angular: Optional[Sequence[float]] = None) -> None:
+        """Set Velocity of one object: ``linear`` (3,) m/s and/or ``angular`` (3,) rad/s,
+        world frame (None: unchanged)."""
+        fields = dict(object=object_id)
+        if linear is not None:
+            fields.update(set_linear=True, linear=_floats(linear))
+        if angular is not None:
+            fields.update(set_angular=True, angular=_floats(angular))
+        self.call("set_velocity", **fields)
+
+    def add_body_force(self, object_id: str, kind: ForceKind, vector: Sequence[float],
+                       vector_in_body_frame: bool = False, at_point: bool = False,
+                       point: Sequence[float] = (0.0, 0.0, 0.0),
+                       point_in_body_frame: bool = False) -> str:
+        """Set External Force: a persistent force (N, at the centre of mass or at ``point``, m)
+        or torque (N m) on an object, world or body frame; returns its ID."""
+        return self.call("set_external_force", object=object_id, kind=int(ForceKind(kind)),
+                         vector=_floats(vector),
+                         vector_in_body_frame=bool(vector_in_body_frame),
+                         at_point=bool(at_point), point=_floats(point),
+                         point_in_body_frame=bool(point_in_body_frame)).id
+
+    def remove_body_force(self, force_id: str) -> None:
+        self.call("set_external_force", remove=True, id=force_id)
+
+    # -- joints and motors -----------------------------------------------------------------
+    def add_joint(self, spec: JointSpec) -> str:
+        """Set Joint, action CREATE; returns the joint's ID."""
+        return self.call("set_joint", action=int(SetJointAction.CREATE), id=spec.id,
+                         type=int(spec.type), body1=spec.body1, body2=spec.body2,
+                         anchor=_floats(spec.anchor), axis1=_floats(spec.axis1),
+                         axis2=_floats(spec.axis2), axis3=_floats(spec.axis3),
+                         parameters=parameter_messages(spec.parameters)).id
+
+    def set_joint_parameters(self, joint_id: str, parameters: Sequence) -> None:
+        """Set Joint, action SET_PARAMETERS: (JointParameter, axis 1..3, value) triples on a
+        joint or a motor, all or nothing."""
+        self.call("set_joint", action=int(SetJointAction.SET_PARAMETERS), id=joint_id,
+                  parameters=parameter_messages(parameters))
+
+    def remove_joint(self, joint_id: str) -> None:
+        """Set Joint, action REMOVE (its motors and forces go with it)."""
+        self.call("set_joint", action=int(SetJointAction.REMOVE), id=joint_id)
+
+    def add_motor(self, spec: MotorSpec) -> str:
+        """Set Motor; returns the motor's ID."""
+        return self.call("set_motor", id=spec.id, joint=spec.joint, kind=int(spec.kind),
+                         body1=spec.body1, body2=spec.body2, axes=_floats(spec.axes),
+                         axis_frames=[int(f) for f in spec.axis_frames],
+                         max_forces=_floats(spec.max_forces)).id
+
+    def remove_motor(self, motor_id: str) -> None:
+        self.call("set_motor", remove=True, id=motor_id)
+
+    def set_velocities(self, motors: Sequence[str], velocities: Sequence[float]) -> None:
+        """Set Velocity: the goal speeds of ``motors``, one per motor axis in order (rad/s
+        angular, m/s linear)."""
+        self.call("set_velocity", motors=list(motors), velocities=_floats(velocities))
+
+    def add_joint_force(self, joint_id: str, magnitudes: Sequence[float]) -> str:
+        """Set Joint Force: persistent magnitudes along the joint's axes (N m rotations, N
+        translations; odin_common.interface.JOINT_FORCE_MAGNITUDES); returns its ID."""
+        return self.call("set_joint_force", joint=joint_id, magnitudes=_floats(magnitudes)).id
+
+    def remove_joint_force(self, force_id: str) -> None:
+        self.call("set_joint_force", remove=True, id=force_id)
 
     # -- plans --------------------------------------------------------------------------------
     def execute(self, plan: BuildPlan,
                 progress: Optional[Callable[[int, object, str], None]] = None) -> dict:
-        """Sends every request of ``plan`` in order; returns the world's IDs:
+        """Sends every step of ``plan`` in order; returns the world's IDs:
         {"bodies": {planned body ID: world ID}, "joints": {joint key: world ID},
-        "motors": {joint key: world motor ID}}.
+        "motors": {joint key: world motor ID}}. ``progress(k, step, answer)`` after each.
 
         Joint and motor IDs the world returns replace the predicted ones in ``plan.robots``.
         Stops at the first refusal (``WorldError``); what was built before stays built."""
-        bodies: dict = {}
-        joints: dict = {}
-        motors: dict = {}
+        ids = BuiltIds()
         for k, step in enumerate(plan.steps, start=1):
-            if isinstance(step, EntityRequest):
-                members = list(step.objects) + list(step.composites)
-                answer = self.build_entity(step)
-                for member, got in zip(members, answer):
-                    bodies[member.id] = got
-                label = step.name
-            elif isinstance(step, ObjectRequest):
-                label = bodies[step.id] = self.build_object(step)
-            elif isinstance(step, CompositeRequest):
-                label = bodies[step.id] = self.build_composite(step)
-            elif isinstance(step, JointRequest):
-                label = joints[step.key] = self.set_joint(step, bodies)
-            elif isinstance(step, MotorRequest):
-                label = motors[step.joint_key] = self.set_motor(joints[step.joint_key],
-                                                                step.kind)
-            else:
-                raise TypeError(f"unknown plan step {step!r}")
+            answer = step.send(self, ids)
             if progress is not None:
-                progress(k, step, label)
-        for handle in plan.robots:
-            for body in handle.bodies:
-                body.body_id = bodies.get(body.body_id, body.body_id)
-            if handle.joint_keys:
-                handle.joint_ids = [joints[k] for k in handle.joint_keys]
-                handle.motor_ids = [motors[k] for k in handle.joint_keys]
-        return {"bodies": bodies, "joints": joints, "motors": motors}
+                progress(k, step, answer)
+        plan.record_world_ids(ids)
+        return ids.as_dict()
 
 
 def run_position_path(client: WorldClient, handle: RobotHandle, rows: np.ndarray,
@@ -215,11 +328,11 @@ def run_velocity_path(client: WorldClient, handle: RobotHandle, rows: np.ndarray
     period = 1.0 / rate
     start = time.monotonic()
     for k, row in enumerate(rows, start=1):
-        client.set_velocity(handle.motor_ids, row)
+        client.set_velocities(handle.motor_ids, row)
         if progress is not None:
             progress(k)
         delay = start + k * period - time.monotonic()
         if delay > 0:
             sleep(delay)
     if stop:
-        client.set_velocity(handle.motor_ids, np.zeros(len(handle.motor_ids)))
+        client.set_velocities(handle.motor_ids, np.zeros(len(handle.motor_ids)))

@@ -8,24 +8,37 @@ list (Set parameters). A motor can be put on the chosen joint (then driven from 
 """
 from __future__ import annotations
 
-from PyQt5.QtWidgets import (QCheckBox, QComboBox, QGridLayout, QGroupBox, QHBoxLayout,
-                             QLabel, QListWidget, QPushButton, QVBoxLayout, QWidget)
+from PyQt5.QtWidgets import (QComboBox, QGridLayout, QGroupBox, QHBoxLayout, QLabel,
+                             QListWidget, QPushButton, QVBoxLayout, QWidget)
 
 from gui.window.fields import InputError, VectorRow, checked_spin, int_spin
-from gui.window.scene import JOINT_TYPES
+from gui.window.scene import JOINT_TYPE_NAMES
+from odin_common.interface import (JOINT_AXES_USED, JOINT_USES_ANCHOR, JointParameter,
+                                   JointType, MotorKind)
+from odin_common.specs import JointSpec, MotorSpec
+from odin_common.world_parameters import default
 
 STATIC = "Static environment"
-#: (Messages/JointParameter constant, label, default, low, high)
+#: (parameter, label, value shown first, low, high); a joint's ERP and CFM start at the world's
 PARAMETERS = [
-    (0, "Low stop (rad or m)", -1.0, -1e3, 1e3), (1, "High stop (rad or m)", 1.0, -1e3, 1e3),
-    (2, "Stop bounce", 0.0, 0.0, 1.0), (3, "CFM", 1e-5, 0.0, 1.0), (4, "ERP", 0.2, 0.0, 1.0),
-    (5, "Stop ERP", 0.2, 0.0, 1.0), (6, "Stop CFM", 1e-5, 0.0, 1.0),
-    (7, "Suspension ERP (hinge2)", 0.2, 0.0, 1.0),
-    (8, "Suspension CFM (hinge2)", 1e-5, 0.0, 1.0), (9, "Fudge factor", 1.0, 0.0, 1.0),
+    (JointParameter.LO_STOP, "Low stop (rad or m)", -1.0, -1e3, 1e3),
+    (JointParameter.HI_STOP, "High stop (rad or m)", 1.0, -1e3, 1e3),
+    (JointParameter.BOUNCE, "Stop bounce", 0.0, 0.0, 1.0),
+    (JointParameter.CFM, "CFM", default("cfm"), 0.0, 1.0),
+    (JointParameter.ERP, "ERP", default("erp"), 0.0, 1.0),
+    (JointParameter.STOP_ERP, "Stop ERP", default("erp"), 0.0, 1.0),
+    (JointParameter.STOP_CFM, "Stop CFM", default("cfm"), 0.0, 1.0),
+    (JointParameter.SUSPENSION_ERP, "Suspension ERP (hinge2)", default("erp"), 0.0, 1.0),
+    (JointParameter.SUSPENSION_CFM, "Suspension CFM (hinge2)", default("cfm"), 0.0, 1.0),
+    (JointParameter.FUDGE_FACTOR, "Fudge factor", 1.0, 0.0, 1.0),
 ]
-#: joint type -> motor kind (0 angular, 1 linear) for "Add motor"
-MOTOR_KIND = {1: 0, 2: 1, 3: 1, 4: 0, 5: 0, 6: 1, 7: 0}
-MOTOR_AXES = {1: 1, 2: 1, 3: 1, 4: 2, 5: 2, 6: 1, 7: 2}
+#: joint type -> the motor "Add motor" puts on it: its kind and number of axes
+MOTORS = {
+    JointType.HINGE: (MotorKind.ANGULAR, 1), JointType.SLIDER: (MotorKind.LINEAR, 1),
+    JointType.PISTON: (MotorKind.LINEAR, 1), JointType.UNIVERSAL: (MotorKind.ANGULAR, 2),
+    JointType.HINGE2: (MotorKind.ANGULAR, 2), JointType.PR: (MotorKind.LINEAR, 1),
+    JointType.PU: (MotorKind.ANGULAR, 2),
+}
 
 
 class JointsTab(QWidget):
@@ -33,8 +46,8 @@ class JointsTab(QWidget):
         super().__init__(parent)
         self.window = window
         self.type = QComboBox()
-        self.type.addItems([t[0] for t in JOINT_TYPES])
-        self.type.setCurrentIndex(1)
+        self.type.addItems([JOINT_TYPE_NAMES[t] for t in JointType])   # index = JointType
+        self.type.setCurrentIndex(JointType.HINGE)
         self.body1 = QComboBox()
         self.body2 = QComboBox()
         self.anchor = VectorRow("xyz", (0.0, 0.0, 0.0), -1e4, 1e4, 3, 0.1, "m")
@@ -63,10 +76,10 @@ class JointsTab(QWidget):
         pgrid.addWidget(QLabel("Axis"), 0, 0)
         pgrid.addWidget(self.param_axis, 0, 1)
         self.param_fields = {}
-        for k, (code, label, value, low, high) in enumerate(PARAMETERS):
+        for k, (parameter, label, value, low, high) in enumerate(PARAMETERS):
             check, box = checked_spin(label, value, low, high, 6, 0.05)
             box.valueChanged.connect(lambda _v, c=check: c.setChecked(True))
-            self.param_fields[code] = (check, box)
+            self.param_fields[parameter] = (check, box)
             pgrid.addWidget(check, 1 + k // 2, 2 * (k % 2))
             pgrid.addWidget(box, 1 + k // 2, 2 * (k % 2) + 1)
 
@@ -101,11 +114,12 @@ class JointsTab(QWidget):
         self._type_changed(self.type.currentIndex())
 
     def _type_changed(self, index: int) -> None:
-        _, anchor, axes = JOINT_TYPES[index]
-        self.anchor.setEnabled(anchor)
+        joint_type = JointType(index)
+        self.anchor.setEnabled(joint_type in JOINT_USES_ANCHOR)
+        axes = len(JOINT_AXES_USED[joint_type])
         for k, row in enumerate(self.axes):
             row.setEnabled(k < axes)
-        self.body2.setEnabled(index != 9)    # Plane 2D: body1 only
+        self.body2.setEnabled(joint_type != JointType.PLANE2D)    # body1 only
 
     def enabled_rows(self) -> list:
         """Names of the enabled geometry rows (for tests and tool tips)."""
@@ -136,17 +150,17 @@ class JointsTab(QWidget):
         return item.text() if item is not None else None
 
     def parameters(self) -> list:
-        from Messages.msg import JointParameter
+        """(JointParameter, axis, value) of the checked parameters."""
         axis = int(self.param_axis.value())
-        return [JointParameter(parameter=code, axis=axis, value=float(box.value()))
-                for code, (check, box) in self.param_fields.items() if check.isChecked()]
+        return [(parameter, axis, float(box.value()))
+                for parameter, (check, box) in self.param_fields.items() if check.isChecked()]
 
     def _clear_checks(self) -> None:
         for check, _ in self.param_fields.values():
             check.setChecked(False)
 
     def create(self) -> None:
-        joint_type = self.type.currentIndex()
+        joint_type = JointType(self.type.currentIndex())
         body1 = self.body1.currentText()
         body2 = self.body2.currentText() if self.body2.isEnabled() else STATIC
         body1 = "" if body1 in (STATIC, "") else body1
@@ -158,23 +172,20 @@ class JointsTab(QWidget):
         if body1 and body1 == body2:
             self.window.show_error(f"Create joint: {body1} cannot be joined to itself")
             return
-        fields = dict(action=0, type=joint_type, body1=body1, body2=body2,
-                      anchor=list(self.anchor.values()),
-                      axis1=list(self.axes[0].values()), axis2=list(self.axes[1].values()),
-                      axis3=list(self.axes[2].values()), parameters=self.parameters())
-        for k in range(JOINT_TYPES[joint_type][2]):
-            if not any(fields[f"axis{k + 1}"]):
-                self.window.show_error(f"Create joint: axis {k + 1} is zero; give it a "
-                                       "direction")
+        spec = JointSpec(type=joint_type, body1=body1, body2=body2, anchor=self.anchor.values(),
+                         axis1=self.axes[0].values(), axis2=self.axes[1].values(),
+                         axis3=self.axes[2].values(), parameters=tuple(self.parameters()))
+        for k, axis in enumerate(JOINT_AXES_USED[joint_type], start=1):
+            if not any(getattr(spec, axis)):
+                self.window.show_error(f"Create joint: axis {k} is zero; give it a direction")
                 return
 
-        def done(response):
+        def done(joint_id):
             self._clear_checks()
-            self.window.simulation.add_built("Joints", response.id, response.id)
-            self.window.show_info(f"Built joint {response.id}")
+            self.window.simulation.add_built("Joints", joint_id, joint_id)
+            self.window.show_info(f"Built joint {joint_id}")
 
-        self.window.call("Create Joint", lambda client, job: client.call("set_joint",
-                                                                          **fields), done)
+        self.window.call("Create Joint", lambda client, job: client.add_joint(spec), done)
 
     def set_parameters(self) -> None:
         joint_id = self.selected()
@@ -192,8 +203,8 @@ class JointsTab(QWidget):
             self._clear_checks()
             self.window.show_info(f"Parameters of {joint_id} set")
 
-        self.window.call("Set Joint parameters", lambda client, job: client.call(
-            "set_joint", action=1, id=joint_id, parameters=params), done)
+        self.window.call("Set Joint parameters", lambda client, job:
+                         client.set_joint_parameters(joint_id, params), done)
 
     def remove(self) -> None:
         joint_id = self.selected()
@@ -205,21 +216,21 @@ class JointsTab(QWidget):
             self.window.simulation.remove_built(joint_id)
             self.window.show_info(f"Removed {joint_id}")
 
-        self.window.call("Remove Joint", lambda client, job: client.call(
-            "set_joint", action=2, id=joint_id), done)
+        self.window.call("Remove Joint", lambda client, job: client.remove_joint(joint_id), done)
 
     def add_motor(self) -> None:
         joint_id = self.selected()
         joint_type = self.window.scene.joints.get(joint_id)
-        if joint_id is None or joint_type not in MOTOR_KIND:
+        if joint_id is None or joint_type not in MOTORS:
             self.window.show_error("Add motor: choose a hinge, slider, piston, universal, "
                                    "hinge2, PR or PU joint in the list")
             return
+        kind, axes = MOTORS[joint_type]
 
-        def done(response):
-            self.window.scene.add_motor(response.id, MOTOR_AXES[joint_type])
-            self.window.simulation.add_built("Motors", response.id, response.id)
-            self.window.show_info(f"Built motor {response.id}")
+        def done(motor_id):
+            self.window.scene.add_motor(motor_id, axes)
+            self.window.simulation.add_built("Motors", motor_id, motor_id)
+            self.window.show_info(f"Built motor {motor_id}")
 
-        self.window.call("Add motor", lambda client, job: client.call(
-            "set_motor", joint=joint_id, kind=MOTOR_KIND[joint_type]), done)
+        self.window.call("Add motor", lambda client, job: client.add_motor(
+            MotorSpec(joint=joint_id, kind=kind)), done)

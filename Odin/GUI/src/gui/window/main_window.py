@@ -25,13 +25,14 @@ from gui.window.settings_tab import SettingsTab
 from gui.window.simulation_tab import SimulationTab
 from gui.window.viewer_panel import ViewerPanel
 from gui.window.worker import WorldWorker
+from odin_common.interface import VIEWER_NAMESPACE, WORLD_NAMESPACE
 
 SLOW_AFTER = 1.0        # s: a call taking longer makes the status bar say the world is slow
 SILENT_AFTER = 2.0      # s: no world_update for this long while connected: "not publishing"
 
 
 class MainWindow(QMainWindow):
-    def __init__(self, world: str = "/virtual_world", viewer: str = "/viewer",
+    def __init__(self, world: str = WORLD_NAMESPACE, viewer: str = VIEWER_NAMESPACE,
                  ros: bool = True, poll_period: float = 0.5):
         super().__init__()
         self.setWindowTitle("Odin GUI")

@@ -16,10 +16,15 @@ from PyQt5.QtWidgets import (QButtonGroup, QCheckBox, QComboBox, QFileDialog, QG
                              QHBoxLayout, QLabel, QListWidget, QPushButton, QRadioButton,
                              QToolBox, QVBoxLayout, QWidget)
 
-from gui.window.fields import InputError, VectorRow, int_spin, spin
-from gui.window.scene import JOINT_FORCE_AXES, JOINT_TYPES
+from gui.window.fields import VectorRow, int_spin, spin
+from gui.window.scene import JOINT_TYPE_NAMES
+from odin_common.interface import JOINT_FORCE_MAGNITUDES, ForceKind
+from odin_common.step_values import StepValues
 
 ACTIONS = ["force", "torque", "angular velocity", "linear velocity"]
+#: the actions that add a persistent force (by their index in ACTIONS)
+FORCE_ACTIONS = {0: ForceKind.FORCE, 1: ForceKind.TORQUE}
+ANGULAR_VELOCITY = 2
 
 
 class MotionTab(QWidget):
@@ -185,13 +190,15 @@ class MotionTab(QWidget):
 
     def _joint_changed(self) -> None:
         joint_type = self.window.scene.joints.get(self.joint.currentText())
-        count = JOINT_FORCE_AXES.get(joint_type, 0) if joint_type is not None else 3
+        magnitudes = JOINT_FORCE_MAGNITUDES.get(joint_type, ())
+        count = len(magnitudes) if joint_type is not None else 3
         for k, box in enumerate(self.magnitudes.boxes):
             box.setEnabled(k < count)
         self.joint_force_button.setEnabled(count > 0)
         if joint_type is not None:
-            self.joint_force_button.setToolTip(f"{JOINT_TYPES[joint_type][0]}: {count} "
-                                               "magnitude(s)")
+            self.joint_force_button.setToolTip(
+                f"{JOINT_TYPE_NAMES.get(joint_type, joint_type)}: {count} magnitude(s)"
+                + (f" ({', '.join(magnitudes)})" if magnitudes else ""))
 
     def _motor_changed(self) -> None:
         axes = self.window.scene.motors.get(self.motor.currentText(), 1)
@@ -205,42 +212,41 @@ class MotionTab(QWidget):
             self.window.show_error("Move object: choose an object (build one first)")
             return
         action = self.action_group.checkedId()
-        vector = list(self.vector.values())
-        if action in (0, 1):
-            fields = dict(object=object_id, kind=action, vector=vector,
-                          vector_in_body_frame=self.vector_relative.isChecked(),
-                          at_point=action == 0 and self.at_point.isChecked(),
-                          point=list(self.point.values()),
-                          point_in_body_frame=self.point_relative.isChecked())
+        vector = self.vector.values()
+        if action in FORCE_ACTIONS:
+            kind = FORCE_ACTIONS[action]
+            options = dict(vector_in_body_frame=self.vector_relative.isChecked(),
+                           at_point=kind == ForceKind.FORCE and self.at_point.isChecked(),
+                           point=self.point.values(),
+                           point_in_body_frame=self.point_relative.isChecked())
 
-            def done(response):
-                self.window.scene.add_force(response.id)
-                self.window.show_info(f"Added {response.id}")
+            def done(force_id):
+                self.window.scene.add_force(force_id)
+                self.window.show_info(f"Added {force_id}")
 
-            self.window.call("Set External Force", lambda client, job: client.call(
-                "set_external_force", **fields), done)
+            self.window.call("Set External Force", lambda client, job: client.add_body_force(
+                object_id, kind, vector, **options), done)
         else:
-            fields = dict(object=object_id)
-            if action == 2:
-                fields.update(set_angular=True, angular=vector)
-            else:
-                fields.update(set_linear=True, linear=vector)
-            self.window.call("Set Velocity", lambda client, job: client.call(
-                "set_velocity", **fields),
+            velocity = dict(angular=vector) if action == ANGULAR_VELOCITY else \
+                dict(linear=vector)
+            self.window.call("Set Velocity", lambda client, job: client.set_body_velocity(
+                object_id, **velocity),
                 lambda _: self.window.show_info(f"Velocity of {object_id} set"))
 
     def delete_force(self) -> None:
-        self._delete_selected(self.forces, "set_external_force", "Remove External Force",
+        self._delete_selected(self.forces, lambda client, force_id:
+                              client.remove_body_force(force_id), "Remove External Force",
                               "a force or torque")
 
-    def _delete_selected(self, listing, service: str, label: str, what: str) -> None:
-        """Removes the force (on an object or a joint) chosen in ``listing``."""
+    def _delete_selected(self, listing, remove, label: str, what: str) -> None:
+        """Removes the force (on an object or a joint) chosen in ``listing`` with
+        ``remove(client, force_id)``."""
         item = listing.currentItem()
         if item is None:
             self.window.show_error(f"Delete: select {what} in the list")
             return
         force_id = item.text()
-        self.window.call(label, lambda client, job: client.call(service, remove=True, id=force_id),
+        self.window.call(label, lambda client, job: remove(client, force_id),
                          lambda _: self.window.scene.remove_force(force_id))
 
     # -- joints ---------------------------------------------------------------------------
@@ -250,18 +256,20 @@ class MotionTab(QWidget):
             self.window.show_error("Move joint: choose a joint (build one first)")
             return
         joint_type = self.window.scene.joints.get(joint_id)
-        count = JOINT_FORCE_AXES.get(joint_type, 1)
-        magnitudes = list(self.magnitudes.values()[:count])
+        # a type that takes none (fixed) or not reported yet: one, for the world to judge
+        count = len(JOINT_FORCE_MAGNITUDES.get(joint_type, ())) or 1
+        magnitudes = self.magnitudes.values()[:count]
 
-        def done(response):
-            self.window.scene.add_joint_force(response.id)
-            self.window.show_info(f"Added {response.id}")
+        def done(force_id):
+            self.window.scene.add_joint_force(force_id)
+            self.window.show_info(f"Added {force_id}")
 
-        self.window.call("Set Joint Force", lambda client, job: client.call(
-            "set_joint_force", joint=joint_id, magnitudes=magnitudes), done)
+        self.window.call("Set Joint Force", lambda client, job: client.add_joint_force(
+            joint_id, magnitudes), done)
 
     def delete_joint_force(self) -> None:
-        self._delete_selected(self.joint_forces, "set_joint_force", "Remove Joint Force",
+        self._delete_selected(self.joint_forces, lambda client, force_id:
+                              client.remove_joint_force(force_id), "Remove Joint Force",
                               "a joint force")
 
     # -- motors ---------------------------------------------------------------------------
@@ -273,7 +281,7 @@ class MotionTab(QWidget):
             return
         axes = self.window.scene.motors.get(motor_id, 1)
         speeds = list(self.motor_speeds.values()[:axes])
-        self.window.call("Set Velocity", lambda client, job: client.set_velocity(
+        self.window.call("Set Velocity", lambda client, job: client.set_velocities(
             [motor_id], speeds), lambda _: self.window.show_info(f"{motor_id}: goal {speeds}"))
 
     # -- robots ---------------------------------------------------------------------------
@@ -303,7 +311,7 @@ class MotionTab(QWidget):
             return
         if kind == "position" and self.double.value():
             rows = refine(rows, int(self.double.value()))
-        rate = self.window.publication_rate or 25.0
+        rate = self.window.publication_rate or StepValues().rate
         total = len(rows)
         name = pathlib.Path(path).name
 
@@ -315,7 +323,7 @@ class MotionTab(QWidget):
                 runner(client, handle, rows, rate, progress=job.progress, sleep=job.sleep)
             except Cancelled:
                 if kind == "velocity":   # leave the robot still, as a finished path does
-                    client.set_velocity(handle.motor_ids, [0.0] * len(handle.motor_ids))
+                    client.set_velocities(handle.motor_ids, [0.0] * len(handle.motor_ids))
                 raise
             return total
 

@@ -10,6 +10,7 @@ The list below shows every object in the world (from ``world_update``).
 from __future__ import annotations
 
 import pathlib
+from dataclasses import replace
 
 import numpy as np
 from PyQt5.QtWidgets import (QCheckBox, QComboBox, QFileDialog, QFormLayout, QGridLayout,
@@ -18,6 +19,8 @@ from PyQt5.QtWidgets import (QCheckBox, QComboBox, QFileDialog, QFormLayout, QGr
 
 from gui.window.fields import InputError, VectorRow, name_edit, quaternion_row, spin, \
     unit_quaternion
+from odin_common.rotations import quaternion_to_matrix
+from odin_common.specs import CompositeSpec, ObjectSpec
 
 SHAPES = ["Sphere", "Cylinder", "Box", "Mesh from file"]
 #: shape -> [(preset name, parameters)]
@@ -160,8 +163,8 @@ class ObjectsTab(QWidget):
 
     # -- create -------------------------------------------------------------------------------
     def object_request(self):
-        """The (kind, request) to send, or ``InputError`` saying what is missing."""
-        from gui.core.build import ObjectRequest
+        """The ObjectSpec to build, or ("mesh", name, file, scale, common fields) for a mesh
+        file (read on the worker); ``InputError`` saying what is missing."""
         name = self.name.text().strip()
         if not name:
             raise InputError("Create object: type a name for the object")
@@ -171,11 +174,11 @@ class ObjectsTab(QWidget):
         shape = SHAPES[self.shape.currentIndex()]
         static = self.static.isChecked()
         common = dict(mass=float(self.mass.value()), position=self.position.values(),
-                      orientation=quaternion, color=(0.0, 0.0, 0.0, 0.0),
-                      fixed=self.fixed.isChecked() and not static, geometry_only=static)
+                      orientation=quaternion, fixed=self.fixed.isChecked() and not static,
+                      geometry_only=static)
         if shape != "Mesh from file":
             params = tuple(float(b.value()) for b in self.params[shape])
-            return ObjectRequest(name=name, parameters=params, indices=(), **common)
+            return ObjectSpec(name=name, parameters=params, **common)
         path = self.mesh_path.text().strip()
         if not path:
             raise InputError("Create object: choose a mesh file")
@@ -231,7 +234,7 @@ class ObjectsTab(QWidget):
             self.window.show_info(f"Removed {object_id}")
 
         self.window.call("Remove Object",
-                         lambda client, job: client.call("remove_object", id=object_id), done)
+                         lambda client, job: client.remove_object(object_id), done)
 
     def set_transformation(self) -> None:
         object_id = self.selected()
@@ -262,8 +265,7 @@ class ObjectsTab(QWidget):
 
 def _build_mesh(client, name: str, path: str, scale: float, common: dict):
     """Reads a mesh file and builds it (worker thread); returns (ID, part names or None)."""
-    from gui.core.build import CompositeRequest, shape_to_body
-    from odin_common.rotations import quaternion_to_matrix
+    from gui.core.build import shape_to_body
     from gui.core.shapes import read_shape
     shape = read_shape(path, scale)
     if shape.is_empty:
@@ -271,11 +273,8 @@ def _build_mesh(client, name: str, path: str, scale: float, common: dict):
     pose = np.eye(4)
     pose[:3, :3] = quaternion_to_matrix(common["orientation"])
     pose[:3, 3] = common["position"]
-    request, _ = shape_to_body(name, shape, pose, common["mass"], common["geometry_only"])
-    if isinstance(request, CompositeRequest):
-        from dataclasses import replace
-        request = replace(request, fixed=common["fixed"])
-        return client.build_composite(request), [p.name for p in request.parts]
-    from dataclasses import replace
-    request = replace(request, fixed=common["fixed"])
-    return client.build_object(request), None
+    spec, _ = shape_to_body(name, shape, pose, common["mass"], common["geometry_only"])
+    spec = replace(spec, fixed=common["fixed"])
+    if isinstance(spec, CompositeSpec):
+        return client.build_composite(spec), [p.name for p in spec.parts]
+    return client.build_object(spec), None

@@ -17,6 +17,8 @@ import threading
 from PyQt5.QtCore import QObject, pyqtSignal
 from PyQt5.QtGui import QImage
 
+from odin_common.interface import VIEWER_NAMESPACE, WORLD_NAMESPACE
+
 _FORMATS = {"rgb8": (QImage.Format_RGB888, 3), "bgr8": (QImage.Format_RGB888, 3),
             "mono8": (QImage.Format_Grayscale8, 1), "rgba8": (QImage.Format_RGBA8888, 4)}
 
@@ -42,7 +44,8 @@ class RosLink(QObject):
     image = pyqtSignal(object)
     _image_ready = pyqtSignal()
 
-    def __init__(self, world: str = "/virtual_world", viewer: str = "/viewer", parent=None):
+    def __init__(self, world: str = WORLD_NAMESPACE, viewer: str = VIEWER_NAMESPACE,
+                 parent=None):
         super().__init__(parent)
         import rospy
         from sensor_msgs.msg import Image, JointState

@@ -13,14 +13,16 @@ from typing import Optional
 
 from PyQt5.QtCore import QObject, pyqtSignal
 
-#: Messages/Joint types: name, anchor used, axes used (1..3)
-JOINT_TYPES = [
-    ("Ball", True, 0), ("Hinge", True, 1), ("Slider", False, 1), ("Piston", True, 1),
-    ("Universal", True, 2), ("Hinge2", True, 2), ("PR (prismatic-rotoide)", True, 2),
-    ("PU (prismatic-universal)", True, 3), ("Fixed", False, 0), ("Plane 2D", False, 0),
-]
-#: magnitudes a joint force takes per joint type (Set Joint Force)
-JOINT_FORCE_AXES = {0: 3, 1: 1, 2: 1, 3: 1, 4: 2, 5: 2, 6: 2, 7: 2}
+from odin_common.interface import JointType, motor_joint
+
+JOINT_TYPE_NAMES = {
+    JointType.BALL: "Ball", JointType.HINGE: "Hinge", JointType.SLIDER: "Slider",
+    JointType.PISTON: "Piston", JointType.UNIVERSAL: "Universal", JointType.HINGE2: "Hinge2",
+    JointType.PR: "PR (prismatic-rotoide)", JointType.PU: "PU (prismatic-universal)",
+    JointType.FIXED: "Fixed", JointType.PLANE2D: "Plane 2D",
+}
+"""How the window names each joint type (what each one uses and takes:
+odin_common.interface's joint tables)."""
 
 
 class SceneModel(QObject):
@@ -32,7 +34,7 @@ class SceneModel(QObject):
         self.geometries: set = set()    # geometry names of the last world_update
         self.poses: dict = {}           # geometry name -> (position, quaternion wxyz)
         self.objects: list = []         # object IDs in the world, sorted
-        self.joints: dict = {}          # joint ID -> type (from joint_data)
+        self.joints: dict = {}          # joint ID -> JointType value (from joint_data)
         self.motors: dict = {}          # motor ID -> number of axes
         self.forces: list = []          # external force / torque IDs
         self.joint_forces: list = []    # joint force IDs
@@ -68,8 +70,8 @@ class SceneModel(QObject):
         joints = {j.id: int(j.type) for j in msg.joints}
         if joints != self.joints:
             self.joints = joints
-            motors = {m: n for m, n in self.motors.items() if m[len("motor:"):] in joints
-                      or not m.startswith("motor:")}
+            motors = {m: n for m, n in self.motors.items() if motor_joint(m) in joints
+                      or not motor_joint(m)}
             stale = [f for f in self.joint_forces if f.split(":", 1)[1].rsplit(":", 1)[0]
                      not in joints]
             self.changed.emit("joints")

@@ -3,45 +3,65 @@
 Step: any subset of the four step values (a check box each; unchecked means "not given"); the
 world resolves conflicts and answers the values in force, which are shown beside the fields.
 World parameters: each with a check box (zero is a valid value of most), sent together in one
-Set World (all-or-nothing); the values in force come back and are shown. The values in force
-are read when the world comes up (a Set Step / Set World with nothing set).
+Set World (all-or-nothing); the values in force come back and are shown. Their first values,
+units and ranges are odin_common.world_parameters'. The values in force are read through the
+client when the world comes up (an empty Set Step / Set World answers them).
 """
 from __future__ import annotations
+
+from typing import Optional
 
 from PyQt5.QtWidgets import (QButtonGroup, QCheckBox, QComboBox, QGridLayout, QHBoxLayout,
                              QLabel, QPushButton, QRadioButton, QToolBox, QVBoxLayout, QWidget)
 
 from gui.window.fields import VectorRow, checked_spin, int_spin, spin
+from odin_common.interface import Solver
+from odin_common.step_values import MAX_RATE, MAX_STEP, MAX_STEPS_PER_CYCLE, StepValues
+from odin_common.world_parameters import PARAMETER_INFO, default
 
-#: (request field, label, default, low, high, decimals, step, unit) of the scalar parameters
+#: (parameter, label, decimals, step, bound of the field where the parameter has none) of the
+#: scalar parameters, per page
 SCALARS = {
     "ERP and CFM": [
-        ("erp", "Error reduction parameter (ERP)", 0.2, 0.0, 1.0, 4, 0.05, ""),
-        ("cfm", "Constraint force mixing (CFM)", 1e-5, 0.0, 1.0, 7, 1e-5, ""),
+        ("erp", "Error reduction parameter (ERP)", 4, 0.05, None),
+        ("cfm", "Constraint force mixing (CFM)", 7, 1e-5, 1.0),
     ],
     "Speed limits and contact layer": [
-        ("max_angular_speed", "Maximum angular speed (0: none)", 0.0, 0.0, 1e4, 3, 1.0,
-         "rad/s"),
+        ("max_angular_speed", "Maximum angular speed (0: none)", 3, 1.0, 1e4),
         ("contact_max_correcting_velocity", "Contact max correcting velocity (0: unlimited)",
-         0.0, 0.0, 1e4, 3, 0.1, "m/s"),
-        ("contact_surface_layer", "Contact surface layer", 0.001, 0.0, 1.0, 4, 0.001, "m"),
+         3, 0.1, 1e4),
+        ("contact_surface_layer", "Contact surface layer", 4, 0.001, 1.0),
     ],
     "Damping": [
-        ("linear_damping", "Linear damping", 0.0, 0.0, 1.0, 4, 0.01, ""),
-        ("linear_damping_threshold", "Linear damping threshold", 0.01, 0.0, 1e3, 4, 0.01,
-         "m/s"),
-        ("angular_damping", "Angular damping", 0.0, 0.0, 1.0, 4, 0.01, ""),
-        ("angular_damping_threshold", "Angular damping threshold", 0.01, 0.0, 1e3, 4, 0.01,
-         "rad/s"),
+        ("linear_damping", "Linear damping", 4, 0.01, None),
+        ("linear_damping_threshold", "Linear damping threshold", 4, 0.01, 1e3),
+        ("angular_damping", "Angular damping", 4, 0.01, None),
+        ("angular_damping_threshold", "Angular damping threshold", 4, 0.01, 1e3),
     ],
     "Contacts": [
-        ("friction", "Friction (Coulomb mu)", 1.0, 0.0, 1e3, 3, 0.1, ""),
-        ("bounce", "Bounce (restitution)", 0.0, 0.0, 1.0, 3, 0.05, ""),
-        ("bounce_velocity", "Bounce velocity", 0.1, 0.0, 1e3, 3, 0.05, "m/s"),
+        ("friction", "Friction (Coulomb mu; negative: infinite)", 3, 0.1, 1e3),
+        ("bounce", "Bounce (restitution)", 3, 0.05, None),
+        ("bounce_velocity", "Bounce velocity", 3, 0.05, 1e3),
         ("collision_mesh_tolerance", "Collision mesh tolerance (0: as given; meshes built "
-         "afterwards)", 0.0, 0.0, 1.0, 4, 0.001, "m"),
+         "afterwards)", 4, 0.001, None),
     ],
 }
+SOLVER_NAMES = {Solver.QUICKSTEP: "QuickStep", Solver.WORLDSTEP: "WorldStep"}
+SOLVER_ITEMS = {Solver.QUICKSTEP: "QuickStep (iterative, handles piles)",
+                Solver.WORLDSTEP: "WorldStep (exact, the thesis's)"}
+
+
+def _unit(name: str) -> str:
+    unit = PARAMETER_INFO[name].unit
+    return "" if unit == "-" else unit.replace("^2", "²")
+
+
+def _range(name: str, bound: Optional[float]) -> tuple:
+    """(low, high) of a parameter's field: its range, ``bound`` above where it has no upper
+    bound, ``-bound`` below where it has no lower one (friction: negative is infinite)."""
+    info = PARAMETER_INFO[name]
+    return (float(info.low if info.low is not None else -bound),
+            float(info.high if info.high is not None else bound))
 
 
 class SettingsTab(QWidget):
@@ -55,11 +75,15 @@ class SettingsTab(QWidget):
         # -- step page
         page = QWidget()
         grid = QGridLayout(page)
+        first = StepValues()   # shown until the world answers with the values in force
         self.step_fields = {
-            "step": checked_spin("Step", 0.001, 1e-6, 1.0, 6, 0.0005, "s"),
-            "steps_per_cycle": (QCheckBox("Steps per cycle"), int_spin(40, 1, 100000)),
-            "cycle_time": checked_spin("Cycle time", 0.04, 1e-6, 10.0, 5, 0.01, "s"),
-            "rate": checked_spin("Rate (publications / s)", 25.0, 0.01, 1000.0, 2, 1.0, "Hz"),
+            "step": checked_spin("Step", first.step, 1e-6, MAX_STEP, 6, 0.0005, "s"),
+            "steps_per_cycle": (QCheckBox("Steps per cycle"),
+                                int_spin(first.steps_per_cycle, 1, MAX_STEPS_PER_CYCLE)),
+            "cycle_time": checked_spin("Cycle time", first.cycle_time, 1e-6, 10.0, 5, 0.01,
+                                       "s"),
+            "rate": checked_spin("Rate (publications / s)", first.rate, 0.01, MAX_RATE, 2, 1.0,
+                                 "Hz"),
         }
         grid.addWidget(QLabel("<b>send</b>"), 0, 0)
         grid.addWidget(QLabel("<b>in force</b>"), 0, 2)
@@ -82,7 +106,8 @@ class SettingsTab(QWidget):
         page = QWidget()
         grid = QGridLayout(page)
         self.gravity_check = QCheckBox("Set gravity")
-        self.gravity = VectorRow("xyz", (0.0, 0.0, -9.81), -1e3, 1e3, 3, 0.1, "m/s²")
+        self.gravity = VectorRow("xyz", default("gravity"), -1e3, 1e3, 3, 0.1,
+                                 _unit("gravity"))
         grid.addWidget(self.gravity_check, 0, 0)
         grid.addWidget(self.gravity, 0, 1)
         grid.addWidget(QLabel("in force:"), 1, 0)
@@ -103,7 +128,8 @@ class SettingsTab(QWidget):
         grid.addWidget(self.contacts_radio, 0, 1)
         grid.addWidget(self.highlight_radio, 1, 1)
         self.max_contacts_check = QCheckBox("Maximum contacts per pair")
-        self.max_contacts = int_spin(3, 1, 64)
+        info = PARAMETER_INFO["max_contacts"]
+        self.max_contacts = int_spin(default("max_contacts"), int(info.low), int(info.high))
         grid.addWidget(self.max_contacts_check, 2, 0)
         grid.addWidget(self.max_contacts, 2, 1)
         self._in_force_label(grid, "contact_less", 0)
@@ -114,7 +140,8 @@ class SettingsTab(QWidget):
         for title, rows in SCALARS.items():
             page = QWidget()
             grid = QGridLayout(page)
-            for row, (key, label, value, low, high, decimals, step, unit) in enumerate(rows):
+            for row, (key, label, decimals, step, bound) in enumerate(rows):
+                value, (low, high), unit = default(key), _range(key, bound), _unit(key)
                 if key == "bounce_velocity":
                     check = QCheckBox(label + " (sent with bounce)")
                     check.setEnabled(False)
@@ -134,9 +161,11 @@ class SettingsTab(QWidget):
         grid = QGridLayout(page)
         self.solver_check = QCheckBox("Set solver")
         self.solver = QComboBox()
-        self.solver.addItems(["QuickStep (iterative, handles piles)",
-                              "WorldStep (exact, the thesis's)"])
-        self.iterations = int_spin(20, 1, 1000, "QuickStep iterations")
+        self.solver.addItems([SOLVER_ITEMS[s] for s in Solver])        # index = Solver
+        self.solver.setCurrentIndex(default("solver"))
+        info = PARAMETER_INFO["quickstep_iterations"]
+        self.iterations = int_spin(default("quickstep_iterations"), int(info.low),
+                                   int(info.high), "QuickStep iterations")
         grid.addWidget(self.solver_check, 0, 0)
         grid.addWidget(self.solver, 0, 1)
         grid.addWidget(QLabel("QuickStep iterations"), 1, 0)
@@ -178,59 +207,62 @@ class SettingsTab(QWidget):
 
     def send_step(self) -> None:
         fields = self.step_request()
-        self.window.call("Set Step", lambda client, job: client.call("set_step", **fields),
+        self.window.call("Set Step", lambda client, job: client.set_step(**fields),
                          self.show_step)
 
-    def show_step(self, response) -> None:
+    def show_step(self, values) -> None:
+        """Shows the step values in force (odin_common.step_values.StepValues)."""
         for key in self.step_fields:
-            value = getattr(response, key)
+            value = getattr(values, key)
             self.in_force[key] = value
             self.in_force_labels[key].setText(f"{value:g}")
         for check, _ in self.step_fields.values():
             check.setChecked(False)
-        self.window.publication_rate = float(response.rate)
+        self.window.publication_rate = float(values.rate)
 
     # -- world --------------------------------------------------------------------------------
-    def world_request(self) -> dict:
-        fields: dict = {}
+    def world_changes(self) -> dict:
+        """{world parameter: value} of the checked parameters (the names of
+        odin_common.world_parameters)."""
+        changes: dict = {}
         if self.gravity_check.isChecked():
-            fields.update(set_gravity=True, gravity=list(self.gravity.values()))
+            changes["gravity"] = self.gravity.values()
         if self.policy_check.isChecked():
-            fields.update(set_contact_less=True, contact_less=self.highlight_radio.isChecked())
+            changes["contact_less"] = self.highlight_radio.isChecked()
         if self.max_contacts_check.isChecked():
-            fields.update(set_max_contacts=True, max_contacts=int(self.max_contacts.value()))
+            changes["max_contacts"] = int(self.max_contacts.value())
         for key, check in self.world_checks.items():
             if key != "bounce_velocity" and check.isChecked():
-                fields[f"set_{key}"] = True
-                fields[key] = float(self.world_boxes[key].value())
-        if fields.get("set_bounce"):
-            fields["bounce_velocity"] = float(self.world_boxes["bounce_velocity"].value())
+                changes[key] = float(self.world_boxes[key].value())
+        if "bounce" in changes:
+            changes["bounce_velocity"] = float(self.world_boxes["bounce_velocity"].value())
         if self.solver_check.isChecked():
-            fields.update(set_solver=True, solver=self.solver.currentIndex(),
-                          quickstep_iterations=int(self.iterations.value()))
-        return fields
+            changes["solver"] = Solver(self.solver.currentIndex())
+            changes["quickstep_iterations"] = int(self.iterations.value())
+        return changes
 
     def send_world(self) -> None:
-        fields = self.world_request()
-        if not fields:
+        changes = self.world_changes()
+        if not changes:
             self.window.show_error("Set World: check at least one parameter to send")
             return
-        self.window.call("Set World", lambda client, job: client.call("set_world", **fields),
+        self.window.call("Set World", lambda client, job: client.set_world(**changes),
                          self.show_world)
 
-    def show_world(self, response) -> None:
+    def show_world(self, parameters) -> None:
+        """Shows the world parameters in force (odin_common WorldParameters)."""
         for key, label in self.in_force_labels.items():
             if key in self.step_fields:
                 continue
-            value = getattr(response, key)
+            value = getattr(parameters, key)
             self.in_force[key] = value
             if key == "gravity":
                 text = "(" + ", ".join(f"{v:g}" for v in value) + ")"
             elif key == "contact_less":
                 text = "detect only" if value else "contacts"
             elif key == "solver":
-                text = ("WorldStep" if value else "QuickStep") + \
-                    f", {response.quickstep_iterations} it."
+                text = SOLVER_NAMES.get(value, str(value)) + \
+                    f", {parameters.quickstep_iterations} it."
             else:
                 text = f"{value:g}"
             label.setText(text)
@@ -239,31 +271,9 @@ class SettingsTab(QWidget):
             check.setChecked(False)
 
     def refresh(self) -> None:
-        """Shows the values the world started with: its ``~`` parameters on the parameter
-        server, or their documented defaults (docs/parameters.md). The world answers an empty
-        Set Step / Set World with a refusal, so there is no way to read the values in force
-        without setting one; every later answer replaces these."""
-        namespace = self.window.world_namespace
-
+        """Shows the step values and world parameters in force, read through the client."""
         def read(client, job):
-            import rospy
-            from types import SimpleNamespace
-            get = lambda name, default: rospy.get_param(f"{namespace}/{name}", default)
-            step = float(get("step", 0.001))
-            steps = int(get("steps_per_cycle", 40))
-            rate = float(get("rate", 25.0))
-            step_values = SimpleNamespace(step=step, steps_per_cycle=steps,
-                                          cycle_time=step * steps, rate=rate)
-            world = SimpleNamespace(**{name: get(name, default) for name, default in [
-                ("gravity", [0.0, 0.0, -9.81]), ("erp", 0.2), ("cfm", 1e-5),
-                ("max_angular_speed", 0.0), ("contact_max_correcting_velocity", 0.0),
-                ("contact_surface_layer", 0.001), ("linear_damping", 0.0),
-                ("linear_damping_threshold", 0.01), ("angular_damping", 0.0),
-                ("angular_damping_threshold", 0.01), ("max_contacts", 3), ("friction", 1.0),
-                ("bounce", 0.0), ("bounce_velocity", 0.1), ("solver", 0),
-                ("quickstep_iterations", 20), ("contact_less", False),
-                ("collision_mesh_tolerance", 0.0)]})
-            return step_values, world
+            return client.step_values(), client.world_parameters()
 
         def done(values):
             self.show_step(values[0])

@@ -2,7 +2,7 @@
 the Simulate / Pause button.
 
 Opening runs on the worker: the problem is read and planned (``gui.core.build.plan_problem``) and
-sent request by request (``WorldClient.execute``); each answer adds its element to the tree as
+sent step by step (``WorldClient.execute``); each answer adds the step's entries to the tree as
 it comes, under its robot (Links, Joints, Motors) or under "Scene objects".
 
 The button follows the world's real state: the Start answer, then the stamps of
@@ -18,6 +18,8 @@ import time
 from PyQt5.QtCore import Qt, pyqtSignal
 from PyQt5.QtWidgets import (QCheckBox, QFileDialog, QHBoxLayout, QLabel, QPushButton,
                              QTreeWidget, QTreeWidgetItem, QVBoxLayout, QWidget)
+
+from odin_common.specs import CompositeSpec
 
 RUNNING_STYLE = "QPushButton { background: #2e7d32; color: white; font-weight: bold; }"
 PAUSED_STYLE = "QPushButton { font-weight: bold; }"
@@ -131,23 +133,13 @@ class SimulationTab(QWidget):
                                   progress)
 
     def _start_plan(self, plan, replace: bool) -> None:
-        from gui.core.build import CompositeRequest, EntityRequest
         self._plan = plan
         if replace:
             self._clear()
-        roles = {inst.name: inst.role for inst in plan.problem.instances}
-        self._owner_of = {}
-        owner = None
-        for step in plan.steps:
-            if isinstance(step, EntityRequest):
-                owner = step.name
-                for member in list(step.objects) + list(step.composites):
-                    if isinstance(member, CompositeRequest):
-                        self.window.scene.add_composite(member.id, [p.name for p in member.parts])
-            elif isinstance(step, CompositeRequest):
-                self.window.scene.add_composite(step.id, [p.name for p in step.parts])
-            self._owner_of[id(step)] = owner
-        self._roles = roles
+        self._roles = {inst.name: inst.role for inst in plan.problem.instances}
+        for body in plan.bodies():
+            if isinstance(body, CompositeSpec):
+                self.window.scene.add_composite(body.id, [p.name for p in body.parts])
 
     def _group(self, *path: str) -> QTreeWidgetItem:
         key = tuple(path)
@@ -164,27 +156,13 @@ class SimulationTab(QWidget):
         return item
 
     def _add_step(self, step, answer) -> None:
-        from gui.core.build import (CompositeRequest, EntityRequest, JointRequest, MotorRequest,
-                               ObjectRequest)
-        owner = self._owner_of.get(id(step))
-        if isinstance(step, EntityRequest):
-            label = f"{step.name} ({self._roles.get(step.name, 'robot')})"
-            self._owner_label = getattr(self, "_owner_label", {})
-            self._owner_label[step.name] = label
-            links = self._group(label, "Links")
-            for member in list(step.objects) + list(step.composites):
-                links.addChild(QTreeWidgetItem([member.id.rsplit("/", 1)[-1], member.id]))
-        elif isinstance(step, (ObjectRequest, CompositeRequest)):
-            group = self._group("Scene objects")
-            label = step.id if isinstance(step, ObjectRequest) else \
-                step.parts[0].name.rsplit("#", 1)[0] + f" ({len(step.parts)} parts)"
-            group.addChild(QTreeWidgetItem([label, str(answer)]))
-        elif isinstance(step, JointRequest):
-            group = self._group(self._owner_label.get(owner, owner or "?"), "Joints")
-            group.addChild(QTreeWidgetItem([step.key.rsplit("/", 1)[-1], str(answer)]))
-        elif isinstance(step, MotorRequest):
-            group = self._group(self._owner_label.get(owner, owner or "?"), "Motors")
-            group.addChild(QTreeWidgetItem([step.joint_key.rsplit("/", 1)[-1], str(answer)]))
+        """The tree items of one step the world answered (under its robot or obstacle, or
+        under "Scene objects")."""
+        owner = () if step.owner is None else \
+            (f"{step.owner} ({self._roles.get(step.owner, 'robot')})",)
+        for entry in step.entries(answer):
+            self._group(*owner, entry.section).addChild(
+                QTreeWidgetItem([entry.name, entry.world_id]))
 
     def add_built(self, group: str, name: str, world_id: str) -> None:
         """An element built from another tab ("Objects", "Joints", "Motors")."""
@@ -227,12 +205,12 @@ class SimulationTab(QWidget):
     def toggle_simulation(self) -> None:
         want = not self.simulating
 
-        def done(response):
+        def done(simulating: bool):
             self._ignore_stamps_until = time.monotonic() + 0.5
-            self.set_simulating(bool(response.simulating))
+            self.set_simulating(simulating)
 
         self.window.call("Simulate" if want else "Pause",
-                         lambda client, job: client.call("start", simulate=want), done)
+                         lambda client, job: client.start() if want else client.pause(), done)
 
     def set_simulating(self, simulating: bool) -> None:
         self.simulating = simulating

@@ -27,6 +27,7 @@ from typing import Any, Callable, Optional
 from PyQt5.QtCore import QThread, pyqtSignal
 
 from gui.errors import GuiError, WorldError
+from odin_common.interface import WORLD_NAMESPACE
 
 
 class Cancelled(GuiError):
@@ -76,7 +77,7 @@ class WorldWorker(QThread):
     failed_job = pyqtSignal(int, str)
     progressed = pyqtSignal(int, object)
 
-    def __init__(self, namespace: str = "/virtual_world", poll_period: float = 0.5,
+    def __init__(self, namespace: str = WORLD_NAMESPACE, poll_period: float = 0.5,
                  name: str = "world", parent=None):
         super().__init__(parent)
         self.namespace = namespace.rstrip("/")

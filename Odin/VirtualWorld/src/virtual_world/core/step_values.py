@@ -1,44 +1,19 @@
-"""The four step values of the Portal and how a partial request resolves (thesis 4.5).
+"""How a partial Set Step request resolves against the step values in force (thesis 4.5);
+the values, their units and ranges are odin_common.step_values'.
 
-* ``step``            -- s, simulated time of one ODE step (the Core's step size);
-* ``steps_per_cycle`` -- ODE steps taken in one Portal cycle;
-* ``cycle_time``      -- s, simulated time of one Portal cycle, always ``step * steps_per_cycle``;
-* ``rate``            -- Hz, Portal cycles (and so publications) per wall-clock second.
-
-``cycle_time`` is not free: it follows from the first two, and a request may give it instead of
-one of them. On conflict ``step`` and ``cycle_time`` win over ``steps_per_cycle``, which is
-rounded to the nearest whole number of steps; the cycle time in force is then recomputed.
-The defaults (table 4.1) make one simulated second last one wall-clock second.
+``cycle_time`` is not free: it follows from ``step`` and ``steps_per_cycle``, and a request may
+give it instead of one of them. On conflict ``step`` and ``cycle_time`` win over
+``steps_per_cycle``, which is rounded to the nearest whole number of steps; the cycle time in
+force is then recomputed.
 """
 from __future__ import annotations
 
-import dataclasses
 import math
 
+from odin_common.step_values import MAX_RATE, MAX_STEP, MAX_STEPS_PER_CYCLE, StepValues
 from virtual_world.errors import InvalidArgument
 
-MAX_STEP = 1.0            # s: beyond this ODE's first-order integration is meaningless
-MAX_STEPS_PER_CYCLE = 1_000_000
-MAX_RATE = 1000.0         # Hz
 _RELATIVE_TOLERANCE = 1e-9
-
-
-@dataclasses.dataclass(frozen=True)
-class StepValues:
-    """Step values in force; see the module docstring for units."""
-
-    step: float = 0.001
-    steps_per_cycle: int = 40
-    rate: float = 25.0
-
-    @property
-    def cycle_time(self) -> float:
-        return self.step * self.steps_per_cycle
-
-    @property
-    def period(self) -> float:
-        """s, wall-clock time of one Portal cycle."""
-        return 1.0 / self.rate
 
 
 def _positive(name: str, value: float, upper: float) -> float:

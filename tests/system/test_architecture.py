@@ -5,7 +5,7 @@ import pathlib
 
 import pytest
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 SOURCES = ROOT / "Odin"
 
 ROS = ("rospy", "rosgraph", "roslib", "rospkg", "genpy", "tf2_ros", "interactive_markers",

@@ -10,12 +10,12 @@ import sys
 
 import pytest
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tools" / "experiments"))
 
 
 @pytest.mark.forked
-def test_contactless_pair_greys_exactly_while_touching():
+def test_contactless_pair_greys_exactly_while_touching(kautham_dir):
     import contactless
     facts = contactless.run()
     o = facts["outcome"]
@@ -48,7 +48,7 @@ def test_contactless_pair_greys_exactly_while_touching():
 
 
 @pytest.mark.forked
-def test_pile_cans_knocked_down_fall_and_bounce():
+def test_pile_cans_knocked_down_fall_and_bounce(kautham_dir):
     import pile
     facts = pile.run(frames=False)
     o = facts["outcome"]
@@ -77,7 +77,7 @@ def test_pile_cans_knocked_down_fall_and_bounce():
 
 
 @pytest.mark.forked
-def test_grasp_carries_the_can_and_releases_it_when_the_hand_opens(tmp_path):
+def test_grasp_carries_the_can_and_releases_it_when_the_hand_opens(tmp_path, kautham_dir):
     import grasp
     facts = grasp.run(frames=False, out_root=tmp_path)  # out/experiments/grasp keeps its frames
     o = facts["outcome"]
@@ -111,7 +111,7 @@ def test_grasp_carries_the_can_and_releases_it_when_the_hand_opens(tmp_path):
     assert o["can_on_floor_at_end"], f"the can ends at {o['can_final_position_m']}"
 
 
-def test_one_command_runs_several_experiments():
+def test_one_command_runs_several_experiments(kautham_dir):
     """`make experiments` runs them one after another from one command; each has a roscore of
     its own, which one rospy process cannot follow (it hung on the second before)."""
     import subprocess

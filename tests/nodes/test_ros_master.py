@@ -1,7 +1,7 @@
 """The ROS harness itself: a private master comes up, answers, and leaves nothing behind."""
 import subprocess
 
-from ros_harness import RosMaster
+from odin_common.ros_master import RosMaster
 
 
 def test_private_master_starts_and_stops_cleanly():

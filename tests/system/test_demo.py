@@ -1,4 +1,6 @@
-"""`make demo`'s script end to end: snapshots in which the sphere moves, nothing left running."""
+"""`make demo`'s script end to end, as in a bare clone (no Kautham corpus): snapshots in which
+the sphere moves, one line about the corpus, nothing left running. (With the corpus, its second
+part is the grasp experiment, which tests/system/test_experiments.py runs.)"""
 import os
 import pathlib
 import subprocess
@@ -7,7 +9,7 @@ import sys
 import numpy as np
 from PIL import Image
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 
 def _processes_pointing_at(uri: str) -> list:
@@ -26,9 +28,12 @@ def _processes_pointing_at(uri: str) -> list:
 
 
 def test_demo_writes_moving_snapshots_and_stops_every_process():
+    bare = dict(os.environ, ODIN_KAUTHAM_DIR=str(ROOT / "out" / "no-kautham-here"))
     result = subprocess.run([sys.executable, str(ROOT / "tools" / "demo.py")],
-                            capture_output=True, text=True, timeout=300)
+                            capture_output=True, text=True, timeout=300, env=bare)
     assert result.returncode == 0, result.stdout + result.stderr
+    skipped = [line for line in result.stdout.splitlines() if "Kautham part is skipped" in line]
+    assert len(skipped) == 1 and "tools/get_kautham.sh" in skipped[0]
     uri = next(line.split()[-1] for line in result.stdout.splitlines()
                if line.startswith("demo: master"))
     assert _processes_pointing_at(uri) == []

@@ -1,8 +1,10 @@
-"""A private ROS master per test, and the nodes started against it.
+"""A private ROS master, and the nodes started against it: what Odin's node tests, demo,
+experiments and benchmarks run on (and what a user's own test suite may use).
 
 Every test that needs ROS gets its own roscore on a free loopback port and its own ROS_HOME,
 so tests never see each other's nodes, and every process started here is stopped (process
-group and all) when the test ends, pass or fail.
+group and all) when the test ends, pass or fail. Needs the ROS command-line tools (roscore,
+rosrun, rosservice), not rospy.
 
     with RosMaster() as master:
         master.rosrun("VirtualWorld", "virtualWorld")

@@ -3,7 +3,7 @@ import os
 import pathlib
 import subprocess
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 DEVEL = ROOT / "build" / "ws" / "devel"
 
 GUI_TO_WORLD = ["NewScene", "SetWorld", "SetStep", "StepOnce", "Start", "BuildObject",

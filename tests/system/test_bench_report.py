@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tools" / "bench"))
 
 import bench_core  # noqa: E402
@@ -81,6 +81,26 @@ def test_a_missing_figure_without_goal_does_not_fail(tmp_path):
     status, printed, readme = _report(_results(latency_p99_ms=None), tmp_path)
     assert status == 0, printed
     assert "| `latency_p99_ms` | - | **missing** | no goal |" in readme
+
+
+def test_absolute_figures_carry_the_host_probed_around_their_module(tmp_path):
+    run = {"figure_modules": {"frame_ms": "viewer", "band": "experiments"},
+           "host_by_module": {"viewer": 1234, "experiments": 987}}
+    status, printed, readme = _report(_results(), tmp_path, run)
+    assert status == 0, printed
+    assert "| 17.8 ms (host 1,234 steps/s) |" in readme
+    assert "| 1.5 x real time (host 987 steps/s) |" in readme
+    assert "| 5.54 ms (host 2,978 steps/s) |" in readme     # no probe: the run's figure
+
+
+def test_caption_says_when_how_long_and_how_fast_the_host_was():
+    run = {"finished": "2026-11-23 00:21 UTC", "seconds": 861.5, "failed_modules": ["gui"],
+           "host_probes": [{"before": "core", "steps_per_s": 2696},
+                           {"before": "gui", "steps_per_s": None},
+                           {"before": "end", "steps_per_s": 4685}]}
+    assert report.caption(run) == ("Last run: 2026-11-23 00:21 UTC; `make bench` took 14.4 min; "
+                                   "host probes 2,696-4,685 native steps/s over the run; "
+                                   "failed modules: gui.\n\n")
 
 
 def test_boundaries_nan_and_undescribed_figures():

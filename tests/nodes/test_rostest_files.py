@@ -1,4 +1,5 @@
-"""Runs every rostest file of the stack (Odin/*/test/*.test) under pytest, the runner CI reads.
+"""Runs every rostest file of the stack (Odin/*/test/rostest/*.test) under pytest, the runner
+CI reads.
 
 rostest gives each file a master of its own on a random port; the wrapper gives it a private
 ROS_HOME and fails with rostest's own output when any test case failed.
@@ -8,13 +9,13 @@ import re
 
 import pytest
 
-from ros_harness import run_rostest
+from odin_common.ros_master import run_rostest
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-TEST_FILES = sorted(ROOT.glob("Odin/*/test/*.test"))
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+TEST_FILES = sorted(ROOT.glob("Odin/*/test/rostest/*.test"))
 
 
-@pytest.mark.parametrize("test_file", TEST_FILES, ids=[f"{p.parent.parent.name}/{p.name}"
+@pytest.mark.parametrize("test_file", TEST_FILES, ids=[f"{p.parents[2].name}/{p.name}"
                                                         for p in TEST_FILES])
 def test_rostest_file(test_file):
     result = run_rostest(str(test_file))

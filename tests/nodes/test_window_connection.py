@@ -11,7 +11,7 @@ import pytest
 
 pytestmark = pytest.mark.forked
 
-ROOT = pathlib.Path(__file__).resolve().parents[3]
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 
 def test_window_waits_for_the_world_then_reconnects(ros_master):

@@ -7,7 +7,7 @@ import subprocess
 
 import pytest
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 SCRIPT = ROOT / "tools" / "get_kautham.sh"
 MANIFEST = ROOT / "tools" / "kautham" / "MANIFEST.md"
 SAMPLE = ["legacy_2012/examples/TRO/2DRR_obstacle.xml", "legacy_2012/examples/robots/2DRR.rob",

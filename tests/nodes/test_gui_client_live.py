@@ -10,10 +10,9 @@ import pytest
 
 pytestmark = pytest.mark.forked
 
-KAUTHAM = pathlib.Path(os.environ.get("ODIN_KAUTHAM_DIR",
-                                      pathlib.Path(__file__).resolve().parents[4] / "shared"
-                                      / "kautham"))
-LEGACY = KAUTHAM / "legacy_2012" / "examples"
+@pytest.fixture
+def legacy(kautham_dir) -> pathlib.Path:
+    return kautham_dir / "legacy_2012" / "examples"
 
 
 @pytest.fixture
@@ -24,9 +23,9 @@ def world(ros_master):
     assert node.poll() is None, "virtualWorld died:\n" + ros_master.log_text(node)[-3000:]
 
 
-def test_load_problem_builds_the_hand_and_prints_progress(world):
+def test_load_problem_builds_the_hand_and_prints_progress(world, legacy):
     result = world.run(["rosrun", "GUI", "load_problem",
-                        str(LEGACY / "TX90_RHand_ICRA10_5PMD_TwoCan.xml")], timeout=120)
+                        str(legacy / "TX90_RHand_ICRA10_5PMD_TwoCan.xml")], timeout=120)
     lines = result.stdout.splitlines()
     assert lines[-1].startswith("built ")
     assert any("[1/53] entity TX90 SAHand Right: 25 bodies" in l for l in lines)
@@ -41,7 +40,7 @@ def test_load_problem_error_builds_nothing(world, tmp_path):
     assert result.stderr.strip().count("\n") == 0 and f"{bad}:3:" in result.stderr
 
 
-def test_initial_position_and_paths_move_the_links(world, tmp_path):
+def test_initial_position_and_paths_move_the_links(world, tmp_path, legacy):
     import rospy
     from Messages.msg import SpaceDistribution
 
@@ -49,7 +48,7 @@ def test_initial_position_and_paths_move_the_links(world, tmp_path):
     from gui.ros.client import WorldClient
     from gui.core.kautham.problem import load_problem
 
-    problem_file = LEGACY / "TRO" / "2DRR_obstacle.xml"
+    problem_file = legacy / "TRO" / "2DRR_obstacle.xml"
     world.run(["rosrun", "GUI", "load_problem", str(problem_file)], timeout=60)
     initial = tmp_path / "initial.txt"
     initial.write_text("30 45 0\n")
@@ -81,7 +80,7 @@ def test_initial_position_and_paths_move_the_links(world, tmp_path):
     client.close()
 
 
-def test_motor_goal_joint_value_and_forward_kinematics_share_one_sign(world):
+def test_motor_goal_joint_value_and_forward_kinematics_share_one_sign(world, legacy):
     """A positive goal speed raises the joint value the world reports, and the links end where
     forward kinematics puts them for that value (Kautham's sign convention end to end)."""
     import rospy
@@ -91,14 +90,14 @@ def test_motor_goal_joint_value_and_forward_kinematics_share_one_sign(world):
     from gui.ros.client import WorldClient
     from gui.core.kautham.problem import load_problem
 
-    problem_file = LEGACY / "TRO" / "2DRR_obstacle.xml"
+    problem_file = legacy / "TRO" / "2DRR_obstacle.xml"
     world.run(["rosrun", "GUI", "load_problem", str(problem_file)], timeout=60)
     handle = plan_problem(load_problem(problem_file)).robots[0]
     rospy.init_node("sign_test", anonymous=True, disable_signals=True)
     client = WorldClient()
     client.call("set_world", set_solver=True, solver=1, quickstep_iterations=20)
     speeds = [0.5 if i == 0 else 0.0 for i in range(len(handle.motor_ids))]
-    client.set_velocity(handle.motor_ids, speeds)
+    client.set_velocities(handle.motor_ids, speeds)
     client.call("step_once", cycles=25)                          # 1 s at 0.5 rad/s
     joints = rospy.wait_for_message("/virtual_world/joint_data", JointsData, timeout=10)
     values = {j.id: j.positions[0] for j in joints.joints if j.positions}

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from PIL import Image as PilImage
 
-from pixels import is_background, is_grey, is_hue, patch
+from viewer.core.pixels import is_background, is_grey, is_hue, patch
 
 BACKGROUND = (0.93, 0.94, 0.96)
 
