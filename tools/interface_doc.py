@@ -20,6 +20,8 @@ PARAMETERS_DOC = ROOT / "docs" / "parameters.md"
 
 KNOWN = "known"
 RECON = "reconstructed"
+PLANNING = ("new (past the thesis: its first line of future work, planning with collision "
+            "detection and physics)")
 
 # service type -> (provenance, example request YAML or None); its ROS name and server come
 # from odin_common.interface's service tables
@@ -72,6 +74,16 @@ SERVICES = {
                          "{object: ball, kind: 0, vector: [0, 0, 5.0]}"),
     "SetJointForce": (f"{KNOWN}: thesis 5.4.3; per-axis magnitudes and id format {RECON}",
                       "{joint: '1:ball&', magnitudes: [0.2]}"),
+    "GetWorld": ("new (past the thesis): the values in force and what the world holds", None),
+    "SaveState": (f"{PLANNING}; the whole dynamic state, bit for bit", "{name: start}"),
+    "RestoreState": (f"{PLANNING}; refused when the contents changed", "{name: start}"),
+    "Reset": (f"{PLANNING}; the state right after the last build or removal", None),
+    "Propagate": (f"{PLANNING}; controls as in Set Velocity and Set External Force",
+                  "{duration: 0.2, motors: ['motor:1:ball&'], velocities: [1.0], forces: "
+                  "[{object: ball, kind: 0, vector: [0, 0, 5.0]}]}"),
+    "CheckCollision": (f"{PLANNING}; the thesis's PQP-like use, synchronous",
+                       "{situations: [{name: ball, position: [0, 0, 0.05], "
+                       "orientation: [1, 0, 0, 0]}]}"),
     "ViewObject": (f"{KNOWN}: thesis 3.3.2, 6.4.1; fields {RECON} (those of Build Object's "
                    f"shape)",
                    "{id: marker, parameters: [0.05], position: [0, 0, 0], "
@@ -108,6 +120,9 @@ MESSAGES = {
     "Joint": ("joint type constants", "-", f"the kinds {KNOWN} (thesis 5.3); numbering {RECON}"),
     "JointParameter": ("in Set Joint", "-",
                        f"the parameters {KNOWN} (thesis 5.3.2, issue 3); encoding {RECON}"),
+    "WorldParameters": ("in Get World", "-", "new: the fields of Set World's values in force"),
+    "BodyState": ("in Propagate's answer", "-", "new"),
+    "BodyForce": ("in Propagate's request", "-", "new: the fields of Set External Force"),
 }
 
 HEADER = """# Odin's ROS interface
@@ -121,6 +136,16 @@ z up; **quaternions are (w, x, y, z)**, ODE's order, everywhere they cross a nod
 them. Every response starts with `bool success` and `string message`; a refused request
 (`success: false`) changes nothing. Creation services return the `id` they gave.
 
+**Determinism.** The same world, built by the same calls and stepped the same way, gives
+bit-identical poses and velocities, whatever the process did before (New Scenes, removals, other
+worlds in the same process) and in a fresh process: contacts are made in the order of the
+geometries' creation, and each world keeps its own state of ODE's random generator (QuickStep
+reorders constraints with it). Restore State puts a saved state back bit for bit, so stepping on
+from it repeats what followed the save. The guarantee holds for the same libode build on the same
+machine architecture (floating-point results differ between builds and instruction sets), and
+for the same calls: a call that depends on the wall clock (Start, with its real-time cycles)
+repeats only if the number of steps between calls repeats; Step Once and Propagate always do.
+
 "known" marks what the thesis (`shared/spec/000_7f7d4f850af4f9e9.txt`) or the traces in
 `shared/spec/interface-evidence.md` state; "reconstructed" marks what Odin had to design
 because the original .msg/.srv files are not public.
@@ -129,7 +154,7 @@ because the original .msg/.srv files are not public.
 
 | node | executable | serves | publishes | calls |
 |---|---|---|---|---|
-| `/virtual_world` | `rosrun VirtualWorld virtualWorld` | the 15 world services | `~world_update`, `~collided`, `~contacts`, `~joint_data`, `~real_time_factor`, `/joint_states`, `/clock` | the Viewer's services (optional) |
+| `/virtual_world` | `rosrun VirtualWorld virtualWorld` | the 15 world services and 6 of Odin's own | `~world_update`, `~collided`, `~contacts`, `~joint_data`, `~real_time_factor`, `/joint_states`, `/clock` | the Viewer's services (optional) |
 | `/viewer` | `rosrun Viewer viewer` | View Object, Viewer Remove Object, New Scene, Save Snapshot, Set Camera | `~image` (sensor_msgs/Image, rgb8, 25 Hz) | - |
 | `/gui` | `rosrun GUI gui` (window), `problem_info`, `load_problem`, `run_path` | - | - | the world's services |
 

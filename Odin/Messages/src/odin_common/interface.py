@@ -236,8 +236,11 @@ WORLD_SERVICES: Dict[str, str] = {
     "remove_object": "RemoveObject", "set_joint": "SetJoint", "set_motor": "SetMotor",
     "set_position": "SetPosition", "set_velocity": "SetVelocity",
     "set_external_force": "SetExternalForce", "set_joint_force": "SetJointForce",
+    "get_world": "GetWorld", "save_state": "SaveState", "restore_state": "RestoreState",
+    "reset": "Reset", "propagate": "Propagate", "check_collision": "CheckCollision",
 }
-"""The VirtualWorld's services: name under ``~`` -> type in the Services package."""
+"""The VirtualWorld's services: name under ``~`` -> type in the Services package (the
+thesis's 15, then Odin's own)."""
 
 VIEWER_SERVICES: Dict[str, str] = {
     "view_object": "ViewObject", "remove_object": "ViewerRemoveObject",

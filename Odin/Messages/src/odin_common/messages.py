@@ -10,7 +10,9 @@ from typing import Sequence, Tuple
 
 import numpy as np
 
-from Messages.msg import Composite, JointParameter, Object, Part, Situation
+from Messages.msg import (BodyForce, BodyState, Composite, JointParameter, Object, Part,
+                          Situation, WorldParameters)
+from odin_common import world_parameters
 from odin_common.specs import CompositeSpec, ObjectSpec, PartSpec
 
 
@@ -91,6 +93,40 @@ def situation_poses(messages) -> list:
     return [(m.name, tuple(m.position), tuple(m.orientation)) for m in messages]
 
 
-__all__ = ["object_message", "object_spec", "part_message", "part_spec", "composite_message",
+def world_parameters_message(parameters: world_parameters.WorldParameters) -> WorldParameters:
+    return WorldParameters(**parameters.as_dict())
+
+
+def world_parameters_of(message: WorldParameters) -> world_parameters.WorldParameters:
+    values = {info.name: getattr(message, info.name) for info in world_parameters.PARAMETERS}
+    values["gravity"] = tuple(values["gravity"])
+    return world_parameters.WorldParameters(**values)
+
+
+def body_state_message(state) -> BodyState:
+    """Anything with id, position, orientation, linear, angular -> Messages/BodyState."""
+    return BodyState(id=state.id, position=_floats(state.position),
+                     orientation=_floats(state.orientation), linear=_floats(state.linear),
+                     angular=_floats(state.angular))
+
+
+def body_force_arguments(message: BodyForce) -> dict:
+    """Messages/BodyForce -> the keyword arguments of a body force (the Core's
+    add_body_force)."""
+    return dict(object_id=message.object, kind=message.kind, vector=tuple(message.vector),
+                vector_in_body_frame=message.vector_in_body_frame, at_point=message.at_point,
+                point=tuple(message.point), point_in_body_frame=message.point_in_body_frame)
+
+
+def body_force_message(object_id: str, kind: int, vector, vector_in_body_frame: bool = False,
+                       at_point: bool = False, point=(0.0, 0.0, 0.0),
+                       point_in_body_frame: bool = False) -> BodyForce:
+    return BodyForce(object=object_id, kind=int(kind), vector=_floats(vector),
+                     vector_in_body_frame=bool(vector_in_body_frame), at_point=bool(at_point),
+                     point=_floats(point), point_in_body_frame=bool(point_in_body_frame))
+
+
+__all__ = ["world_parameters_message", "world_parameters_of", "body_state_message",
+           "body_force_arguments", "body_force_message", "object_message", "object_spec", "part_message", "part_spec", "composite_message",
            "composite_spec", "parameter_messages", "parameter_triples", "situation_messages",
            "situation_poses"]

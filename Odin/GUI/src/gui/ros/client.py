@@ -19,7 +19,7 @@ importing this module does not import rospy (only the generated message classes)
 from __future__ import annotations
 
 import time
-from typing import Callable, NamedTuple, Optional, Sequence, Tuple
+from typing import Callable, Dict, NamedTuple, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -27,8 +27,8 @@ from gui.core.build import BuildPlan, BuiltIds, RobotHandle
 from gui.errors import WorldError
 from odin_common.errors import InvalidArgument
 from odin_common.interface import WORLD_NAMESPACE, WORLD_SERVICES, ForceKind, SetJointAction
-from odin_common.messages import (composite_message, object_message, parameter_messages,
-                                  situation_messages)
+from odin_common.messages import (body_force_message, composite_message, object_message,
+                                  parameter_messages, situation_messages, world_parameters_of)
 from odin_common.specs import CompositeSpec, EntitySpec, JointSpec, MotorSpec, ObjectSpec
 from odin_common.step_values import StepValues
 from odin_common.world_parameters import (PARAMETER_INFO, PARAMETERS, ParameterInfo,
@@ -63,6 +63,33 @@ def _world_parameters(response) -> WorldParameters:
         value = _field(info, getattr(response, info.name))
         values[info.name] = tuple(value) if info.kind == "vector" else value
     return WorldParameters(**values)
+
+
+class WorldInventory(NamedTuple):
+    """Get World's answer: the values in force and the IDs of what the world holds."""
+    parameters: WorldParameters
+    step_values: StepValues
+    sim_time: float
+    simulating: bool
+    objects: Tuple[str, ...]
+    entities: Tuple[str, ...]
+    joints: Tuple[str, ...]
+    motors: Tuple[str, ...]
+    body_forces: Tuple[str, ...]
+    joint_forces: Tuple[str, ...]
+    snapshots: Tuple[str, ...]
+
+
+class PropagationResult(NamedTuple):
+    """Propagate's answer: start (s), step (s), steps, the final state {object ID: (position,
+    orientation, linear, angular)}, collisions (first, second, depth m, first time s) and the
+    wall time (s)."""
+    start_time: float
+    step: float
+    steps: int
+    states: Dict[str, tuple]
+    collisions: Tuple[tuple, ...]
+    wall_time: float
 
 
 def _step_values(response) -> StepValues:
@@ -148,9 +175,17 @@ class WorldClient:
             fields[name] = _field(info, value)
         return _world_parameters(self.call("set_world", **fields))
 
+    def world(self) -> "WorldInventory":
+        """Get World: what the world holds and the values in force."""
+        r = self.call("get_world")
+        return WorldInventory(world_parameters_of(r.parameters), _step_values(r),
+                              float(r.sim_time), bool(r.simulating), tuple(r.objects),
+                              tuple(r.entities), tuple(r.joints), tuple(r.motors),
+                              tuple(r.body_forces), tuple(r.joint_forces), tuple(r.snapshots))
+
     def world_parameters(self) -> WorldParameters:
-        """The world parameters in force (an empty Set World is refused but answers them)."""
-        return _world_parameters(self.ask("set_world"))
+        """The world parameters in force."""
+        return self.world().parameters
 
     def set_step(self, step: Optional[float] = None, steps_per_cycle: Optional[int] = None,
                  cycle_time: Optional[float] = None, rate: Optional[float] = None) -> StepValues:
@@ -168,8 +203,8 @@ class WorldClient:
         return _step_values(self.call("set_step", **fields))
 
     def step_values(self) -> StepValues:
-        """The step values in force (an empty Set Step is refused but answers them)."""
-        return _step_values(self.ask("set_step"))
+        """The step values in force."""
+        return self.world().step_values
 
     def publication_rate(self) -> float:
         """The world's publications per wall-clock second (Hz)."""
@@ -284,6 +319,50 @@ class WorldClient:
         self.call("set_joint_force", remove=True, id=force_id)
 
     # -- plans --------------------------------------------------------------------------------
+    # -- planners: snapshots, propagation, collision queries ----------------------------------
+    def save_state(self, name: str) -> None:
+        """Save State: the whole dynamic state kept under ``name``."""
+        self.call("save_state", name=name)
+
+    def restore_state(self, name: str) -> float:
+        """Restore State; returns the simulated time after it (s)."""
+        return float(self.call("restore_state", name=name).sim_time)
+
+    def reset(self) -> float:
+        """Reset to the state right after the last build; returns the simulated time (s)."""
+        return float(self.call("reset").sim_time)
+
+    def propagate(self, duration: float, step: float = 0.0,
+                  motor_goals: Optional[Dict[str, Sequence[float]]] = None,
+                  forces: Sequence[dict] = (), start: str = "", keep: bool = False
+                  ) -> "PropagationResult":
+        """Propagate: ``duration`` s (steps of ``step`` s, 0: the world's) from the snapshot
+        ``start`` (or now) under ``motor_goals`` ({motor id: goal speeds}) and ``forces`` (each
+        the keyword arguments of odin_common.messages.body_force_message); the world goes back
+        unless ``keep``."""
+        goals = motor_goals or {}
+        r = self.call("propagate", start=start, duration=float(duration), step=float(step),
+                      motors=list(goals), velocities=[float(v) for g in goals.values()
+                                                      for v in g],
+                      forces=[body_force_message(**f) for f in forces], keep=bool(keep))
+        states = {s.id: (tuple(s.position), tuple(s.orientation), tuple(s.linear),
+                         tuple(s.angular)) for s in r.states}
+        collisions = tuple((c.first, c.second, c.depth, t)
+                           for c, t in zip(r.collisions, r.first_times))
+        return PropagationResult(float(r.start_time), float(r.step), int(r.steps), states,
+                                 collisions, float(r.wall_time))
+
+    def check_collision(self, poses: Sequence) -> list:
+        """Check Collision for ``poses`` ((object ID, position m, quaternion (w, x, y, z))):
+        [(first, second, depth m)] of the pairs that would collide; the world is unchanged."""
+        r = self.call("check_collision", situations=situation_messages(poses))
+        return [(p.first, p.second, p.depth) for p in r.pairs]
+
+    def check_configuration(self, handle: RobotHandle, values: Sequence[float]) -> list:
+        """Check Collision for a robot at joint ``values`` (rad / m, the robot's movable joints
+        in order), every link placed by forward kinematics."""
+        return self.check_collision(handle.situations(values))
+
     def execute(self, plan: BuildPlan,
                 progress: Optional[Callable[[int, object, str], None]] = None) -> dict:
         """Sends every step of ``plan`` in order; returns the world's IDs:

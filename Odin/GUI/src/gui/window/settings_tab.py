@@ -273,7 +273,8 @@ class SettingsTab(QWidget):
     def refresh(self) -> None:
         """Shows the step values and world parameters in force, read through the client."""
         def read(client, job):
-            return client.step_values(), client.world_parameters()
+            world = client.world()
+            return world.step_values, world.parameters
 
         def done(values):
             self.show_step(values[0])

@@ -284,6 +284,15 @@ class Core:
         return motors.axis_counts(self._scene, motor_ids)
 
     @_locked
+    def split_motor_velocities(self, motor_ids: Sequence[str],
+                               velocities: Sequence[float]) -> Dict[str, Tuple[float, ...]]:
+        """{motor id: its goal speeds} from one flat list (Set Velocity's and Propagate's
+        request: each motor takes as many values as it has axes, in order)."""
+        if len(motor_ids) == 0 and len(velocities) == 0:
+            return {}
+        return motors.split_velocities(self._scene, motor_ids, velocities)
+
+    @_locked
     def motor_goals(self) -> Dict[str, List[float]]:
         """Every motor's goal speeds per axis (rad/s or m/s)."""
         return {motor_id: list(m.velocity) for motor_id, m in self._scene.motors.items()}

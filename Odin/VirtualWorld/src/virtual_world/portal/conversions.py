@@ -24,19 +24,19 @@ def view_requests(geometries) -> list:
                               list(g.orientation), list(g.color)) for g in geometries]
 
 
+def collision_pairs(collisions) -> list:
+    """Core collisions (first, second, depth, points) -> Messages/CollisionPair."""
+    return [CollisionPair(c.first, c.second, c.depth, [Point(*point) for point in c.points])
+            for c in collisions]
+
+
 def collided_message(collisions, stamp) -> Collided:
-    """Core collisions (first, second, depth, points) -> Messages/Collided."""
+    """Core collisions -> Messages/Collided (each geometry named once in ``names``)."""
     message = Collided()
     message.header.stamp = stamp
     message.header.frame_id = "world"
-    names = {}
-    for collision in collisions:
-        names.setdefault(collision.first, None)
-        names.setdefault(collision.second, None)
-        message.pairs.append(CollisionPair(
-            collision.first, collision.second, collision.depth,
-            [Point(*point) for point in collision.points]))
-    message.names = list(names)
+    message.pairs = collision_pairs(collisions)
+    message.names = list(dict.fromkeys(n for c in collisions for n in (c.first, c.second)))
     return message
 
 
@@ -111,5 +111,5 @@ class _PreSerialised(SpaceDistribution):
         buff.write(self._body)
 
 
-__all__ = ["view_requests", "collided_message", "joint_data", "joint_state_message",
+__all__ = ["view_requests", "collision_pairs", "collided_message", "joint_data", "joint_state_message",
            "SpaceDistributionWriter"]

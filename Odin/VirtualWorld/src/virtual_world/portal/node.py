@@ -9,7 +9,9 @@ Services (odin_common.interface.WORLD_SERVICES; Services/*, each answering ``suc
 ``message``): ``~new_scene``, ``~set_world``, ``~set_step``, ``~step_once``, ``~start``,
 ``~build_object``, ``~build_composite``, ``~build_entity``, ``~remove_object``,
 ``~set_joint``, ``~set_motor``, ``~set_position``, ``~set_velocity``, ``~set_external_force``,
-``~set_joint_force``.
+``~set_joint_force``; and Odin's own: ``~get_world`` (what the world holds, the values in
+force), ``~save_state``, ``~restore_state``, ``~reset`` (snapshots), ``~propagate`` (run under
+controls without publishing, then back) and ``~check_collision`` (a synchronous query).
 
 Topics published (every cycle, or at ``~rate`` per wall-clock second under ``~free_run``):
   ``~world_update``      Messages/SpaceDistribution: pose of every geometry (m, world frame,
@@ -302,6 +304,60 @@ class Portal:
             request.object, request.kind, tuple(request.vector), request.vector_in_body_frame,
             request.at_point, tuple(request.point), request.point_in_body_frame)
         return {"id": force_id, "message": f"added {force_id}"}
+
+    def get_world(self, request) -> dict:
+        core, values = self.core, self.loop.step_values
+        return {"parameters": messages.world_parameters_message(core.world_parameters),
+                **self._step_fields(), "sim_time": core.sim_time,
+                "simulating": self.loop.simulate, "objects": core.object_ids(),
+                "entities": list(core.entities()), "joints": core.joint_ids(),
+                "motors": core.motor_ids(), "body_forces": core.body_force_ids(),
+                "joint_forces": core.joint_force_ids(), "snapshots": core.snapshot_names(),
+                "message": f"{len(core.object_ids())} objects at {core.sim_time:g} s"}
+
+    def save_state(self, request) -> dict:
+        self.core.save_state(request.name)
+        return {"message": f"saved {request.name!r} at {self.core.sim_time:g} s"}
+
+    def restore_state(self, request) -> dict:
+        self.core.restore_state(request.name)
+        self._sync_loop_time()
+        return {"sim_time": self.core.sim_time, "message": f"restored {request.name!r}"}
+
+    def reset(self, request) -> dict:
+        self.core.reset()
+        self._sync_loop_time()
+        return {"sim_time": self.core.sim_time, "message": "reset to the last build"}
+
+    def _sync_loop_time(self) -> None:
+        """The loop publishes the Core's simulated time, which a snapshot put back."""
+        self.loop.sim_time = self.core.sim_time
+
+    def propagate(self, request) -> dict:
+        goals = self.core.split_motor_velocities(list(request.motors),
+                                                 list(request.velocities))
+        step = request.step or self.loop.step_values.step
+        result = self.core.propagate(
+            request.duration, step, motor_goals=goals,
+            body_forces=[messages.body_force_arguments(f) for f in request.forces],
+            start=request.start, keep=request.keep)
+        if result.kept:
+            self._sync_loop_time()
+        return {"start_time": result.start_time, "step": result.step_size,
+                "steps": result.steps,
+                "states": [messages.body_state_message(s) for s in result.states],
+                "collisions": conversions.collision_pairs(result.collisions),
+                "first_times": [c.first_time for c in result.collisions],
+                "wall_time": result.wall_time,
+                "message": f"{result.steps} steps in {result.wall_time:.3g} s"
+                           + (", kept" if result.kept else "")}
+
+    def check_collision(self, request) -> dict:
+        if not request.situations:
+            raise InvalidArgument("no situation given")
+        pairs = self.core.check_collision(messages.situation_poses(request.situations))
+        return {"pairs": conversions.collision_pairs(pairs),
+                "message": f"{len(pairs)} colliding pair(s)"}
 
     def set_joint_force(self, request) -> dict:
         if request.remove:

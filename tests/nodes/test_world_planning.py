@@ -1,0 +1,118 @@
+"""The world node's services for planners, through ROS: Get World, Save/Restore State, Reset,
+Propagate and Check Collision. Poses cross ROS as float64, so "the same" is exact here too.
+
+Each test has its own roscore and runs in a forked process (rospy.init_node once per process).
+"""
+from __future__ import annotations
+
+import pytest
+
+pytestmark = pytest.mark.forked
+
+
+@pytest.fixture
+def world(ros_master):
+    """A paused virtualWorld node and a raw client of it."""
+    import rospy
+    from world_client import WorldClient
+
+    node = ros_master.rosrun("VirtualWorld", "virtualWorld")
+    ros_master.wait_for_service("/virtual_world/check_collision")
+    rospy.init_node("odin_test_client", anonymous=True, disable_signals=True)
+    client = WorldClient()
+    yield client
+    client.close()
+    assert node.poll() is None, "virtualWorld died:\n" + ros_master.log_text(node)[-3000:]
+
+
+def _scene(world):
+    """Ground, a pile of five spheres and a pendulum on a motor."""
+    from world_client import box, sphere
+    world.ok("build_object", object=box("ground", (4, 4, 0.2), (0, 0, -0.1), geometry_only=True))
+    for i in range(5):
+        world.ok("build_object", object=sphere(f"s{i}", 0.1, (0.05 * i, 0, 0.3 + 0.21 * i)))
+    world.ok("build_object", object=sphere("bob", 0.1, (2, 0, 1)))
+    world.ok("set_joint", action=0, type=1, body1="bob", body2="", anchor=[2, 0, 1.5],
+             axis1=[0, 1, 0])
+    world.ok("set_motor", joint="1:bob&", max_forces=[2.0])
+
+
+def _states(response) -> dict:
+    return {s.id: (tuple(s.position), tuple(s.orientation), tuple(s.linear), tuple(s.angular))
+            for s in response.states}
+
+
+def test_get_world_says_what_the_world_holds_and_the_values_in_force(world):
+    _scene(world)
+    world.ok("set_world", set_erp=True, erp=0.3)
+    world.ok("save_state", name="built")
+    world.ok("set_external_force", object="s0", kind=0, vector=[0, 0, 1])
+    got = world.ok("get_world")
+    assert got.objects == ["ground", "s0", "s1", "s2", "s3", "s4", "bob"]
+    assert got.joints == ["1:bob&"] and got.motors == ["motor:1:bob&"]
+    assert got.body_forces == ["force:s0:0"] and got.snapshots == ["built"]
+    assert got.parameters.erp == pytest.approx(0.3) and got.parameters.max_contacts == 3
+    assert (got.step, got.steps_per_cycle, got.rate) == (0.001, 40, 25.0)
+    assert not got.simulating and got.sim_time == 0.0
+
+
+def test_restore_and_propagate_repeat_exactly(world):
+    _scene(world)
+    world.ok("step_once", cycles=5)
+    world.ok("save_state", name="s")
+    first = world.ok("propagate", duration=0.5, motors=["motor:1:bob&"], velocities=[1.5])
+    again = world.ok("propagate", duration=0.5, motors=["motor:1:bob&"], velocities=[1.5])
+    assert first.steps == 500 and first.start_time == pytest.approx(0.2)
+    assert _states(first) == _states(again)          # the world went back in between
+    kept = world.ok("propagate", duration=0.5, motors=["motor:1:bob&"], velocities=[1.5],
+                    keep=True)
+    assert _states(kept) == _states(first)
+    restored = world.ok("restore_state", name="s")
+    assert restored.sim_time == pytest.approx(0.2)
+    from_snapshot = world.ok("propagate", start="s", duration=0.5, motors=["motor:1:bob&"],
+                             velocities=[1.5])
+    assert _states(from_snapshot) == _states(first)
+    collided = {(c.first, c.second) for c in first.collisions}
+    assert ("ground", "s0") in collided and len(first.first_times) == len(first.collisions)
+
+
+def test_reset_returns_to_the_state_after_the_build(world):
+    _scene(world)
+    start = world.ok("propagate", duration=0.001)      # one step from the start, not kept
+    world.ok("step_once", cycles=10)
+    assert world.ok("reset").sim_time == 0.0
+    assert _states(world.ok("propagate", duration=0.001)) == _states(start)
+
+
+def test_a_collision_query_answers_without_changing_the_world(world):
+    _scene(world)
+    before = world.ok("propagate", duration=0.001)
+    hit = world.ok("check_collision", situations=[_situation("bob", (0, 0, 0.05))])
+    assert ("bob", "ground") in {(p.first, p.second) for p in hit.pairs}
+    assert _states(world.ok("propagate", duration=0.001)) == _states(before)
+
+
+def _situation(name, position):
+    from Messages.msg import Situation
+    return Situation(name=name, position=list(position), orientation=[1, 0, 0, 0])
+
+
+def test_bad_planning_requests_are_refused_and_change_nothing(world):
+    _scene(world)
+    world.ok("save_state", name="s")
+    before = world.ok("propagate", duration=0.001)
+    for service, fields in [
+            ("restore_state", dict(name="nope")),
+            ("save_state", dict(name="")),
+            ("propagate", dict(duration=-1.0)),
+            ("propagate", dict(duration=0.1, start="nope")),
+            ("propagate", dict(duration=0.1, motors=["motor:1:bob&"], velocities=[1.0, 2.0])),
+            ("propagate", dict(duration=0.1, motors=["motor:x"], velocities=[1.0])),
+            ("check_collision", dict(situations=[])),
+            ("check_collision", dict(situations=[_situation("ghost", (0, 0, 0))]))]:
+        response = world(service, **fields)
+        assert not response.success and response.message, (service, fields)
+    assert _states(world.ok("propagate", duration=0.001)) == _states(before)
+    world.ok("build_object", object=__import__("world_client").sphere("late", 0.1, (3, 3, 1)))
+    refused = world("restore_state", name="s")
+    assert not refused.success and "late" in refused.message
