@@ -20,6 +20,7 @@ PINS = [
     (MotorKind, srv.SetMotorRequest),
     (AxisFrame, srv.SetMotorRequest),
     (ForceKind, srv.SetExternalForceRequest),
+    (ForceKind, msg.BodyForce),
     (Solver, srv.SetWorldRequest),
 ]
 
@@ -55,6 +56,17 @@ def test_world_parameters_are_set_worlds_fields_in_order():
     flags = [name for name in fields if name.startswith("set_")]
     assert flags == list(world_parameters.set_world_flags())
     assert list(srv.SetWorldResponse.__slots__[2:]) == values
+
+
+def test_the_world_parameters_message_holds_every_parameter_in_order():
+    assert list(msg.WorldParameters.__slots__) == [p.name for p in world_parameters.PARAMETERS]
+
+
+def test_the_spec_message_conversions_round_trip():
+    from odin_common import messages
+    parameters = world_parameters.WorldParameters(gravity=(0, 0, -1.0), erp=0.3, solver=1)
+    assert messages.world_parameters_of(messages.world_parameters_message(parameters)) == \
+        parameters
 
 
 def test_every_parameter_has_a_default_and_the_defaults_are_valid():
