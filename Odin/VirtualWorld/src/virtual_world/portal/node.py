@@ -50,23 +50,17 @@ from std_msgs.msg import Float64
 
 from Messages.msg import Collided, JointsData, SpaceDistribution
 from Services import srv
-from odin_common import OdinError, messages
-from odin_common.interface import WORLD_SERVICES, SetJointAction
-from odin_common.specs import EntitySpec, JointSpec, MotorSpec
-from odin_common.world_parameters import PARAMETERS, set_world_flags
-from virtual_world.core import Core
-from virtual_world.core import step_values
+from odin_common import OdinError
+from odin_common.interface import WORLD_SERVICES
+from odin_common.world_parameters import PARAMETERS
+from virtual_world.core import Core, step_values
 from virtual_world.core.loop import CycleReport, RealTimeFactor, WorldLoop
-from virtual_world.errors import InvalidArgument
 from virtual_world.portal import conversions
 from virtual_world.portal.parameters import DEFAULTS
+from virtual_world.portal.services import WorldServices
 from virtual_world.portal.viewer_link import ViewerLink
 
 _log = logging.getLogger("rosout")
-
-#: Set World request flags -> the world parameters each applies (value fields follow it).
-WORLD_FIELDS = set_world_flags()
-
 
 class Portal:
     """Owns the Core, its loop thread, the ROS servers and publishers (thesis 4.1-4.6)."""
@@ -86,6 +80,7 @@ class Portal:
         self._writer = conversions.SpaceDistributionWriter()
         self.viewer = ViewerLink(rospy.get_param("~viewer", DEFAULTS["viewer"]),
                                  self._viewer_poses)
+        self.services = WorldServices(self.core, self.loop, self.viewer)
         self._advertise()
         self._serve()
 
@@ -121,7 +116,8 @@ class Portal:
         for name, type_name in WORLD_SERVICES.items():
             service_class = getattr(srv, type_name)
             self.servers.append(rospy.Service(
-                f"~{name}", service_class, self._guarded(service_class, getattr(self, name))))
+                f"~{name}", service_class,
+                self._guarded(service_class, getattr(self.services, name))))
 
     def _guarded(self, service_class, handler: Callable) -> Callable:
         """Runs ``handler(request) -> dict`` on the loop thread and turns the outcome into the
@@ -130,7 +126,7 @@ class Portal:
         Set Step also report the values in force when they refuse."""
         response_class = service_class._response_class
         in_force = {srv.SetWorld: lambda: self.core.world_parameters.as_dict(),
-                    srv.SetStep: self._step_fields}.get(service_class, dict)
+                    srv.SetStep: self.services.step_fields}.get(service_class, dict)
 
         def serve(request):
             try:
@@ -194,178 +190,6 @@ class Portal:
             return {}
         names, positions, quaternions = snapshot
         return {name: (positions[i], quaternions[i]) for i, name in enumerate(names)}
-
-    # -- services (run on the loop thread; return the response's fields) ----------------------
-    def new_scene(self, request) -> dict:
-        self.core.new_scene()
-        self.viewer.new_scene()
-        return {"message": "new scene"}
-
-    def set_world(self, request) -> dict:
-        changes = {name: getattr(request, name) for flag, names in WORLD_FIELDS.items()
-                   if getattr(request, flag) for name in names}
-        if "gravity" in changes:
-            changes["gravity"] = tuple(changes["gravity"])
-        parameters = self.core.set_world_parameters(**changes)
-        return dict(parameters.as_dict(), message=f"set {', '.join(sorted(changes))}")
-
-    def set_step(self, request) -> dict:
-        values, note = step_values.resolve(self.loop.step_values, request.step,
-                                           request.steps_per_cycle, request.cycle_time,
-                                           request.rate)
-        self.loop.step_values = values
-        return dict(self._step_fields(), message=note)
-
-    def _step_fields(self) -> dict:
-        values = self.loop.step_values
-        return {"step": values.step, "steps_per_cycle": values.steps_per_cycle,
-                "cycle_time": values.cycle_time, "rate": values.rate}
-
-    def step_once(self, request) -> dict:
-        sim_time = self.loop.step_cycles(request.cycles)
-        return {"sim_time": sim_time, "message": f"{request.cycles or 1} cycle(s)"}
-
-    def start(self, request) -> dict:
-        self.loop.simulate = bool(request.simulate)
-        return {"simulating": self.loop.simulate,
-                "message": "simulating" if self.loop.simulate else "paused"}
-
-    def build_object(self, request) -> dict:
-        built = self.core.build_object(messages.object_spec(request.object))
-        self.viewer.view(conversions.view_requests(built.geometries))
-        return {"id": built.id}
-
-    def build_composite(self, request) -> dict:
-        built = self.core.build_composite(messages.composite_spec(request.composite))
-        self.viewer.view(conversions.view_requests(built.geometries))
-        return {"id": built.id}
-
-    def build_entity(self, request) -> dict:
-        built = self.core.build_entity(EntitySpec(
-            request.name, [messages.object_spec(o) for o in request.objects],
-            [messages.composite_spec(c) for c in request.composites],
-            request.internal_collisions))
-        self.viewer.view(conversions.view_requests(built.geometries))
-        return {"id": built.name, "ids": built.ids}
-
-    def remove_object(self, request) -> dict:
-        removed = self.core.remove_object(request.id)
-        self.viewer.remove(removed.geometries)
-        also = [*removed.joints, *removed.motors, *removed.forces]
-        return {"message": f"removed {request.id}" + (f" and {', '.join(also)}" if also else "")}
-
-    def set_joint(self, request) -> dict:
-        parameters = messages.parameter_triples(request.parameters)
-        if request.action == SetJointAction.CREATE:
-            joint_id = self.core.add_joint(JointSpec(
-                request.type, request.body1, request.body2, tuple(request.anchor),
-                tuple(request.axis1), tuple(request.axis2), tuple(request.axis3), parameters,
-                request.id))
-            return {"id": joint_id, "message": f"created {joint_id}"}
-        if request.action == SetJointAction.SET_PARAMETERS:
-            self.core.set_joint_parameters(request.id, parameters)
-            return {"id": request.id, "message": f"set {len(parameters)} parameter(s)"}
-        if request.action == SetJointAction.REMOVE:
-            removed = self.core.remove_joint(request.id)
-            also = [*removed.motors, *removed.forces]
-            return {"id": request.id,
-                    "message": f"removed {request.id}" + (f" and {', '.join(also)}" if also else "")}
-        raise InvalidArgument(f"unknown action {request.action} ("
-                              + ", ".join(f"{a.name}={a.value}" for a in SetJointAction) + ")")
-
-    def set_motor(self, request) -> dict:
-        if request.remove:
-            self.core.remove_motor(request.id)
-            return {"id": request.id, "message": f"removed {request.id}"}
-        motor_id = self.core.add_motor(MotorSpec(
-            request.joint, request.kind, request.body1, request.body2, tuple(request.axes),
-            tuple(request.axis_frames), tuple(request.max_forces), request.id))
-        return {"id": motor_id, "message": f"created {motor_id}"}
-
-    def set_position(self, request) -> dict:
-        if not request.situations:
-            raise InvalidArgument("no situation given")
-        self.core.set_poses(messages.situation_poses(request.situations),
-                            reset_velocity=request.reset_velocity)
-        return {"message": f"moved {len(request.situations)} object(s)"}
-
-    def set_velocity(self, request) -> dict:
-        self.core.set_velocities(
-            request.object, tuple(request.linear) if request.set_linear else None,
-            tuple(request.angular) if request.set_angular else None, list(request.motors),
-            list(request.velocities))
-        return {"message": "velocities set"}
-
-    def set_external_force(self, request) -> dict:
-        if request.remove:
-            self.core.remove_body_force(request.id)
-            return {"id": request.id, "message": f"removed {request.id}"}
-        force_id = self.core.add_body_force(
-            request.object, request.kind, tuple(request.vector), request.vector_in_body_frame,
-            request.at_point, tuple(request.point), request.point_in_body_frame)
-        return {"id": force_id, "message": f"added {force_id}"}
-
-    def get_world(self, request) -> dict:
-        core, values = self.core, self.loop.step_values
-        return {"parameters": messages.world_parameters_message(core.world_parameters),
-                **self._step_fields(), "sim_time": core.sim_time,
-                "simulating": self.loop.simulate, "objects": core.object_ids(),
-                "entities": list(core.entities()), "joints": core.joint_ids(),
-                "motors": core.motor_ids(), "body_forces": core.body_force_ids(),
-                "joint_forces": core.joint_force_ids(), "snapshots": core.snapshot_names(),
-                "message": f"{len(core.object_ids())} objects at {core.sim_time:g} s"}
-
-    def save_state(self, request) -> dict:
-        self.core.save_state(request.name)
-        return {"message": f"saved {request.name!r} at {self.core.sim_time:g} s"}
-
-    def restore_state(self, request) -> dict:
-        self.core.restore_state(request.name)
-        self._sync_loop_time()
-        return {"sim_time": self.core.sim_time, "message": f"restored {request.name!r}"}
-
-    def reset(self, request) -> dict:
-        self.core.reset()
-        self._sync_loop_time()
-        return {"sim_time": self.core.sim_time, "message": "reset to the last build"}
-
-    def _sync_loop_time(self) -> None:
-        """The loop publishes the Core's simulated time, which a snapshot put back."""
-        self.loop.sim_time = self.core.sim_time
-
-    def propagate(self, request) -> dict:
-        goals = self.core.split_motor_velocities(list(request.motors),
-                                                 list(request.velocities))
-        step = request.step or self.loop.step_values.step
-        result = self.core.propagate(
-            request.duration, step, motor_goals=goals,
-            body_forces=[messages.body_force_arguments(f) for f in request.forces],
-            start=request.start, keep=request.keep)
-        if result.kept:
-            self._sync_loop_time()
-        return {"start_time": result.start_time, "step": result.step_size,
-                "steps": result.steps,
-                "states": [messages.body_state_message(s) for s in result.states],
-                "collisions": conversions.collision_pairs(result.collisions),
-                "first_times": [c.first_time for c in result.collisions],
-                "wall_time": result.wall_time,
-                "message": f"{result.steps} steps in {result.wall_time:.3g} s"
-                           + (", kept" if result.kept else "")}
-
-    def check_collision(self, request) -> dict:
-        if not request.situations:
-            raise InvalidArgument("no situation given")
-        pairs = self.core.check_collision(messages.situation_poses(request.situations))
-        return {"pairs": conversions.collision_pairs(pairs),
-                "message": f"{len(pairs)} colliding pair(s)"}
-
-    def set_joint_force(self, request) -> dict:
-        if request.remove:
-            self.core.remove_joint_force(request.id)
-            return {"id": request.id, "message": f"removed {request.id}"}
-        force_id = self.core.add_joint_force(request.joint, tuple(request.magnitudes))
-        return {"id": force_id, "message": f"added {force_id}"}
-
 
 def main() -> None:
     rospy.init_node("virtual_world")
