@@ -123,6 +123,10 @@ MESSAGES = {
     "WorldParameters": ("in Get World", "-", "new: the fields of Set World's values in force"),
     "BodyState": ("in Propagate's answer", "-", "new"),
     "BodyForce": ("in Propagate's request", "-", "new: the fields of Set External Force"),
+    "RecordStart": ("`/odin/record/start` in a recording (the world node's `~record`)",
+                    "VirtualWorld, once", "new"),
+    "Advance": ("`/odin/record/advance` in a recording (`rosrun VirtualWorld replay BAG` "
+                "compares its poses bit for bit)", "VirtualWorld, every advance", "new"),
 }
 
 HEADER = """# Odin's ROS interface

@@ -31,7 +31,8 @@ Services called: ``<~viewer>/view_object``, ``/remove_object``, ``/new_scene`` (
 ``viewer_link``).
 
 Parameters (read at start): the node's own (``virtual_world.portal.parameters``: ``~rate``,
-``~step``, ``~steps_per_cycle``, ``~simulate``, ``~free_run``, ``~viewer``) and every world
+``~step``, ``~steps_per_cycle``, ``~simulate``, ``~free_run``, ``~viewer``, ``~record``: a
+rosbag of what changed the world, see ``recorder``) and every world
 parameter under its own name (``~gravity``, ``~erp``, ... odin_common.world_parameters), with
 units and defaults in docs/parameters.md.
 """
@@ -57,7 +58,8 @@ from virtual_world.core import Core, step_values
 from virtual_world.core.loop import CycleReport, RealTimeFactor, WorldLoop
 from virtual_world.portal import conversions
 from virtual_world.portal.parameters import DEFAULTS
-from virtual_world.portal.services import WorldServices
+from virtual_world.portal.recorder import Recorder
+from virtual_world.portal.services import READ_ONLY, WorldServices
 from virtual_world.portal.viewer_link import ViewerLink
 
 _log = logging.getLogger("rosout")
@@ -81,6 +83,8 @@ class Portal:
         self.viewer = ViewerLink(rospy.get_param("~viewer", DEFAULTS["viewer"]),
                                  self._viewer_poses)
         self.services = WorldServices(self.core, self.loop, self.viewer)
+        record = rospy.get_param("~record", DEFAULTS["record"])
+        self.recorder = Recorder(record, self.core.world_parameters, values) if record else None
         self._advertise()
         self._serve()
 
@@ -116,8 +120,20 @@ class Portal:
         for name, type_name in WORLD_SERVICES.items():
             service_class = getattr(srv, type_name)
             self.servers.append(rospy.Service(
-                f"~{name}", service_class,
-                self._guarded(service_class, getattr(self.services, name))))
+                f"~{name}", service_class, self._guarded(service_class, self._handler(name))))
+
+    def _handler(self, name: str) -> Callable:
+        """The service's handler, which also records a state-changing request that
+        succeeded (``~record``)."""
+        handle = getattr(self.services, name)
+        if self.recorder is None or name in READ_ONLY:
+            return handle
+
+        def handle_and_record(request) -> dict:
+            fields = handle(request)
+            self.recorder.request(name, request)
+            return fields
+        return handle_and_record
 
     def _guarded(self, service_class, handler: Callable) -> Callable:
         """Runs ``handler(request) -> dict`` on the loop thread and turns the outcome into the
@@ -147,11 +163,15 @@ class Portal:
         try:
             self.loop.run()
         finally:
+            if self.recorder is not None:
+                self.recorder.close()
             self.viewer.close()
             self.core.close()
 
     def core_advance(self, step: float, count: int) -> float:
         self.core.step(step, count)
+        if self.recorder is not None:
+            self.recorder.advance(step, count, self.core.sim_time, *self.core.poses())
         return self.core.sim_time
 
     def _publish(self, report: CycleReport) -> None:

@@ -22,6 +22,9 @@ NODE_PARAMETERS: Tuple[NodeParameter, ...] = (
     NodeParameter("free_run", False, "-",
                   "cycles back to back (batch work); publications still at `~rate`"),
     NodeParameter("viewer", VIEWER_NAMESPACE, "-", "namespace of the Viewer's services"),
+    NodeParameter("record", "", "-", "a rosbag file to record every state-changing request "
+                  "and every advance into (`rosrun VirtualWorld replay FILE` re-runs it); "
+                  "empty: no recording"),
 )
 """The world node's parameters besides the world parameters, in documentation order."""
 
