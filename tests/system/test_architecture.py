@@ -29,6 +29,8 @@ RULES = {
     "gui.ros": QT + ("gui.window", "virtual_world", "viewer"),
     "virtual_world.portal": QT + ("viewer", "gui", "virtual_world.ode"),
     "viewer.portal": QT + ("virtual_world", "gui"),
+    "virtual_world.pool": QT + ("virtual_world.core", "virtual_world.ode",
+                                "virtual_world.portal", "viewer", "gui"),
 }
 # the generated message classes are allowed in odin_common.messages only
 EXCEPTIONS = {"odin_common.messages": ("Messages.msg",)}

@@ -109,6 +109,11 @@ def test_grasp_carries_the_can_and_releases_it_when_the_hand_opens(tmp_path, kau
         f"{o.get('latest_on_floor_after_opening_s')} s), never rising: "
         f"{o.get('falls_without_rising')}")
     assert o["can_on_floor_at_end"], f"the can ends at {o['can_final_position_m']}"
+    # the carry, propagated again from the snapshot taken when it began (a planner's use),
+    # ends with the can exactly where the run's own carry put it
+    carry = facts["carry_propagated"]
+    assert carry["can_where_the_run_put_it"], carry
+    assert carry["simulated_s"] > 1.0 and carry["rtf"] > 0
 
 
 def test_one_command_runs_several_experiments(kautham_dir):

@@ -157,9 +157,11 @@ def run(frames: bool = True, out_root=None) -> dict:
         s.client.set_velocities([forearm, wrist], [0.0, 0.0])
         closeup("lifted")
         phase("carry")
+        s.client.save_state("carry")    # propagated again at the end (carry_propagated)
         shoulder = motor_of(handle, "Shoulder")
         s.client.set_velocities([shoulder], [p["carry_shoulder_rad_s"]])
         advance(int(p["carry_s"] * per_s))
+        carried_at = s.sim_time
         s.client.set_velocities([shoulder], [0.0])
         advance(int(0.3 * per_s))
         closeup("carried")
@@ -172,14 +174,33 @@ def run(frames: bool = True, out_root=None) -> dict:
         advance(int(p["fall_s"] * per_s))
         closeup("dropped")
         phase("end")
+        probe = propagate_carry(s, shoulder, dict(phases)["carry"], carried_at)
         s.finish()
         facts = analyse(s, dict(phases))
+        facts["carry_propagated"] = probe
         facts["phases_s"] = dict(phases)
         if closeups:
             facts["closeups"] = str(closeup_sheet(closeups, s.out / "closeups.png")
                                     .relative_to(common.ROOT))
         common.write_summary(s, facts, p)
     return facts
+
+
+def propagate_carry(s: "common.Session", shoulder: str, started: float, ended: float) -> dict:
+    """The carry once more, as a planner would run it: Propagate from the snapshot taken when
+    the carry began, with the same shoulder speed, for as long; the world goes back where the
+    run left it. The can must end where the run's own carry put it, bit for bit (the world is
+    deterministic), and the figure is how fast the world propagates the held can."""
+    probe = s.client.propagate(ended - started, start="carry",
+                               motor_goals={shoulder: [PARAMETERS["carry_shoulder_rad_s"]]})
+    s.wait_for_update()
+    with s.record.lock:
+        as_run = s.record.poses[round(ended, 6)][CAN]
+    propagated = probe.states[CAN]
+    return {"simulated_s": round(probe.steps * probe.step, 6), "wall_s": probe.wall_time,
+            "rtf": round(probe.steps * probe.step / probe.wall_time, 4),
+            "can_where_the_run_put_it": tuple(propagated[0]) == tuple(as_run[0])
+            and tuple(propagated[1]) == tuple(as_run[1])}
 
 
 #: close-ups: the camera looks at the can (or the palm) from outside the hand, from this
