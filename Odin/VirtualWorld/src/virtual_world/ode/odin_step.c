@@ -85,10 +85,11 @@ void odin_world_free_buffers(OdinWorld *w) {
     free(w->records);
     free(w->table);
     free(w->pairs);
+    free(w->pairs_sorted);
     free(w->contacts);
     w->records = NULL;
     w->table = NULL;
-    w->pairs = NULL;
+    w->pairs = w->pairs_sorted = NULL;
     w->contacts = NULL;
     w->n_records = w->cap_records = w->table_cap = 0;
     w->n_pairs = w->cap_pairs = w->n_contacts = w->cap_contacts = 0;
@@ -104,6 +105,9 @@ static int keep_pair(OdinWorld *w, dGeomID g1, dGeomID g2, long s1, long s2,
         OdinPair *pairs = realloc(w->pairs, (size_t)cap * sizeof(OdinPair));
         if (!pairs) return 0;
         w->pairs = pairs;
+        OdinPair *sorted = realloc(w->pairs_sorted, (size_t)cap * sizeof(OdinPair));
+        if (!sorted) return 0;
+        w->pairs_sorted = sorted;
         w->cap_pairs = cap;
     }
     if (w->n_contacts + n > w->cap_contacts) {
@@ -115,23 +119,36 @@ static int keep_pair(OdinWorld *w, dGeomID g1, dGeomID g2, long s1, long s2,
         w->cap_contacts = cap;
     }
     OdinPair *p = &w->pairs[w->n_pairs++];
-    p->g1 = g1; p->g2 = g2; p->s1 = s1; p->s2 = s2;
+    p->g1 = g1; p->g2 = g2;
+    p->key = (uint64_t)s1 << 32 | (uint64_t)(uint32_t)s2;
     p->first = w->n_contacts;
     p->n = n;
     for (int i = 0; i < n; ++i) w->contacts[w->n_contacts++] = c[i].geom;
     return 1;
 }
 
-static int by_serials(const void *a, const void *b) {
-    const OdinPair *p = (const OdinPair *)a, *q = (const OdinPair *)b;
-    if (p->s1 != q->s1) return p->s1 < q->s1 ? -1 : 1;
-    return (p->s2 > q->s2) - (p->s2 < q->s2);
+/* Sorts the pass's pairs by key: a least-significant-digit radix sort, a byte at a time,
+ * skipping the bytes every key shares (with fewer than 65,536 geoms, four of the eight): a
+ * few operations per pair, where qsort's comparisons cost a step 3 % of its instructions. */
+static void sort_pairs(OdinWorld *w) {
+    int n = w->n_pairs, count[256];
+    OdinPair *from = w->pairs, *to = w->pairs_sorted;
+    for (int shift = 0; shift < 64; shift += 8) {
+        memset(count, 0, sizeof count);
+        for (int i = 0; i < n; ++i) count[(from[i].key >> shift) & 255]++;
+        if (count[(from[0].key >> shift) & 255] == n) continue; /* one byte value: in order */
+        for (int b = 0, sum = 0; b < 256; ++b) { int c = count[b]; count[b] = sum; sum += c; }
+        for (int i = 0; i < n; ++i) to[count[(from[i].key >> shift) & 255]++] = from[i];
+        OdinPair *t = from; from = to; to = t;
+    }
+    w->pairs = from;
+    w->pairs_sorted = to;
 }
 
 /* Creates the pass's contact joints, pair by pair in serial order: the same scene gives the
  * same constraints in the same order, whatever order the hash space found the pairs in. */
 static void make_contacts(OdinWorld *w) {
-    if (!w->unordered) qsort(w->pairs, (size_t)w->n_pairs, sizeof(OdinPair), by_serials);
+    if (!w->unordered && w->n_pairs > 1) sort_pairs(w);
     int mode = dContactApprox1;
     if (w->bounce > 0) mode |= dContactBounce;
     for (int k = 0; k < w->n_pairs; ++k) {

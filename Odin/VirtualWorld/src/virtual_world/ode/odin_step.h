@@ -10,6 +10,7 @@
 #ifndef ODIN_STEP_H
 #define ODIN_STEP_H
 #include <ode/ode.h>
+#include <stdint.h>
 
 #define ODIN_MAX_CONTACTS 64   /* upper bound for max_contacts per pair */
 #define ODIN_RECORD_POINTS 8   /* contact points kept per recorded pair */
@@ -53,7 +54,7 @@ typedef struct OdinGeomInfo {
 /* A colliding pair found in one collide pass, its contacts at contacts[first .. first + n). */
 typedef struct OdinPair {
     dGeomID g1, g2;          /* in serial order */
-    long s1, s2;             /* their serials, s1 < s2 */
+    uint64_t key;            /* serial of g1 << 32 | serial of g2: the order of contacts */
     int first, n;
 } OdinPair;
 
@@ -96,7 +97,7 @@ typedef struct OdinWorld {
     OdinCollision *records; int n_records; int cap_records;
     int *table; int table_cap;   /* open addressing over records (contact-less dedupe) */
     /* internal: one collide pass's pairs and contacts, sorted before contact joints are made */
-    OdinPair *pairs; int n_pairs; int cap_pairs;
+    OdinPair *pairs; OdinPair *pairs_sorted; int n_pairs; int cap_pairs;
     dContactGeom *contacts; int n_contacts; int cap_contacts;
     int buffer_overflow;     /* pairs dropped because memory ran out */
 } OdinWorld;
