@@ -75,6 +75,10 @@ SERVICES = {
     "SetJointForce": (f"{KNOWN}: thesis 5.4.3; per-axis magnitudes and id format {RECON}",
                       "{joint: '1:ball&', magnitudes: [0.2]}"),
     "GetWorld": ("new (past the thesis): the values in force and what the world holds", None),
+    "SetSurface": ("new (past the thesis): per-object contact properties, as Kautham's URDF "
+                   "<contact_coefficients> and its environments' contact tables give them",
+                   "{id: ball, surface: {set_friction: true, friction: 0.4, set_bounce: true, "
+                   "bounce: 0.5, bounce_velocity: 0.05}}"),
     "SaveState": (f"{PLANNING}; the whole dynamic state, bit for bit", "{name: start}"),
     "RestoreState": (f"{PLANNING}; refused when the contents changed", "{name: start}"),
     "Reset": (f"{PLANNING}; the state right after the last build or removal", None),
@@ -121,6 +125,9 @@ MESSAGES = {
     "JointParameter": ("in Set Joint", "-",
                        f"the parameters {KNOWN} (thesis 5.3.2, issue 3); encoding {RECON}"),
     "WorldParameters": ("in Get World", "-", "new: the fields of Set World's values in force"),
+    "Surface": ("in Object, Part and Set Surface", "-",
+                "new: per-surface friction, restitution and soft contact, with the mixing "
+                "rule of two surfaces"),
     "BodyState": ("in Propagate's answer", "-", "new"),
     "BodyForce": ("in Propagate's request", "-", "new: the fields of Set External Force"),
     "RecordStart": ("`/odin/record/start` in a recording (the world node's `~record`)",

@@ -9,7 +9,7 @@ from Messages import msg
 from Services import srv
 from odin_common import interface, world_parameters
 from odin_common.interface import (AxisFrame, ForceKind, JointParameter, JointType, MotorKind,
-                                   SetJointAction, Solver)
+                                   SetJointAction, Shape, Solver)
 
 SRV_DIR = pathlib.Path(__file__).resolve().parents[2] / "Services" / "srv"
 
@@ -21,6 +21,7 @@ PINS = [
     (AxisFrame, srv.SetMotorRequest),
     (ForceKind, srv.SetExternalForceRequest),
     (ForceKind, msg.BodyForce),
+    (Shape, msg.Object),
     (Solver, srv.SetWorldRequest),
 ]
 
@@ -67,6 +68,16 @@ def test_the_spec_message_conversions_round_trip():
     parameters = world_parameters.WorldParameters(gravity=(0, 0, -1.0), erp=0.3, solver=1)
     assert messages.world_parameters_of(messages.world_parameters_message(parameters)) == \
         parameters
+
+
+def test_a_surface_survives_the_round_trip_through_its_message():
+    import math
+    from odin_common import messages
+    from odin_common.specs import Surface
+    for surface in (Surface(), Surface(friction=math.inf, bounce=0.4, bounce_velocity=0.2),
+                    Surface(friction=0.3, friction2=0.1, friction_direction=(0.0, 1.0, 0.0),
+                            stiffness=1e5, damping=30.0)):
+        assert messages.surface_of(messages.surface_message(surface)) == surface
 
 
 def test_every_parameter_has_a_default_and_the_defaults_are_valid():

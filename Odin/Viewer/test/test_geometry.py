@@ -123,3 +123,26 @@ def test_finely_tessellated_surface_is_smooth():
     mesh = geometry_from_parameters(vertices, triangles)
     apex = mesh.normals_B[mesh.indices_B[0::3]]
     np.testing.assert_allclose(apex, [[0, 0, 1]] * 16, atol=1e-6)
+
+
+def test_a_capsule_is_one_closed_mesh_of_its_size():
+    from viewer.core.geometry import capsule_geometry
+    g = geometry_from_parameters([0.05, 0.3], shape=5)
+    assert g.kind == "mesh" and g.closed and g.radius == pytest.approx(0.2, rel=1e-3)
+    z = g.vertices_B[:, 2]
+    assert z.min() == pytest.approx(-0.2, abs=1e-6) and z.max() == pytest.approx(0.2, abs=1e-6)
+    rim = np.hypot(g.vertices_B[:, 0], g.vertices_B[:, 1])
+    assert rim.max() == pytest.approx(0.05, rel=1e-3)
+    assert capsule_geometry(0.05, 0.3).triangle_count == g.triangle_count
+
+
+def test_a_plane_is_a_large_unbounded_floor():
+    g = geometry_from_parameters([], shape=6)
+    assert g.kind == "box" and not g.bounded and g.scale_B[2] < 0.01 and g.scale_B[0] >= 50
+
+
+@pytest.mark.parametrize("parameters,shape", [([0.1], 5), ([1.0], 6), ([0.1, 0.2], 9),
+                                              ([0.1, -0.2], 5)])
+def test_a_named_shape_with_the_wrong_parameters_is_refused(parameters, shape):
+    with pytest.raises(ViewerError):
+        geometry_from_parameters(parameters, shape=shape)

@@ -115,3 +115,12 @@ def test_bounds_and_clip_planes_hold_the_scene():
     near, far = scene.clip_planes()
     distance = np.linalg.norm(np.subtract(scene.camera.eye_W, centre))
     assert 0 < near < distance - radius and far > distance + radius
+
+
+def test_the_camera_fits_the_scene_without_its_infinite_plane():
+    scene = Scene(Camera())
+    scene.view_object("floor", [], position_W=(0, 0, 0), shape=6)
+    assert scene.bounds() is None
+    scene.view_object("ball", [0.5], position_W=(10, 0, 1))
+    centre, radius = scene.bounds()
+    np.testing.assert_allclose(centre, (10, 0, 1)) and radius == pytest.approx(0.5)

@@ -191,22 +191,65 @@ def motor_joint(motor_id: str) -> str:
 
 # ---------------------------------------------------------------------------------- shapes
 
-SHAPE_BY_PARAMETER_COUNT = {1: "sphere", 2: "cylinder", 3: "box"}
-"""The thesis's rule: Object/Part ``parameters`` decide the shape by their number (sphere
-radius; cylinder radius and length along z; box sides x, y, z); a multiple of 3 that is at
-least 9 is a triangle mesh's vertices (with ``indices``)."""
+class Shape(IntEnum):
+    """Messages/Object, Part and View Object ``shape``. BY_COUNT (0, the default) keeps the
+    thesis's rule: the number of ``parameters`` decides the shape (1 sphere, 2 cylinder, 3 box,
+    a multiple of 3 >= 9 mesh). The others name it; their parameters (m, the object's frame):
+    SPHERE radius; CYLINDER radius, length along z; BOX sides x, y, z; MESH vertices (with
+    ``indices``); CAPSULE radius, length of its cylinder along z (hemispheres at both ends);
+    PLANE none: an infinite plane through the object's position with the object's z axis as
+    its normal (static only: geometry_only, never a part of a composite)."""
+    BY_COUNT = 0
+    SPHERE = 1
+    CYLINDER = 2
+    BOX = 3
+    MESH = 4
+    CAPSULE = 5
+    PLANE = 6
+
+    @property
+    def label(self) -> str:
+        return self.name.lower()
 
 
-def shape_kind(parameter_count: int) -> str:
-    """"sphere", "cylinder", "box" or "mesh" for a number of parameters; InvalidArgument for a
-    count that fits no shape."""
-    kind = SHAPE_BY_PARAMETER_COUNT.get(parameter_count)
-    if kind is not None:
-        return kind
-    if parameter_count >= 9 and parameter_count % 3 == 0:
-        return "mesh"
-    raise InvalidArgument(f"{parameter_count} parameters fit no shape (1 sphere, 2 cylinder, "
-                          "3 box, a multiple of 3 >= 9 mesh vertices)")
+SHAPE_BY_PARAMETER_COUNT = {1: Shape.SPHERE, 2: Shape.CYLINDER, 3: Shape.BOX}
+"""The thesis's rule (Shape.BY_COUNT): a multiple of 3 that is at least 9 is a mesh."""
+
+SHAPE_PARAMETERS: Dict[Shape, Tuple[str, ...]] = {
+    Shape.SPHERE: ("radius",), Shape.CYLINDER: ("radius", "length"),
+    Shape.BOX: ("x", "y", "z"), Shape.CAPSULE: ("radius", "length"), Shape.PLANE: (),
+}
+"""What each primitive's parameters are (all m, > 0); a mesh takes vertices."""
+
+
+def shape_of(parameter_count: int, shape: int = Shape.BY_COUNT) -> Shape:
+    """The Shape of ``parameter_count`` parameters asked for as ``shape``; InvalidArgument for
+    an unknown shape or a count that does not fit it."""
+    if isinstance(shape, bool) or shape not in set(Shape):
+        raise InvalidArgument(f"shape {shape!r} is not one of 0..{len(Shape) - 1} "
+                              f"({', '.join(f'{s.value} {s.label}' for s in Shape)})")
+    shape = Shape(shape)
+    is_mesh = parameter_count >= 9 and parameter_count % 3 == 0
+    if shape == Shape.BY_COUNT:
+        found = SHAPE_BY_PARAMETER_COUNT.get(parameter_count, Shape.MESH if is_mesh else None)
+        if found is None:
+            raise InvalidArgument(f"{parameter_count} parameters fit no shape (1 sphere, "
+                                  "2 cylinder, 3 box, a multiple of 3 >= 9 mesh vertices)")
+        return found
+    if shape == Shape.MESH:
+        if not is_mesh:
+            raise InvalidArgument(f"a mesh takes a multiple of 3 >= 9 parameters (vertices), "
+                                  f"got {parameter_count}")
+    elif parameter_count != len(SHAPE_PARAMETERS[shape]):
+        names = ", ".join(SHAPE_PARAMETERS[shape]) or "none"
+        raise InvalidArgument(f"a {shape.label} takes {len(SHAPE_PARAMETERS[shape])} "
+                              f"parameter(s) ({names}), got {parameter_count}")
+    return shape
+
+
+def shape_kind(parameter_count: int, shape: int = Shape.BY_COUNT) -> str:
+    """"sphere", "cylinder", "box", "mesh", "capsule" or "plane" (see shape_of)."""
+    return shape_of(parameter_count, shape).label
 
 
 # ---------------------------------------------------------------------------------- IDs
@@ -238,6 +281,7 @@ WORLD_SERVICES: Dict[str, str] = {
     "set_external_force": "SetExternalForce", "set_joint_force": "SetJointForce",
     "get_world": "GetWorld", "save_state": "SaveState", "restore_state": "RestoreState",
     "reset": "Reset", "propagate": "Propagate", "check_collision": "CheckCollision",
+    "set_surface": "SetSurface",
 }
 """The VirtualWorld's services: name under ``~`` -> type in the Services package (the
 thesis's 15, then Odin's own)."""
@@ -263,6 +307,7 @@ __all__ = ["NodeParameter", "JointType", "JointParameter", "SetJointAction", "Mo
            "JOINT_NEEDS_TWO_BODIES", "JOINT_AXIS2_ON_BODY2", "JOINT_FORCE_MAGNITUDES", "JOINT_STATE_AXES", "JOINT_PARAMETERS",
            "JOINT_PARAMETER_AXES", "MOTOR_PARAMETERS", "UNIT_PARAMETERS",
            "NON_NEGATIVE_PARAMETERS", "joint_type", "default_joint_id", "MOTOR_PREFIX", "default_motor_id", "motor_joint",
-           "SHAPE_BY_PARAMETER_COUNT", "shape_kind", "COMPOSITE_MARK", "composite_id",
+           "Shape", "SHAPE_BY_PARAMETER_COUNT", "SHAPE_PARAMETERS", "shape_of",
+           "shape_kind", "COMPOSITE_MARK", "composite_id",
            "is_composite_id", "WORLD_NAMESPACE", "VIEWER_NAMESPACE", "WORLD_SERVICES",
            "VIEWER_SERVICES"]

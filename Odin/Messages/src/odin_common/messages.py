@@ -10,10 +10,12 @@ from typing import Sequence, Tuple
 
 import numpy as np
 
+import math
+
 from Messages.msg import (BodyForce, BodyState, Composite, JointParameter, Object, Part,
-                          Situation, WorldParameters)
+                          Situation, Surface as SurfaceMessage, WorldParameters)
 from odin_common import world_parameters
-from odin_common.specs import CompositeSpec, ObjectSpec, PartSpec
+from odin_common.specs import CompositeSpec, ObjectSpec, PartSpec, Surface
 
 
 def _floats(values) -> list:
@@ -24,13 +26,49 @@ def _indices(values) -> list:
     return np.asarray(values, dtype=np.uint32).reshape(-1).tolist()
 
 
+def surface_message(surface: Surface) -> SurfaceMessage:
+    m = SurfaceMessage()
+    if surface.friction is not None:
+        m.set_friction = True
+        m.friction = -1.0 if math.isinf(surface.friction) else float(surface.friction)
+    if surface.friction2 is not None:
+        m.set_friction2 = True
+        m.friction2 = float(surface.friction2)
+        m.friction_direction = _floats(surface.friction_direction)
+    if surface.bounce is not None:
+        m.set_bounce = True
+        m.bounce = float(surface.bounce)
+        m.bounce_velocity = float(surface.bounce_velocity)
+    if surface.stiffness is not None:
+        m.set_softness = True
+        m.stiffness = float(surface.stiffness)
+        m.damping = float(surface.damping)
+    return m
+
+
+def surface_of(m: SurfaceMessage) -> Surface:
+    """Messages/Surface -> Surface (a negative friction is infinite)."""
+    friction = None
+    if m.set_friction:
+        friction = math.inf if m.friction < 0 else m.friction
+    return Surface(friction=friction,
+                   friction2=m.friction2 if m.set_friction2 else None,
+                   friction_direction=tuple(m.friction_direction) if m.set_friction2
+                   else (1.0, 0.0, 0.0),
+                   bounce=m.bounce if m.set_bounce else None,
+                   bounce_velocity=m.bounce_velocity if m.set_bounce else 0.0,
+                   stiffness=m.stiffness if m.set_softness else None,
+                   damping=m.damping if m.set_softness else 0.0)
+
+
 def object_message(spec: ObjectSpec) -> Object:
     return Object(name=spec.name, parameters=_floats(spec.parameters),
                   indices=_indices(spec.indices), mass=float(spec.mass),
                   inertia=_floats(spec.inertia), position=_floats(spec.position),
                   orientation=_floats(spec.orientation), color=_floats(spec.color),
                   fixed=bool(spec.fixed), geometry_only=bool(spec.geometry_only),
-                  no_collisions=bool(spec.no_collisions))
+                  no_collisions=bool(spec.no_collisions), shape=int(spec.shape),
+                  surface=surface_message(spec.surface))
 
 
 def object_spec(message: Object) -> ObjectSpec:
@@ -39,21 +77,24 @@ def object_spec(message: Object) -> ObjectSpec:
                       inertia=tuple(message.inertia), position=tuple(message.position),
                       orientation=tuple(message.orientation), color=tuple(message.color),
                       fixed=message.fixed, geometry_only=message.geometry_only,
-                      no_collisions=message.no_collisions)
+                      no_collisions=message.no_collisions, shape=message.shape,
+                      surface=surface_of(message.surface))
 
 
 def part_message(spec: PartSpec) -> Part:
     return Part(name=spec.name, parameters=_floats(spec.parameters),
                 indices=_indices(spec.indices), mass=float(spec.mass),
                 position=_floats(spec.position), orientation=_floats(spec.orientation),
-                color=_floats(spec.color))
+                color=_floats(spec.color), shape=int(spec.shape),
+                surface=surface_message(spec.surface))
 
 
 def part_spec(message: Part) -> PartSpec:
     return PartSpec(name=message.name, parameters=tuple(message.parameters),
                     indices=tuple(message.indices), mass=message.mass,
                     position=tuple(message.position), orientation=tuple(message.orientation),
-                    color=tuple(message.color))
+                    color=tuple(message.color), shape=message.shape,
+                    surface=surface_of(message.surface))
 
 
 def composite_message(spec: CompositeSpec) -> Composite:
@@ -126,7 +167,7 @@ def body_force_message(object_id: str, kind: int, vector, vector_in_body_frame: 
                      point=_floats(point), point_in_body_frame=bool(point_in_body_frame))
 
 
-__all__ = ["world_parameters_message", "world_parameters_of", "body_state_message",
+__all__ = ["surface_message", "surface_of", "world_parameters_message", "world_parameters_of", "body_state_message",
            "body_force_arguments", "body_force_message", "object_message", "object_spec", "part_message", "part_spec", "composite_message",
            "composite_spec", "parameter_messages", "parameter_triples", "situation_messages",
            "situation_poses"]

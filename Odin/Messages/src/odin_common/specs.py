@@ -9,14 +9,42 @@ thousands of numbers, which tuples would copy for nothing.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Sequence, Tuple
+from typing import Optional, Sequence, Tuple
 
-from odin_common.interface import (JointType, MotorKind, composite_id, default_joint_id,
-                                   default_motor_id, shape_kind)
+from odin_common.interface import (JointType, MotorKind, Shape, composite_id,
+                                   default_joint_id, default_motor_id, shape_kind)
 from odin_common.rotations import IDENTITY_WXYZ
 
 NO_COLOR = (0.0, 0.0, 0.0, 0.0)
 """All zero: the Viewer's default colour."""
+
+
+@dataclass(frozen=True)
+class Surface:
+    """Messages/Surface: contact properties of a surface; None: not set (the world's value).
+
+    friction: Coulomb mu >= 0 (math.inf: infinite). friction2: mu along
+    ``friction_direction`` (a unit vector in the geometry's own frame), for anisotropic
+    friction. bounce: restitution in [0, 1], with bounce_velocity (m/s) the least incoming
+    speed that bounces. stiffness (kp, N/m), with damping (kd, N s/m): a soft contact. Two
+    surfaces in contact mix their values: the smaller friction, the larger restitution, the
+    smaller bounce velocity, stiffness and damping in series (docs/INTERFACE.md)."""
+    friction: Optional[float] = None
+    friction2: Optional[float] = None
+    friction_direction: Sequence[float] = (1.0, 0.0, 0.0)
+    bounce: Optional[float] = None
+    bounce_velocity: float = 0.0
+    stiffness: Optional[float] = None
+    damping: float = 0.0
+
+    @property
+    def is_set(self) -> bool:
+        return any(v is not None for v in (self.friction, self.friction2, self.bounce,
+                                           self.stiffness))
+
+
+WORLD_SURFACE = Surface()
+"""Nothing set: every contact value is the world's."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -32,6 +60,9 @@ class ObjectSpec:
     position (m, world), orientation (w, x, y, z): the object's frame. color: RGBA in [0, 1].
     fixed: a kinematic body that forces and contacts never move. geometry_only: no body.
     no_collisions: collides with nothing (Kautham's <Collision enabled="false">).
+    shape: odin_common.interface.Shape; BY_COUNT (0) follows the count rule above, the others
+        name a shape (CAPSULE: radius, length; PLANE: no parameter, static only).
+    surface: contact properties of its geometry (Surface).
     """
     name: str
     parameters: Sequence[float]
@@ -44,14 +75,17 @@ class ObjectSpec:
     fixed: bool = False
     geometry_only: bool = False
     no_collisions: bool = False
+    shape: int = Shape.BY_COUNT
+    surface: Surface = WORLD_SURFACE
 
     @property
     def id(self) -> str:
         return self.name
 
     @property
-    def shape(self) -> str:
-        return shape_kind(len(self.parameters))
+    def kind(self) -> str:
+        """"sphere", "cylinder", "box", "mesh", "capsule" or "plane"."""
+        return shape_kind(len(self.parameters), self.shape)
 
     @property
     def triangle_count(self) -> int:
@@ -60,8 +94,8 @@ class ObjectSpec:
 
 @dataclass(frozen=True, eq=False)
 class PartSpec:
-    """Messages/Part: one geometry of a composite; pose in the composite's frame; shape,
-    mass and colour as in ObjectSpec."""
+    """Messages/Part: one geometry of a composite; pose in the composite's frame; shape (not a
+    plane), mass, colour and surface as in ObjectSpec."""
     name: str
     parameters: Sequence[float]
     indices: Sequence[int] = ()
@@ -69,10 +103,12 @@ class PartSpec:
     position: Sequence[float] = (0.0, 0.0, 0.0)
     orientation: Sequence[float] = IDENTITY_WXYZ
     color: Sequence[float] = NO_COLOR
+    shape: int = Shape.BY_COUNT
+    surface: Surface = WORLD_SURFACE
 
     @property
-    def shape(self) -> str:
-        return shape_kind(len(self.parameters))
+    def kind(self) -> str:
+        return shape_kind(len(self.parameters), self.shape)
 
     @property
     def triangle_count(self) -> int:
@@ -161,5 +197,5 @@ class MotorSpec:
         return self.id or default_motor_id(self.joint, self.body1, self.body2)
 
 
-__all__ = ["NO_COLOR", "ObjectSpec", "PartSpec", "CompositeSpec", "EntitySpec", "JointSpec",
+__all__ = ["Surface", "WORLD_SURFACE", "NO_COLOR", "ObjectSpec", "PartSpec", "CompositeSpec", "EntitySpec", "JointSpec",
            "MotorSpec"]

@@ -86,7 +86,7 @@ class StepEntry(NamedTuple):
 # the world's IDs in ``ids`` (BuiltIds) and returns the world's answer (an ID).
 
 def _object_description(spec: ObjectSpec, entity: Optional[str]) -> dict:
-    shape = spec.shape
+    shape = spec.kind
     return dict(name=spec.name, entity=entity, shape=shape, position=list(spec.position),
                 quaternion=list(spec.orientation), triangles=spec.triangle_count,
                 mass=None if spec.geometry_only else spec.mass, static=spec.geometry_only,

@@ -18,6 +18,7 @@ from typing import Sequence
 import numpy as np
 
 from odin_common.errors import InvalidArgument
+from odin_common.interface import SHAPE_PARAMETERS, Shape, shape_of
 from odin_common.meshes import cluster_vertices
 from odin_common.rotations import quaternion_to_matrix, unit_quaternion
 from viewer.errors import ViewerError
@@ -67,6 +68,8 @@ class Geometry:
     radius: m, radius of a sphere about the body origin that holds the whole shape.
     closed: the surface is closed and its triangles face outwards (counter-clockwise), so back
         faces are never seen: the renderer culls them and lights one side only.
+    bounded: False for a plane (infinite in the world, drawn as a large floor): the camera
+        fits the scene without it.
     key: unique per Geometry, so that a renderer can cache GPU buffers by it.
     """
     kind: str
@@ -76,6 +79,7 @@ class Geometry:
     normals_B: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.float32))
     indices_B: np.ndarray = field(default_factory=lambda: np.zeros(0, np.uint32))
     closed: bool = True
+    bounded: bool = True
     key: int = field(default_factory=lambda: next(_keys))
 
     @property
@@ -92,27 +96,69 @@ def _positive(values: Sequence[float], names: Sequence[str], shape: str) -> list
     return out
 
 
-def geometry_from_parameters(parameters: Sequence[float], indices: Sequence[int] = ()) -> Geometry:
-    """The shape that ``parameters`` (and, for meshes, ``indices``) describe; see the module doc.
+#: m: a plane (infinite in the world) is drawn as a square floor this wide, this thin, its
+#: top face on the plane
+PLANE_DRAWN_SIZE = 60.0
+PLANE_DRAWN_THICKNESS = 0.002
+
+
+def geometry_from_parameters(parameters: Sequence[float], indices: Sequence[int] = (),
+                             shape: int = Shape.BY_COUNT) -> Geometry:
+    """The shape that ``parameters`` (and, for meshes, ``indices``) describe, asked for as
+    ``shape`` (odin_common.interface.Shape; 0: by their count); see the module doc.
 
     Raises :class:`ViewerError` for a wrong parameter count, non-positive or non-finite sizes,
     an empty mesh, an index count that is not a multiple of 3 or an index out of range.
     """
     params = np.asarray(parameters, dtype=float).reshape(-1)
-    n = params.size
-    if n == 1:
-        (r,) = _positive(params, ["radius"], "sphere")
+    try:
+        kind = shape_of(params.size, shape)
+    except InvalidArgument as error:
+        raise ViewerError(str(error)) from None
+    names = [f"side {name}" if kind == Shape.BOX else name
+             for name in SHAPE_PARAMETERS.get(kind, ())]
+    if kind == Shape.SPHERE:
+        (r,) = _positive(params, names, "sphere")
         return Geometry("sphere", (r, r, r), r)
-    if n == 2:
-        r, length = _positive(params, ["radius", "length"], "cylinder")
+    if kind == Shape.CYLINDER:
+        r, length = _positive(params, names, "cylinder")
         return Geometry("cylinder", (r, r, length), math.hypot(r, length / 2))
-    if n == 3:
-        sides = _positive(params, ["side x", "side y", "side z"], "box")
+    if kind == Shape.BOX:
+        sides = _positive(params, names, "box")
         return Geometry("box", tuple(sides), 0.5 * math.sqrt(sum(s * s for s in sides)))
-    if n < 9 or n % 3:
-        raise ViewerError(f"{n} parameters describe no shape: 1 sphere, 2 cylinder, 3 box, "
-                          f"9 or more (a multiple of 3) mesh vertices")
+    if kind == Shape.CAPSULE:
+        return capsule_geometry(*_positive(params, names, "capsule"))
+    if kind == Shape.PLANE:
+        return Geometry("box", (PLANE_DRAWN_SIZE, PLANE_DRAWN_SIZE, PLANE_DRAWN_THICKNESS), 0.0,
+                        bounded=False)
     return mesh_geometry(params.reshape(-1, 3), indices)
+
+
+def capsule_geometry(radius: float, length: float, slices: int = 32, stacks: int = 8
+                     ) -> Geometry:
+    """A capsule: a cylinder of ``length`` along z with hemispheres of ``radius`` at both
+    ends, as one closed mesh (m)."""
+    rings = []   # (z, ring radius) between the poles, from the bottom up
+    for k in range(1, stacks + 1):       # bottom hemisphere, to the equator
+        a = -math.pi / 2 + k * math.pi / 2 / stacks
+        rings.append((-length / 2 + radius * math.sin(a), radius * math.cos(a)))
+    for k in range(stacks):              # top hemisphere, from the equator
+        a = k * math.pi / 2 / stacks
+        rings.append((length / 2 + radius * math.sin(a), radius * math.cos(a)))
+    angles = np.linspace(0.0, 2 * math.pi, slices, endpoint=False)
+    top = len(rings) * slices + 1
+    vertices = np.array([(0.0, 0.0, -length / 2 - radius)]
+                        + [(r * math.cos(t), r * math.sin(t), z) for z, r in rings
+                           for t in angles] + [(0.0, 0.0, length / 2 + radius)])
+    triangles = []
+    for k in range(slices):              # the poles' fans, counter-clockwise seen outside
+        triangles += [(0, 1 + (k + 1) % slices, 1 + k),
+                      (top, top - slices + k, top - slices + (k + 1) % slices)]
+    for ring in range(len(rings) - 1):
+        for k in range(slices):
+            a, b = 1 + ring * slices + k, 1 + ring * slices + (k + 1) % slices
+            triangles += [(a, b, b + slices), (a, b + slices, a + slices)]
+    return mesh_geometry(vertices, np.array(triangles).reshape(-1))
 
 
 #: corners whose face turns more than this from the smoothed vertex normal get a vertex of

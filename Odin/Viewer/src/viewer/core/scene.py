@@ -59,13 +59,13 @@ class ViewRequest:
 
 def prepare_view(object_id: str, parameters: Sequence[float], indices: Sequence[int],
                  position_W: Sequence[float], orientation_wxyz: Sequence[float],
-                 color: Sequence[float]) -> ViewRequest:
+                 color: Sequence[float], shape: int = 0) -> ViewRequest:
     """Checks a View Object request and builds its geometry (no scene needed, so a service
     callback can do it on its own thread). Raises :class:`ViewerError` if anything is wrong."""
     object_id = check_id(object_id)
     where = f"object {object_id!r}"
     try:
-        geometry = geometry_from_parameters(parameters, indices)
+        geometry = geometry_from_parameters(parameters, indices, shape)
     except ViewerError as error:
         raise ViewerError(f"{where}: {error}") from None
     return ViewRequest(object_id, geometry, pose_matrix(position_W, orientation_wxyz, where),
@@ -138,10 +138,10 @@ class Scene:
     def view_object(self, object_id: str, parameters: Sequence[float], indices: Sequence[int] = (),
                     position_W: Sequence[float] = (0, 0, 0),
                     orientation_wxyz: Sequence[float] = (1, 0, 0, 0),
-                    color: Sequence[float] = (0, 0, 0, 0)) -> bool:
+                    color: Sequence[float] = (0, 0, 0, 0), shape: int = 0) -> bool:
         """:func:`prepare_view` and :meth:`view` in one call."""
         return self.view(prepare_view(object_id, parameters, indices, position_W,
-                                      orientation_wxyz, color))
+                                      orientation_wxyz, color, shape))
 
     def remove_object(self, object_id: str) -> None:
         if object_id not in self._objects:
@@ -200,11 +200,13 @@ class Scene:
 
     # -- bounds and camera -----------------------------------------------------------------
     def bounds(self) -> Optional[tuple]:
-        """(centre (3,) m, radius m) of a sphere holding every object, or None if empty."""
-        if not self._objects:
+        """(centre (3,) m, radius m) of a sphere holding every bounded object (planes are
+        infinite), or None if there is none."""
+        bounded = [o for o in self._objects.values() if o.geometry.bounded]
+        if not bounded:
             return None
-        centres = np.array([o.pose_W[:3, 3] for o in self._objects.values()])
-        radii = np.array([o.geometry.radius for o in self._objects.values()])
+        centres = np.array([o.pose_W[:3, 3] for o in bounded])
+        radii = np.array([o.geometry.radius for o in bounded])
         low = (centres - radii[:, None]).min(axis=0)
         high = (centres + radii[:, None]).max(axis=0)
         centre = (low + high) / 2

@@ -158,7 +158,7 @@ class Portal:
     def _view_object(self, req) -> ViewObjectResponse:
         def work():
             request = prepare_view(req.id, req.parameters, req.indices, req.position,
-                                   req.orientation, req.color)   # checked on this thread
+                                   req.orientation, req.color, req.shape)   # on this thread
             replaced = self.loop.call(lambda scene, _: scene.view(request))
             return f"replaced {req.id!r}" if replaced else f"added {req.id!r}"
         return self._answer(ViewObjectResponse, work)

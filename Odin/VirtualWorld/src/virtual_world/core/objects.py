@@ -32,7 +32,8 @@ IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
 
 @dataclass(eq=False)
 class _Part:
-    """A checked geometry: shape and mass, pose in the object's frame, what was given."""
+    """A checked geometry: shape and mass, pose in the object's frame, surface, what was
+    given."""
     name: str
     shape: Shape
     mass: float
@@ -41,6 +42,8 @@ class _Part:
     color: Tuple[float, ...]
     parameters: Sequence[float]
     indices: Sequence[int]
+    shape_asked: int
+    surface: object   # odin_common.specs.Surface
 
 
 @dataclass(eq=False)
@@ -60,12 +63,17 @@ class _Prepared:
 
 # ---------------------------------------------------------------------------------- checks
 
-def _part(what: str, name: str, parameters, indices, mass: float, position, orientation,
-          color) -> _Part:
-    return _Part(name, prepare_shape(what, parameters, indices), mass,
-                 check.vector(f"{what}: position", position),
+def _part(what: str, given, mass: float, position, orientation) -> _Part:
+    """The checked geometry of an ObjectSpec or PartSpec ``given``."""
+    shape = prepare_shape(what, given.parameters, given.indices, given.shape)
+    surface = check.surface(what, given.surface)
+    if shape.kind == "plane" and surface.friction2 is not None:
+        raise InvalidArgument(f"{what}: anisotropic friction (friction2) on a plane is not "
+                              "supported")
+    return _Part(given.name, shape, mass, check.vector(f"{what}: position", position),
                  check.quaternion(f"{what}: orientation", orientation),
-                 tuple(check.vector(f"{what}: color", color, 4).tolist()), parameters, indices)
+                 tuple(check.vector(f"{what}: color", given.color, 4).tolist()),
+                 given.parameters, given.indices, int(given.shape), surface)
 
 
 def _centred(what: str, dmass) -> np.ndarray:
@@ -86,8 +94,9 @@ def prepare_object(spec: ObjectSpec) -> _Prepared:
     mass = check.number(f"{what}: mass", spec.mass)
     if mass <= 0 and not geometry_only:  # a body-less geometry has no mass to check
         raise InvalidArgument(f"{what}: mass {spec.mass!r} must be positive")
-    part = _part(what, name, spec.parameters, spec.indices, mass, (0.0, 0.0, 0.0), IDENTITY,
-                 spec.color)
+    part = _part(what, spec, mass, (0.0, 0.0, 0.0), IDENTITY)
+    if part.shape.kind == "plane" and not geometry_only:
+        raise InvalidArgument(f"{what}: a plane is static: give geometry_only")
     position = check.vector(f"{what}: position", spec.position)
     orientation = check.quaternion(f"{what}: orientation", spec.orientation)
     fixed = check.flag(f"{what}: fixed", spec.fixed)
@@ -119,8 +128,10 @@ def prepare_composite(spec: CompositeSpec) -> _Prepared:
         mass = check.number(f"{what}: mass", given.mass)
         if mass <= 0:
             raise InvalidArgument(f"{what}: mass {given.mass!r} must be positive")
-        parts.append(_part(what, name, given.parameters, given.indices, mass, given.position,
-                           given.orientation, given.color))
+        part = _part(what, given, mass, given.position, given.orientation)
+        if part.shape.kind == "plane":
+            raise InvalidArgument(f"{what}: a plane cannot be a part of a composite")
+        parts.append(part)
     object_id = composite_id([p.name for p in parts])
     what = f"composite {object_id!r}"
     position = check.vector(f"{what}: position", spec.position)
@@ -178,19 +189,24 @@ def _build_geometry(scene: Scene, p: _Prepared, part: _Part, body, tag: int) -> 
         vertices, triangles = collision_mesh(shape, scene.parameters.collision_mesh_tolerance)
         geom = handles.new_trimesh(scene.c.space, vertices, triangles, scene.take_serial(),
                                    body)
+    elif shape.kind == "plane":
+        geom = handles.new_primitive(scene.c.space, "plane", _plane(p.position, p.orientation),
+                                     scene.take_serial())
     else:
         geom = handles.new_primitive(scene.c.space, shape.kind, shape.dims,
                                      scene.take_serial(), body)
     if body is not None:
         bodies.set_geom_offset(geom.ptr, (part.position - p.com).tolist(),
                                part.orientation.tolist())
-    else:
+    elif shape.kind != "plane":
         place_static(geom.ptr, p.position, p.orientation, part.position, part.orientation)
     bodies.set_geom_tag(geom, tag)
+    bodies.set_surface(geom, part.surface)
     if p.no_collisions:
         bodies.exclude_from_collisions(geom.ptr)
     record = GeometryRecord(part.name, geom, p.object_id, part.position, part.orientation,
-                            shape, part.parameters, part.indices, part.color)
+                            shape, part.parameters, part.indices, part.color, part.shape_asked,
+                            part.surface)
     scene.add_geometry(record)
     return record
 
@@ -200,13 +216,24 @@ def _built_geometries(records: Sequence[GeometryRecord]) -> Tuple[BuiltGeometry,
     return tuple(BuiltGeometry(r.name, tuple(np.asarray(r.parameters, float).tolist()),
                                tuple(int(i) for i in np.asarray(r.indices).reshape(-1)),
                                r.color, tuple(positions[k].tolist()),
-                               tuple(quaternions[k].tolist()))
+                               tuple(quaternions[k].tolist()), r.shape_asked)
                  for k, r in enumerate(records))
+
+
+def _plane(position: np.ndarray, orientation: np.ndarray) -> Tuple[float, float, float, float]:
+    """(a, b, c, d) of the plane through ``position`` whose normal is the object's z axis."""
+    normal = quaternion_to_matrix(orientation)[:, 2]
+    return (*normal.tolist(), float(normal @ position))
 
 
 def place_static(geom, position: np.ndarray, orientation: np.ndarray,
                  part_position: np.ndarray, part_orientation: np.ndarray) -> None:
-    """A static geom at the object's pose composed with its pose in the object frame."""
+    """A static geom at the object's pose composed with its pose in the object frame; a plane
+    through the object's position, normal to its z axis."""
+    if bodies.is_plane(geom):
+        a, b, c, d = _plane(position, orientation)
+        bodies.place_plane(geom, (a, b, c), d)
+        return
     bodies.set_geom_pose(geom, (position + quaternion_to_matrix(orientation) @ part_position)
                          .tolist(), quaternion_multiply(orientation, part_orientation).tolist())
 
@@ -332,6 +359,22 @@ def set_velocity(scene: Scene, object_id: str, linear=None, angular=None) -> Non
     angular = None if angular is None else check.vector("angular velocity", angular)
     bodies.set_body_velocity(obj.body.ptr, None if linear is None else linear.tolist(),
                              None if angular is None else angular.tolist())
+
+
+def set_surface(scene: Scene, name: str, surface) -> None:
+    """The contact properties of an object's geometries (an object ID) or of one geometry (a
+    composite part's name), from the next step on."""
+    surface = check.surface(f"surface of {name!r}", surface)
+    if name in scene.objects:
+        geometries = scene.objects[name].geometries
+    else:
+        geometries = [scene.geometry(name)]
+    if surface.friction2 is not None and any(g.shape.kind == "plane" for g in geometries):
+        raise InvalidArgument(f"{name!r}: anisotropic friction (friction2) on a plane is not "
+                              "supported")
+    for geometry in geometries:
+        bodies.set_surface(geometry.owner, surface)
+        geometry.surface = surface
 
 
 def entity_members(scene: Scene) -> Dict[str, List[str]]:

@@ -19,14 +19,15 @@ from virtual_world.ode.handles import Owner
 
 class BuiltGeometry(NamedTuple):
     """One geometry as built: name, the shape's Object/Part parameters and indices (m, its
-    own frame), colour (RGBA), and its world pose (m; quaternion (w, x, y, z)) right after
-    the build. What a Viewer needs to show it."""
+    own frame), colour (RGBA), its world pose (m; quaternion (w, x, y, z)) right after the
+    build, and the shape as asked (odin_common.interface.Shape). What a Viewer needs."""
     name: str
     parameters: Tuple[float, ...]
     indices: Tuple[int, ...]
     color: Tuple[float, ...]
     position: Tuple[float, float, float]
     orientation: Tuple[float, float, float, float]
+    shape: int = 0
 
 
 class Built(NamedTuple):
@@ -109,10 +110,11 @@ class Propagation(NamedTuple):
 class GeometryRecord:
     """One ODE geom: its owner, the object it belongs to and its pose in the object frame."""
     __slots__ = ("name", "owner", "object_id", "position", "orientation", "shape",
-                 "parameters", "indices", "color")
+                 "parameters", "indices", "color", "shape_asked", "surface")
 
     def __init__(self, name: str, owner: Owner, object_id: str, position: np.ndarray,
-                 orientation: np.ndarray, shape: Shape, parameters, indices, color):
+                 orientation: np.ndarray, shape: Shape, parameters, indices, color,
+                 shape_asked: int = 0, surface=None):
         self.name = name
         self.owner = owner
         self.object_id = object_id
@@ -122,6 +124,8 @@ class GeometryRecord:
         self.parameters = parameters    # as given (the Viewer draws the given mesh)
         self.indices = indices
         self.color = color
+        self.shape_asked = shape_asked  # odin_common.interface.Shape, as the spec gave it
+        self.surface = surface          # odin_common.specs.Surface
 
 
 class ObjectRecord:

@@ -21,16 +21,18 @@ MIN_CELLS_ACROSS = 6
 
 @dataclass(frozen=True, eq=False)
 class Shape:
-    """A checked shape: kind "sphere" | "cylinder" | "box" | "mesh"; dims for primitives
-    (m); vertices (n, 3) float64 m and triangles (m, 3) uint32 for meshes."""
+    """A checked shape: kind "sphere" | "cylinder" | "box" | "capsule" | "plane" | "mesh";
+    dims for primitives (m; none for a plane); vertices (n, 3) float64 m and triangles (m, 3)
+    uint32 for meshes."""
     kind: str
     dims: Tuple[float, ...] = ()
     vertices: Optional[np.ndarray] = None
     triangles: Optional[np.ndarray] = None
 
 
-def prepare_shape(what: str, parameters, indices) -> Shape:
-    """The Shape of Object/Part ``parameters`` and ``indices``; InvalidArgument naming
+def prepare_shape(what: str, parameters, indices, shape: int = 0) -> Shape:
+    """The Shape of Object/Part ``parameters`` and ``indices`` asked for as ``shape``
+    (odin_common.interface.Shape; 0: by the count of parameters); InvalidArgument naming
     ``what`` when they describe none (or a mesh whose every triangle is degenerate)."""
     try:
         values = np.array(parameters, dtype=float).reshape(-1)
@@ -40,7 +42,7 @@ def prepare_shape(what: str, parameters, indices) -> Shape:
     if not np.all(np.isfinite(values)):
         raise InvalidArgument(f"{what}: parameters {list(parameters)!r} are not finite")
     try:
-        kind = shape_kind(values.size)
+        kind = shape_kind(values.size, shape)
     except common.InvalidArgument as error:
         raise InvalidArgument(f"{what}: {error}") from None
     if kind != "mesh":

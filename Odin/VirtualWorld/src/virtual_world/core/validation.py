@@ -2,6 +2,7 @@
 InvalidArgument naming ``what`` and the offending value; none calls ODE."""
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import Callable, TypeVar
 
@@ -97,3 +98,33 @@ def count(what: str, value, low: int = 1) -> int:
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
         raise InvalidArgument(f"{what}={value!r} must be an integer >= {low}")
     return int(value)
+
+
+def surface(what: str, value):
+    """A Surface (odin_common.specs) with its values in range; the friction direction made
+    unit."""
+    from odin_common.specs import Surface
+    if not isinstance(value, Surface):
+        raise InvalidArgument(f"{what}: {value!r} is not a Surface")
+    if value.friction is not None:
+        mu = number(f"{what}: friction", value.friction, allow_inf=True)
+        if mu < 0:
+            raise InvalidArgument(f"{what}: friction={mu!r} must be >= 0 (math.inf: infinite)")
+    direction = value.friction_direction
+    if value.friction2 is not None:
+        if number(f"{what}: friction2", value.friction2) < 0:
+            raise InvalidArgument(f"{what}: friction2={value.friction2!r} must be >= 0")
+        direction = tuple(axis(f"{what}: friction_direction", direction).tolist())
+    if value.bounce is not None:
+        e = number(f"{what}: bounce", value.bounce)
+        if not 0 <= e <= 1:
+            raise InvalidArgument(f"{what}: bounce={e!r} must be in [0, 1]")
+        if number(f"{what}: bounce_velocity", value.bounce_velocity) < 0:
+            raise InvalidArgument(f"{what}: bounce_velocity={value.bounce_velocity!r} must be "
+                                  ">= 0")
+    if value.stiffness is not None:
+        if number(f"{what}: stiffness", value.stiffness) <= 0:
+            raise InvalidArgument(f"{what}: stiffness={value.stiffness!r} must be > 0")
+        if number(f"{what}: damping", value.damping) < 0:
+            raise InvalidArgument(f"{what}: damping={value.damping!r} must be >= 0")
+    return dataclasses.replace(value, friction_direction=direction)

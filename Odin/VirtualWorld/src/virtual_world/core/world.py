@@ -180,6 +180,13 @@ class Core:
         """Names of the object's geometries (one, or a composite's parts)."""
         return [g.name for g in self._scene.object(object_id).geometries]
 
+    @_changes_state
+    def set_surface(self, name: str, surface) -> None:
+        """The contact properties (odin_common.specs.Surface) of an object's geometries (an
+        object ID) or of one part of a composite (its geometry name), from now on; how two
+        surfaces mix in a contact: Messages/Surface."""
+        objects.set_surface(self._scene, name, surface)
+
     @_locked
     def collision_triangle_count(self, geometry_name: str) -> int:
         """Triangles ODE collides with for a mesh geometry (fewer than given when it was built

@@ -7,6 +7,7 @@ between an object's frame and its centre of mass. Arguments are already checked.
 """
 from __future__ import annotations
 
+import math
 from typing import Sequence, Tuple
 
 import numpy as np
@@ -98,16 +99,52 @@ def set_geom_pose(geom, position: Sequence[float], quaternion: Sequence[float]) 
     lib.dGeomSetQuaternion(geom, list(quaternion))
 
 
+def is_plane(geom) -> bool:
+    """ODE's planes are not placeable: asking one for its position ends the process."""
+    return lib.dGeomGetClass(geom) == lib.dPlaneClass
+
+
 def static_geom_pose(geom) -> np.ndarray:
-    """(15,) a static geom's position (3) and rotation matrix (12), bit for bit."""
+    """(15,) a static geom's position (3) and rotation matrix (12), bit for bit; a plane's
+    parameters a, b, c, d (then zeros)."""
+    if is_plane(geom):
+        abcd = ffi.new("dVector4")
+        lib.dGeomPlaneGetParams(geom, abcd)
+        return np.array([abcd[0], abcd[1], abcd[2], abcd[3]] + [0.0] * 11)
     p, R = lib.dGeomGetPosition(geom), lib.dGeomGetRotation(geom)
     return np.array([p[0], p[1], p[2]] + [R[k] for k in range(12)])
 
 
 def set_static_geom_pose(geom, pose: np.ndarray) -> None:
     """Puts back a pose read by static_geom_pose (ODE copies both as given)."""
+    if is_plane(geom):
+        lib.dGeomPlaneSetParams(geom, *pose[:4].tolist())
+        return
     lib.dGeomSetPosition(geom, *pose[:3].tolist())
     lib.dGeomSetRotation(geom, pose[3:].tolist())
+
+
+def place_plane(geom, normal: Sequence[float], offset: float) -> None:
+    """Moves a plane: normal . x = offset (m), world frame."""
+    lib.dGeomPlaneSetParams(geom, *normal, offset)
+
+
+def set_surface(geom_owner, surface) -> None:
+    """The geom's contact properties (odin_common.specs.Surface, already checked), which
+    odin_step.c mixes with the other geom's for each contact."""
+    info = geom_owner.data
+    info.has_friction = surface.friction is not None
+    info.mu = lib.dInfinity if info.has_friction and math.isinf(surface.friction) else \
+        (surface.friction or 0.0)
+    info.has_friction2 = surface.friction2 is not None
+    info.mu2 = surface.friction2 or 0.0
+    info.fdir = list(surface.friction_direction)
+    info.has_bounce = surface.bounce is not None
+    info.bounce = surface.bounce or 0.0
+    info.bounce_vel = surface.bounce_velocity
+    info.has_softness = surface.stiffness is not None
+    info.kp = surface.stiffness or 0.0
+    info.kd = surface.damping
 
 
 def set_geom_tag(geom_owner, tag: int) -> None:
@@ -135,6 +172,8 @@ def primitive_mass(kind: str, dims: Sequence[float], mass: float):
         lib.dMassSetSphereTotal(m, mass, dims[0])
     elif kind == "cylinder":
         lib.dMassSetCylinderTotal(m, mass, 3, dims[0], dims[1])
+    elif kind == "capsule":
+        lib.dMassSetCapsuleTotal(m, mass, 3, dims[0], dims[1])
     elif kind == "box":
         lib.dMassSetBoxTotal(m, mass, *dims)
     else:

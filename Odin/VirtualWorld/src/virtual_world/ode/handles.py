@@ -136,15 +136,21 @@ def new_geom(ptr: Any, space: Owner, serial: int, body: Optional[Owner] = None,
 
 def new_primitive(space: Owner, kind: str, dims: Sequence[float], serial: int,
                   body: Optional[Owner] = None) -> Owner:
-    """A sphere (radius), cylinder (radius, length along z) or box (sides x, y, z), m."""
+    """A sphere (radius), cylinder or capsule (radius, length along z) or box (sides x, y,
+    z), m; or a plane (dims: a, b, c, d with a x + b y + c z = d, the normal unit; never on a
+    body: ODE's planes are not placeable)."""
     if kind == "sphere":
         ptr = lib.dCreateSphere(space.ptr, dims[0])
     elif kind == "cylinder":
         ptr = lib.dCreateCylinder(space.ptr, dims[0], dims[1])
+    elif kind == "capsule":
+        ptr = lib.dCreateCapsule(space.ptr, dims[0], dims[1])
     elif kind == "box":
         ptr = lib.dCreateBox(space.ptr, dims[0], dims[1], dims[2])
+    elif kind == "plane" and body is None:
+        ptr = lib.dCreatePlane(space.ptr, *dims)
     else:
-        raise ValueError(f"no ODE primitive {kind!r}")
+        raise ValueError(f"no ODE primitive {kind!r}" + (" on a body" if body else ""))
     return new_geom(ptr, space, serial, body)
 
 

@@ -92,6 +92,7 @@ void dMassSetParameters(dMass *, dReal themass, dReal cgx, dReal cgy, dReal cgz,
                         dReal I11, dReal I22, dReal I33, dReal I12, dReal I13, dReal I23);
 void dMassSetSphereTotal(dMass *, dReal total_mass, dReal radius);
 void dMassSetCylinderTotal(dMass *, dReal total_mass, int direction, dReal radius, dReal length);
+void dMassSetCapsuleTotal(dMass *, dReal total_mass, int direction, dReal radius, dReal length);
 void dMassSetBoxTotal(dMass *, dReal total_mass, dReal lx, dReal ly, dReal lz);
 void dMassTranslate(dMass *, dReal x, dReal y, dReal z);
 void dMassRotate(dMass *, const dMatrix3 R);
@@ -121,6 +122,12 @@ void dGeomSetOffsetQuaternion(dGeomID geom, const dQuaternion Q);
 dGeomID dCreateSphere(dSpaceID space, dReal radius);
 dGeomID dCreateBox(dSpaceID space, dReal lx, dReal ly, dReal lz);
 dGeomID dCreateCylinder(dSpaceID space, dReal radius, dReal length);
+dGeomID dCreateCapsule(dSpaceID space, dReal radius, dReal length);
+dGeomID dCreatePlane(dSpaceID space, dReal a, dReal b, dReal c, dReal d);
+void dGeomPlaneSetParams(dGeomID plane, dReal a, dReal b, dReal c, dReal d);
+void dGeomPlaneGetParams(dGeomID plane, dVector4 result);
+int dGeomGetClass(dGeomID);
+enum { dSphereClass, dBoxClass, dCapsuleClass, dCylinderClass, dPlaneClass, ... };
 dTriMeshDataID dGeomTriMeshDataCreate(void);
 void dGeomTriMeshDataDestroy(dTriMeshDataID g);
 void dGeomTriMeshDataBuildDouble(dTriMeshDataID g, const void *Vertices, int VertexStride,

@@ -3,6 +3,7 @@
  * the vectorised pose read-out and ODE's message routing. */
 #include "odin_step.h"
 
+#include <math.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -145,25 +146,89 @@ static void sort_pairs(OdinWorld *w) {
     w->pairs_sorted = to;
 }
 
+/* ---------------------------------------------------------------- surfaces */
+
+static double min2(double a, double b) { return a < b ? a : b; }
+static double max2(double a, double b) { return a > b ? a : b; }
+
+/* Springs (and dampers) in series: 1/k = 1/k1 + 1/k2; a side without one is rigid. */
+static double series(int has1, double k1, int has2, double k2) {
+    if (!has1) return k2;
+    if (!has2) return k1;
+    return k1 + k2 > 0 ? k1 * k2 / (k1 + k2) : 0.0;
+}
+
+/* The surface of a contact between g1 and g2 (docs/INTERFACE.md, Messages/Surface): the
+ * smaller friction, the larger restitution, the smaller bounce velocity, stiffness and damping
+ * in series; what neither sets is the world's. fdir (world frame) is set when the contact is
+ * anisotropic: the direction of the first surface that has one, along which friction2 acts
+ * (the smaller of the two surfaces' frictions along it) and friction across it. h: the step
+ * (s). Returns whether the contact is anisotropic. */
+static int mix_surface(const OdinWorld *w, dGeomID g1, dGeomID g2, double h,
+                       dSurfaceParameters *s, dVector3 fdir) {
+    const OdinGeomInfo *a = info_of(g1), *b = info_of(g2);
+    int mode = dContactApprox1;
+    double mu_a = a->has_friction ? a->mu : w->mu, mu_b = b->has_friction ? b->mu : w->mu;
+    s->mu = min2(mu_a, mu_b);
+    const OdinGeomInfo *aniso = a->has_friction2 ? a : b->has_friction2 ? b : NULL;
+    if (aniso) {
+        dGeomID owner = aniso == a ? g1 : g2;
+        const dReal *R = dGeomGetRotation(owner);
+        for (int k = 0; k < 3; ++k)
+            fdir[k] = R[4 * k] * aniso->fdir[0] + R[4 * k + 1] * aniso->fdir[1]
+                      + R[4 * k + 2] * aniso->fdir[2];
+        double mu2_a = a->has_friction2 ? a->mu2 : mu_a, mu2_b = b->has_friction2 ? b->mu2 : mu_b;
+        s->mu2 = s->mu;                  /* ODE: mu acts along fdir1, mu2 across it */
+        s->mu = min2(mu2_a, mu2_b);
+        mode |= dContactMu2 | dContactFDir1;
+    }
+    if (a->has_bounce || b->has_bounce) {
+        s->bounce = max2(a->has_bounce ? a->bounce : w->bounce, b->has_bounce ? b->bounce : w->bounce);
+        s->bounce_vel = min2(a->has_bounce ? a->bounce_vel : w->bounce_vel,
+                             b->has_bounce ? b->bounce_vel : w->bounce_vel);
+    } else {
+        s->bounce = w->bounce;
+        s->bounce_vel = w->bounce_vel;
+    }
+    if (s->bounce > 0) mode |= dContactBounce;
+    if (a->has_softness || b->has_softness) {
+        double kp = series(a->has_softness, a->kp, b->has_softness, b->kp);
+        double kd = series(a->has_softness, a->kd, b->has_softness, b->kd);
+        s->soft_erp = h * kp / (h * kp + kd);
+        s->soft_cfm = 1.0 / (h * kp + kd);
+        mode |= dContactSoftERP | dContactSoftCFM;
+    }
+    s->mode = mode;
+    return aniso != NULL;
+}
+
+/* Projects the friction direction f onto the contact plane of normal n (ODE wants fdir1 in
+ * it); 0 when f is along n, where no direction is left. */
+static int in_contact_plane(dVector3 f, const dVector3 n) {
+    dReal d = f[0] * n[0] + f[1] * n[1] + f[2] * n[2];
+    for (int k = 0; k < 3; ++k) f[k] -= d * n[k];
+    dReal len = dSqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+    if (len < 1e-9) return 0;
+    for (int k = 0; k < 3; ++k) f[k] /= len;
+    return 1;
+}
+
 /* Creates the pass's contact joints, pair by pair in serial order: the same scene gives the
  * same constraints in the same order, whatever order the hash space found the pairs in. */
-static void make_contacts(OdinWorld *w) {
+static void make_contacts(OdinWorld *w, double h) {
     if (!w->unordered && w->n_pairs > 1) sort_pairs(w);
-    int mode = dContactApprox1;
-    if (w->bounce > 0) mode |= dContactBounce;
     for (int k = 0; k < w->n_pairs; ++k) {
         const OdinPair *p = &w->pairs[k];
         dBodyID b1 = dGeomGetBody(p->g1), b2 = dGeomGetBody(p->g2);
+        dContact contact;
+        memset(&contact, 0, sizeof contact);
+        int anisotropic = mix_surface(w, p->g1, p->g2, h, &contact.surface, contact.fdir1);
         for (int i = 0; i < p->n; ++i) {
-            dContact contact;
-            memset(&contact, 0, sizeof contact);
-            contact.geom = w->contacts[p->first + i];
-            contact.surface.mode = mode;
-            contact.surface.mu = w->mu;
-            contact.surface.bounce = w->bounce;
-            contact.surface.bounce_vel = w->bounce_vel;
-            dJointID c = dJointCreateContact(w->world, w->contact_group, &contact);
-            dJointAttach(c, b1, b2);
+            dContact c = contact;
+            c.geom = w->contacts[p->first + i];
+            if (anisotropic && !in_contact_plane(c.fdir1, c.geom.normal))
+                c.surface.mode &= ~(dContactMu2 | dContactFDir1); /* along the normal */
+            dJointAttach(dJointCreateContact(w->world, w->contact_group, &c), b1, b2);
         }
         w->last_step_contacts += p->n;
     }
@@ -284,7 +349,7 @@ int odin_world_step(OdinWorld *w, double h, int count) {
             if (w->recording) odin_world_clear_records(w);
         }
         dSpaceCollide(w->space, w, &near_callback);   /* 1. collisions, */
-        if (!w->contact_less) make_contacts(w);       /*    contacts in serial order */
+        if (!w->contact_less) make_contacts(w, h);    /*    contacts in serial order */
         apply_body_forces(w);                         /* 2. forces and torques on bodies */
         apply_joint_forces(w);                        /* 3. joint forces and motor goals */
         apply_motor_goals(w);
@@ -319,8 +384,25 @@ void odin_world_detect(OdinWorld *w, int any_policy) {
 
 /* ---------------------------------------------------------------- read-out */
 
+/* A plane has no pose in ODE (it is not placeable: asking for one ends the process): it is
+ * reported at its point nearest the origin, turned so that z is its normal. */
+static void plane_pose(dGeomID g, double *p, double *q) {
+    dVector4 abcd;
+    dGeomPlaneGetParams(g, abcd);
+    for (int k = 0; k < 3; ++k) p[k] = abcd[3] * abcd[k];
+    /* the shortest rotation from z to the normal n: q = (1 + z.n, z x n), normalised */
+    double w = 1.0 + abcd[2], x = -abcd[1], y = abcd[0], z = 0.0;
+    if (w < 1e-9) { w = 0.0; x = 1.0; y = 0.0; } /* n = -z: half a turn about x */
+    double len = sqrt(w * w + x * x + y * y + z * z);
+    q[0] = w / len; q[1] = x / len; q[2] = y / len; q[3] = z / len;
+}
+
 void odin_read_poses(dGeomID *geoms, int n, double *pos, double *quat) {
     for (int i = 0; i < n; ++i) {
+        if (dGeomGetClass(geoms[i]) == dPlaneClass) {
+            plane_pose(geoms[i], pos + 3 * i, quat + 4 * i);
+            continue;
+        }
         const dReal *p = dGeomGetPosition(geoms[i]);
         dQuaternion q;
         dGeomGetQuaternion(geoms[i], q);

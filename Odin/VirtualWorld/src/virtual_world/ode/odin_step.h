@@ -49,6 +49,13 @@ typedef struct OdinMotorGoal {
 typedef struct OdinGeomInfo {
     long serial;
     long tag;
+    /* the surface's contact properties (odin_common.specs.Surface); a flag 0: the world's */
+    int has_friction, has_friction2, has_bounce, has_softness;
+    double mu;               /* dInfinity allowed */
+    double mu2;
+    double fdir[3];          /* unit, the geom's own frame: the direction of mu2 */
+    double bounce, bounce_vel;
+    double kp, kd;           /* N/m, N s/m */
 } OdinGeomInfo;
 
 /* A colliding pair found in one collide pass, its contacts at contacts[first .. first + n). */

@@ -21,7 +21,7 @@ def view_requests(geometries) -> list:
     """View Object requests for geometries as the Core built them (core.BuiltGeometry), or
     as they are now (at their present poses)."""
     return [ViewObjectRequest(g.name, list(g.parameters), list(g.indices), list(g.position),
-                              list(g.orientation), list(g.color)) for g in geometries]
+                              list(g.orientation), list(g.color), g.shape) for g in geometries]
 
 
 def collision_pairs(collisions) -> list:

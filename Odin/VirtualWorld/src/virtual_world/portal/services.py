@@ -158,6 +158,10 @@ class WorldServices:
             request.at_point, tuple(request.point), request.point_in_body_frame)
         return {"id": force_id, "message": f"added {force_id}"}
 
+    def set_surface(self, request) -> dict:
+        self.core.set_surface(request.id, messages.surface_of(request.surface))
+        return {"message": f"surface of {request.id} set"}
+
     def get_world(self, request) -> dict:
         core = self.core
         return {"parameters": messages.world_parameters_message(core.world_parameters),

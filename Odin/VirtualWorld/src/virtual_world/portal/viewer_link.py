@@ -128,7 +128,8 @@ class ViewerLink:
             if request.id in poses:
                 position, orientation = poses[request.id]
                 request = ViewObjectRequest(request.id, request.parameters, request.indices,
-                                            list(position), list(orientation), request.color)
+                                            list(position), list(orientation), request.color,
+                                            request.shape)
             self._call("view_object", ViewObject, request)
         _log.info("Viewer at %s received the current scene (%d geometries)",
                   self._namespace, len(scene))
