@@ -14,6 +14,7 @@ from typing import Any, Dict, Optional, Tuple
 
 from odin_common.errors import InvalidArgument
 from odin_common.interface import Solver
+from odin_common.limits import MAX_GRAVITY
 
 # a tolerance above 1 m is mm taken for m
 _MAX_MESH_TOLERANCE = 1.0
@@ -82,6 +83,19 @@ PARAMETERS: Tuple[ParameterInfo, ...] = (
                   "and the Viewer keep the given mesh; a mesh fewer than 6 cells across "
                   "collides as given", "set_collision_mesh_tolerance", 0, _MAX_MESH_TOLERANCE,
                   zero_means="meshes collide as given"),
+    ParameterInfo("divergence_speed", "float", "m/s",
+                  "the divergence guard: a body faster than this has diverged (it is parked, "
+                  "see divergence_policy); requests may not set a faster velocity",
+                  "set_divergence", 1e-3, 1e8),
+    ParameterInfo("divergence_angular_speed", "float", "rad/s",
+                  "the same for spin", "set_divergence", 1e-3, 1e8),
+    ParameterInfo("world_extent", "float", "m",
+                  "a body farther than this from the origin along any axis has diverged; "
+                  "requests may not place anything farther", "set_divergence", 1.0, 1e8),
+    ParameterInfo("divergence_policy", "int", "-",
+                  "what follows a divergence: 0 the body is parked (kinematic, still, "
+                  "colliding with nothing, within the extent) and the world goes on; 1 parked "
+                  "and the simulation paused", "set_divergence", 0, 1),
 )
 """Every world parameter, in the order of Set World's request."""
 
@@ -112,6 +126,10 @@ class WorldParameters:
     quickstep_iterations: int = 20
     contact_less: bool = False
     collision_mesh_tolerance: float = 0.0
+    divergence_speed: float = 1000.0
+    divergence_angular_speed: float = 10000.0
+    world_extent: float = 10000.0
+    divergence_policy: int = 0
 
     def replace(self, **changes) -> "WorldParameters":
         """A validated copy with ``changes``; unknown names raise InvalidArgument."""
@@ -175,6 +193,8 @@ def _vector(name: str, value) -> Tuple[float, float, float]:
         raise InvalidArgument(f"{name}={value!r} is not a 3-vector") from None
     if len(values) != 3 or not all(math.isfinite(v) for v in values):
         raise InvalidArgument(f"{name}={value!r} is not a finite 3-vector")
+    if max(abs(v) for v in values) > MAX_GRAVITY:
+        raise InvalidArgument(f"{name}={value!r}: a component beyond the limit {MAX_GRAVITY:g}")
     return values
 
 

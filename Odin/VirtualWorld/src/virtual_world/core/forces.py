@@ -10,6 +10,9 @@ from __future__ import annotations
 
 from typing import Dict, Iterable, Sequence
 
+import numpy as np
+
+from odin_common import limits
 from odin_common.interface import JOINT_FORCE_MAGNITUDES, ForceKind
 from virtual_world.core import validation as check
 from virtual_world.core.records import BodyForceRecord, JointForceRecord
@@ -28,9 +31,12 @@ def add_body_force(scene: Scene, object_id: str, kind: int, vector,
     kind = ForceKind(kind)
     obj = scene.body_object(object_id, "force")
     vector = check.vector("force vector", vector)
+    check.at_most(f"{kind.name.lower()} on {object_id!r}", float(np.linalg.norm(vector)),
+                  limits.MAX_FORCE, "N" if kind == ForceKind.FORCE else "N m")
     vector_in_body_frame = check.flag("vector_in_body_frame", vector_in_body_frame)
     at_point = check.flag("at_point", at_point)
-    point = check.vector("force point", point)
+    point = check.within_extent("force point", check.vector("force point", point),
+                                scene.parameters.world_extent)
     point_in_body_frame = check.flag("point_in_body_frame", point_in_body_frame)
     if kind == ForceKind.TORQUE and at_point:
         raise InvalidArgument("a torque has no point of application (at_point=True)")
@@ -81,6 +87,8 @@ def add_joint_force(scene: Scene, joint_id: str, magnitudes: Sequence[float]) ->
         raise InvalidArgument(f"a {joint.type.label} joint force takes {count} magnitude(s); "
                               f"got {list(magnitudes)!r}")
     values = check.vector("joint force magnitudes", magnitudes, count)
+    check.at_most(f"joint force on {joint_id!r}", float(np.max(np.abs(values))),
+                  limits.MAX_FORCE, "N or N m")
     force_id = _free_id(scene.joint_forces, f"jointforce:{joint_id}")
     scene.joint_forces[force_id] = JointForceRecord(joint_id, values)
     joint.forces.add(force_id)

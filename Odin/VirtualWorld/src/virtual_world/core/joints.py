@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from typing import List, Sequence, Tuple
 
+from odin_common import limits
 from odin_common.interface import (JOINT_AXES_USED, JOINT_NEEDS_TWO_BODIES,
                                    JOINT_PARAMETER_AXES, JOINT_PARAMETERS,
                                    MOTOR_PARAMETERS, NON_NEGATIVE_PARAMETERS, UNIT_PARAMETERS,
@@ -49,7 +50,8 @@ def create_joint(scene: Scene, spec: JointSpec) -> str:
     joint_id = check.text("joint id", spec.id) or spec.default_id
     if joint_id in scene.joints or joint_id in scene.motors:
         raise DuplicateName(f"joint id {joint_id!r} is already taken")
-    anchor = check.vector("anchor", spec.anchor)
+    anchor = check.within_extent("anchor", check.vector("anchor", spec.anchor),
+                                 scene.parameters.world_extent)
     # only the axes the type uses are checked: a request leaves the others at zero
     uses = JOINT_AXES_USED[kind]
     axes = [check.axis(name, value) if name in uses else None
@@ -128,6 +130,12 @@ def _check_parameters(parameters, allowed, axes: int, kind: str, joint_id: str) 
             raise InvalidArgument(f"{label}={value!r} must be >= 0")
         if parameter == JointParameter.MAX_FORCE and value < 0:
             value = ode_joints.INFINITY
+        elif parameter == JointParameter.MAX_FORCE:
+            check.at_most(f"{label} of {kind} {joint_id!r}", value, limits.MAX_FORCE,
+                          "N or N m (negative: infinite)")
+        if parameter == JointParameter.VELOCITY:
+            check.at_most(f"{label} of {kind} {joint_id!r}", abs(value),
+                          limits.MAX_MOTOR_SPEED, "rad/s or m/s")
         checked.append((parameter, int(axis), value))
     return checked
 

@@ -8,8 +8,11 @@ from __future__ import annotations
 
 from typing import List, Mapping, Sequence
 
+import math
+
 import numpy as np
 
+from odin_common import limits
 from odin_common.interface import JOINT_AXIS2_ON_BODY2, AxisFrame, JointParameter, MotorKind
 from odin_common.specs import MotorSpec
 from virtual_world.core import validation as check
@@ -63,6 +66,9 @@ def create_motor(scene: Scene, spec: MotorSpec) -> str:
     frames = _axis_frames(spec.axis_frames, naxes, objects)
     max_forces = [check.number("max force", f, allow_inf=True) for f in spec.max_forces] \
         if len(spec.max_forces) else [-1.0] * naxes
+    for force in max_forces:
+        if math.isfinite(force):
+            check.at_most("max force", force, limits.MAX_FORCE, "N or N m (negative: infinite)")
     if len(max_forces) != naxes:
         raise InvalidArgument(f"max_forces {list(spec.max_forces)!r}: need one per axis "
                               f"({naxes})")
@@ -131,6 +137,8 @@ def set_velocities(scene: Scene, velocities: Mapping[str, Sequence[float]]) -> N
         if vector is None or vector.size != motor.naxes:
             raise InvalidArgument(f"motor {motor_id!r} has {motor.naxes} axes; got "
                                   f"{values!r}")
+        check.at_most(f"goal speed of {motor_id!r}", float(np.max(np.abs(vector))),
+                      limits.MAX_MOTOR_SPEED, "rad/s or m/s")
         checked.append((motor, vector.tolist()))
     for motor, values in checked:
         motor.velocity = values

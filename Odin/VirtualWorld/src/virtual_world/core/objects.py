@@ -13,10 +13,11 @@ from typing import Dict, List, Sequence, Set, Tuple
 
 import numpy as np
 
+from odin_common import limits
 from odin_common.interface import composite_id
 from odin_common.rotations import quaternion_multiply, quaternion_to_matrix
 from odin_common.specs import CompositeSpec, EntitySpec, ObjectSpec, PartSpec
-from virtual_world.core import forces, joints, motors, readout, validation as check
+from virtual_world.core import forces, guard, joints, motors, readout, validation as check
 from virtual_world.core.mass import check_mass, shape_mass
 from virtual_world.core.records import (Built, BuiltEntity, BuiltGeometry, GeometryRecord,
                                         ObjectRecord, Removed)
@@ -92,8 +93,8 @@ def prepare_object(spec: ObjectSpec) -> _Prepared:
     geometry_only = check.flag(f"{what}: geometry_only", spec.geometry_only)
     no_collisions = check.flag(f"{what}: no_collisions", spec.no_collisions)
     mass = check.number(f"{what}: mass", spec.mass)
-    if mass <= 0 and not geometry_only:  # a body-less geometry has no mass to check
-        raise InvalidArgument(f"{what}: mass {spec.mass!r} must be positive")
+    if not geometry_only:  # a body-less geometry has no mass to check
+        check.mass(what, mass)
     part = _part(what, spec, mass, (0.0, 0.0, 0.0), IDENTITY)
     if part.shape.kind == "plane" and not geometry_only:
         raise InvalidArgument(f"{what}: a plane is static: give geometry_only")
@@ -125,9 +126,7 @@ def prepare_composite(spec: CompositeSpec) -> _Prepared:
             raise InvalidArgument(f"{given!r} is not a PartSpec")
         name = check.name("part name", given.name)
         what = f"part {name!r}"
-        mass = check.number(f"{what}: mass", given.mass)
-        if mass <= 0:
-            raise InvalidArgument(f"{what}: mass {given.mass!r} must be positive")
+        mass = check.mass(what, check.number(f"{what}: mass", given.mass))
         part = _part(what, given, mass, given.position, given.orientation)
         if part.shape.kind == "plane":
             raise InvalidArgument(f"{what}: a plane cannot be a part of a composite")
@@ -148,6 +147,27 @@ def prepare_composite(spec: CompositeSpec) -> _Prepared:
         com = _centred(f"object {object_id!r}", dmass)
     return _Prepared(spec, object_id, parts, position, orientation, fixed, geometry_only,
                      no_collisions, dmass, com)
+
+
+def check_ranges(scene: Scene, prepared: Sequence[_Prepared]) -> None:
+    """InvalidArgument for an object beyond the world's extent, a size outside the limits, a
+    mesh of too many triangles (odin_common.limits, world_extent)."""
+    extent = scene.parameters.world_extent
+    for p in prepared:
+        what = f"object {p.object_id!r}"
+        check.within_extent(f"{what}: position", p.position, extent)
+        for part in p.parts:
+            shape, where = part.shape, f"{what}: part {part.name!r}"
+            check.within_extent(f"{where}: position", part.position, extent)
+            if shape.kind == "mesh":
+                check.at_most(f"{where}: triangles", len(shape.triangles),
+                              limits.MAX_MESH_TRIANGLES, "triangles")
+                check.within_extent(f"{where}: a vertex", shape.vertices, extent)
+            elif shape.dims:
+                check.at_most(f"{where}: size", max(shape.dims), 2 * extent, "m")
+                if min(shape.dims) < limits.MIN_SIZE:
+                    raise InvalidArgument(f"{where}: size {min(shape.dims)!r} m is below the "
+                                          f"limit {limits.MIN_SIZE:g} m")
 
 
 def check_new_names(scene: Scene, prepared: Sequence[_Prepared]) -> None:
@@ -179,6 +199,8 @@ def build(scene: Scene, prepared: _Prepared, tag: int = 0) -> Built:
     for part in p.parts:
         obj.geometries.append(_build_geometry(scene, p, part, body, tag))
     scene.objects[p.object_id] = obj
+    if body is not None and not p.fixed:
+        guard.refresh(scene)
     drain_messages()
     return Built(p.object_id, _built_geometries(obj.geometries))
 
@@ -240,12 +262,14 @@ def place_static(geom, position: np.ndarray, orientation: np.ndarray,
 
 def build_object(scene: Scene, spec: ObjectSpec) -> Built:
     prepared = prepare_object(spec)
+    check_ranges(scene, [prepared])
     check_new_names(scene, [prepared])
     return build(scene, prepared)
 
 
 def build_composite(scene: Scene, spec: CompositeSpec) -> Built:
     prepared = prepare_composite(spec)
+    check_ranges(scene, [prepared])
     check_new_names(scene, [prepared])
     return build(scene, prepared)
 
@@ -262,6 +286,7 @@ def build_entity(scene: Scene, spec: EntitySpec) -> BuiltEntity:
     prepared += [prepare_composite(s) for s in spec.composites]
     if not prepared:
         raise InvalidArgument(f"entity {name!r} has no objects")
+    check_ranges(scene, prepared)
     check_new_names(scene, prepared)
     tag = 0
     if not internal:
@@ -304,12 +329,14 @@ def remove_object(scene: Scene, object_id: str) -> Removed:
         forces.drop_body_forces(scene, obj.forces)
     names = tuple(g.name for g in obj.geometries)
     readout.carry_collisions(scene, set(names))
+    del scene.objects[object_id]
+    scene.parked.pop(object_id, None)
+    guard.refresh(scene)        # before the body goes: C must never see a freed body
     for geometry in obj.geometries:
         scene.drop_geometry(geometry)
         geometry.owner.close()
     if obj.body is not None:
         obj.body.close()
-    del scene.objects[object_id]
     if obj.entity is not None:
         members = scene.entities[obj.entity]
         members.remove(object_id)
@@ -331,7 +358,9 @@ def check_poses(scene: Scene, poses) -> list:
         except (TypeError, ValueError):
             raise InvalidArgument(f"{item!r} is not (id, position, orientation)") from None
         obj = scene.object(object_id)
-        checked.append((obj, check.vector(f"position of {object_id!r}", position),
+        where = f"position of {object_id!r}"
+        checked.append((obj, check.within_extent(where, check.vector(where, position),
+                                                 scene.parameters.world_extent),
                         check.quaternion(f"orientation of {object_id!r}", orientation)))
     return checked
 
@@ -355,8 +384,7 @@ def set_velocity(scene: Scene, object_id: str, linear=None, angular=None) -> Non
     """Linear velocity of the centre of mass (m/s) and/or angular velocity (rad/s), world
     frame; None keeps the current one. A fixed (kinematic) body then moves at it."""
     obj = scene.body_object(object_id, "set_velocity")
-    linear = None if linear is None else check.vector("linear velocity", linear)
-    angular = None if angular is None else check.vector("angular velocity", angular)
+    linear, angular = check_velocities(scene, linear, angular)
     bodies.set_body_velocity(obj.body.ptr, None if linear is None else linear.tolist(),
                              None if angular is None else angular.tolist())
 
@@ -375,6 +403,21 @@ def set_surface(scene: Scene, name: str, surface) -> None:
     for geometry in geometries:
         bodies.set_surface(geometry.owner, surface)
         geometry.surface = surface
+
+
+def check_velocities(scene: Scene, linear=None, angular=None):
+    """(linear (3,) m/s or None, angular (3,) rad/s or None), checked: finite, and within the
+    divergence guard's speeds (a faster body would be parked at once)."""
+    p = scene.parameters
+    if linear is not None:
+        linear = check.vector("linear velocity", linear)
+        check.at_most("linear velocity", float(np.linalg.norm(linear)), p.divergence_speed,
+                      "m/s (divergence_speed)")
+    if angular is not None:
+        angular = check.vector("angular velocity", angular)
+        check.at_most("angular velocity", float(np.linalg.norm(angular)),
+                      p.divergence_angular_speed, "rad/s (divergence_angular_speed)")
+    return linear, angular
 
 
 def entity_members(scene: Scene) -> Dict[str, List[str]]:

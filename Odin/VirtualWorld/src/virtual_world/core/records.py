@@ -81,6 +81,20 @@ class Collision(NamedTuple):
     first_time: float = float("nan")
 
 
+class Divergence(NamedTuple):
+    """A body the divergence guard found gone wrong after a step and parked: the object, why,
+    the value that broke the bound (NaN when a value was not finite), its position (m),
+    velocity (m/s) and angular velocity (rad/s) as the step left them (world frame, centre of
+    mass), and the simulated time of that step (s)."""
+    id: str
+    reason: str
+    value: float
+    position: Tuple[float, float, float]
+    velocity: Tuple[float, float, float]
+    angular: Tuple[float, float, float]
+    time: float
+
+
 class BodyState(NamedTuple):
     """An object's state: position of its frame's origin (m), orientation (w, x, y, z),
     linear velocity of its centre of mass (m/s), angular velocity (rad/s); world frame."""

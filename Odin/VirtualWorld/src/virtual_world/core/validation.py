@@ -9,7 +9,7 @@ from typing import Callable, TypeVar
 import numpy as np
 
 from odin_common import errors as common
-from odin_common import rotations
+from odin_common import limits, rotations
 from virtual_world.errors import InvalidArgument
 
 R = TypeVar("R")
@@ -128,3 +128,36 @@ def surface(what: str, value):
         if number(f"{what}: damping", value.damping) < 0:
             raise InvalidArgument(f"{what}: damping={value.damping!r} must be >= 0")
     return dataclasses.replace(value, friction_direction=direction)
+
+
+def mass(what: str, value: float) -> float:
+    """A body's mass, kg, within odin_common.limits."""
+    if value <= 0:
+        raise InvalidArgument(f"{what}: mass {value!r} must be positive")
+    if not limits.MIN_MASS <= value <= limits.MAX_MASS:
+        raise InvalidArgument(f"{what}: mass {value!r} kg is outside the limits "
+                              f"[{limits.MIN_MASS:g}, {limits.MAX_MASS:g}] kg")
+    return value
+
+
+def at_most(what: str, magnitude: float, limit: float, unit: str) -> None:
+    """InvalidArgument unless ``magnitude`` <= ``limit`` (the field and the limit named)."""
+    if magnitude > limit:
+        raise InvalidArgument(f"{what}: {magnitude:.6g} {unit} is beyond the limit "
+                              f"{limit:g} {unit}")
+
+
+def within_extent(what: str, position: np.ndarray, extent: float) -> np.ndarray:
+    """A position (m) no farther than the world's extent along any axis (world_extent)."""
+    at_most(what, float(np.max(np.abs(position))), extent, "m from the origin (world_extent)")
+    return position
+
+
+def step_size(value) -> float:
+    """A step, s, within odin_common.limits and step_values' MAX_STEP."""
+    from odin_common.step_values import MAX_STEP
+    value = number("step_size", value)
+    if not limits.MIN_STEP <= value <= MAX_STEP:
+        raise InvalidArgument(f"step_size={value!r} s is outside [{limits.MIN_STEP:g}, "
+                              f"{MAX_STEP:g}] s")
+    return value

@@ -24,10 +24,10 @@ import numpy as np
 from odin_common.interface import ForceKind, JointType, MotorKind
 from odin_common.specs import CompositeSpec, EntitySpec, JointSpec, MotorSpec, ObjectSpec
 from odin_common.world_parameters import WorldParameters
-from virtual_world.core import (forces, joints, motors, objects, readout, snapshots,
+from virtual_world.core import (forces, guard, joints, motors, objects, readout, snapshots,
                                 validation as check)
-from virtual_world.core.records import (BodyState, Built, BuiltEntity, Collision, JointState,
-                                        Propagation, Removed)
+from virtual_world.core.records import (BodyState, Built, BuiltEntity, Collision, Divergence,
+                                        JointState, Propagation, Removed)
 from virtual_world.core.scene import Scene
 from virtual_world.errors import Closed, InvalidArgument, UnknownName
 from virtual_world.ode import bodies
@@ -222,8 +222,7 @@ class Core:
         scene = self._scene
         if object_id:
             scene.body_object(object_id, "set_velocity")
-            linear = None if linear is None else check.vector("linear", linear)
-            angular = None if angular is None else check.vector("angular", angular)
+            linear, angular = objects.check_velocities(scene, linear, angular)
         goals = motors.split_velocities(scene, motor_ids, velocities) if len(motor_ids) else {}
         motors.set_velocities(scene, goals)
         if object_id:
@@ -406,10 +405,9 @@ class Core:
         Everything is checked before anything changes."""
         scene = self._scene
         duration = check.number("duration", duration)
-        step_size = check.number("step_size", step_size)
-        if duration <= 0 or step_size <= 0:
-            raise InvalidArgument(f"duration={duration!r} and step_size={step_size!r} must be "
-                                  "positive")
+        step_size = check.step_size(step_size)
+        if duration <= 0:
+            raise InvalidArgument(f"duration={duration!r} must be positive")
         steps = max(1, round(duration / step_size))
         keep = check.flag("keep", keep)
         start_snapshot = self._snapshot(start) if start else None
@@ -441,10 +439,11 @@ class Core:
         start_time, start_step = scene.sim_time, scene.c.step_count
         scene.c.record_every_step = True
         try:
-            scene.c.step(step_size, steps)
+            steps = scene.c.step(step_size, steps)
         finally:
             scene.c.record_every_step = False
         scene.sim_time += step_size * steps
+        guard.collect(scene, step_size)
         drain_messages()
         collisions = tuple(sorted(
             c._replace(first_time=start_time + (step - start_step) * step_size)
@@ -485,17 +484,27 @@ class Core:
     def step(self, step_size: float, count: int = 1) -> None:
         """Runs ``count`` steps of ``step_size`` s, all in one C call: collide (contacts or
         recording), body forces, joint forces and motor goals, (Quick)Step, empty contacts."""
-        step_size = check.number("step_size", step_size)
-        if step_size <= 0:
-            raise InvalidArgument(f"step_size={step_size!r} must be positive")
+        step_size = check.step_size(step_size)
         if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
             raise InvalidArgument(f"count={count!r} must be a positive integer")
         scene = self._scene
         if not scene.parameters.contact_less:
             scene.carried = {}
-        scene.c.step(step_size, int(count))
-        scene.sim_time += step_size * int(count)
+        taken = scene.c.step(step_size, int(count))
+        scene.sim_time += step_size * taken
+        guard.collect(scene, step_size)
         drain_messages()
+
+    @_locked
+    def take_divergences(self) -> List[Divergence]:
+        """The bodies the divergence guard parked since the last call (each reported once)."""
+        found, self._scene.divergences = self._scene.divergences, []
+        return found
+
+    @_locked
+    def parked_objects(self) -> List[str]:
+        """The objects the divergence guard parked (kinematic, still, colliding with nothing)."""
+        return list(self._scene.parked)
 
     @_locked
     def detect_collisions(self) -> None:

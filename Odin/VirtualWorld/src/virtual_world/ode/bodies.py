@@ -53,6 +53,29 @@ def body_state(body) -> Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
             np.array([v[0], v[1], v[2]]), np.array([w[0], w[1], w[2]]))
 
 
+def unpark(body, collide: bool) -> None:
+    """Undoes the divergence guard's parking (odin_step.c): the body dynamic again, its geoms
+    colliding again unless ``collide`` is False (an object without collisions)."""
+    lib.dBodySetDynamic(body)
+    bits = 0 if not collide else ffi.cast("unsigned long", -1)
+    geom = lib.dBodyGetFirstGeom(body)
+    while geom != ffi.NULL:
+        lib.dGeomSetCategoryBits(geom, bits)
+        lib.dGeomSetCollideBits(geom, bits)
+        geom = lib.dBodyGetNextGeom(geom)
+
+
+def park(body) -> None:
+    """Parks a body as the divergence guard does: kinematic, still, colliding with nothing."""
+    lib.dBodySetKinematic(body)
+    set_body_velocity(body, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+    geom = lib.dBodyGetFirstGeom(body)
+    while geom != ffi.NULL:
+        lib.dGeomSetCategoryBits(geom, 0)
+        lib.dGeomSetCollideBits(geom, 0)
+        geom = lib.dBodyGetNextGeom(geom)
+
+
 def body_mass(body) -> Tuple[float, np.ndarray]:
     """(mass kg, inertia (3, 3) kg m^2 about the centre of mass, body axes)."""
     m = ffi.new("dMass *")

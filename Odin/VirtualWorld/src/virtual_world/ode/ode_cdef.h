@@ -78,6 +78,9 @@ const dReal *dBodyGetTorque(dBodyID);
 void dBodySetMass(dBodyID, const dMass *mass);
 void dBodyGetMass(dBodyID, dMass *mass);
 void dBodySetKinematic(dBodyID);
+void dBodySetDynamic(dBodyID);
+dGeomID dBodyGetFirstGeom(dBodyID);
+dGeomID dBodyGetNextGeom(dGeomID);
 const dReal *dBodyGetRotation(dBodyID);
 int dBodyIsEnabled(dBodyID);
 void dBodyEnable(dBodyID);
@@ -247,6 +250,7 @@ void dJointSetLMotorAxis(dJointID, int anum, int rel, dReal x, dReal y, dReal z)
 
 /* Category and collide bits (the hash space skips pairs whose bits do not meet). */
 void dGeomSetCategoryBits(dGeomID, unsigned long bits);
+unsigned long dGeomGetCategoryBits(dGeomID);
 void dGeomSetCollideBits(dGeomID, unsigned long bits);
 
 /* Odin's own declarations follow, taken from odin_step.h by build_ode.py (one source). */

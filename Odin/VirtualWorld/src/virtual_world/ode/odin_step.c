@@ -85,6 +85,9 @@ void odin_world_clear_records(OdinWorld *w) {
 void odin_world_free_buffers(OdinWorld *w) {
     free(w->records);
     free(w->table);
+    free(w->diverged);
+    w->diverged = NULL;
+    w->n_diverged = w->cap_diverged = 0;
     free(w->pairs);
     free(w->pairs_sorted);
     free(w->contacts);
@@ -336,10 +339,92 @@ static void apply_motor_goals(const OdinWorld *w) {
     }
 }
 
+/* ---------------------------------------------------------------- the divergence guard */
+
+static double clamp_to(double x, double bound) {
+    if (!isfinite(x)) return 0.0;
+    return x > bound ? bound : x < -bound ? -bound : x;
+}
+
+/* Parks a body that went wrong: still, kinematic, colliding with nothing, within the extent,
+ * its rotation finite; then no later collide or step can meet its values. */
+static void park(const OdinWorld *w, dBodyID b) {
+    const dReal *p = dBodyGetPosition(b), *q = dBodyGetQuaternion(b);
+    double x = clamp_to(p[0], w->extent), y = clamp_to(p[1], w->extent),
+           z = clamp_to(p[2], w->extent);
+    if (!(isfinite(q[0]) && isfinite(q[1]) && isfinite(q[2]) && isfinite(q[3]))) {
+        dQuaternion identity = {1, 0, 0, 0};
+        dBodySetQuaternion(b, identity);
+    }
+    dBodySetPosition(b, x, y, z);
+    dBodySetLinearVel(b, 0, 0, 0);
+    dBodySetAngularVel(b, 0, 0, 0);
+    dBodySetForce(b, 0, 0, 0);
+    dBodySetTorque(b, 0, 0, 0);
+    dBodySetKinematic(b);
+    for (dGeomID g = dBodyGetFirstGeom(b); g; g = dBodyGetNextGeom(g)) {
+        dGeomSetCategoryBits(g, 0);
+        dGeomSetCollideBits(g, 0);
+    }
+}
+
+static int finite3(const dReal *v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
+static double norm3(const dReal *v) { return sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
+
+/* Why a body broke the guard's bounds (0: it did not), and by how much. */
+static int diverged(const OdinWorld *w, dBodyID b, double *value) {
+    const dReal *p = dBodyGetPosition(b), *q = dBodyGetQuaternion(b);
+    const dReal *v = dBodyGetLinearVel(b), *a = dBodyGetAngularVel(b);
+    if (!finite3(p) || !finite3(v) || !finite3(a) || !isfinite(q[0]) || !isfinite(q[1])
+        || !isfinite(q[2]) || !isfinite(q[3])) {
+        *value = NAN;
+        return 1;
+    }
+    if ((*value = norm3(v)) > w->max_speed) return 2;
+    if ((*value = norm3(a)) > w->max_spin) return 3;
+    for (int k = 0; k < 3; ++k)
+        if (fabs(*value = p[k]) > w->extent) return 4;
+    return 0;
+}
+
+/* Checks every guarded body after a step; parks and records those gone wrong (and drops them
+ * from the guarded list). Returns how many it parked. */
+static int guard(OdinWorld *w) {
+    int parked = 0;
+    for (int i = 0; i < w->n_guarded; ++i) {
+        dBodyID b = w->guarded[i];
+        double value;
+        int reason = diverged(w, b, &value);
+        if (!reason) continue;
+        if (w->n_diverged >= w->cap_diverged) {
+            int cap = w->cap_diverged ? 2 * w->cap_diverged : 16;
+            OdinDivergence *more = realloc(w->diverged, (size_t)cap * sizeof(OdinDivergence));
+            if (more) { w->diverged = more; w->cap_diverged = cap; }
+        }
+        if (w->n_diverged < w->cap_diverged) {
+            OdinDivergence *d = &w->diverged[w->n_diverged++];
+            d->body = b;
+            d->reason = reason;
+            d->value = value;
+            memcpy(d->position, dBodyGetPosition(b), sizeof d->position);
+            memcpy(d->velocity, dBodyGetLinearVel(b), sizeof d->velocity);
+            memcpy(d->angular, dBodyGetAngularVel(b), sizeof d->angular);
+            d->step = w->step_count;
+        }
+        park(w, b);
+        w->guarded[i--] = w->guarded[--w->n_guarded]; /* no longer guarded */
+        parked++;
+    }
+    return parked;
+}
+
+void odin_world_clear_divergences(OdinWorld *w) { w->n_diverged = 0; }
+
 /* ---------------------------------------------------------------- step (thesis 5.5) */
 
 int odin_world_step(OdinWorld *w, double h, int count) {
-    for (int s = 0; s < count; ++s) {
+    int s;
+    for (s = 0; s < count; ++s) {
         w->last_step_contacts = 0;
         /* contact policy: the pairs of the last step; contact-less: every step, kept until read */
         if (w->contact_less || w->record_every_step) {
@@ -363,9 +448,13 @@ int odin_world_step(OdinWorld *w, double h, int count) {
         /* 5. fixed bodies are kinematic (dBodySetKinematic): nothing to reset */
         dJointGroupEmpty(w->contact_group);           /* 6. contacts last one step */
         w->step_count++;
+        if (guard(w) && w->stop_on_divergence) {      /* 7. nothing diverged may go on */
+            s++;
+            break;
+        }
     }
     w->recording = 0;
-    return 0;
+    return s;
 }
 
 /* Collision detection on the present poses, no step. The pairs go into the records like a

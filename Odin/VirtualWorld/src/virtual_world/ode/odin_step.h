@@ -65,6 +65,17 @@ typedef struct OdinPair {
     int first, n;
 } OdinPair;
 
+/* A body the divergence guard found gone wrong after a step (and parked): reason 1 a value not
+ * finite, 2 too fast (m/s), 3 spinning too fast (rad/s), 4 beyond the world's extent (m);
+ * value: what broke the bound; its state as the step left it. */
+typedef struct OdinDivergence {
+    dBodyID body;
+    int reason;
+    double value;
+    double position[3], velocity[3], angular[3];
+    long step;
+} OdinDivergence;
+
 /* A pair of geoms found colliding; depth is the deepest ODE contact depth seen; first_step the
  * world's step count when it was first seen since the records were cleared. */
 typedef struct OdinCollision {
@@ -98,6 +109,14 @@ typedef struct OdinWorld {
     int record_every_step;   /* contact policy: record the pairs of every step, not the last */
     int unordered;           /* benchmarks only: contacts made as the hash space finds them
                                 (not deterministic), to measure what the ordering costs */
+    /* the divergence guard: after every step each guarded body must be finite, slower than
+     * max_speed (m/s) and max_spin (rad/s) and within extent (m) of the origin on every axis;
+     * one that is not is parked (made kinematic, still, colliding with nothing, put back
+     * within the extent) before ODE's collision code can see it, and recorded */
+    dBodyID *guarded; int n_guarded;   /* the dynamic bodies (Python's array) */
+    double max_speed, max_spin, extent;
+    int stop_on_divergence;  /* 1: the step loop stops after a step that parked a body */
+    OdinDivergence *diverged; int n_diverged; int cap_diverged;
     long step_count;         /* steps taken since the scene began */
     int recording;           /* internal: record pairs during this collide pass */
     int record_overflow;     /* pairs dropped because memory ran out */
@@ -110,8 +129,11 @@ typedef struct OdinWorld {
 } OdinWorld;
 
 
-/* Runs `count` steps of `h` seconds. Returns 0. */
+/* Runs `count` steps of `h` seconds; returns the steps taken (fewer when the guard parked a
+ * body and stop_on_divergence is set). */
 int odin_world_step(OdinWorld *w, double h, int count);
+/* Forgets the divergences Python has read. */
+void odin_world_clear_divergences(OdinWorld *w);
 /* Records the pairs touching now, without stepping and without contacts: under the contact-less
  * policy always; under the contact policy only when any_policy (a collision query). */
 void odin_world_detect(OdinWorld *w, int any_policy);

@@ -19,6 +19,7 @@ from virtual_world.ode.bindings import ffi, lib
 BodyForce = Tuple  # (body ptr, torque, vector_in_body, at_point, point_in_body, vector, point)
 JointForce = Tuple  # (joint ptr, ODE joint type, magnitudes)
 MotorGoal = Tuple  # (motor ptr, MotorKind, velocities)
+Divergence = Tuple  # (body address, reason, value, position, velocity, angular, step)
 Record = Tuple  # (geom address 1, geom address 2, depth m, points ((x, y, z), ...) m,
 #                  the step count when first seen)
 
@@ -57,6 +58,10 @@ class CWorld:
         s.bounce_vel = p.bounce_velocity
         s.contact_less = int(p.contact_less)
         s.solver = int(p.solver)
+        s.max_speed = p.divergence_speed
+        s.max_spin = p.divergence_angular_speed
+        s.extent = p.world_extent
+        s.stop_on_divergence = int(p.divergence_policy == 1)
 
     @property
     def max_contacts(self) -> int:
@@ -119,6 +124,21 @@ class CWorld:
                 g.velocity[k] = value
         self._install("motors", array, len(goals))
 
+    def set_guarded(self, bodies: Sequence) -> None:
+        """The bodies the divergence guard checks after every step (the dynamic ones)."""
+        array = ffi.new("dBodyID[]", list(bodies) or 1)
+        self._install("guarded", array, len(bodies))
+
+    def divergences(self) -> List[Divergence]:
+        """The bodies the guard parked since the last call (body address, reason, value,
+        position, velocity, angular velocity, step count), forgotten once read."""
+        s = self.struct
+        out = [(int(ffi.cast("uintptr_t", d.body)), int(d.reason), float(d.value),
+                tuple(d.position), tuple(d.velocity), tuple(d.angular), int(d.step))
+               for d in (s.diverged[i] for i in range(s.n_diverged))]
+        lib.odin_world_clear_divergences(s)
+        return out
+
     def update_motor_goal(self, slot: int, velocities: Sequence[float]) -> None:
         goal = self._arrays["motors"][slot]
         for k, value in enumerate(velocities):
@@ -130,9 +150,11 @@ class CWorld:
         self._arrays[field] = array
 
     # -- stepping and read-out ---------------------------------------------------------------
-    def step(self, step_size: float, count: int) -> None:
-        """``count`` steps in one C call (odin_step.c: collide, actions, step, empty)."""
-        lib.odin_world_step(self.struct, step_size, count)
+    def step(self, step_size: float, count: int) -> int:
+        """``count`` steps in one C call (odin_step.c: collide, actions, step, empty, guard);
+        returns the steps taken (fewer when the guard parked a body under the pausing
+        policy)."""
+        return int(lib.odin_world_step(self.struct, step_size, count))
 
     def detect(self, any_policy: bool = False) -> None:
         """Records what touches now, without stepping or contacts: under the contact-less
@@ -163,7 +185,7 @@ class CWorld:
         if self.world.closed:
             return
         s = self.struct
-        for field in ("forces", "joint_forces", "motors"):
+        for field in ("forces", "joint_forces", "motors", "guarded"):
             setattr(s, field, ffi.NULL)
             setattr(s, "n_" + field, 0)
         self._arrays.clear()

@@ -12,6 +12,7 @@ from typing import Sequence
 import numpy as np
 
 from Messages.msg import Collided, CollisionPair, JointData, SpaceDistribution
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Point
 from sensor_msgs.msg import JointState
 from Services.srv import ViewObjectRequest
@@ -37,6 +38,25 @@ def collided_message(collisions, stamp) -> Collided:
     message.header.frame_id = "world"
     message.pairs = collision_pairs(collisions)
     message.names = list(dict.fromkeys(n for c in collisions for n in (c.first, c.second)))
+    return message
+
+
+def divergence_diagnostics(divergences, stamp) -> DiagnosticArray:
+    """Core divergences -> diagnostic_msgs/DiagnosticArray, one ERROR status each."""
+    message = DiagnosticArray()
+    message.header.stamp = stamp
+    for event in divergences:
+        values = [KeyValue("object", event.id), KeyValue("reason", event.reason),
+                  KeyValue("value", f"{event.value:.9g}"),
+                  KeyValue("simulated time (s)", f"{event.time:.9g}")]
+        for label, vector in (("position (m)", event.position),
+                              ("velocity (m/s)", event.velocity),
+                              ("angular velocity (rad/s)", event.angular)):
+            values.append(KeyValue(label, " ".join(f"{v:.9g}" for v in vector)))
+        message.status.append(DiagnosticStatus(
+            level=DiagnosticStatus.ERROR, name="virtual_world: divergence guard",
+            message=f"{event.id} diverged ({event.reason}) and was parked",
+            hardware_id="virtual_world", values=values))
     return message
 
 
@@ -111,5 +131,5 @@ class _PreSerialised(SpaceDistribution):
         buff.write(self._body)
 
 
-__all__ = ["view_requests", "collision_pairs", "collided_message", "joint_data", "joint_state_message",
+__all__ = ["view_requests", "collision_pairs", "collided_message", "divergence_diagnostics", "joint_data", "joint_state_message",
            "SpaceDistributionWriter"]

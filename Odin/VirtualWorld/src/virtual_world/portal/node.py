@@ -25,7 +25,9 @@ Topics published (every cycle, or at ``~rate`` per wall-clock second under ``~fr
   ``/joint_states``      sensor_msgs/JointState: the same, one name per joint axis
                          (``<joint id>`` for one-axis joints, ``<joint id>/<axis>`` otherwise);
   ``/clock``             rosgraph_msgs/Clock: simulated time, for nodes with use_sim_time;
-  ``~real_time_factor``  std_msgs/Float64: simulated s per wall-clock s over the last second.
+  ``~real_time_factor``  std_msgs/Float64: simulated s per wall-clock s over the last second;
+  ``/diagnostics``       diagnostic_msgs/DiagnosticArray: an ERROR for each body the divergence
+                         guard parked (the object, why, its values), when it happens.
 
 Services called: ``<~viewer>/view_object``, ``/remove_object``, ``/new_scene`` (optional: see
 ``viewer_link``).
@@ -45,6 +47,7 @@ import traceback
 from typing import Callable
 
 import rospy
+from diagnostic_msgs.msg import DiagnosticArray
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
@@ -113,6 +116,7 @@ class Portal:
         self.pub_joint_states = rospy.Publisher("/joint_states", JointState, queue_size=10)
         self.pub_clock = rospy.Publisher("/clock", Clock, queue_size=10)
         self.pub_rtf = rospy.Publisher("~real_time_factor", Float64, queue_size=10)
+        self.pub_diagnostics = rospy.Publisher("/diagnostics", DiagnosticArray, queue_size=10)
 
     def _serve(self) -> None:
         """One server per world service, each answered by the method of the same name."""
@@ -169,10 +173,27 @@ class Portal:
             self.core.close()
 
     def core_advance(self, step: float, count: int) -> float:
+        before = self.core.sim_time
         self.core.step(step, count)
+        taken = round((self.core.sim_time - before) / step)
         if self.recorder is not None:
-            self.recorder.advance(step, count, self.core.sim_time, *self.core.poses())
+            self.recorder.advance(step, taken, self.core.sim_time, *self.core.poses())
+        self._report_divergences()
         return self.core.sim_time
+
+    def _report_divergences(self) -> None:
+        """Each body the divergence guard parked: an ERROR on /diagnostics and in the log;
+        under the pausing policy the simulation pauses (the world keeps answering)."""
+        found = self.core.take_divergences()
+        if not found:
+            return
+        for event in found:
+            _log.error("virtual_world: %s diverged at %.6g s (%s, %s); parked",
+                       event.id, event.time, event.reason, event.value)
+        self.pub_diagnostics.publish(conversions.divergence_diagnostics(
+            found, rospy.Time.from_sec(self.core.sim_time)))
+        if self.core.world_parameters.divergence_policy == 1:
+            self.loop.simulate = False
 
     def _publish(self, report: CycleReport) -> None:
         rtf = self._rtf.add(report.wall_time, report.sim_time)
