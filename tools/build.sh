@@ -13,7 +13,14 @@ force=()
 if [ ! -f "$ws/build/.odin-configured" ]; then force=(--force-cmake); fi
 # catkin_make runs Python tools; keep the venv first on PATH.
 export PATH="$root/.venv/bin:$PATH"
-catkin_make -C "$ws" "${force[@]}" -DPYTHON_EXECUTABLE="$python" -DCATKIN_ENABLE_TESTING=OFF \
-  > "$root/build/catkin_make.log" 2>&1 || { tail -40 "$root/build/catkin_make.log" >&2; exit 1; }
+make_workspace() {
+  catkin_make -C "$ws" "$@" -DPYTHON_EXECUTABLE="$python" -DCATKIN_ENABLE_TESTING=OFF \
+    > "$root/build/catkin_make.log" 2>&1
+}
+if ! make_workspace "${force[@]}"; then
+  # a .msg that gained a dependency (a field of another message type) needs cmake again
+  if grep -q "Please rerun cmake" "$root/build/catkin_make.log" && make_workspace --force-cmake
+  then :; else tail -40 "$root/build/catkin_make.log" >&2; exit 1; fi
+fi
 touch "$ws/build/.odin-configured"
 echo "build.sh: catkin workspace built in $ws"

@@ -79,6 +79,8 @@ SERVICES = {
                    "<contact_coefficients> and its environments' contact tables give them",
                    "{id: ball, surface: {set_friction: true, friction: 0.4, set_bounce: true, "
                    "bounce: 0.5, bounce_velocity: 0.05}}"),
+    "GetState": ("new (past the thesis): states, masses, joint reactions (ODE's feedback) and "
+                 "motor goals", "{objects: [ball], joints: ['1:ball&']}"),
     "SaveState": (f"{PLANNING}; the whole dynamic state, bit for bit", "{name: start}"),
     "RestoreState": (f"{PLANNING}; refused when the contents changed", "{name: start}"),
     "Reset": (f"{PLANNING}; the state right after the last build or removal", None),

@@ -116,3 +116,23 @@ def test_bad_planning_requests_are_refused_and_change_nothing(world):
     world.ok("build_object", object=__import__("world_client").sphere("late", 0.1, (3, 3, 1)))
     refused = world("restore_state", name="s")
     assert not refused.success and "late" in refused.message
+
+
+def test_get_state_gives_masses_joint_reactions_and_motor_goals(world):
+    _scene(world)
+    world.ok("set_velocity", motors=["motor:1:bob&"], velocities=[0.5])
+    world.ok("step_once", cycles=2)
+    state = world.ok("get_state", objects=["bob"], joints=["1:bob&"])
+    (bob,) = state.bodies
+    assert bob.id == "bob" and list(state.masses) == [1.0]
+    assert state.inertias[0] == pytest.approx(0.4 * 1.0 * 0.1 ** 2)
+    (joint,) = state.joints
+    assert joint.rates[0] == pytest.approx(0.5, abs=1e-3)     # QuickStep, the default
+    # the hinge holds the bob's weight: its force on the bob is up, m g
+    assert state.reactions1[0].force.z == pytest.approx(9.81, rel=0.02)
+    everything = world.ok("get_state")
+    assert everything.motors == ["motor:1:bob&"] and list(everything.motor_goals) == [0.5]
+    assert list(everything.motor_max_forces) == [2.0] and list(everything.motor_axes) == [1]
+    assert [b.id for b in everything.bodies] == ["s0", "s1", "s2", "s3", "s4", "bob"]
+    refused = world("get_state", objects=["ground"])
+    assert not refused.success and "geometry only" in refused.message

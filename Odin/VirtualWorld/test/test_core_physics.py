@@ -409,3 +409,27 @@ def test_a_mesh_a_few_cells_across_collides_as_given(core):
     assert core.collision_triangle_count("bead") == len(faces)
     with pytest.raises(UnknownName):
         core.collision_triangle_count("nothing")
+
+
+def test_contact_reports_carry_normals_and_the_forces_that_hold_a_box(core):
+    ground(core)
+    core.build_object(ObjectSpec("box", [0.4, 0.3, 0.2], mass=3.0, position=(0, 0, 0.1)))
+    core.step(0.001, 500)
+    (pair,) = core.read_collisions()
+    assert (pair.first, pair.second) == ("box", "ground")
+    np.testing.assert_allclose(pair.normals, [(0, 0, 1)] * len(pair.points), atol=1e-9)
+    total = np.sum(pair.forces, axis=0)            # the ground holds the box up: m g
+    assert total[2] == pytest.approx(3.0 * 9.81, rel=1e-3)
+    assert np.hypot(total[0], total[1]) < 0.05 * total[2]
+
+
+def test_a_joint_reports_the_force_it_applies(core):
+    core.set_world_parameters(solver=vc.WORLDSTEP)
+    core.build_object(ObjectSpec("bob", [0.1], mass=2.0, position=(0.5, 0, 0)))
+    joint = core.create_joint(vc.HINGE, "bob", "", anchor=(0, 0, 0), axis1=(0, 1, 0))
+    core.create_motor(joint=joint)                 # holds it level
+    core.step(0.001, 20)
+    _, (reaction,), (motor,) = core.state()
+    assert reaction.force1[2] == pytest.approx(2.0 * 9.81, rel=1e-3)   # up, m g
+    assert reaction.force2 == (0.0, 0.0, 0.0)      # the static world's side
+    assert motor.goals == (0.0,) and motor.max_forces == (math.inf,)

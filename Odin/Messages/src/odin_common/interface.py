@@ -279,7 +279,7 @@ WORLD_SERVICES: Dict[str, str] = {
     "remove_object": "RemoveObject", "set_joint": "SetJoint", "set_motor": "SetMotor",
     "set_position": "SetPosition", "set_velocity": "SetVelocity",
     "set_external_force": "SetExternalForce", "set_joint_force": "SetJointForce",
-    "get_world": "GetWorld", "save_state": "SaveState", "restore_state": "RestoreState",
+    "get_world": "GetWorld", "get_state": "GetState", "save_state": "SaveState", "restore_state": "RestoreState",
     "reset": "Reset", "propagate": "Propagate", "check_collision": "CheckCollision",
     "set_surface": "SetSurface",
 }

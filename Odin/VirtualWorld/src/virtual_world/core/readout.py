@@ -14,9 +14,12 @@ from typing import List, Set, Tuple
 import numpy as np
 
 from odin_common.rotations import quaternion_to_matrix
-from virtual_world.core.records import Collision
+from odin_common.interface import JointParameter
+from virtual_world.core.records import (Collision, JointReaction, MotorState,
+                                        ObjectState)
 from virtual_world.core.scene import Scene
 from virtual_world.ode import bodies
+from virtual_world.ode import joints as ode_joints
 
 
 def poses(scene: Scene) -> Tuple[List[str], np.ndarray, np.ndarray]:
@@ -48,12 +51,15 @@ def named_records(scene: Scene) -> List[Tuple[Collision, int]]:
     """C's collision records under geometry names (sorted within a pair), each with the step
     count when it was first seen."""
     result = []
-    for address1, address2, depth, points, first_step in scene.c.records():
+    for address1, address2, depth, points, first_step, normals, forces in scene.c.records():
         first = scene.geometry_names[address1]
         second = scene.geometry_names[address2]
-        if second < first:
+        if second < first:   # named in order: normals and forces then act on the other one
             first, second = second, first
-        result.append((Collision(first, second, depth, points), first_step))
+            normals = tuple(tuple(-v for v in n) for n in normals)
+            forces = tuple(tuple(-v for v in f) for f in forces)
+        result.append((Collision(first, second, depth, points, normals=normals, forces=forces),
+                       first_step))
     return result
 
 
@@ -85,3 +91,35 @@ def read_collisions(scene: Scene) -> List[Collision]:
     if scene.parameters.contact_less:
         scene.carried = {}
     return result
+
+
+def object_states(scene: Scene, object_ids) -> List[ObjectState]:
+    """ObjectState of each object asked for (all with a body when none), checked first."""
+    ids = list(object_ids) or [i for i, o in scene.objects.items() if o.body is not None]
+    for object_id in ids:
+        scene.body_object(object_id, "state")
+    out = []
+    for object_id in ids:
+        position, orientation, linear, angular = body_state(scene, object_id)
+        mass, center, inertia = mass_properties(scene, object_id)
+        out.append(ObjectState(object_id, *(tuple(v.tolist()) for v in (
+            position, orientation, linear, angular)), mass, tuple(center.tolist()),
+            tuple(inertia.reshape(-1).tolist())))
+    return out
+
+
+def joint_reactions(scene: Scene, joint_ids) -> List[JointReaction]:
+    """JointReaction of each joint asked for (all when none), checked first."""
+    ids = list(joint_ids) or list(scene.joints)
+    records = [scene.joint(j) for j in ids]
+    return [JointReaction(r.id, int(r.type), *ode_joints.joint_state(r.owner.ptr, r.type),
+                          *ode_joints.reactions(r.owner)) for r in records]
+
+
+def motor_states(scene: Scene, motor_ids) -> List[MotorState]:
+    """MotorState of each motor asked for (all when none), checked first."""
+    ids = list(motor_ids) or list(scene.motors)
+    records = [scene.motor(m) for m in ids]
+    return [MotorState(m.id, m.joint or "", tuple(m.velocity), tuple(
+        ode_joints.motor_parameter(m.owner.ptr, m.kind, JointParameter.MAX_FORCE, axis)
+        for axis in range(1, m.naxes + 1))) for m in records]

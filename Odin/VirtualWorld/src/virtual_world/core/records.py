@@ -73,12 +73,52 @@ class JointState(NamedTuple):
 class Collision(NamedTuple):
     """Two colliding geometries (names, sorted), the deepest penetration depth (m), up to 8
     contact points (world, m) of the deepest occurrence and, where the Core knows it, the
-    simulated time (s) the pair was first seen (NaN otherwise)."""
+    simulated time (s) the pair was first seen (NaN otherwise). Per point: the contact normal
+    (unit, world: the direction the contact pushes ``first``) and, under the contact policy,
+    the contact's force on ``first`` (N, world; empty when no contact joint was made)."""
     first: str
     second: str
     depth: float
     points: Tuple[Tuple[float, float, float], ...]
     first_time: float = float("nan")
+    normals: Tuple[Tuple[float, float, float], ...] = ()
+    forces: Tuple[Tuple[float, float, float], ...] = ()
+
+
+class ObjectState(NamedTuple):
+    """An object's state and mass: BodyState's fields, then mass (kg), centre of mass (m, the
+    object's frame) and inertia (3 x 3 kg m^2 about the centre of mass, object axes, row by
+    row)."""
+    id: str
+    position: Tuple[float, float, float]
+    orientation: Tuple[float, float, float, float]
+    linear: Tuple[float, float, float]
+    angular: Tuple[float, float, float]
+    mass: float
+    center_of_mass: Tuple[float, float, float]
+    inertia: Tuple[float, ...]
+
+
+class JointReaction(NamedTuple):
+    """A joint's state (JointState's positions and rates) and what it applied in the last
+    step: force (N) and torque (N m) on its first and second body, world frame."""
+    id: str
+    type: int
+    positions: Tuple[float, ...]
+    rates: Tuple[float, ...]
+    force1: Tuple[float, float, float]
+    torque1: Tuple[float, float, float]
+    force2: Tuple[float, float, float]
+    torque2: Tuple[float, float, float]
+
+
+class MotorState(NamedTuple):
+    """A motor's goal speeds (rad/s or m/s) and maximum forces (N m or N; inf: unlimited),
+    per axis, and the joint it drives ("" for none)."""
+    id: str
+    joint: str
+    goals: Tuple[float, ...]
+    max_forces: Tuple[float, ...]
 
 
 class Divergence(NamedTuple):

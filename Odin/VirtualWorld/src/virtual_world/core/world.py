@@ -27,7 +27,8 @@ from odin_common.world_parameters import WorldParameters
 from virtual_world.core import (forces, guard, joints, motors, objects, readout, snapshots,
                                 validation as check)
 from virtual_world.core.records import (BodyState, Built, BuiltEntity, Collision, Divergence,
-                                        JointState, Propagation, Removed)
+                                        JointReaction, JointState, MotorState, ObjectState,
+                                        Propagation, Removed)
 from virtual_world.core.scene import Scene
 from virtual_world.errors import Closed, InvalidArgument, UnknownName
 from virtual_world.ode import bodies
@@ -541,6 +542,24 @@ class Core:
         """(mass kg, centre of mass (3,) m in the object frame, inertia (3,3) kg m^2 about the
         centre of mass, object axes) as ODE holds them."""
         return readout.mass_properties(self._scene, object_id)
+
+    @_locked
+    def state(self, objects: Sequence[str] = (), joints: Sequence[str] = (),
+              motors: Sequence[str] = ()) -> Tuple[List[ObjectState], List[JointReaction],
+                                                   List[MotorState]]:
+        """Get State: for the objects, joints and motors named (each list empty: all of them),
+        their states: poses, velocities, mass and inertia; joint positions, rates and the
+        force and torque each joint applied to its bodies in the last step; motor goals and
+        maximum forces. Unknown names raise before anything is read."""
+        scene = self._scene
+        for object_id in objects:
+            scene.body_object(object_id, "state")
+        for joint_id in joints:
+            scene.joint(joint_id)
+        for motor_id in motors:
+            scene.motor(motor_id)
+        return (readout.object_states(scene, objects), readout.joint_reactions(scene, joints),
+                readout.motor_states(scene, motors))
 
     @_locked
     def read_collisions(self) -> List[Collision]:

@@ -189,9 +189,12 @@ _CREATE_MOTOR = {MotorKind.ANGULAR: lib.dJointCreateAMotor,
 
 def _attached(ptr: Any, world: Owner, bodies: Sequence[Owner]) -> Owner:
     """Adopts a new joint and attaches it: bodies[0] is ODE's body 1; with one body, body 2 is
-    the static world (NULL)."""
-    owner = Owner("joint", ptr, parents=(world, *bodies))
+    the static world (NULL). Its feedback (``owner.data``, a dJointFeedback ODE fills at every
+    step: the force and torque the joint applies to each body) is kept with it."""
+    feedback = ffi.new("dJointFeedback *")
+    owner = Owner("joint", ptr, parents=(world, *bodies), data=feedback)
     lib.dJointAttach(ptr, bodies[0].ptr, bodies[1].ptr if len(bodies) > 1 else ffi.NULL)
+    lib.dJointSetFeedback(ptr, feedback)
     return owner
 
 

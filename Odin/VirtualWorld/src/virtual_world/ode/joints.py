@@ -131,6 +131,14 @@ def set_motor_parameter(motor, kind: MotorKind, parameter: JointParameter, axis:
     _SET_MOTOR_PARAMETER[kind](motor, ode_parameter(parameter, axis), value)
 
 
+def reactions(joint_owner) -> Tuple[Tuple[float, ...], ...]:
+    """(force on body 1 (N), torque on body 1 (N m), force on body 2, torque on body 2), world
+    frame: what the joint applied in the last step (ODE's joint feedback; zeros before a
+    step, and for the static world's side)."""
+    f = joint_owner.data
+    return tuple(tuple(v[k] for k in range(3)) for v in (f.f1, f.t1, f.f2, f.t2))
+
+
 def joint_parameter(joint, kind: JointType, parameter: JointParameter, axis: int) -> float:
     return float(_GET_PARAMETER[kind](joint, ode_parameter(parameter, axis)))
 

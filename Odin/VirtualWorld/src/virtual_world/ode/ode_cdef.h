@@ -17,6 +17,7 @@ typedef struct dxTriMeshData *dTriMeshDataID;
 
 typedef struct dMass { dReal mass; dVector3 c; dMatrix3 I; } dMass;
 typedef struct dContactGeom dContactGeom;   /* opaque here: only C code reads contacts */
+typedef struct dJointFeedback { dVector3 f1; dVector3 t1; dVector3 f2; dVector3 t2; } dJointFeedback;
 
 static const double dInfinity;
 
@@ -143,6 +144,7 @@ dGeomID dCreateTriMesh(dSpaceID space, dTriMeshDataID Data, void *Callback, void
 /* joints */
 void dJointDestroy(dJointID);
 void dJointAttach(dJointID, dBodyID body1, dBodyID body2);
+void dJointSetFeedback(dJointID, dJointFeedback *);
 int dJointGetType(dJointID);
 dBodyID dJointGetBody(dJointID, int index);
 int dAreConnected(dBodyID, dBodyID);

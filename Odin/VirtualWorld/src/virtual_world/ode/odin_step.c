@@ -43,9 +43,10 @@ static int grow_records(OdinWorld *w) {
     return 1;
 }
 
-static void record_pair(OdinWorld *w, dGeomID o1, dGeomID o2, const dContact *c, int n) {
+/* Records a colliding pair (o1 the lower serial), keeping its deepest occurrence; returns the
+ * record's index, or -1 (memory ran out, or a shallower occurrence of a recorded pair). */
+static int record_pair(OdinWorld *w, dGeomID o1, dGeomID o2, const dContact *c, int n) {
     dGeomID a = o1, b = o2;
-    if ((uintptr_t)a > (uintptr_t)b) { a = o2; b = o1; }
     double depth = 0.0;
     for (int i = 0; i < n; ++i)
         if (c[i].geom.depth > depth) depth = c[i].geom.depth;
@@ -58,10 +59,10 @@ static void record_pair(OdinWorld *w, dGeomID o1, dGeomID o2, const dContact *c,
             if (q->g1 == a && q->g2 == b) { r = q; break; }
             h = (h + 1) & mask;
         }
-        if (r && depth <= r->depth) return; /* keep the deepest occurrence */
+        if (r && depth <= r->depth) return -1; /* keep the deepest occurrence */
     }
     if (!r) {
-        if (w->n_records >= w->cap_records && !grow_records(w)) { w->record_overflow++; return; }
+        if (w->n_records >= w->cap_records && !grow_records(w)) { w->record_overflow++; return -1; }
         r = &w->records[w->n_records++];
         r->g1 = a;
         r->g2 = b;
@@ -73,8 +74,13 @@ static void record_pair(OdinWorld *w, dGeomID o1, dGeomID o2, const dContact *c,
     }
     r->depth = depth;
     r->npoints = n < ODIN_RECORD_POINTS ? n : ODIN_RECORD_POINTS;
+    r->has_forces = 0;
     for (int i = 0; i < r->npoints; ++i)
-        for (int k = 0; k < 3; ++k) r->points[i][k] = c[i].geom.pos[k];
+        for (int k = 0; k < 3; ++k) {
+            r->points[i][k] = c[i].geom.pos[k];
+            r->normals[i][k] = c[i].geom.normal[k];
+        }
+    return (int)(r - w->records);
 }
 
 void odin_world_clear_records(OdinWorld *w) {
@@ -87,6 +93,13 @@ void odin_world_free_buffers(OdinWorld *w) {
     free(w->table);
     free(w->diverged);
     w->diverged = NULL;
+    free(w->feedback);
+    free(w->feedback_record);
+    free(w->feedback_point);
+    free(w->feedback_sign);
+    w->feedback = NULL;
+    w->feedback_record = w->feedback_point = w->feedback_sign = NULL;
+    w->n_feedback = w->cap_feedback = 0;
     w->n_diverged = w->cap_diverged = 0;
     free(w->pairs);
     free(w->pairs_sorted);
@@ -103,7 +116,7 @@ void odin_world_free_buffers(OdinWorld *w) {
 
 /* Keeps a colliding pair's contacts until the pass ends; 0 when memory ran out. */
 static int keep_pair(OdinWorld *w, dGeomID g1, dGeomID g2, long s1, long s2,
-                     const dContact *c, int n) {
+                     const dContact *c, int n, int record) {
     if (w->n_pairs >= w->cap_pairs) {
         int cap = w->cap_pairs ? 2 * w->cap_pairs : 256;
         OdinPair *pairs = realloc(w->pairs, (size_t)cap * sizeof(OdinPair));
@@ -127,6 +140,7 @@ static int keep_pair(OdinWorld *w, dGeomID g1, dGeomID g2, long s1, long s2,
     p->key = (uint64_t)s1 << 32 | (uint64_t)(uint32_t)s2;
     p->first = w->n_contacts;
     p->n = n;
+    p->record = record;
     for (int i = 0; i < n; ++i) w->contacts[w->n_contacts++] = c[i].geom;
     return 1;
 }
@@ -216,10 +230,44 @@ static int in_contact_plane(dVector3 f, const dVector3 n) {
     return 1;
 }
 
+/* Room for the joint feedback of n contacts; 0 when memory ran out (then no forces). */
+static int feedback_room(OdinWorld *w, int n) {
+    if (n <= w->cap_feedback) return 1;
+    int cap = w->cap_feedback ? w->cap_feedback : 256;
+    while (cap < n) cap *= 2;
+    dJointFeedback *f = realloc(w->feedback, (size_t)cap * sizeof(dJointFeedback));
+    if (f) w->feedback = f;
+    int *r = realloc(w->feedback_record, (size_t)cap * sizeof(int));
+    if (r) w->feedback_record = r;
+    int *p = realloc(w->feedback_point, (size_t)cap * sizeof(int));
+    if (p) w->feedback_point = p;
+    int *g = realloc(w->feedback_sign, (size_t)cap * sizeof(int));
+    if (g) w->feedback_sign = g;
+    if (!f || !r || !p || !g) return 0;
+    w->cap_feedback = cap;
+    return 1;
+}
+
+/* After the step: each recorded contact's force on the pair's first geom, from ODE's joint
+ * feedback (f1 is the force on the joint's first body: the first geom's, or, when that geom is
+ * static, the other's, whose opposite it then is). */
+static void read_contact_forces(OdinWorld *w) {
+    for (int k = 0; k < w->n_feedback; ++k) {
+        OdinCollision *r = &w->records[w->feedback_record[k]];
+        int i = w->feedback_point[k];
+        for (int j = 0; j < 3; ++j) r->forces[i][j] = w->feedback_sign[k] * w->feedback[k].f1[j];
+        r->has_forces = 1;
+    }
+    w->n_feedback = 0;
+}
+
 /* Creates the pass's contact joints, pair by pair in serial order: the same scene gives the
- * same constraints in the same order, whatever order the hash space found the pairs in. */
+ * same constraints in the same order, whatever order the hash space found the pairs in. While
+ * recording, the contacts of recorded pairs get joint feedback (read_contact_forces). */
 static void make_contacts(OdinWorld *w, double h) {
     if (!w->unordered && w->n_pairs > 1) sort_pairs(w);
+    int feedback = w->recording && feedback_room(w, w->n_contacts);
+    w->n_feedback = 0;
     for (int k = 0; k < w->n_pairs; ++k) {
         const OdinPair *p = &w->pairs[k];
         dBodyID b1 = dGeomGetBody(p->g1), b2 = dGeomGetBody(p->g2);
@@ -231,7 +279,15 @@ static void make_contacts(OdinWorld *w, double h) {
             c.geom = w->contacts[p->first + i];
             if (anisotropic && !in_contact_plane(c.fdir1, c.geom.normal))
                 c.surface.mode &= ~(dContactMu2 | dContactFDir1); /* along the normal */
-            dJointAttach(dJointCreateContact(w->world, w->contact_group, &c), b1, b2);
+            dJointID joint = dJointCreateContact(w->world, w->contact_group, &c);
+            dJointAttach(joint, b1, b2);
+            if (feedback && p->record >= 0 && i < ODIN_RECORD_POINTS) {
+                int k = w->n_feedback++;
+                dJointSetFeedback(joint, &w->feedback[k]);
+                w->feedback_record[k] = p->record;
+                w->feedback_point[k] = i;
+                w->feedback_sign[k] = b1 ? 1 : -1;
+            }
         }
         w->last_step_contacts += p->n;
     }
@@ -258,9 +314,10 @@ static void near_callback(void *data, dGeomID o1, dGeomID o2) {
     dContact contact[ODIN_MAX_CONTACTS];
     int n = dCollide(o1, o2, w->max_contacts, &contact[0].geom, sizeof(dContact));
     if (n <= 0) return;
-    if (w->recording) record_pair(w, o1, o2, contact, n);
+    int record = w->recording ? record_pair(w, o1, o2, contact, n) : -1;
     if (w->contact_less) return;
-    if (!keep_pair(w, o1, o2, i1->serial, i2->serial, contact, n)) w->buffer_overflow++;
+    if (!keep_pair(w, o1, o2, i1->serial, i2->serial, contact, n, record))
+        w->buffer_overflow++;
 }
 
 /* ---------------------------------------------------------------- persistent actions */
@@ -446,6 +503,7 @@ int odin_world_step(OdinWorld *w, double h, int count) {
             dWorldStep(w->world, h);
         }
         /* 5. fixed bodies are kinematic (dBodySetKinematic): nothing to reset */
+        if (w->recording && !w->contact_less) read_contact_forces(w);
         dJointGroupEmpty(w->contact_group);           /* 6. contacts last one step */
         w->step_count++;
         if (guard(w) && w->stop_on_divergence) {      /* 7. nothing diverged may go on */

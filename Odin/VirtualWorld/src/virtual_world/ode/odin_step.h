@@ -63,6 +63,7 @@ typedef struct OdinPair {
     dGeomID g1, g2;          /* in serial order */
     uint64_t key;            /* serial of g1 << 32 | serial of g2: the order of contacts */
     int first, n;
+    int record;              /* its collision record (index), or -1 */
 } OdinPair;
 
 /* A body the divergence guard found gone wrong after a step (and parked): reason 1 a value not
@@ -76,14 +77,20 @@ typedef struct OdinDivergence {
     long step;
 } OdinDivergence;
 
-/* A pair of geoms found colliding; depth is the deepest ODE contact depth seen; first_step the
- * world's step count when it was first seen since the records were cleared. */
+/* A pair of geoms found colliding (g1 the lower serial); depth is the deepest ODE contact depth
+ * seen; first_step the world's step count when it was first seen since the records were
+ * cleared; points and normals (unit: the direction the contact pushes g1) of the deepest
+ * occurrence; forces (N, world: the contact's force on g1 at each point) when has_forces (the
+ * contact policy's last step of a call, from ODE's joint feedback). */
 typedef struct OdinCollision {
     dGeomID g1, g2;
     double depth;
     long first_step;
     int npoints;
     double points[ODIN_RECORD_POINTS][3];
+    double normals[ODIN_RECORD_POINTS][3];
+    double forces[ODIN_RECORD_POINTS][3];
+    int has_forces;
 } OdinCollision;
 
 typedef struct OdinWorld {
@@ -126,6 +133,9 @@ typedef struct OdinWorld {
     OdinPair *pairs; OdinPair *pairs_sorted; int n_pairs; int cap_pairs;
     dContactGeom *contacts; int n_contacts; int cap_contacts;
     int buffer_overflow;     /* pairs dropped because memory ran out */
+    /* internal: joint feedback of the recorded contacts of the last step of a call */
+    dJointFeedback *feedback; int n_feedback; int cap_feedback;
+    int *feedback_record, *feedback_point, *feedback_sign;
 } OdinWorld;
 
 

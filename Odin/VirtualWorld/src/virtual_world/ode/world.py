@@ -21,7 +21,8 @@ JointForce = Tuple  # (joint ptr, ODE joint type, magnitudes)
 MotorGoal = Tuple  # (motor ptr, MotorKind, velocities)
 Divergence = Tuple  # (body address, reason, value, position, velocity, angular, step)
 Record = Tuple  # (geom address 1, geom address 2, depth m, points ((x, y, z), ...) m,
-#                  the step count when first seen)
+#                  the step count when first seen, normals (unit, pushing geom 1), forces on
+#                  geom 1 (N, world; () when not measured))
 
 
 class CWorld:
@@ -171,10 +172,11 @@ class CWorld:
         out = []
         for i in range(s.n_records):
             r = s.records[i]
-            points = tuple((r.points[k][0], r.points[k][1], r.points[k][2])
-                           for k in range(r.npoints))
+            points = tuple(tuple(r.points[k]) for k in range(r.npoints))
+            normals = tuple(tuple(r.normals[k]) for k in range(r.npoints))
+            forces = tuple(tuple(r.forces[k]) for k in range(r.npoints)) if r.has_forces else ()
             out.append((int(ffi.cast("uintptr_t", r.g1)), int(ffi.cast("uintptr_t", r.g2)),
-                        float(r.depth), points, int(r.first_step)))
+                        float(r.depth), points, int(r.first_step), normals, forces))
         return out
 
     def clear_records(self) -> None:

@@ -13,7 +13,7 @@ import numpy as np
 
 from Messages.msg import Collided, CollisionPair, JointData, SpaceDistribution
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
-from geometry_msgs.msg import Point
+from geometry_msgs.msg import Point, Vector3, Wrench
 from sensor_msgs.msg import JointState
 from Services.srv import ViewObjectRequest
 
@@ -27,7 +27,8 @@ def view_requests(geometries) -> list:
 
 def collision_pairs(collisions) -> list:
     """Core collisions (first, second, depth, points) -> Messages/CollisionPair."""
-    return [CollisionPair(c.first, c.second, c.depth, [Point(*point) for point in c.points])
+    return [CollisionPair(c.first, c.second, c.depth, [Point(*point) for point in c.points],
+                          [Vector3(*n) for n in c.normals], [Vector3(*f) for f in c.forces])
             for c in collisions]
 
 
@@ -58,6 +59,10 @@ def divergence_diagnostics(divergences, stamp) -> DiagnosticArray:
             message=f"{event.id} diverged ({event.reason}) and was parked",
             hardware_id="virtual_world", values=values))
     return message
+
+
+def wrench(force, torque) -> Wrench:
+    return Wrench(Vector3(*force), Vector3(*torque))
 
 
 def joint_data(states) -> list:
@@ -131,5 +136,5 @@ class _PreSerialised(SpaceDistribution):
         buff.write(self._body)
 
 
-__all__ = ["view_requests", "collision_pairs", "collided_message", "divergence_diagnostics", "joint_data", "joint_state_message",
-           "SpaceDistributionWriter"]
+__all__ = ["view_requests", "collision_pairs", "collided_message", "divergence_diagnostics",
+           "wrench", "joint_data", "joint_state_message", "SpaceDistributionWriter"]

@@ -8,6 +8,8 @@ generated message classes; every rule is the Core's (a refusal is its OdinError)
 """
 from __future__ import annotations
 
+from geometry_msgs.msg import Vector3
+
 from odin_common import messages
 from odin_common.interface import SetJointAction
 from odin_common.specs import EntitySpec, JointSpec, MotorSpec
@@ -20,7 +22,7 @@ from virtual_world.portal import conversions
 WORLD_FIELDS = set_world_flags()
 
 #: services that only read: they change nothing and a recording leaves them out
-READ_ONLY = frozenset({"get_world", "check_collision"})
+READ_ONLY = frozenset({"get_world", "get_state", "check_collision"})
 #: services that drive the loop: a recording holds the advances they caused instead
 LOOP_CONTROL = frozenset({"start", "step_once"})
 
@@ -171,6 +173,22 @@ class WorldServices:
                 "motors": core.motor_ids(), "body_forces": core.body_force_ids(),
                 "joint_forces": core.joint_force_ids(), "snapshots": core.snapshot_names(),
                 "message": f"{len(core.object_ids())} objects at {core.sim_time:g} s"}
+
+    def get_state(self, request) -> dict:
+        bodies, joints, motors = self.core.state(request.objects, request.joints,
+                                                 request.motors)
+        return {"bodies": [messages.body_state_message(b) for b in bodies],
+                "masses": [b.mass for b in bodies],
+                "centers_of_mass": [Vector3(*b.center_of_mass) for b in bodies],
+                "inertias": [v for b in bodies for v in b.inertia],
+                "joints": conversions.joint_data(joints),
+                "reactions1": [conversions.wrench(j.force1, j.torque1) for j in joints],
+                "reactions2": [conversions.wrench(j.force2, j.torque2) for j in joints],
+                "motors": [m.id for m in motors], "motor_joints": [m.joint for m in motors],
+                "motor_axes": [len(m.goals) for m in motors],
+                "motor_goals": [v for m in motors for v in m.goals],
+                "motor_max_forces": [v for m in motors for v in m.max_forces],
+                "message": f"{len(bodies)} bodies, {len(joints)} joints, {len(motors)} motors"}
 
     def save_state(self, request) -> dict:
         self.core.save_state(request.name)
