@@ -75,6 +75,9 @@ SERVICES = {
     "SetJointForce": (f"{KNOWN}: thesis 5.4.3; per-axis magnitudes and id format {RECON}",
                       "{joint: '1:ball&', magnitudes: [0.2]}"),
     "GetWorld": ("new (past the thesis): the values in force and what the world holds", None),
+    "SetServo": ("new (past the thesis): joint servos (a position target tracked by a motor "
+                 "under its force limit), for run_path --tracked", "{motors: ['motor:1:ball&'], "
+                 "targets: [0.2]}"),
     "SetSurface": ("new (past the thesis): per-object contact properties, as Kautham's URDF "
                    "<contact_coefficients> and its environments' contact tables give them",
                    "{id: ball, surface: {set_friction: true, friction: 0.4, set_bounce: true, "
@@ -134,6 +137,8 @@ MESSAGES = {
     "BodyForce": ("in Propagate's request", "-", "new: the fields of Set External Force"),
     "RecordStart": ("`/odin/record/start` in a recording (the world node's `~record`)",
                     "VirtualWorld, once", "new"),
+    "ServoStates": ("/virtual_world/servo_states", "VirtualWorld, every cycle with a servo",
+                    "new"),
     "Advance": ("`/odin/record/advance` in a recording (`rosrun VirtualWorld replay BAG` "
                 "compares its poses bit for bit)", "VirtualWorld, every advance", "new"),
 }

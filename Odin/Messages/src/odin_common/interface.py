@@ -189,6 +189,15 @@ def motor_joint(motor_id: str) -> str:
     return motor_id[len(MOTOR_PREFIX):] if motor_id.startswith(MOTOR_PREFIX) else ""
 
 
+# ---------------------------------------------------------------------------------- servos
+
+SERVO_GAIN = 20.0
+"""1/s: a servo's default position gain (its motor's speed per unit of position error; the
+error then decays with a time constant of 1/gain)."""
+SERVO_MAX_SPEED = 2.0
+"""rad/s or m/s: a servo's default speed limit (a robot's own limits take its place)."""
+
+
 # ---------------------------------------------------------------------------------- shapes
 
 class Shape(IntEnum):
@@ -281,7 +290,7 @@ WORLD_SERVICES: Dict[str, str] = {
     "set_external_force": "SetExternalForce", "set_joint_force": "SetJointForce",
     "get_world": "GetWorld", "get_state": "GetState", "save_state": "SaveState", "restore_state": "RestoreState",
     "reset": "Reset", "propagate": "Propagate", "check_collision": "CheckCollision",
-    "set_surface": "SetSurface",
+    "set_surface": "SetSurface", "set_servo": "SetServo",
 }
 """The VirtualWorld's services: name under ``~`` -> type in the Services package (the
 thesis's 15, then Odin's own)."""
@@ -302,7 +311,7 @@ class NodeParameter(NamedTuple):
     what: str
 
 
-__all__ = ["NodeParameter", "JointType", "JointParameter", "SetJointAction", "MotorKind", "AxisFrame",
+__all__ = ["NodeParameter", "SERVO_GAIN", "SERVO_MAX_SPEED", "JointType", "JointParameter", "SetJointAction", "MotorKind", "AxisFrame",
            "ForceKind", "Solver", "JOINT_AXES_USED", "JOINT_USES_ANCHOR",
            "JOINT_NEEDS_TWO_BODIES", "JOINT_AXIS2_ON_BODY2", "JOINT_FORCE_MAGNITUDES", "JOINT_STATE_AXES", "JOINT_PARAMETERS",
            "JOINT_PARAMETER_AXES", "MOTOR_PARAMETERS", "UNIT_PARAMETERS",

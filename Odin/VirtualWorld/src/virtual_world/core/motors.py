@@ -6,17 +6,17 @@ robot held by its motors keeps its pose. Goal speeds: rad/s (angular) or m/s (li
 """
 from __future__ import annotations
 
-from typing import List, Mapping, Sequence
-
 import math
+from typing import List, Mapping, Sequence
 
 import numpy as np
 
 from odin_common import limits
-from odin_common.interface import JOINT_AXIS2_ON_BODY2, AxisFrame, JointParameter, MotorKind
+from odin_common.interface import (JOINT_AXIS2_ON_BODY2, SERVO_GAIN, SERVO_MAX_SPEED, AxisFrame,
+                                   JointParameter, MotorKind)
 from odin_common.specs import MotorSpec
 from virtual_world.core import validation as check
-from virtual_world.core.records import MotorRecord
+from virtual_world.core.records import MotorRecord, Servo, ServoState
 from virtual_world.core.scene import Scene
 from virtual_world.errors import DuplicateName, InvalidArgument, Unsupported
 from virtual_world.ode import handles
@@ -36,6 +36,7 @@ def create_motor(scene: Scene, spec: MotorSpec) -> str:
     axes_values = check.flat_vector("axes", spec.axes) if len(spec.axes) else np.zeros(0)
     joint = None
     ode_frames = None   # frames in ODE's terms, when the joint decides them
+    on_joint_axes = False
     if joint_id:
         joint = scene.joint(joint_id)
         if (body1 or body2) and (body1, body2) != joint.bodies:
@@ -48,6 +49,7 @@ def create_motor(scene: Scene, spec: MotorSpec) -> str:
                 raise Unsupported(f"joint {joint_id!r} ({joint.type.label}) has no "
                                   f"{kind.name.lower()} axis; give axes")
             axes_values = np.concatenate(found)
+            on_joint_axes = True
             if len(found) == 2 and joint.type in JOINT_AXIS2_ON_BODY2 and \
                     not len(spec.axis_frames):
                 # axis 1 turns with ODE's body 1, axis 2 with body 2 (or the world): as the
@@ -83,7 +85,8 @@ def create_motor(scene: Scene, spec: MotorSpec) -> str:
         frames = [{AxisFrame.GLOBAL: 0, AxisFrame.FIRST_BODY: 2,
                    AxisFrame.SECOND_BODY: 1}[f] for f in frames]
     ode_joints.configure_motor(owner.ptr, kind, unit_axes, frames, max_forces)
-    motor = MotorRecord(motor_id, owner, kind, naxes, joint_id or None, (body1, body2))
+    motor = MotorRecord(motor_id, owner, kind, naxes, joint_id or None, (body1, body2),
+                        on_joint_axes)
     scene.motors[motor_id] = motor
     if joint is not None:
         joint.motors.add(motor_id)
@@ -145,19 +148,18 @@ def set_velocities(scene: Scene, velocities: Mapping[str, Sequence[float]]) -> N
         scene.c.update_motor_goal(scene.motor_slots[motor.id], values)
 
 
-def split_velocities(scene: Scene, motor_ids: Sequence[str],
-                     velocities: Sequence[float]) -> dict:
-    """{motor id: its goal speeds} from one flat list, each motor taking as many values as it
-    has axes, in order (Set Velocity's request)."""
+def split_per_axis(scene: Scene, motor_ids: Sequence[str], values: Sequence[float],
+                   what: str = "velocities") -> dict:
+    """{motor id: its values} from one flat list, each motor taking as many values as it has
+    axes, in order (Set Velocity's velocities, Set Servo's lists)."""
     counts = axis_counts(scene, motor_ids)
-    if sum(counts) != len(velocities):
-        raise InvalidArgument(f"{len(velocities)} velocities for motors with {sum(counts)} "
-                              "axes in all")
-    goals, cursor = {}, 0
+    if sum(counts) != len(values):
+        raise InvalidArgument(f"{len(values)} {what} for motors with {sum(counts)} axes in all")
+    split, cursor = {}, 0
     for motor_id, count in zip(motor_ids, counts):
-        goals[motor_id] = tuple(velocities[cursor:cursor + count])
+        split[motor_id] = tuple(values[cursor:cursor + count])
         cursor += count
-    return goals
+    return split
 
 
 def set_parameters(scene: Scene, motor: MotorRecord, checked: list) -> None:
@@ -171,7 +173,95 @@ def set_parameters(scene: Scene, motor: MotorRecord, checked: list) -> None:
 
 
 def rebuild_goals(scene: Scene) -> None:
-    """Hands C the goal array of every motor, in creation order."""
+    """Hands C the goal array of every motor, in creation order, servos included."""
     motors = list(scene.motors.values())
     scene.motor_slots = {m.id: i for i, m in enumerate(motors)}
     scene.c.set_motor_goals([(m.owner.ptr, m.kind, m.velocity) for m in motors])
+    for slot, motor in enumerate(motors):
+        if motor.servo is not None:
+            scene.c.update_servo(slot, _servo_arguments(scene, motor))
+
+
+def _servo_arguments(scene: Scene, motor: MotorRecord) -> tuple:
+    joint = scene.joints[motor.joint]
+    components = ode_joints.SERVO_COMPONENTS[motor.kind][joint.type]
+    signs = [ode_joints.SERVO_SIGNS.get((joint.type, c), 1.0) for c in components]
+    servo = motor.servo
+    return (joint.owner.ptr, ode_joints.ODE_JOINT_TYPE[joint.type], components, signs,
+            servo.targets, servo.rates, servo.gains, servo.max_speeds)
+
+
+def set_servos(scene: Scene, servos: Mapping[str, Mapping]) -> None:
+    """Servo mode for each motor: {motor id: {"targets": per axis (rad or m, the joint's
+    reported units), optional "rates" (feed-forward, rad/s or m/s; 0), "gains" (1/s;
+    interface.SERVO_GAIN), "max_speeds" (rad/s or m/s; interface.SERVO_MAX_SPEED),
+    "max_forces" (N m or N; the motor's as it is)}}. Before every step the motor's speed on
+    each axis becomes clamp(rate + gain (target - q), +-max_speed) with q the joint's value.
+    A servo drives a motor made on a joint with the joint's own axes. All checked first."""
+    checked = []
+    for motor_id, fields in dict(servos).items():
+        motor = scene.motor(motor_id)
+        if not motor.on_joint_axes or motor.joint not in scene.joints or \
+                scene.joints[motor.joint].type not in ode_joints.SERVO_COMPONENTS[motor.kind]:
+            raise Unsupported(f"motor {motor_id!r} is no servo: a servo drives a motor made "
+                              "on a joint with the joint's own axes")
+        fields = dict(fields)
+        unknown = set(fields) - {"targets", "rates", "gains", "max_speeds", "max_forces"}
+        if unknown or "targets" not in fields:
+            raise InvalidArgument(f"servo of {motor_id!r}: give targets (and optionally rates, "
+                                  f"gains, max_speeds, max_forces); got {sorted(fields)}")
+
+        def per_axis(name, default, low, high, unit):
+            given = fields.get(name)
+            if given is None or len(given) == 0:
+                return (default,) * motor.naxes
+            values = check.flat_vector(f"{name} of servo {motor_id!r}", given)
+            if values.size != motor.naxes:
+                raise InvalidArgument(f"servo {motor_id!r} has {motor.naxes} axes; got "
+                                      f"{values.size} {name}")
+            for v in values:
+                if not low <= v <= high:
+                    raise InvalidArgument(f"{name} of servo {motor_id!r}: {v!r} {unit} is "
+                                          f"outside [{low:g}, {high:g}] {unit}")
+            return tuple(values.tolist())
+        extent = scene.parameters.world_extent
+        servo = Servo(per_axis("targets", 0.0, -extent, extent, "rad or m"),
+                      per_axis("rates", 0.0, -limits.MAX_MOTOR_SPEED, limits.MAX_MOTOR_SPEED,
+                               "rad/s or m/s"),
+                      per_axis("gains", SERVO_GAIN, 0.0, 1e6, "1/s"),
+                      per_axis("max_speeds", SERVO_MAX_SPEED, 0.0, limits.MAX_MOTOR_SPEED,
+                               "rad/s or m/s"))
+        forces = fields.get("max_forces")
+        max_forces = None if forces is None or len(forces) == 0 else \
+            per_axis("max_forces", 0.0, 0.0, limits.MAX_FORCE, "N m or N")
+        checked.append((motor, servo, max_forces))
+    for motor, servo, max_forces in checked:
+        motor.servo = servo
+        for axis, force in enumerate(max_forces or (), start=1):
+            ode_joints.set_motor_parameter(motor.owner.ptr, motor.kind,
+                                           JointParameter.MAX_FORCE, axis, force)
+        scene.c.update_servo(scene.motor_slots[motor.id], _servo_arguments(scene, motor))
+
+
+def release_servos(scene: Scene, motor_ids: Sequence[str]) -> None:
+    """Back to speed goals, each at zero (the motor holds where it is)."""
+    released = [scene.motor(motor_id) for motor_id in motor_ids]
+    for motor in released:
+        motor.servo = None
+        motor.velocity = [0.0] * motor.naxes
+        slot = scene.motor_slots[motor.id]
+        scene.c.update_servo(slot, None)
+        scene.c.update_motor_goal(slot, motor.velocity)
+
+
+def servo_states(scene: Scene) -> List[ServoState]:
+    """Every servo's targets, the joint's values when the last step began, and the errors."""
+    out = []
+    for motor in scene.motors.values():
+        if motor.servo is None:
+            continue
+        _, _, components, signs, *_ = _servo_arguments(scene, motor)
+        positions = scene.c.servo_positions(scene.motor_slots[motor.id], signs)
+        out.append(ServoState(motor.id, motor.servo.targets, positions,
+                              tuple(t - q for t, q in zip(motor.servo.targets, positions))))
+    return out

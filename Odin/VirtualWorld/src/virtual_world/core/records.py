@@ -214,11 +214,31 @@ class JointRecord:
         self.forces: Set[str] = set()
 
 
+class Servo(NamedTuple):
+    """A motor's servo (core.motors.set_servos): per axis, the target (rad or m, the driven
+    joint's reported units), a feed-forward rate (rad/s or m/s), the gain (1/s) and the speed
+    limit (rad/s or m/s)."""
+    targets: Tuple[float, ...]
+    rates: Tuple[float, ...]
+    gains: Tuple[float, ...]
+    max_speeds: Tuple[float, ...]
+
+
+class ServoState(NamedTuple):
+    """A servo's targets, the joint's values when the last step began, and the errors (target
+    minus value), per axis (rad or m)."""
+    id: str
+    targets: Tuple[float, ...]
+    positions: Tuple[float, ...]
+    errors: Tuple[float, ...]
+
+
 class MotorRecord:
-    __slots__ = ("id", "owner", "kind", "naxes", "joint", "bodies", "velocity")
+    __slots__ = ("id", "owner", "kind", "naxes", "joint", "bodies", "velocity",
+                 "on_joint_axes", "servo")
 
     def __init__(self, motor_id: str, owner: Owner, kind: MotorKind, naxes: int,
-                 joint: Optional[str], bodies: Tuple[str, str]):
+                 joint: Optional[str], bodies: Tuple[str, str], on_joint_axes: bool = False):
         self.id = motor_id
         self.owner = owner
         self.kind = kind
@@ -226,6 +246,8 @@ class MotorRecord:
         self.joint = joint
         self.bodies = bodies
         self.velocity: List[float] = [0.0] * naxes   # goal speeds, rad/s or m/s
+        self.on_joint_axes = on_joint_axes           # its axes are its joint's own
+        self.servo: Optional[Servo] = None           # position targets instead of speeds
 
 
 class BodyForceRecord(NamedTuple):

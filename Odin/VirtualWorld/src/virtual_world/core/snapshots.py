@@ -40,6 +40,7 @@ class Snapshot:
     joint_parameters: Tuple[Tuple[str, int, int, float], ...]
     motor_parameters: Tuple[Tuple[str, int, int, float], ...]
     motor_goals: Dict[str, Tuple[float, ...]]
+    servos: Dict[str, object]                   # motor id -> records.Servo or None
     body_forces: Dict[str, BodyForceRecord]
     joint_forces: Dict[str, JointForceRecord]
     carried: Dict[Tuple[str, str], Collision]
@@ -66,6 +67,7 @@ def take(scene: Scene) -> Snapshot:
                               ).reshape(-1, 15),
         joint_parameters=_joint_parameters(scene), motor_parameters=_motor_parameters(scene),
         motor_goals={i: tuple(m.velocity) for i, m in scene.motors.items()},
+        servos={i: m.servo for i, m in scene.motors.items()},
         body_forces=dict(scene.body_forces), joint_forces=dict(scene.joint_forces),
         carried=dict(scene.carried), sim_time=scene.sim_time,
         step_count=scene.c.step_count, rand_seed=scene.c.rand_seed, parked=tuple(scene.parked))
@@ -118,6 +120,7 @@ def put_back(scene: Scene, snapshot: Snapshot) -> None:
         ode_joints.set_motor_parameter(motor.owner.ptr, motor.kind, parameter, axis, value)
     for motor_id, goals in snapshot.motor_goals.items():
         scene.motors[motor_id].velocity = list(goals)
+        scene.motors[motor_id].servo = snapshot.servos[motor_id]
     motors.rebuild_goals(scene)
     forces.replace_all(scene, snapshot.body_forces, snapshot.joint_forces)
     scene.c.clear_records()

@@ -28,7 +28,7 @@ from virtual_world.core import (forces, guard, joints, motors, objects, readout,
                                 validation as check)
 from virtual_world.core.records import (BodyState, Built, BuiltEntity, Collision, Divergence,
                                         JointReaction, JointState, MotorState, ObjectState,
-                                        Propagation, Removed)
+                                        Propagation, Removed, ServoState)
 from virtual_world.core.scene import Scene
 from virtual_world.errors import Closed, InvalidArgument, UnknownName
 from virtual_world.ode import bodies
@@ -224,7 +224,7 @@ class Core:
         if object_id:
             scene.body_object(object_id, "set_velocity")
             linear, angular = objects.check_velocities(scene, linear, angular)
-        goals = motors.split_velocities(scene, motor_ids, velocities) if len(motor_ids) else {}
+        goals = motors.split_per_axis(scene, motor_ids, velocities) if len(motor_ids) else {}
         motors.set_velocities(scene, goals)
         if object_id:
             objects.set_velocity(scene, object_id, linear, angular)
@@ -291,13 +291,29 @@ class Core:
         return motors.axis_counts(self._scene, motor_ids)
 
     @_locked
-    def split_motor_velocities(self, motor_ids: Sequence[str],
-                               velocities: Sequence[float]) -> Dict[str, Tuple[float, ...]]:
-        """{motor id: its goal speeds} from one flat list (Set Velocity's and Propagate's
-        request: each motor takes as many values as it has axes, in order)."""
-        if len(motor_ids) == 0 and len(velocities) == 0:
+    def split_per_axis(self, motor_ids: Sequence[str], values: Sequence[float],
+                       what: str = "velocities") -> Dict[str, Tuple[float, ...]]:
+        """{motor id: its values} from one flat list (Set Velocity's, Propagate's and Set
+        Servo's requests: each motor takes as many values as it has axes, in order)."""
+        if len(motor_ids) == 0 and len(values) == 0:
             return {}
-        return motors.split_velocities(self._scene, motor_ids, velocities)
+        return motors.split_per_axis(self._scene, motor_ids, values, what)
+
+    @_changes_state
+    def set_servos(self, servos: Mapping[str, Mapping]) -> None:
+        """Servo mode for motors, all checked first (core.motors.set_servos): each tracks a
+        position target on its joint's axes."""
+        motors.set_servos(self._scene, servos)
+
+    @_changes_state
+    def release_servos(self, motor_ids: Sequence[str]) -> None:
+        """Motors back from servo mode to speed goals, at zero."""
+        motors.release_servos(self._scene, motor_ids)
+
+    @_locked
+    def servo_states(self) -> List[ServoState]:
+        """Every servo's targets, its joint's values when the last step began, and errors."""
+        return motors.servo_states(self._scene)
 
     @_locked
     def motor_goals(self) -> Dict[str, List[float]]:

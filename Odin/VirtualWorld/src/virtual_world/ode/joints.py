@@ -81,6 +81,20 @@ _AXES = {  # the axes a motor on a joint of this type drives, by motor kind
 }
 
 
+SERVO_COMPONENTS = {  # which JointState value each motor axis moves (the order of _AXES)
+    MotorKind.ANGULAR: {T.HINGE: (0,), T.PISTON: (1,), T.UNIVERSAL: (0, 1), T.HINGE2: (0, 1),
+                        T.PR: (1,), T.PU: (1, 2)},
+    MotorKind.LINEAR: {T.SLIDER: (0,), T.PISTON: (0,), T.PR: (0,), T.PU: (0,)},
+}
+"""For a servo: per motor kind and joint type, the component of the joint's state (its
+positions, interface.JOINT_STATE_AXES) that each of the motor's axes drives."""
+
+SERVO_SIGNS = {(T.HINGE2, 1): -1.0}
+"""Components whose reported value moves against the motor's speed: ODE 0.16's hinge-2 angle2
+decreases while its rate (and a motor on that axis) is positive. A servo there tracks the
+negated value, so that a target in reported units still pulls the right way."""
+
+
 def configure_joint(joint, kind: JointType, anchor: Sequence[float], axis1: Sequence[float],
                     axis2: Sequence[float], axis3: Sequence[float]) -> None:
     """Sets the anchor (m, world) and the axes (unit, world) ``kind`` uses; a fixed joint

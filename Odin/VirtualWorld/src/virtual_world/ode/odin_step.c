@@ -386,12 +386,35 @@ static void apply_joint_forces(const OdinWorld *w) {
     }
 }
 
-static void apply_motor_goals(const OdinWorld *w) {
+/* A joint's value (rad or m): component c of what JointState reports for its type. */
+static double joint_value(dJointID j, int type, int c) {
+    switch (type) {
+    case dJointTypeHinge: return dJointGetHingeAngle(j);
+    case dJointTypeSlider: return dJointGetSliderPosition(j);
+    case dJointTypePiston: return c == 0 ? dJointGetPistonPosition(j) : dJointGetPistonAngle(j);
+    case dJointTypeUniversal: return c == 0 ? dJointGetUniversalAngle1(j) : dJointGetUniversalAngle2(j);
+    case dJointTypeHinge2: return c == 0 ? dJointGetHinge2Angle1(j) : dJointGetHinge2Angle2(j);
+    case dJointTypePR: return c == 0 ? dJointGetPRPosition(j) : dJointGetPRAngle(j);
+    case dJointTypePU:
+        return c == 0 ? dJointGetPUPosition(j) : c == 1 ? dJointGetPUAngle1(j) : dJointGetPUAngle2(j);
+    default: return 0.0; /* Python never puts a servo on other types */
+    }
+}
+
+static void apply_motor_goals(OdinWorld *w) {
     for (int i = 0; i < w->n_motors; ++i) {
-        const OdinMotorGoal *g = &w->motors[i];
+        OdinMotorGoal *g = &w->motors[i];
         for (int k = 0; k < g->naxes; ++k) {
-            if (g->kind == 0) dJointSetAMotorParam(g->motor, dParamVel + k * dParamGroup, g->velocity[k]);
-            else dJointSetLMotorParam(g->motor, dParamVel + k * dParamGroup, g->velocity[k]);
+            double v = g->velocity[k];
+            if (g->servo) {
+                double q = g->sign[k] * joint_value(g->joint, g->joint_type, g->component[k]);
+                g->position[k] = q;
+                v = g->target_rate[k] + g->gain[k] * (g->target[k] - q);
+                if (v > g->max_speed[k]) v = g->max_speed[k];
+                if (v < -g->max_speed[k]) v = -g->max_speed[k];
+            }
+            if (g->kind == 0) dJointSetAMotorParam(g->motor, dParamVel + k * dParamGroup, v);
+            else dJointSetLMotorParam(g->motor, dParamVel + k * dParamGroup, v);
         }
     }
 }

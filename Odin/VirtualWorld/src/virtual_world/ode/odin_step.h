@@ -33,12 +33,26 @@ typedef struct OdinJointForce {
     double magnitude[3];
 } OdinJointForce;
 
-/* A motor goal: speeds of an amotor (kind 0) or lmotor (kind 1), set before every step. */
+/* A motor goal: speeds of an amotor (kind 0) or lmotor (kind 1), set before every step. In
+ * servo mode (servo 1) the speed of each axis is computed before every step from a position
+ * target instead: v = clamp(target_rate + gain (target - q), +-max_speed), applied with the
+ * motor's force limit, where q is the driven joint's value on that axis (joint_value) times its
+ * sign; target and position are in those signed units. */
 typedef struct OdinMotorGoal {
     dJointID motor;
     int kind;
     int naxes;
     double velocity[3];
+    int servo;
+    dJointID joint;          /* the joint the motor drives */
+    int joint_type;          /* its ODE dJointType */
+    int component[3];        /* per axis: which of the joint's values (JOINT_STATE_AXES) */
+    double sign[3];          /* +1, or -1 where that value moves against the motor's speed */
+    double target[3];        /* rad or m */
+    double target_rate[3];   /* rad/s or m/s: feed-forward */
+    double gain[3];          /* 1/s */
+    double max_speed[3];     /* rad/s or m/s */
+    double position[3];      /* out: the joint's value when the last step began */
 } OdinMotorGoal;
 
 /* What every geom's data (dGeomSetData) points at; Python allocates it with the geom and keeps

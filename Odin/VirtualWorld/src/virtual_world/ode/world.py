@@ -145,6 +145,30 @@ class CWorld:
         for k, value in enumerate(velocities):
             goal.velocity[k] = value
 
+    def update_servo(self, slot: int, servo) -> None:
+        """Puts a motor in servo mode (``servo``: joint ptr, ODE joint type, components,
+        signs, targets, rates, gains, max speeds, in the joint's reported units), or back to
+        its velocity goals (None)."""
+        goal = self._arrays["motors"][slot]
+        if servo is None:
+            goal.servo = 0
+            return
+        joint, joint_type, components, signs, targets, rates, gains, speeds = servo
+        goal.joint, goal.joint_type = joint, joint_type
+        for k, (c, sign) in enumerate(zip(components, signs)):
+            goal.component[k] = c
+            goal.sign[k] = sign
+            goal.target[k] = sign * targets[k]
+            goal.target_rate[k] = rates[k]
+            goal.gain[k] = gains[k]
+            goal.max_speed[k] = speeds[k]
+        goal.servo = 1
+
+    def servo_positions(self, slot: int, signs: Sequence[float]) -> Tuple[float, ...]:
+        """The joint values a servo read when the last step began, in reported units."""
+        goal = self._arrays["motors"][slot]
+        return tuple(sign * goal.position[k] for k, sign in enumerate(signs))
+
     def _install(self, field: str, array, count: int) -> None:
         setattr(self.struct, field, array)
         setattr(self.struct, "n_" + field, count)

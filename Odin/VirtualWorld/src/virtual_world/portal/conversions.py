@@ -11,7 +11,7 @@ from typing import Sequence
 
 import numpy as np
 
-from Messages.msg import Collided, CollisionPair, JointData, SpaceDistribution
+from Messages.msg import Collided, CollisionPair, JointData, ServoStates, SpaceDistribution
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Point, Vector3, Wrench
 from sensor_msgs.msg import JointState
@@ -58,6 +58,15 @@ def divergence_diagnostics(divergences, stamp) -> DiagnosticArray:
             level=DiagnosticStatus.ERROR, name="virtual_world: divergence guard",
             message=f"{event.id} diverged ({event.reason}) and was parked",
             hardware_id="virtual_world", values=values))
+    return message
+
+
+def servo_states_message(servos, stamp) -> ServoStates:
+    message = ServoStates(motors=[s.id for s in servos], axes=[len(s.targets) for s in servos],
+                          targets=[v for s in servos for v in s.targets],
+                          positions=[v for s in servos for v in s.positions],
+                          errors=[v for s in servos for v in s.errors])
+    message.header.stamp = stamp
     return message
 
 
@@ -137,4 +146,4 @@ class _PreSerialised(SpaceDistribution):
 
 
 __all__ = ["view_requests", "collision_pairs", "collided_message", "divergence_diagnostics",
-           "wrench", "joint_data", "joint_state_message", "SpaceDistributionWriter"]
+           "servo_states_message", "wrench", "joint_data", "joint_state_message", "SpaceDistributionWriter"]

@@ -26,6 +26,8 @@ Topics published (every cycle, or at ``~rate`` per wall-clock second under ``~fr
                          (``<joint id>`` for one-axis joints, ``<joint id>/<axis>`` otherwise);
   ``/clock``             rosgraph_msgs/Clock: simulated time, for nodes with use_sim_time;
   ``~real_time_factor``  std_msgs/Float64: simulated s per wall-clock s over the last second;
+  ``~servo_states``     Messages/ServoStates: every servo's targets, positions and errors
+                         (while there is a servo);
   ``/diagnostics``       diagnostic_msgs/DiagnosticArray: an ERROR for each body the divergence
                          guard parked (the object, why, its values), when it happens.
 
@@ -52,7 +54,7 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
 
-from Messages.msg import Collided, JointsData, SpaceDistribution
+from Messages.msg import Collided, JointsData, ServoStates, SpaceDistribution
 from Services import srv
 from odin_common import OdinError
 from odin_common.interface import WORLD_SERVICES
@@ -117,6 +119,7 @@ class Portal:
         self.pub_clock = rospy.Publisher("/clock", Clock, queue_size=10)
         self.pub_rtf = rospy.Publisher("~real_time_factor", Float64, queue_size=10)
         self.pub_diagnostics = rospy.Publisher("/diagnostics", DiagnosticArray, queue_size=10)
+        self.pub_servos = rospy.Publisher("~servo_states", ServoStates, queue_size=50)
 
     def _serve(self) -> None:
         """One server per world service, each answered by the method of the same name."""
@@ -213,6 +216,9 @@ class Portal:
         elif self.pub_contacts.get_num_connections() > 0:
             self.pub_contacts.publish(conversions.collided_message(collisions, stamp))
         self._publish_joints(stamp)
+        servos = self.core.servo_states()
+        if servos:
+            self.pub_servos.publish(conversions.servo_states_message(servos, stamp))
         self.pub_clock.publish(Clock(clock=stamp))
         self.pub_rtf.publish(Float64(rtf))
 

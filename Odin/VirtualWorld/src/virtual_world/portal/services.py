@@ -160,6 +160,23 @@ class WorldServices:
             request.at_point, tuple(request.point), request.point_in_body_frame)
         return {"id": force_id, "message": f"added {force_id}"}
 
+    def set_servo(self, request) -> dict:
+        motor_ids = list(request.motors)
+        if not motor_ids:
+            raise InvalidArgument("no motor given")
+        if request.release:
+            self.core.release_servos(motor_ids)
+            return {"message": f"released {len(motor_ids)} servo(s)"}
+        servos = {motor_id: {} for motor_id in motor_ids}
+        for name in ("targets", "rates", "gains", "max_speeds", "max_forces"):
+            values = list(getattr(request, name))
+            if name == "targets" or values:
+                for motor_id, split in self.core.split_per_axis(motor_ids, values,
+                                                                name).items():
+                    servos[motor_id][name] = split
+        self.core.set_servos(servos)
+        return {"message": f"{len(motor_ids)} servo(s) set"}
+
     def set_surface(self, request) -> dict:
         self.core.set_surface(request.id, messages.surface_of(request.surface))
         return {"message": f"surface of {request.id} set"}
@@ -209,8 +226,7 @@ class WorldServices:
         self.loop.sim_time = self.core.sim_time
 
     def propagate(self, request) -> dict:
-        goals = self.core.split_motor_velocities(list(request.motors),
-                                                 list(request.velocities))
+        goals = self.core.split_per_axis(list(request.motors), list(request.velocities))
         step = request.step or self.loop.step_values.step
         result = self.core.propagate(
             request.duration, step, motor_goals=goals,

@@ -1,0 +1,134 @@
+"""Joint servos: a motor that tracks a position target, before every step setting its speed
+to clamp(rate + gain (target - q), +-max_speed) under its force limit. Checked against the
+closed forms: the error decays as exp(-gain t); a saturated servo moves at its speed limit; a
+servo too weak for its load stops where the load's torque equals its force limit."""
+import math
+
+import numpy as np
+import pytest
+
+from odin_common.interface import SERVO_GAIN, SERVO_MAX_SPEED
+from virtual_world.core import (HINGE, HINGE2, SLIDER, UNIVERSAL, Core, ObjectSpec,
+                                WorldParameters)
+from virtual_world.errors import InvalidArgument, Unsupported
+
+H = 0.001
+
+
+def rotor(gravity=(0.0, 0.0, 0.0), max_force=100.0):
+    """A rod on a hinge about y at the origin (mass 1 kg, its centre 0.25 m out along x)."""
+    core = Core(WorldParameters(gravity=gravity, solver=1))
+    core.build_object(ObjectSpec("rod", [0.5, 0.05, 0.05], mass=1.0, position=(0.25, 0, 0)))
+    joint = core.create_joint(HINGE, "rod", "", anchor=(0, 0, 0), axis1=(0, 1, 0))
+    motor = core.create_motor(joint=joint, max_forces=[max_force])
+    return core, joint, motor
+
+
+def angle(core, joint):
+    return {s.id: s for s in core.joint_states()}[joint].positions[0]
+
+
+def test_the_error_decays_as_exp_of_minus_gain_t():
+    core, joint, motor = rotor()
+    core.set_servos({motor: {"targets": [0.3], "gains": [10.0], "max_speeds": [100.0]}})
+    core.step(H, 100)
+    # the motor's speed follows the error step by step: e(n) = e0 (1 - gain h)^n
+    assert 0.3 - angle(core, joint) == pytest.approx(0.3 * (1 - 10.0 * H) ** 100, rel=0.02)
+    core.step(H, 1900)
+    assert angle(core, joint) == pytest.approx(0.3, abs=1e-6)
+    (state,) = core.servo_states()
+    assert state.targets == (0.3,) and abs(state.errors[0]) < 1e-6
+    core.close()
+
+
+def test_a_far_target_is_reached_at_the_speed_limit_with_the_defaults():
+    core, joint, motor = rotor()
+    core.set_servos({motor: {"targets": [-2.0]}})
+    core.step(H, 200)
+    rate = {s.id: s for s in core.joint_states()}[joint].rates[0]
+    assert rate == pytest.approx(-SERVO_MAX_SPEED, rel=1e-6)
+    core.step(H, 1500)
+    assert angle(core, joint) == pytest.approx(-2.0, abs=1e-5)
+    core.close()
+
+
+def test_a_servo_too_weak_for_its_load_gives_way_at_its_force_limit():
+    torque, limit = 2.0, 1.5                      # N m: the load beats the servo by 0.5
+    core, joint, motor = rotor(max_force=limit)
+    core.set_servos({motor: {"targets": [0.0]}})
+    core.add_joint_force(joint, [torque])
+    core.step(H, 500)
+    # the servo pushes back with all it has: the rod turns at (torque - limit) / I about the
+    # hinge, I = m (a^2 + b^2) / 12 + m d^2 for the 0.5 x 0.05 box 0.25 m out
+    inertia = 1.0 * (0.5 ** 2 + 0.05 ** 2) / 12 + 1.0 * 0.25 ** 2
+    rate = {s.id: s for s in core.joint_states()}[joint].rates[0]
+    assert rate == pytest.approx((torque - limit) / inertia * 0.5, rel=1e-3)
+    core.close()
+
+
+def test_a_slider_servo_and_a_universal_servo_reach_their_targets():
+    core = Core(WorldParameters(gravity=(0, 0, 0), solver=1))
+    core.build_object(ObjectSpec("cart", [0.2, 0.2, 0.2], position=(0, 0, 0)))
+    slider = core.create_joint(SLIDER, "cart", "", axis1=(1, 0, 0))
+    linear = core.create_motor(joint=slider, kind=1, max_forces=[100.0])
+    core.build_object(ObjectSpec("head", [0.1], position=(3, 0, 0)))
+    universal = core.create_joint(UNIVERSAL, "head", "", anchor=(3, 0, 0), axis1=(1, 0, 0),
+                                  axis2=(0, 1, 0))
+    both = core.create_motor(joint=universal, max_forces=[100.0, 100.0])
+    core.set_servos({linear: {"targets": [0.4], "max_speeds": [1.0]},
+                     both: {"targets": [0.2, -0.3]}})
+    core.step(H, 2000)
+    states = {s.id: s for s in core.joint_states()}
+    assert states[slider].positions[0] == pytest.approx(0.4, abs=1e-5)
+    np.testing.assert_allclose(states[universal].positions, (0.2, -0.3), atol=1e-4)
+    core.close()
+
+
+def test_a_servo_on_a_hinge2s_second_axis_pulls_the_right_way():
+    core = Core(WorldParameters(gravity=(0, 0, 0), solver=1))
+    core.build_object(ObjectSpec("chassis", [1, 1, 0.2], position=(0, 0, 0)))
+    core.create_joint(8, "chassis", "")              # fixed to the world
+    core.build_object(ObjectSpec("wheel", [0.2, 0.1], position=(1, 0, 0)))
+    hinge2 = core.create_joint(HINGE2, "chassis", "wheel", anchor=(1, 0, 0), axis1=(0, 0, 1),
+                               axis2=(0, 1, 0))
+    motor = core.create_motor(joint=hinge2, max_forces=[50.0, 50.0])
+    core.set_servos({motor: {"targets": [0.1, 0.5]}})
+    core.step(H, 2000)
+    state = {s.id: s for s in core.joint_states()}[hinge2]
+    assert state.positions == pytest.approx((0.1, 0.5), abs=1e-4)
+    core.close()
+
+
+def test_a_released_servo_holds_still_and_a_snapshot_brings_the_servo_back():
+    core, joint, motor = rotor(gravity=(0, 0, -9.81))
+    core.set_servos({motor: {"targets": [0.5]}})
+    core.step(H, 50)
+    core.save_state("tracking")
+    core.step(H, 500)
+    tracked = angle(core, joint)
+    core.release_servos([motor])
+    assert core.servo_states() == [] and core.motor_goals()[motor] == [0.0]
+    core.step(H, 500)
+    assert {s.id: s for s in core.joint_states()}[joint].rates[0] == pytest.approx(0, abs=1e-4)
+    core.restore_state("tracking")
+    core.step(H, 500)
+    assert angle(core, joint) == tracked
+    core.close()
+
+
+@pytest.mark.parametrize("servos,error", [
+    ({"motor:1:rod&": {}}, InvalidArgument),
+    ({"motor:1:rod&": {"targets": [0.1, 0.2]}}, InvalidArgument),
+    ({"motor:1:rod&": {"targets": [0.1], "gains": [-1.0]}}, InvalidArgument),
+    ({"motor:1:rod&": {"targets": [0.1], "speed": [1.0]}}, InvalidArgument),
+    ({"motor:1:rod&": {"targets": [math.nan]}}, InvalidArgument),
+    ({"motor:rod&": {"targets": [0.1]}}, Unsupported),
+    ({"nope": {"targets": [0.1]}}, Exception),
+])
+def test_bad_servo_requests_are_refused_and_change_nothing(servos, error):
+    core, joint, motor = rotor()
+    core.create_motor(body1="rod", axes=[0, 0, 1])   # a motor without a joint
+    with pytest.raises(error):
+        core.set_servos({motor: {"targets": [1.0]}, **servos})
+    assert core.servo_states() == []
+    core.close()
