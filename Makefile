@@ -3,7 +3,7 @@ SHELL := /bin/bash
 ROOT  := $(CURDIR)
 ENV   := set -eo pipefail; source $(ROOT)/setup.bash;
 
-.PHONY: setup build demo test bench experiments lint clean
+.PHONY: setup build demo test bench experiments lint mutants clean
 
 setup:
 	@tools/install.sh
@@ -27,6 +27,11 @@ experiments: setup
 
 lint: setup
 	@$(ENV) catkin_lint --strict -W2 Odin
+
+# mutation testing of the Core (C step code and Python), not part of `make test`: writes
+# out/mutants/report.json and report.md, prints the survivors, exits 0 (docs/MUTANTS.md)
+mutants: setup
+	@$(ENV) python tools/mutants/run.py
 
 clean:
 	rm -rf build out .pytest_cache

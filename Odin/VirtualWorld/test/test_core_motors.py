@@ -1,0 +1,91 @@
+"""Motors through the Core: the frame each axis stays fixed in, the maximum force, and the
+ranges of joint and motor parameters, each against a figure written down.
+
+A motor's axes are given in the world frame at creation; ``axis_frames`` says what each axis
+turns with afterwards: the world (0), the first body (1) or the second (2). A body joined to
+the world is ODE's body 1 whichever slot names it, so a positive goal speed turns it about
++axis in both slots. The body here is a sphere (isotropic inertia: no gyroscopic coupling), so
+with an unlimited motor force one step gives it the goal speed about the axis, softened by the
+world's constraint force mixing as ODE mixes it: omega = goal / (1 + cfm I / h).
+"""
+import math
+
+import numpy as np
+import pytest
+
+from virtual_world.core import (ANGULAR, CFM, ERP, HINGE, MAX_FORCE, Core, ObjectSpec,
+                                WorldParameters)
+from virtual_world.errors import InvalidArgument
+
+H = 0.001
+TURN_Z = (math.cos(math.pi / 4), 0.0, 0.0, math.sin(math.pi / 4))   # 90 deg about z: x -> y
+I_BALL = 0.4 * 1.0 * 0.1 ** 2                                         # kg m^2, 1 kg, r = 0.1 m
+SOFT = 1.0 / (1.0 + WorldParameters().cfm * I_BALL / H)              # 0.99996
+
+
+@pytest.fixture
+def core():
+    c = Core(WorldParameters(gravity=(0.0, 0.0, 0.0)))
+    yield c
+    c.close()
+
+
+@pytest.mark.parametrize("slot", [1, 2])
+@pytest.mark.parametrize("frame", ["world", "body"])
+def test_a_motor_axis_turns_with_the_frame_it_is_fixed_in(core, slot, frame):
+    """Axis x given at creation; the ball is then turned 90 degrees about z. An axis fixed in
+    the ball now points along world y, one fixed in the world still along x: the goal speed
+    2 rad/s is reached about that axis, with the ball in either slot."""
+    core.build_object(ObjectSpec("ball", [0.1], mass=1.0))
+    bodies = ("ball", "") if slot == 1 else ("", "ball")
+    axis_frame = 0 if frame == "world" else slot
+    motor = core.create_motor(body1=bodies[0], body2=bodies[1], kind=ANGULAR,
+                              axes=[1.0, 0.0, 0.0], axis_frames=[axis_frame])
+    core.set_poses([("ball", (0.0, 0.0, 0.0), TURN_Z)])
+    core.set_motor_velocities({motor: [2.0]})
+    core.step(H)
+    expected = (2.0, 0.0, 0.0) if frame == "world" else (0.0, 2.0, 0.0)
+    np.testing.assert_allclose(core.body_state("ball")[3], np.multiply(expected, SOFT),
+                               atol=1e-9)
+
+
+def test_a_motor_without_force_cannot_move_the_body_and_an_unlimited_one_reaches_its_goal(core):
+    """Max force 0 N m: the goal 1 rad/s stays a wish; max force < 0 (unlimited): the goal
+    is the speed after one step."""
+    core.build_object(ObjectSpec("wheel", [0.1], mass=1.0))   # I = I_BALL about any axis
+    joint = core.create_joint(HINGE, "", "wheel", axis1=(0.0, 0.0, 1.0))
+    motor = core.create_motor(joint=joint, max_forces=[0.0])
+    core.set_motor_velocities({motor: [1.0]})
+    core.step(H, 10)
+    assert core.joint_states()[0].rates[0] == 0.0
+    core.set_joint_parameters(motor, [(MAX_FORCE, 1, -1.0)])
+    core.step(H)
+    assert core.joint_states()[0].rates[0] == pytest.approx(SOFT, rel=1e-9)
+    core.set_joint_parameters(motor, [(MAX_FORCE, 1, 0.0)])
+    core.set_motor_velocities({motor: [-1.0]})
+    core.step(H, 10)
+    assert core.joint_states()[0].rates[0] == pytest.approx(SOFT, rel=1e-9)   # coasts on
+
+
+def test_parameter_ranges_include_their_bounds_and_axes_start_at_1(core):
+    """ERP-like values in [0, 1] and CFM-like values >= 0 are accepted at their bounds; axis
+    0 (axes count from 1) and values just outside are refused, and refused calls change
+    nothing."""
+    core.build_object(ObjectSpec("a", [0.1], mass=1.0))
+    joint = core.create_joint(HINGE, "", "a", axis1=(0.0, 0.0, 1.0))
+    core.set_joint_parameters(joint, [(ERP, 1, 0.0), (ERP, 1, 1.0), (CFM, 1, 0.0)])
+    for bad in ([(ERP, 0, 0.5)], [(ERP, 1, -1e-9)], [(ERP, 1, 1 + 1e-9)], [(CFM, 1, -1e-9)]):
+        with pytest.raises(InvalidArgument):
+            core.set_joint_parameters(joint, bad)
+
+
+def test_a_motor_on_a_joint_takes_the_joints_bodies_and_no_others(core):
+    """Naming one body of a joint that is not the joint's is refused, as naming both is."""
+    for name in ("a", "b", "c"):
+        core.build_object(ObjectSpec(name, [0.1], mass=1.0, position=(hash(name) % 7, 0, 0)))
+    joint = core.create_joint(HINGE, "a", "b", anchor=(0.0, 0.0, 0.0), axis1=(0.0, 0.0, 1.0))
+    for bodies in (("c", ""), ("", "c"), ("a", "c")):
+        with pytest.raises(InvalidArgument):
+            core.create_motor(joint=joint, body1=bodies[0], body2=bodies[1])
+    assert core.motor_ids() == []
+    assert core.create_motor(joint=joint, body1="a", body2="b") == f"motor:{joint}"
