@@ -136,3 +136,28 @@ def test_get_state_gives_masses_joint_reactions_and_motor_goals(world):
     assert [b.id for b in everything.bodies] == ["s0", "s1", "s2", "s3", "s4", "bob"]
     refused = world("get_state", objects=["ground"])
     assert not refused.success and "geometry only" in refused.message
+
+
+def test_a_servo_holds_a_joint_at_its_target_and_reports_it(world):
+    """The pendulum's hinge servoed to 0.3 rad: the joint gets there and ~servo_states says so;
+    released, the motor holds at speed zero; a servo on no motor is refused."""
+    import rospy
+    from Messages.msg import ServoStates
+
+    _scene(world)
+    world.ok("set_servo", motors=["motor:1:bob&"], targets=[0.3], max_forces=[20.0])
+    world.ok("step_once", cycles=50)                     # 2 s
+    state = world.ok("get_state", joints=["1:bob&"])
+    assert state.joints[0].positions[0] == pytest.approx(0.3, abs=0.01)
+    world.ok("start", simulate=True)
+    report = rospy.wait_for_message("/virtual_world/servo_states", ServoStates, timeout=10)
+    world.ok("start", simulate=False)
+    assert report.motors == ["motor:1:bob&"] and list(report.axes) == [1]
+    assert report.targets[0] == 0.3 and abs(report.errors[0]) < 0.01
+    refused = world("set_servo", motors=["nothing"], targets=[0.0])
+    assert not refused.success and "nothing" in refused.message
+    refused = world("set_servo", motors=["motor:1:bob&"], targets=[0.0, 1.0])
+    assert not refused.success
+    world.ok("set_servo", motors=["motor:1:bob&"], release=True)
+    got = world.ok("get_state")
+    assert list(got.motor_goals) == [0.0]
