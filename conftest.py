@@ -11,6 +11,9 @@ import tempfile
 import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parent
+# the raw test client of the world node (tests/nodes/world_client.py) serves the GUI's window
+# tests too, whichever test file runs first or alone
+sys.path.insert(0, str(ROOT / "tests" / "nodes"))
 
 from odin_common.ros_master import RosMaster  # noqa: E402
 
@@ -99,4 +102,9 @@ def _run_forked(item) -> list:
         return [TestReport(item.nodeid, item.location, {}, "failed",
                            f"the forked test process ended with status {status:#x} "
                            "before reporting", "call")]
-    return [config.hook.pytest_report_from_serializable(config=config, data=d) for d in data]
+    reports = [config.hook.pytest_report_from_serializable(config=config, data=d) for d in data]
+    for report in reports:
+        # JSON made the (path, line, message) of a skip a list; pytest's summary wants a tuple
+        if isinstance(report.longrepr, list):
+            report.longrepr = tuple(report.longrepr)
+    return reports

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import pathlib
 import shutil
 import subprocess
@@ -16,12 +15,13 @@ import pytest
 from gui.core.build import EntityStep, JointStep, plan_problem
 from odin_common.specs import CompositeSpec
 from gui.errors import GuiError, ProblemError, ShapeError
+from gui.core.kautham.corpus import corpus_dir
 from gui.core.kautham.problem import load_problem
 from gui.core.kautham.robot_rob import read_dh_robot
 
-KAUTHAM = pathlib.Path(os.environ.get("ODIN_KAUTHAM_DIR",
-                                      pathlib.Path(__file__).resolve().parents[4] / "shared"
-                                      / "kautham"))
+# every test here reads the corpus: without it they skip (or fail under CI) like the rest
+pytestmark = pytest.mark.usefixtures("kautham_dir")
+KAUTHAM = corpus_dir() or pathlib.Path("/no-kautham-corpus")   # paths for collection only
 LEGACY = KAUTHAM / "legacy_2012" / "examples"
 CURRENT = KAUTHAM / "current_2025" / "demos"
 SCRIPTS = pathlib.Path(__file__).resolve().parents[1] / "scripts"
