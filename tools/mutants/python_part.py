@@ -7,8 +7,8 @@ repository is never touched: the runner lays a project of its own out in a scrat
 
     <scratch>/src/virtual_world/   a copy of Odin/VirtualWorld/src/virtual_world
     <scratch>/tests/               a copy of the Core's tests (Odin/VirtualWorld/test/test_*.py)
-    <scratch>/tests/conftest.py    a check that the package the tests import is the mutated
-                                   copy, and caches emptied before every test
+    <scratch>/tests/conftest.py    the repository's ``forked`` hook, and a check that the
+                                   package the tests import is the mutated copy
     <scratch>/setup.cfg            mutmut's configuration (the scope) and pytest's markers
 
 and reads the verdicts back from mutmut's ``*.meta`` files, and each mutant's change from the
@@ -129,20 +129,24 @@ timeout_constant = 5.0
 
 [tool:pytest]
 markers =
-    forked: in the repository, a forked child; here, the mutant's own (see conftest.py)
+    forked: run the test in a forked child process (the repository's conftest.py)
     slow: takes more than ~20 s
 """
 
 CONFTEST = '''\
-"""Written by tools/mutants/python_part.py: a check that the package under test is the
-mutated copy, not the repository's, and caches emptied before every test (mutmut forks each
-mutant's run from a process that ran the clean tests: a module-level cache would hand the
-mutant the unmutated results). Tests marked ``forked`` run in the mutant's own process: mutmut
-already runs each mutant in a forked child, so an ODE abort ends that child (crashed), and the
-test counts in mutmut's map of which tests call which function."""
+"""Written by tools/mutants/python_part.py: the repository's ``forked`` hook, a check that the
+package under test is the mutated copy, not the repository's, and caches emptied before every
+test (mutmut forks each mutant's run from a process that ran the clean tests: a module-level
+cache would hand the mutant the unmutated results)."""
+import importlib.util
 import pathlib
 
 import pytest
+
+_spec = importlib.util.spec_from_file_location("_odin_root_conftest", {root_conftest!r})
+_root = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(_root)
+pytest_runtest_protocol = _root.pytest_runtest_protocol
 
 import virtual_world.core  # noqa: E402
 
@@ -172,6 +176,7 @@ def prepare(scratch: pathlib.Path, files: List[pathlib.Path]) -> None:
     patterns = "\n".join(f"    {p}" for p in MESSAGE_LINES)
     (scratch / "setup.cfg").write_text(SETUP_CFG.format(only=only, patterns=patterns))
     (scratch / "tests" / "conftest.py").write_text(CONFTEST.format(
+        root_conftest=str(ROOT / "conftest.py"),
         mutants=str((scratch / "mutants").resolve()) + os.sep))
 
 
