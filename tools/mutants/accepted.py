@@ -40,6 +40,9 @@ class AcceptedPython(NamedTuple):
 
 
 P = AcceptedPython
+_CALLER_PASSES = "the Core, the function's only caller, always passes this argument"
+_TAGS = "entity tags stay distinct and non-zero, which is all the near-callback reads"
+_RESHAPE = "numpy's reshape takes any negative size as 'the rest': -2 is -1"
 
 PYTHON: Tuple[AcceptedPython, ...] = (
     # the two names of a pair are two geometries' names, which are unique: never equal
@@ -51,6 +54,52 @@ PYTHON: Tuple[AcceptedPython, ...] = (
     P("virtual_world/core/readout.py", "carry_collisions",
       ("if old is None or c.depth > old.depth:",), ("if old is None or c.depth >= old.depth:",),
       "differs only for two occurrences at exactly equal depth, where either is the deepest"),
+
+    # Defaults of topic functions that their one caller, the Core, always passes explicitly
+    # (Core.add_body_force passes all seven arguments, Core.set_poses passes reset_velocity).
+    P("virtual_world/core/forces.py", "add_body_force",
+      ("vector_in_body_frame: bool = False, at_point: bool = False,",),
+      ("vector_in_body_frame: bool = True, at_point: bool = False,",), _CALLER_PASSES),
+    P("virtual_world/core/forces.py", "add_body_force",
+      ("vector_in_body_frame: bool = False, at_point: bool = False,",),
+      ("vector_in_body_frame: bool = False, at_point: bool = True,",), _CALLER_PASSES),
+    P("virtual_world/core/forces.py", "add_body_force",
+      ("point=(0.0, 0.0, 0.0), point_in_body_frame: bool = False) -> str:",),
+      ("point=(0.0, 0.0, 0.0), point_in_body_frame: bool = True) -> str:",), _CALLER_PASSES),
+    P("virtual_world/core/objects.py", "set_poses", ("reset_velocity: bool = False) -> None:",),
+      ("reset_velocity: bool = True) -> None:",), _CALLER_PASSES),
+
+    # Entity tags only need to be distinct and non-zero (0 means "no entity"): starting at 2
+    # or stepping by 2 gives other numbers with the same meaning.
+    P("virtual_world/core/scene.py", "Scene.__init__",
+      ("self.next_tag = 1                               # geom tag of the next entity",),
+      ("self.next_tag = 2                               # geom tag of the next entity",),
+      _TAGS),
+    P("virtual_world/core/objects.py", "build_entity", ("scene.next_tag += 1",),
+      ("scene.next_tag += 2",), _TAGS),
+
+    # numpy (1.24, Debian's) reads any negative size in reshape as "the rest", not only -1.
+    *(P(file, function, (line,), (line.replace("reshape(-1", "reshape(-2"),), _RESHAPE)
+      for file, function, line in (
+          ("virtual_world/core/objects.py", "_built_geometries",
+           "tuple(int(i) for i in np.asarray(r.indices).reshape(-1)),"),
+          ("virtual_world/core/shapes.py", "prepare_shape",
+           "values = np.array(parameters, dtype=float).reshape(-1)"),
+          ("virtual_world/core/shapes.py", "prepare_shape",
+           "index_values = np.array(indices, dtype=float).reshape(-1)"),
+          ("virtual_world/core/shapes.py", "prepare_shape",
+           "return _mesh(what, values.reshape(-1, 3), index_values)"),
+          ("virtual_world/core/shapes.py", "_mesh",
+           "triangles = index_values.astype(np.uint32).reshape(-1, 3)"),
+          ("virtual_world/core/shapes.py", "collision_mesh",
+           "return vertices, indices.astype(np.uint32).reshape(-1, 3)"),
+          ("virtual_world/core/validation.py", "vector",
+           "array = np.array(value, dtype=float).reshape(-1)"),
+          ("virtual_world/ode/handles.py", "new_trimesh",
+           'vertices = ffi.new("double[]", np.asarray(vertices, dtype=float).reshape(-1).tolist())'),
+          ("virtual_world/ode/handles.py", "new_trimesh",
+           'indices = ffi.new("dTriIndex[]", np.asarray(triangles).reshape(-1).tolist())'),
+      )),
 )
 
 

@@ -13,8 +13,8 @@ import math
 import numpy as np
 import pytest
 
-from virtual_world.core import (ANGULAR, CFM, ERP, HINGE, MAX_FORCE, Core, ObjectSpec,
-                                WorldParameters)
+from virtual_world.core import (ANGULAR, CFM, ERP, HI_STOP, HINGE, LO_STOP, MAX_FORCE, Core,
+                                ObjectSpec, WorldParameters)
 from virtual_world.errors import InvalidArgument
 
 H = 0.001
@@ -89,3 +89,43 @@ def test_a_motor_on_a_joint_takes_the_joints_bodies_and_no_others(core):
             core.create_motor(joint=joint, body1=bodies[0], body2=bodies[1])
     assert core.motor_ids() == []
     assert core.create_motor(joint=joint, body1="a", body2="b") == f"motor:{joint}"
+
+
+def test_set_velocities_splits_one_flat_list_among_motors_by_their_axes(core):
+    """Set Velocity's list (1.5) + (0.5, -0.25): the one-axis motor takes the first value,
+    the two-axis motor the next two; each ball turns at its goals (softened as above). A list
+    of the wrong length is refused and changes nothing."""
+    core.build_object(ObjectSpec("one", [0.1], mass=1.0))
+    core.build_object(ObjectSpec("two", [0.1], mass=1.0, position=(1.0, 0.0, 0.0)))
+    m1 = core.create_motor(motor_id="m1", body1="one", axes=[0.0, 0.0, 1.0], axis_frames=[0])
+    m2 = core.create_motor(motor_id="m2", body1="two", axes=[1.0, 0.0, 0.0, 0.0, 1.0, 0.0],
+                           axis_frames=[0, 0])
+    with pytest.raises(InvalidArgument):
+        core.set_velocities(motor_ids=[m1, m2], velocities=[1.5, 0.5])
+    assert core.motor_goals() == {m1: [0.0], m2: [0.0, 0.0]}
+    core.set_velocities(motor_ids=[m1, m2], velocities=[1.5, 0.5, -0.25])
+    assert core.motor_goals() == {m1: [1.5], m2: [0.5, -0.25]}
+    core.step(H)
+    np.testing.assert_allclose(core.body_state("one")[3], np.multiply((0.0, 0.0, 1.5), SOFT),
+                               atol=1e-9)
+    np.testing.assert_allclose(core.body_state("two")[3], np.multiply((0.5, -0.25, 0.0), SOFT),
+                               atol=1e-9)
+
+
+def test_a_motors_max_force_may_be_given_as_infinite(core):
+    core.build_object(ObjectSpec("ball", [0.1], mass=1.0))
+    motor = core.create_motor(body1="ball", axes=[0.0, 0.0, 1.0], max_forces=[math.inf])
+    core.set_motor_velocities({motor: [3.0]})
+    core.step(H)
+    assert core.body_state("ball")[3][2] == pytest.approx(3.0 * SOFT, rel=1e-9)
+
+
+def test_joint_parameters_given_at_creation_act(core):
+    """Stops at +-0.2 rad given with the hinge: a 1 N m torque on a ball (I = I_BALL) would
+    turn it 0.5 * 250 * 1^2 = 125 rad in 1 s; the stop holds it near 0.2 rad."""
+    core.build_object(ObjectSpec("arm", [0.1], mass=1.0))
+    joint = core.create_joint(HINGE, "", "arm", axis1=(0.0, 0.0, 1.0),
+                              parameters=[(LO_STOP, 1, -0.2), (HI_STOP, 1, 0.2)])
+    core.add_joint_force(joint, [1.0])
+    core.step(H, 1000)
+    assert core.joint_states()[0].positions[0] == pytest.approx(0.2, abs=0.02)

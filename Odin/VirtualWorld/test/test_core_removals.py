@@ -90,3 +90,34 @@ def test_a_removal_between_contact_less_reads_keeps_each_pairs_deepest_and_drops
         assert core.read_collisions() == []
     finally:
         core.close()
+
+
+def test_removing_an_object_reports_every_joint_motor_and_force_that_went_with_it(core):
+    """The middle ball of three has two joints, a motor of its own to the first ball and a
+    force: all four go with it, and the outer balls, now free, keep their velocities."""
+    for name, x in (("a", 0.0), ("b", 1.0), ("c", 2.0)):
+        core.build_object(ObjectSpec(name, [0.1], mass=1.0, position=(x, 0.0, 0.0)))
+    ab = core.create_joint(HINGE, "a", "b", anchor=(0.5, 0.0, 0.0), axis1=(0.0, 0.0, 1.0))
+    bc = core.create_joint(HINGE, "b", "c", anchor=(1.5, 0.0, 0.0), axis1=(0.0, 0.0, 1.0))
+    motor = core.create_motor(motor_id="spin", body1="b", body2="a", axes=[1.0, 0.0, 0.0])
+    force = core.add_body_force("b", FORCE, (0.0, 1.0, 0.0))
+    removed = core.remove_object("b")
+    assert set(removed.joints) == {ab, bc} and removed.motors == (motor,)
+    assert removed.forces == (force,) and removed.geometries == ("b",)
+    assert core.joint_ids() == [] and core.motor_ids() == [] and core.body_force_ids() == []
+    core.set_velocity("a", linear=(0.0, 1.0, 0.0))
+    core.step(H, N)
+    np.testing.assert_allclose(core.body_state("a")[2], (0.0, 1.0, 0.0))
+
+
+def test_an_entity_lists_its_living_members_and_goes_with_the_last(core):
+    from virtual_world.core import EntitySpec
+    core.build_entity(EntitySpec("robot", [ObjectSpec("l1", [0.1]),
+                                           ObjectSpec("l2", [0.1], position=(1.0, 0.0, 0.0))]))
+    core.build_entity(EntitySpec("", [ObjectSpec("x", [0.1], position=(3.0, 0.0, 0.0))]))
+    assert core.entities() == {"robot": ["l1", "l2"], "entity1": ["x"]}
+    core.remove_object("l1")
+    assert core.entities() == {"robot": ["l2"], "entity1": ["x"]}
+    core.remove_object("l2")
+    assert core.entities() == {"entity1": ["x"]}
+    assert core.build_entity(EntitySpec("", [ObjectSpec("y", [0.1])])).name == "entity2"

@@ -1,0 +1,72 @@
+"""Objects through the Core: mass properties given or computed from a closed mesh, set against
+closed forms, and what set_poses does to velocities."""
+import math
+
+import numpy as np
+import pytest
+
+from virtual_world.core import TORQUE, Core, ObjectSpec, WorldParameters
+
+H = 0.001
+
+
+@pytest.fixture
+def core():
+    c = Core(WorldParameters(gravity=(0.0, 0.0, 0.0)))
+    yield c
+    c.close()
+
+
+def test_a_given_inertia_is_the_bodys_and_sets_its_angular_acceleration(core):
+    """[Ixx, Iyy, Izz, Ixy, Ixz, Iyz] about the origin: the matrix mass_properties reports, and
+    a torque tau gives the angular velocity h I^-1 tau after one step."""
+    values = [2.0, 3.0, 4.0, 0.1, 0.2, 0.3]
+    matrix = np.array([[2.0, 0.1, 0.2], [0.1, 3.0, 0.3], [0.2, 0.3, 4.0]])
+    core.build_object(ObjectSpec("o", [0.2, 0.2, 0.2], mass=5.0, inertia=values))
+    mass, com, inertia = core.mass_properties("o")
+    assert mass == 5.0
+    np.testing.assert_array_equal(com, 0.0)
+    np.testing.assert_allclose(inertia, matrix, rtol=1e-12)
+    tau = np.array([0.5, -1.0, 2.0])
+    core.add_body_force("o", TORQUE, tau)
+    core.step(H)
+    np.testing.assert_allclose(core.body_state("o")[3], H * np.linalg.solve(matrix, tau),
+                               rtol=1e-9)
+
+
+@pytest.mark.parametrize("winding", [1, -1], ids=["outward", "inward"])
+def test_a_closed_tetrahedron_has_its_exact_centre_and_inertia(core, winding):
+    """The corner tetrahedron (0, a e_x, a e_y, a e_z) of mass m: centre of mass a/4 (1, 1, 1),
+    inertia about it 3 m a^2 / 40 on the diagonal and m a^2 / 80 off it (from
+    int x^2 dm = m a^2 / 10 and int x y dm = m a^2 / 20 about the corner). Its bounding box
+    would put the centre at a/2 and the inertia elsewhere: the closed-mesh rule must be used,
+    whichever way the faces wind."""
+    a, m = 0.6, 4.0
+    vertices = [0.0, 0.0, 0.0, a, 0.0, 0.0, 0.0, a, 0.0, 0.0, 0.0, a]
+    faces = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])[:, ::winding]
+    core.build_object(ObjectSpec("tet", vertices, faces.reshape(-1).tolist(), mass=m))
+    mass, com, inertia = core.mass_properties("tet")
+    assert mass == pytest.approx(m)
+    np.testing.assert_allclose(com, (a / 4, a / 4, a / 4), atol=1e-12)
+    expected = np.full((3, 3), m * a * a / 80) + np.eye(3) * (3 * m * a * a / 40 - m * a * a / 80)
+    np.testing.assert_allclose(inertia, expected, atol=1e-12)
+
+
+def test_set_poses_keeps_the_velocities_unless_told_to_reset_them(core):
+    """A ball moving at (1, 2, 3) m/s and turning at (0.5, 0, -0.5) rad/s is moved: it keeps
+    both velocities; moved with reset_velocity it is at rest, and stays where it was put."""
+    core.build_object(ObjectSpec("ball", [0.1], mass=1.0))
+    core.build_object(ObjectSpec("other", [0.1], mass=1.0, position=(5.0, 0.0, 0.0)))
+    for name in ("ball", "other"):
+        core.set_velocity(name, linear=(1.0, 2.0, 3.0), angular=(0.5, 0.0, -0.5))
+    core.set_poses([("ball", (0.0, 0.0, 1.0), (1.0, 0.0, 0.0, 0.0))])
+    np.testing.assert_allclose(core.body_state("ball")[2], (1.0, 2.0, 3.0))
+    np.testing.assert_allclose(core.body_state("ball")[3], (0.5, 0.0, -0.5))
+    turned = (math.cos(0.3), 0.0, math.sin(0.3), 0.0)
+    core.set_poses([("ball", (0.0, 0.0, 2.0), turned)], reset_velocity=True)
+    position, orientation, v, w = core.body_state("ball")
+    np.testing.assert_array_equal(v, 0.0)
+    np.testing.assert_array_equal(w, 0.0)
+    core.step(H, 10)
+    np.testing.assert_allclose(core.body_state("ball")[0], (0.0, 0.0, 2.0), atol=1e-15)
+    np.testing.assert_allclose(core.body_state("other")[2], (1.0, 2.0, 3.0))   # untouched
