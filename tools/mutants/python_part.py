@@ -146,10 +146,10 @@ import pathlib
 
 import pytest
 
-# No cyclic garbage collection in the mutants' processes: a Core left unclosed in a reference
-# cycle (a test that raised while it was built, its traceback kept) crashes the collector,
-# whose pass runs the handles' finalizers in no set order (dBodyDestroy after dWorldDestroy:
-# docs/MUTANTS.md). mutmut runs every test in one process, so one such Core ended the run.
+# No cyclic garbage collection in the mutants' processes: the collector finalizes a dropped
+# Core's handles in no set order, and a mutant of handles.py that breaks their records would
+# then crash whichever later test the collection happened in (docs/MUTANTS.md); without the
+# collector it fails in the test that closes the Core.
 gc.disable()
 
 _spec = importlib.util.spec_from_file_location("_odin_root_conftest", {root_conftest!r})

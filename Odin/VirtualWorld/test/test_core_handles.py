@@ -167,3 +167,19 @@ def test_ode_messages_are_drained_into_logging(caplog):
         assert drain_messages() == ["hello from ODE"]
     assert "hello from ODE" in caplog.text
     assert drain_messages() == []
+
+
+def test_a_core_dropped_in_a_reference_cycle_is_freed_children_first(spy):
+    """The collector finalizes a whole unreachable scene at once, in no set order: the world
+    still goes last (it used to go first, and its bodies' dBodyDestroy then crashed)."""
+    for _ in range(3):
+        core = Core()
+        build_scene(core)
+        cycle = [core]
+        cycle.append(cycle)
+        del core, cycle
+        gc.collect()
+    counts = collections.Counter()
+    for (kind, _), count in spy.items():      # addresses are reused from scene to scene
+        counts[kind] += count
+    assert counts["world"] == 3 and counts["body"] == 3 * 3 and counts["geom"] == 3 * 5

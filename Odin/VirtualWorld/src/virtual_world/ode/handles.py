@@ -5,10 +5,11 @@ Rules (dm_control / pymunk style):
   * every owner frees its handle exactly once: ``close()`` is idempotent and a
     ``weakref.finalize`` frees a forgotten owner when it is collected (never twice);
   * a child holds its parents strongly, so no parent is freed under a living child;
-  * a parent holds its children weakly and closes them first when it closes (ODE's
-    dWorldDestroy would otherwise destroy bodies and joints behind their owners' backs, and
-    dBodyDestroy would turn attached geoms into static ones); spaces are created with
-    cleanup off, so geoms are only ever destroyed by their owners;
+  * a parent frees its children's handles first when it closes, or when the collector
+    finalizes it in whatever order (ODE's dWorldDestroy would otherwise destroy bodies and
+    joints behind their owners' backs, and dBodyDestroy would turn attached geoms into static
+    ones): the order is kept in handle records (_Handle) that hold no owner; spaces are
+    created with cleanup off, so geoms are only ever destroyed by their owners;
   * a trimesh geom keeps its vertex and index arrays (ODE does not copy them) and its trimesh
     data owner alive, and frees that data after the geom.
 
@@ -36,11 +37,40 @@ DESTROYERS: Dict[str, Callable[[Any], None]] = {
 }
 
 
-def _free(kind: str, ptr: Any, keep: Tuple[Any, ...]) -> None:
-    DESTROYERS[kind](ptr)
-    for item in keep:  # owners kept by this handle (a trimesh's data) go right after it
-        if isinstance(item, Owner):
-            item.close()
+class _Handle:
+    """The record of one ODE handle that the owner's finalizer holds: what to free, the
+    handles freed first (children, held strongly: the record outlives its owner) and after.
+
+    The cyclic garbage collector may run the finalizers of a whole dropped scene in one pass,
+    in any order, after clearing every weak reference into it: a world's finalizer must still
+    free its bodies and joints first (dWorldDestroy frees them behind their owners' backs), so
+    the order lives here, in records the collector leaves alone, not in the owners."""
+
+    __slots__ = ("kind", "ptr", "keep", "parents", "children")
+
+    def __init__(self, kind: str, ptr: Any, parents: Tuple["_Handle", ...], keep: Tuple[Any, ...]):
+        self.kind = kind
+        self.ptr = ptr
+        self.keep = keep
+        self.parents = parents
+        self.children: Dict[int, "_Handle"] = {}
+        for parent in parents:
+            parent.children[id(self)] = self
+
+    def free(self) -> None:
+        """Frees the children, then this handle, then the owners it kept; once."""
+        if self.ptr is None:
+            return
+        for child in list(self.children.values()):
+            child.free()
+        ptr, self.ptr = self.ptr, None
+        DESTROYERS[self.kind](ptr)
+        for parent in self.parents:
+            parent.children.pop(id(self), None)
+        for item in self.keep:  # owners kept by this handle (a trimesh's data) go right after it
+            if isinstance(item, Owner):
+                item.close()
+        self.keep = ()
 
 
 class Owner:
@@ -50,32 +80,29 @@ class Owner:
     keep:    Python objects (cffi arrays, other owners) kept alive until the handle is freed.
     """
 
-    __slots__ = ("kind", "_ptr", "_parents", "_children", "_finalizer", "data", "__weakref__")
+    __slots__ = ("kind", "_handle", "_parents", "_finalizer", "data", "__weakref__")
 
     def __init__(self, kind: str, ptr: Any, parents: Iterable["Owner"] = (),
                  keep: Tuple[Any, ...] = (), data: Any = None):
         if ptr == ffi.NULL:
             raise MemoryError(f"ODE returned NULL for a new {kind}")
         self.kind = kind
-        self._ptr = ptr
         self._parents = tuple(parents)
-        self._children: "weakref.WeakSet[Owner]" = weakref.WeakSet()
-        for parent in self._parents:
-            parent._children.add(self)
         self.data = data  # C memory the handle points at (a geom's OdinGeomInfo), kept alive
-        self._finalizer = weakref.finalize(self, _free, kind, ptr, (*keep, data))
+        self._handle = _Handle(kind, ptr, tuple(p._handle for p in self._parents), (*keep, data))
+        self._finalizer = weakref.finalize(self, self._handle.free)
         self._finalizer.atexit = False  # ODE may already be closed at interpreter exit
 
     @property
     def ptr(self) -> Any:
         """The live C handle; raises if closed."""
-        if self._ptr is None:
+        if self._handle.ptr is None:
             raise ValueError(f"{self.kind} handle already freed")
-        return self._ptr
+        return self._handle.ptr
 
     @property
     def closed(self) -> bool:
-        return self._ptr is None
+        return self._handle.ptr is None
 
     @property
     def address(self) -> int:
@@ -84,14 +111,8 @@ class Owner:
 
     def close(self) -> None:
         """Frees children first, then the handle; a second call does nothing."""
-        if self._ptr is None:
-            return
-        for child in list(self._children):
-            child.close()
-        self._ptr = None
-        self._finalizer()
-        for parent in self._parents:
-            parent._children.discard(self)
+        self._finalizer.detach()
+        self._handle.free()
 
 
 # ---------------------------------------------------------------------------------- world
