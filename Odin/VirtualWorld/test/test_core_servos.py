@@ -41,14 +41,26 @@ def test_the_error_decays_as_exp_of_minus_gain_t():
     core.close()
 
 
-def test_a_far_target_is_reached_at_the_speed_limit_with_the_defaults():
+def test_the_feed_forward_rate_moves_the_rest_point_by_rate_over_gain():
+    """A servo told its target moves at 1 rad/s while the target stays at 0: the speed
+    rate + gain (0 - q) is zero at q = rate / gain, where the joint settles."""
     core, joint, motor = rotor()
-    core.set_servos({motor: {"targets": [-2.0]}})
+    core.set_servos({motor: {"targets": [0.0], "rates": [1.0], "gains": [20.0]}})
+    core.step(H, 1000)
+    assert angle(core, joint) == pytest.approx(1.0 / 20.0, rel=1e-4)
+    core.close()
+
+
+@pytest.mark.parametrize("target", [-2.0, 2.0])
+def test_a_far_target_is_reached_at_the_speed_limit_with_the_defaults(target):
+    """Either way: the bound holds above as well as below."""
+    core, joint, motor = rotor()
+    core.set_servos({motor: {"targets": [target]}})
     core.step(H, 200)
     rate = {s.id: s for s in core.joint_states()}[joint].rates[0]
-    assert rate == pytest.approx(-SERVO_MAX_SPEED, rel=1e-6)
+    assert rate == pytest.approx(math.copysign(SERVO_MAX_SPEED, target), rel=1e-6)
     core.step(H, 1500)
-    assert angle(core, joint) == pytest.approx(-2.0, abs=1e-5)
+    assert angle(core, joint) == pytest.approx(target, abs=1e-5)
     core.close()
 
 

@@ -64,6 +64,36 @@ def test_the_contact_policy_reports_the_pairs_of_the_last_step_of_a_call(count):
         core.close()
 
 
+def test_a_collision_query_leaves_no_contact_behind_for_the_next_step():
+    """check_collision finds two spheres made to overlap, then puts them back apart: the next
+    step makes no contact from the query (in zero gravity nothing moves)."""
+    core = world()
+    core.build_object(ObjectSpec("a", [R], position=(0, 0, 0)))
+    core.build_object(ObjectSpec("b", [R], position=(1, 0, 0)))
+    found = core.check_collision([("b", (R, 0, 0), (1, 0, 0, 0))])
+    assert pairs(found) == {("a", "b")}
+    core.step(H, 1)
+    for name in ("a", "b"):
+        assert not np.any(core.body_state(name)[2]) and not np.any(core.body_state(name)[3])
+    assert core.last_step_contacts == 0
+    core.close()
+
+
+def test_the_contact_policy_reports_the_last_call_only_even_when_nobody_read_the_one_before():
+    """Two overlapping spheres are stepped, nobody reads the pair, they are moved apart and
+    stepped again: the second call touched nothing, so nothing is reported."""
+    core = world()
+    core.build_object(ObjectSpec("a", [R], position=(0, 0, 0)))
+    core.build_object(ObjectSpec("b", [R], position=(1.5 * R, 0, 0)))
+    core.step(H, 1)
+    assert core.last_step_contacts > 0
+    core.set_poses([("b", (1, 0, 0), (1, 0, 0, 0))])
+    core.step(H, 1)
+    assert core.last_step_contacts == 0
+    assert core.read_collisions() == []
+    core.close()
+
+
 def test_objects_that_cannot_move_get_no_contacts_but_contact_less_reports_them():
     """Fixed box a sunk 1/64 m into the static ground, fixed box c sunk 1/32 m into a, and a
     static wall through the ground: nothing there can move, so the contact policy makes no

@@ -124,12 +124,14 @@ def test_a_capsule_has_its_mass_and_stands_on_its_end():
 
 # ------------------------------------------------------------------ friction
 
-def slide(box_surface=Surface(), ground_surface=Surface(), push=(1.0, 0.0), **world_params):
-    """A 1 kg box launched at 2 m/s along ``push`` on a plane: its deceleration (m/s^2)."""
+def slide(box_surface=Surface(), ground_surface=Surface(), push=(1.0, 0.0),
+          orientation=(1, 0, 0, 0), **world_params):
+    """A 1 kg box (turned by ``orientation``, wxyz) launched at 2 m/s along ``push`` (world
+    x, y) on a plane: its deceleration (m/s^2)."""
     core = world(**world_params)
     ground_plane(core, ground_surface)
     core.build_object(ObjectSpec("box", (0.4, 0.4, 0.1), mass=1.0, position=(0, 0, 0.05),
-                                 surface=box_surface))
+                                 orientation=orientation, surface=box_surface))
     core.step(H, 200)
     core.set_velocity("box", linear=(2.0 * push[0], 2.0 * push[1], 0.0))
     core.step(H, 50)
@@ -152,6 +154,10 @@ def test_anisotropic_friction_follows_its_direction():
     skate = Surface(friction=1.0, friction2=0.0, friction_direction=(1, 0, 0))
     assert slide(skate, push=(1.0, 0.0)) == pytest.approx(0.0, abs=1e-6)        # along it
     assert slide(skate, push=(0.0, 1.0)) == pytest.approx(1.0 * G, rel=1e-3)    # across it
+    # the direction is the object's: turned a quarter about z, the box skates along world y
+    quarter = turn((0, 0, 1), math.pi / 2)
+    assert slide(skate, push=(0.0, 1.0), orientation=quarter) == pytest.approx(0.0, abs=1e-6)
+    assert slide(skate, push=(1.0, 0.0), orientation=quarter) == pytest.approx(G, rel=1e-3)
 
 
 def test_set_surface_changes_friction_from_now_on():

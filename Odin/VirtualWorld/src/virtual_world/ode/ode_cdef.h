@@ -56,6 +56,8 @@ void dWorldSetMaxAngularSpeed(dWorldID w, dReal max_speed);
 
 /* spaces and joint groups */
 dSpaceID dHashSpaceCreate(dSpaceID space);
+void dSpaceAdd(dSpaceID, dGeomID);
+void dSpaceRemove(dSpaceID, dGeomID);
 void dSpaceDestroy(dSpaceID);
 void dSpaceSetCleanup(dSpaceID space, int mode);
 int dSpaceGetNumGeoms(dSpaceID);
