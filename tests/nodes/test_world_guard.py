@@ -47,3 +47,39 @@ def test_a_diverging_body_is_parked_reported_and_the_world_runs_on(ros_master):
     assert world.ok("get_world").sim_time > 0.2
     world.close()
     assert node.poll() is None, ros_master.log_text(node)[-2000:]
+
+
+def test_resource_limits_refuse_what_would_exhaust_memory_and_the_node_goes_on(ros_master):
+    """~max_request_mb: a 2 MB mesh request against a 1 MB cap fails the call before the node
+    reads its body; ~max_objects and ~max_snapshots refuse with a message; a bad limit stops
+    the node at start with one line."""
+    import rospy
+    from world_client import WorldClient, sphere
+    from Messages.msg import Object
+
+    node = ros_master.rosrun("VirtualWorld", "virtualWorld", "_max_request_mb:=1",
+                             "_max_objects:=2", "_max_snapshots:=1")
+    ros_master.wait_for_service("/virtual_world/save_state")
+    rospy.init_node("odin_test_client", anonymous=True, disable_signals=True)
+    world = WorldClient()
+    vertices = [float(i % 7) * 0.01 for i in range(3 * 90_000)]        # 2.1 MB of float64
+    big = Object(name="big", parameters=vertices, indices=[0, 1, 2], mass=1.0,
+                 position=[0, 0, 0], orientation=[1, 0, 0, 0])
+    with pytest.raises(rospy.ServiceException):
+        world("build_object", object=big)
+    world._proxies.clear()                                  # that connection was dropped
+    assert "limit is 1,048,576 bytes" in ros_master.log_text(node)
+    world.ok("build_object", object=sphere("a"))
+    world.ok("build_object", object=sphere("b", position=(1, 0, 1)))
+    refused = world("build_object", object=sphere("c", position=(2, 0, 1)))
+    assert not refused.success and "max_objects" in refused.message
+    world.ok("save_state", name="one")
+    refused = world("save_state", name="two")
+    assert not refused.success and "max_snapshots" in refused.message
+    assert world.ok("get_world").objects == ["a", "b"]
+    world.close()
+    assert node.poll() is None, ros_master.log_text(node)[-2000:]
+    bad = ros_master.rosrun("VirtualWorld", "virtualWorld", "__name:=bad_world",
+                            "_max_objects:=-5")
+    assert bad.wait(timeout=30) == 2
+    assert "max_objects=-5 must be a positive integer" in ros_master.log_text(bad)

@@ -144,3 +144,42 @@ def test_a_fast_motor_goal_is_refused():
     with pytest.raises(InvalidArgument, match="beyond the limit"):
         core.set_motor_velocities({motor: [1e6]})
     core.close()
+
+
+# ------------------------------------------------------------------ resource limits
+
+def test_resource_limits_refuse_objects_meshes_snapshots_and_steps_beyond_them():
+    from odin_common.limits import ResourceLimits
+    from virtual_world.core import CompositeSpec, PartSpec
+    core = Core(resources=ResourceLimits(max_objects=3, max_mesh_triangles=4, max_snapshots=2))
+    for name in ("a", "b"):
+        core.build_object(ObjectSpec(name, [0.1], position=(0, 0, 1)))
+    composite = CompositeSpec([PartSpec("p", [0.1]), PartSpec("q", [0.1], position=(0.3, 0, 0))])
+    core.build_composite(composite)                      # a composite is one object
+    with pytest.raises(InvalidArgument, match=r"max_objects"):
+        core.build_object(ObjectSpec("c", [0.1]))
+    core.remove_object("a")
+    tetra = ([0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1], [0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3])
+    core.build_object(ObjectSpec("tetra", *tetra))      # 4 triangles: at the limit
+    core.remove_object("tetra")
+    octahedron_half = ([0, 0, 1, 1, 0, 0, 0, 1, 0, -1, 0, 0, 0, -1, 0, 0, 0, -1],
+                       [0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 1, 5, 2, 1])
+    with pytest.raises(InvalidArgument, match=r"max_mesh_triangles.*5 triangles.*limit 4"):
+        core.build_object(ObjectSpec("mesh", *octahedron_half))
+    assert core.object_ids() == ["b", ">p>q"]           # nothing built
+    core.save_state("one")
+    core.save_state("two")
+    core.save_state("two")                               # replacing one is not one more
+    with pytest.raises(InvalidArgument, match=r"max_snapshots"):
+        core.save_state("three")
+    core.remove_state("one")
+    core.save_state("three")
+    with pytest.raises(InvalidArgument, match=r"at most 1,000,000"):
+        core.step(0.001, limits.MAX_STEPS_PER_CALL + 1)
+    with pytest.raises(InvalidArgument, match=r"duration=1e\+300"):
+        core.propagate(1e300, 0.001)
+    assert core.sim_time == 0.0
+    core.close()
+    from odin_common import errors
+    with pytest.raises(errors.InvalidArgument, match="max_objects"):
+        ResourceLimits(max_objects=0)

@@ -1,7 +1,14 @@
 """Sane ranges for what requests may ask: a value outside them is refused (naming the field and
 the limit) before it can reach ODE, where it would make a step diverge or exhaust memory. Where
 a range depends on the world, it is a world parameter (world_parameters: divergence_speed,
-divergence_angular_speed, world_extent: velocities and positions are checked against those)."""
+divergence_angular_speed, world_extent: velocities and positions are checked against those).
+What a world may hold in all (objects, snapshots, a request's bytes) is a ResourceLimits, which
+the world node reads from its ~parameters."""
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+
+from odin_common.errors import InvalidArgument
 
 MAX_FORCE = 1e7
 """N (forces) or N m (torques): a persistent body or joint force, a motor's maximum force."""
@@ -24,4 +31,30 @@ MAX_GRAVITY = 1e4
 """m/s^2: each component of gravity."""
 
 MAX_MESH_TRIANGLES = 2_000_000
-"""Triangles of one mesh (the world node's ~max_mesh_triangles may lower it)."""
+"""Triangles of one mesh, by default (ResourceLimits.max_mesh_triangles)."""
+
+MAX_STEPS_PER_CALL = 1_000_000
+"""Steps one call may ask for (a Step Once, a Propagate): the node answers nothing else
+meanwhile, so a longer run is asked for in pieces (at 1 ms steps, 1,000 s of simulated time)."""
+
+
+@dataclass(frozen=True)
+class ResourceLimits:
+    """What one world may hold, so that no request can exhaust the node's memory; each a
+    positive integer, refused with a message naming it when a request would exceed it.
+
+    max_objects: objects (a composite counts once) in the scene.
+    max_mesh_triangles: triangles of one mesh.
+    max_snapshots: saved states (Save State) at a time.
+    max_request_mb: MB of one incoming ROS message (the world node drops a connection whose
+        next message announces more, before reading it)."""
+    max_objects: int = 100_000
+    max_mesh_triangles: int = MAX_MESH_TRIANGLES
+    max_snapshots: int = 10_000
+    max_request_mb: int = 256
+
+    def __post_init__(self):
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                raise InvalidArgument(f"{f.name}={value!r} must be a positive integer")

@@ -151,8 +151,12 @@ def prepare_composite(spec: CompositeSpec) -> _Prepared:
 
 def check_ranges(scene: Scene, prepared: Sequence[_Prepared]) -> None:
     """InvalidArgument for an object beyond the world's extent, a size outside the limits, a
-    mesh of too many triangles (odin_common.limits, world_extent)."""
-    extent = scene.parameters.world_extent
+    mesh of too many triangles, objects beyond the world's count (odin_common.limits,
+    world_extent, the scene's ResourceLimits)."""
+    extent, resources = scene.parameters.world_extent, scene.resources
+    if len(scene.objects) + len(prepared) > resources.max_objects:
+        raise InvalidArgument(f"{len(prepared)} more object(s) would exceed the world's limit "
+                              f"of {resources.max_objects:,} objects (max_objects)")
     for p in prepared:
         what = f"object {p.object_id!r}"
         check.within_extent(f"{what}: position", p.position, extent)
@@ -160,8 +164,8 @@ def check_ranges(scene: Scene, prepared: Sequence[_Prepared]) -> None:
             shape, where = part.shape, f"{what}: part {part.name!r}"
             check.within_extent(f"{where}: position", part.position, extent)
             if shape.kind == "mesh":
-                check.at_most(f"{where}: triangles", len(shape.triangles),
-                              limits.MAX_MESH_TRIANGLES, "triangles")
+                check.at_most(f"{where}: mesh (max_mesh_triangles)", len(shape.triangles),
+                              resources.max_mesh_triangles, "triangles")
                 check.within_extent(f"{where}: a vertex", shape.vertices, extent)
             elif shape.dims:
                 check.at_most(f"{where}: size", max(shape.dims), 2 * extent, "m")

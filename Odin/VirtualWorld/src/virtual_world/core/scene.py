@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from typing import Dict, FrozenSet, List, Optional, Tuple
 
+from odin_common.limits import ResourceLimits
 from odin_common.world_parameters import WorldParameters
 from virtual_world.core.records import (BodyForceRecord, Collision, GeometryRecord,
                                         JointForceRecord, JointRecord, MotorRecord, ObjectRecord)
@@ -19,8 +20,9 @@ from virtual_world.ode.world import CWorld, PoseReader
 class Scene:
     """The ODE world (``c``) and every record of what it holds."""
 
-    def __init__(self, parameters: WorldParameters):
+    def __init__(self, parameters: WorldParameters, resources: ResourceLimits):
         self.parameters = parameters
+        self.resources = resources
         self.c = CWorld(parameters)
         self.objects: Dict[str, ObjectRecord] = {}
         self.geometries: Dict[str, GeometryRecord] = {}

@@ -153,6 +153,15 @@ def within_extent(what: str, position: np.ndarray, extent: float) -> np.ndarray:
     return position
 
 
+def step_count(count: int, what: str) -> int:
+    """A number of steps for one call, at most limits.MAX_STEPS_PER_CALL; ``what`` names the
+    request in the refusal."""
+    if count > limits.MAX_STEPS_PER_CALL:
+        raise InvalidArgument(f"{what} asks for {count:.3g} steps; one call runs at most "
+                              f"{limits.MAX_STEPS_PER_CALL:,} (ask in pieces)")
+    return int(count)
+
+
 def step_size(value) -> float:
     """A step, s, within odin_common.limits and step_values' MAX_STEP."""
     from odin_common.step_values import MAX_STEP

@@ -22,6 +22,7 @@ from typing import Dict, List, Mapping, Optional, Sequence, Tuple
 import numpy as np
 
 from odin_common.interface import ForceKind, JointType, MotorKind
+from odin_common.limits import ResourceLimits
 from odin_common.specs import CompositeSpec, EntitySpec, JointSpec, MotorSpec, ObjectSpec
 from odin_common.world_parameters import WorldParameters
 from virtual_world.core import (forces, guard, joints, motors, objects, readout, snapshots,
@@ -72,14 +73,20 @@ def _changes_state(method):
 class Core:
     """The virtual world: objects, joints, motors, forces, collisions and the step."""
 
-    def __init__(self, parameters: Optional[WorldParameters] = None):
+    def __init__(self, parameters: Optional[WorldParameters] = None,
+                 resources: ResourceLimits = ResourceLimits()):
+        """``parameters``: the world's (WorldParameters()); ``resources``: what the world may
+        hold (objects, mesh triangles, snapshots), kept across New Scenes."""
         init_ode()
         parameters = WorldParameters() if parameters is None else parameters
         if not isinstance(parameters, WorldParameters):
             raise InvalidArgument(f"parameters={parameters!r} is not a WorldParameters")
+        if not isinstance(resources, ResourceLimits):
+            raise InvalidArgument(f"resources={resources!r} is not a ResourceLimits")
         check.shared(parameters.validate)
         self._lock = threading.RLock()
-        self._scene: Optional[Scene] = Scene(parameters)
+        self.resources = resources
+        self._scene: Optional[Scene] = Scene(parameters, resources)
 
     # ------------------------------------------------------------------ lifetime
 
@@ -89,7 +96,7 @@ class Core:
         same world parameters; sim_time restarts at 0."""
         parameters = self._scene.parameters
         self._scene.close()
-        self._scene = Scene(parameters)
+        self._scene = Scene(parameters, self.resources)
 
     def close(self) -> None:
         """Frees everything; idempotent. Any later call but close() raises Closed."""
@@ -373,7 +380,11 @@ class Core:
         poses, velocities, joint and motor parameters, motor goals, persistent forces,
         simulated time (core.snapshots). New Scene forgets every snapshot."""
         name = check.name("snapshot name", name, allow_marker=True)
-        self._scene.snapshots[name] = snapshots.take(self._scene)
+        held, limit = self._scene.snapshots, self.resources.max_snapshots
+        if name not in held and len(held) >= limit:
+            raise InvalidArgument(f"snapshot {name!r}: the world holds {len(held)} snapshots, "
+                                  f"the limit (max_snapshots); remove one first")
+        held[name] = snapshots.take(self._scene)
 
     @_changes_state
     def restore_state(self, name: str) -> None:
@@ -425,7 +436,8 @@ class Core:
         step_size = check.step_size(step_size)
         if duration <= 0:
             raise InvalidArgument(f"duration={duration!r} must be positive")
-        steps = max(1, round(duration / step_size))
+        steps = check.step_count(max(1, round(min(duration / step_size, 1e18))),
+                                 f"duration={duration!r} s at step {step_size!r} s")
         keep = check.flag("keep", keep)
         start_snapshot = self._snapshot(start) if start else None
         if start_snapshot is not None:
@@ -504,6 +516,7 @@ class Core:
         step_size = check.step_size(step_size)
         if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
             raise InvalidArgument(f"count={count!r} must be a positive integer")
+        count = check.step_count(count, f"count={count!r}")
         scene = self._scene
         if not scene.parameters.contact_less:
             scene.carried = {}

@@ -36,7 +36,8 @@ Services called: ``<~viewer>/view_object``, ``/remove_object``, ``/new_scene`` (
 
 Parameters (read at start): the node's own (``virtual_world.portal.parameters``: ``~rate``,
 ``~step``, ``~steps_per_cycle``, ``~simulate``, ``~free_run``, ``~viewer``, ``~record``: a
-rosbag of what changed the world, see ``recorder``) and every world
+rosbag of what changed the world, see ``recorder``; the resource limits ``~max_objects``,
+``~max_mesh_triangles``, ``~max_snapshots``, ``~max_request_mb``) and every world
 parameter under its own name (``~gravity``, ``~erp``, ... odin_common.world_parameters), with
 units and defaults in docs/parameters.md.
 """
@@ -58,11 +59,12 @@ from Messages.msg import Collided, JointsData, ServoStates, SpaceDistribution
 from Services import srv
 from odin_common import OdinError
 from odin_common.interface import WORLD_SERVICES
+from odin_common.limits import ResourceLimits
 from odin_common.world_parameters import PARAMETERS
 from virtual_world.core import Core, step_values
 from virtual_world.core.loop import CycleReport, RealTimeFactor, WorldLoop
-from virtual_world.portal import conversions
-from virtual_world.portal.parameters import DEFAULTS
+from virtual_world.portal import conversions, message_cap
+from virtual_world.portal.parameters import DEFAULTS, RESOURCE_PARAMETERS
 from virtual_world.portal.recorder import Recorder
 from virtual_world.portal.services import READ_ONLY, WorldServices
 from virtual_world.portal.viewer_link import ViewerLink
@@ -73,7 +75,10 @@ class Portal:
     """Owns the Core, its loop thread, the ROS servers and publishers (thesis 4.1-4.6)."""
 
     def __init__(self):
-        self.core = Core()
+        resources = ResourceLimits(**{name: rospy.get_param(f"~{name}", DEFAULTS[name])
+                                      for name in RESOURCE_PARAMETERS})
+        message_cap.cap_incoming_messages(resources.max_request_mb * 2 ** 20)
+        self.core = Core(resources=resources)
         values = self._initial_step_values()
         initial = self._initial_world_parameters()
         if initial:

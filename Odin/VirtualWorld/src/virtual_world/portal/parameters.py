@@ -9,9 +9,11 @@ from __future__ import annotations
 from typing import Tuple
 
 from odin_common.interface import VIEWER_NAMESPACE, NodeParameter
+from odin_common.limits import ResourceLimits
 from virtual_world.core.step_values import StepValues
 
 _STEP = StepValues()
+_RESOURCES = ResourceLimits()
 
 NODE_PARAMETERS: Tuple[NodeParameter, ...] = (
     NodeParameter("rate", _STEP.rate, "Hz", "Portal cycles (publications) per wall-clock second"),
@@ -25,7 +27,19 @@ NODE_PARAMETERS: Tuple[NodeParameter, ...] = (
     NodeParameter("record", "", "-", "a rosbag file to record every state-changing request "
                   "and every advance into (`rosrun VirtualWorld replay FILE` re-runs it); "
                   "empty: no recording"),
+    NodeParameter("max_objects", _RESOURCES.max_objects, "-",
+                  "objects the world may hold (a composite counts once); more are refused"),
+    NodeParameter("max_mesh_triangles", _RESOURCES.max_mesh_triangles, "-",
+                  "triangles of one mesh; a larger one is refused"),
+    NodeParameter("max_snapshots", _RESOURCES.max_snapshots, "-",
+                  "saved states held at a time; Save State of one more is refused"),
+    NodeParameter("max_request_mb", _RESOURCES.max_request_mb, "MB",
+                  "the largest ROS message the node reads: a larger one is refused from its "
+                  "length header, before its body is read (the caller's call fails)"),
 )
 """The world node's parameters besides the world parameters, in documentation order."""
 
 DEFAULTS = {p.name: p.default for p in NODE_PARAMETERS}
+
+RESOURCE_PARAMETERS = tuple(f for f in ResourceLimits.__dataclass_fields__)
+"""The node parameters that make the world's ResourceLimits (same names)."""
