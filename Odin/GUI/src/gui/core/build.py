@@ -18,10 +18,11 @@ How a problem maps to the world:
   collisions off), then per link one Set Joint: revolute -> HINGE, prismatic -> SLIDER (anchor
   and axis from the joint frame where the robot is built, world frame; LO_STOP/HI_STOP from the
   limits, relative to the value the joint is built at), a non-movable link -> FIXED joint to
-  its parent; a car's wheels -> HINGE2 (steering axis vertical, up for the wheels ahead of the
-  base's centre, down for the others, as Kautham's CarEnvironment; suspension ERP 0.4 / CFM
-  0.8). Then one Set Motor per movable joint (angular for hinges and hinge-2s, linear for
-  sliders; zero speed, so the robot holds its pose; the joint's effort limit as its force
+  its parent; a car's wheels -> HINGE2 (steering axis vertical, opposite for the wheels
+  ahead of the base's centre and the others, as Kautham's CarEnvironment; both axes sent
+  reversed like a hinge's, so that a positive steering turns left and a positive wheel speed
+  rolls the car forward; suspension ERP 0.4 / CFM 0.8). Then one Set Motor per movable joint
+  (angular for hinges and hinge-2s, linear for sliders; zero speed, so the robot holds its pose; the joint's effort limit as its force
   limit, infinite without one), id "motor:" + joint id; a joint with friction gets a second
   motor at zero speed whose force limit is the friction ("friction:" + joint id), a joint
   with damping a third at zero speed, unlimited force and CFM 1 / damping, which makes ODE
@@ -62,8 +63,8 @@ import numpy as np
 from gui.core import inertia as inertia_rule
 from gui.core.kautham import environment
 from gui.core.kinematics import pose_to_position_quaternion
-from gui.core.model import (CAR, FIXED_BASE, REVOLUTE, Configuration, Ignored, Instance,
-                            Problem)
+from gui.core.model import (CAR, FIXED_BASE, REVOLUTE, Configuration, Instance, Problem,
+                            warn_once)
 from gui.core.shapes import Shape
 from gui.core.world_settings import WorldSettings, kautham_world
 from odin_common.interface import (JointParameter, JointType, MotorKind, Shape as ShapeKind,
@@ -571,6 +572,7 @@ class _Planner:
             if world.step is not None:
                 front.append(StepSizeStep(world.step, world.steps_per_cycle, world.rate))
             front.append(ObjectStep(self._ground()))
+        warn_once(self.ignored[len(self.problem.ignored):], "gui.core.build")
         return BuildPlan(problem=self.problem, steps=front + self.steps, robots=self.handles,
                          world=world, ignored=self.ignored)
 
@@ -699,13 +701,18 @@ class _Planner:
     def _wheel(link, frame: np.ndarray, base_pose: np.ndarray, parent_id: str,
                child_id: str) -> JointSpec:
         """A car's wheel on a hinge-2 (Kautham's CarEnvironment): the chassis is body1, the
-        steering axis vertical (up for a wheel ahead of the base's origin along its x, down
-        otherwise), the spin axis the wheel joint's, soft suspension."""
+        steering axis vertical, opposite for the wheels ahead of the base's origin along its x
+        and for the others (so that the rear wheels steer against the front ones, as Kautham's
+        four do), the spin axis the wheel joint's, soft suspension. Both axes are sent
+        reversed, as a robot's hinges are: a hinge-2's angles and rates are body1's turn
+        relative to body2, so a positive steering angle then turns the front wheels left
+        (counter-clockwise seen from above) and a positive wheel speed turns a wheel about
+        its joint's axis (a car whose wheels turn about its y rolls along its +x)."""
         ahead = (np.linalg.inv(base_pose) @ np.append(frame[:3, 3], 1.0))[0] > 0.0
-        up = base_pose[:3, 2] * (1.0 if ahead else -1.0)
+        up = base_pose[:3, 2] * (-1.0 if ahead else 1.0)
         return JointSpec(type=JointType.HINGE2, body1=parent_id, body2=child_id,
                          anchor=_flat(frame[:3, 3]), axis1=_flat(up),
-                         axis2=_flat(frame[:3, :3] @ link.axis),
+                         axis2=_flat(-(frame[:3, :3] @ link.axis)),
                          parameters=((JointParameter.SUSPENSION_ERP, 1,
                                       environment.SUSPENSION_ERP),
                                      (JointParameter.SUSPENSION_CFM, 1,

@@ -23,6 +23,7 @@ units: lengths are m, angles rad, masses kg.
 """
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass, field
 from typing import Optional, Sequence
 
@@ -200,6 +201,17 @@ class Ignored:
     def __str__(self) -> str:
         where = f"{self.source}:{self.line}" if self.line else self.source
         return f"{where}: {self.what}: {self.why}"
+
+
+def warn_once(ignored, logger_name: str = "gui.core") -> None:
+    """Logs each Ignored entry as a warning, once per (file, what) in the list."""
+    log = logging.getLogger(logger_name)
+    seen = set()
+    for item in ignored:
+        key = (item.source, item.what)
+        if key not in seen:
+            seen.add(key)
+            log.warning("not used: %s", item)
 
 
 # Robot kinds: how the world builds and drives a robot (Kautham's ODE environments)

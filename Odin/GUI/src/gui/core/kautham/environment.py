@@ -8,7 +8,8 @@ joint. CarEnvironment.cpp: four wheels on hinge-2 joints (steering axis vertical
 two wheels' up, the others' down; suspension ERP 0.4, CFM 0.8); its controls are a steering
 angle in [-0.5, 0.5] rad, reached at a rate of 1/s under 2 N m, and a wheel speed in
 [-5, 10] rad/s under 50 N m. PlanarChainEnvironment.cpp: motor speeds on the joints under a
-torque limit of 7 N m. twoDRobotEnvironment.cpp and ConstraintAware2DRobotEnvironment.cpp: a
+torque limit of 7 N m, written for its own two-link demo chain (Odin servos a chain's joints
+under each joint's URDF effort limit instead: gui.core.control_path). twoDRobotEnvironment.cpp and ConstraintAware2DRobotEnvironment.cpp: a
 force on the free body.
 """
 from __future__ import annotations
@@ -34,5 +35,3 @@ STEERING_MAX_TORQUE = 2.0
 """N m: the steering motor's force limit."""
 WHEEL_MAX_TORQUE = 50.0
 """N m: the wheel motor's force limit."""
-CHAIN_MAX_TORQUE = 7.0
-"""N m: a chain's motor force limit when its file gives none."""

@@ -54,7 +54,7 @@ from gui.core.kautham.xmlfile import Node, parse_number, read_xml
 from gui.core.kinematics import pose_from_axis_angle
 from gui.core.model import (CAR, FIXED_BASE, FREE_BODY, MOBILE, REVOLUTE, Attachment,
                             Control, ControlSet, Ignored, Instance, Planner, PlannerPhysics,
-                            Problem, RobotModel)
+                            Problem, RobotModel, warn_once)
 from gui.core.shapes import COIN_SUFFIXES, TRIMESH_SUFFIXES
 from gui.errors import ProblemError
 
@@ -107,17 +107,8 @@ def load_problem(path: os.PathLike | str) -> Problem:
                for r in root.findall("Robot"))
     loader = _Loader(path, root, SI if current else LEGACY, current)
     problem = loader.load()
-    _warn_once(problem.ignored)
+    warn_once(problem.ignored, log.name)
     return problem
-
-
-def _warn_once(ignored: List[Ignored]) -> None:
-    seen = set()
-    for item in ignored:
-        key = (item.source, item.what)
-        if key not in seen:
-            seen.add(key)
-            log.warning("not used: %s", item)
 
 
 class _Names:
