@@ -22,8 +22,9 @@ How a problem maps to the world:
   ahead of the base's centre and the others, as Kautham's CarEnvironment; both axes sent
   reversed like a hinge's, so that a positive steering turns left and a positive wheel speed
   rolls the car forward; suspension ERP 0.4 / CFM 0.8). Then one Set Motor per movable joint
-  (angular for hinges and hinge-2s, linear for sliders; zero speed, so the robot holds its pose; the joint's effort limit as its force
-  limit, infinite without one), id "motor:" + joint id; a joint with friction gets a second
+  (angular for hinges and hinge-2s, linear for sliders; zero speed, so the robot holds its
+  pose; the joint's effort limit as its force limit, infinite without one), id "motor:" +
+  joint id; a joint with friction gets a second
   motor at zero speed whose force limit is the friction ("friction:" + joint id), a joint
   with damping a third at zero speed, unlimited force and CFM 1 / damping, which makes ODE
   apply exactly -damping x the joint's rate ("damping:" + joint id).

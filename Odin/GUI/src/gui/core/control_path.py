@@ -54,10 +54,15 @@ kind of robot:
   the controls move, the constant force F = m (2 (x* - x0 - v0 d) / d^2), which would carry
   the base (mass m, at x0 with velocity v0 when the row starts) to the row's position x* in
   its duration d were nothing else acting, each component limited to m times
-  `ControlDefaults.max_acceleration`; the base's orientation is not driven;
+  `ControlDefaults.max_acceleration`; the base's orientation is not driven (Kautham's
+  twoDRobotEnvironment samples the force itself, in [-20, 20] N per axis; a row here is a
+  configuration, as Kautham's control samples through the `.cntr` are, and the force the one
+  that reaches it);
 - a car (two controls, CarEnvironment's): steering angle -0.5 + c1 rad, reached by each wheel
   hinge-2's first axis at a rate of 1/s per radian of error under 2 N m (a servo of gain 1),
   and wheel speed -5 + 15 c2 rad/s on its second axis under 50 N m.
+
+The last row's servo settings stay in force after it (its forces act only for its duration).
 A row whose values leave [0, 1] is refused with its file and line.
 """
 
