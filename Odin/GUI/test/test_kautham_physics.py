@@ -20,7 +20,7 @@ from gui.core.build import (EntityStep, JointStep, MotorStep, ObjectStep, StepSi
 from gui.core.control_path import ControlRow, read_control_path, run_control_path
 from gui.core.kautham.corpus import corpus_dir
 from gui.core.kautham.problem import load_problem
-from gui.core.model import CAR, FIXED_BASE, FREE_BODY
+from gui.core.model import CAR, FIXED_BASE, FREE_BODY, MOBILE
 from gui.errors import PathFileError, ProblemError
 from gui_core_world import CorePort, CoreWorld
 from odin_common.interface import JointParameter, JointType, Shape
@@ -464,3 +464,66 @@ def test_control_path_rows_and_their_errors(tmp_path):
         with pytest.raises(PathFileError, match=fragment) as info:
             read_control_path(path, 2)
         assert info.value.line == line and str(path) in str(info.value)
+
+
+ROVER = """<?xml version="1.0"?><robot name="rover">
+ <link name="base"><inertial><mass value="4"/><inertia ixx="0.033" iyy="0.057" izz="0.083"
+  ixy="0" ixz="0" iyz="0"/></inertial><collision><geometry><box size="0.4 0.3 0.1"/>
+  </geometry><contact_coefficients mu="0.1"/></collision></link>
+ <link name="mast"><inertial><origin xyz="0 0 0.15"/><mass value="0.5"/><inertia ixx="0.0039"
+  iyy="0.0039" izz="0.0002" ixy="0" ixz="0" iyz="0"/></inertial><collision><origin
+  xyz="0 0 0.15"/><geometry><box size="0.05 0.05 0.3"/></geometry></collision></link>
+ <joint name="pan" type="revolute"><parent link="base"/><child link="mast"/><origin
+  xyz="0 0 0.05"/><axis xyz="0 0 1"/><limit lower="-1.5" upper="1.5" effort="5"
+  velocity="1"/></joint>
+</robot>"""
+
+ROVER_CNTR = """<?xml version="1.0"?><ControlSet>
+ <Offset><DOF name="rover/X1" value="0"/><DOF name="rover/X2" value="0"/>
+  <DOF name="rover/X3" value="0"/></Offset>
+ <Control name="rover/x" eigValue="1"><DOF name="rover/X" value="1"/></Control>
+ <Control name="rover/y" eigValue="1"><DOF name="rover/Y" value="1"/></Control>
+ <Control name="rover/pan" eigValue="1"><DOF name="rover/mast" value="1"/></Control>
+</ControlSet>"""
+
+
+def _rover(folder: pathlib.Path) -> pathlib.Path:
+    (folder / "rover.urdf").write_text(ROVER)
+    (folder / "rover.cntr").write_text(ROVER_CNTR)
+    problem = folder / "rover.xml"
+    problem.write_text(
+        '<?xml version="1.0"?><Problem><Robot robot="rover.urdf"><Limits name="X" min="-2" '
+        'max="2"/><Limits name="Y" min="-2" max="2"/><Limits name="Z" min="0.05" max="0.05"/>'
+        '<Home X="0" Y="0" Z="0.05" WX="0" WY="0" WZ="1" TH="0"/></Robot>'
+        '<Controls robot="rover.cntr"/><Planner><Parameters><Name>omplRRTConnect</Name>'
+        '</Parameters><Queries><Query><Init>0.5 0.5 0.5</Init><Goal>0.75 0.25 0.9</Goal>'
+        '</Query></Queries></Planner></Problem>')
+    return problem
+
+
+def test_a_mobile_robot_has_a_free_base_its_controls_drive_with_its_arm(tmp_path, world):
+    """A robot whose controls move its base (the .cntr names X, Y) and a joint: Kautham's
+    mobile base, free and dynamic; a control row pushes the base to its (x, y) and servos the
+    joint, on the ground Kautham's physics adds when asked (BuildDefaults.ground)."""
+    problem = load_problem(_rover(tmp_path))
+    robot = problem.robots[0]
+    assert robot.kind == MOBILE
+    # p = c for X, Y and the joint; X1 = X2 = X3 = 0: Kuffner's quaternion is the identity
+    np.testing.assert_allclose(robot.start.base_pose, np.array(
+        [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0.05], [0, 0, 0, 1]]), atol=1e-12)
+    np.testing.assert_allclose(robot.goal.base_pose[:3, 3], (-2 + 4 * 0.75, -2 + 4 * 0.25,
+                                                             0.05), atol=1e-12)
+    np.testing.assert_allclose(robot.goal.joints, [-1.5 + 0.9 * 3])
+    plan = plan_problem(problem, BuildDefaults(ground=True))
+    entity = _steps(plan, EntityStep)[0].spec
+    assert not any(o.fixed for o in entity.objects)
+    assert [s.spec.type for s in _steps(plan, JointStep)] == [JointType.HINGE]  # no base joint
+    assert next(b for b in plan.bodies() if b.id == "rover/base").surface.friction == 0.1
+    world.execute(plan)
+    world.run(0.5)
+    handle = plan.robot()
+    results = run_control_path(CorePort(world), handle,
+                               [ControlRow(handle.goal.controls, 0.5)] * 8)
+    assert np.linalg.norm(results[-1].base_position[:2] - (1.0, -1.0)) < 0.03
+    pan = {j.id: j.positions[0] for j in world.core.joint_states()}[handle.joint_ids[0]]
+    assert pan + handle.built_at[0] == pytest.approx(1.2, abs=0.02)
