@@ -212,8 +212,23 @@ def render() -> str:
         parts.append(f"### {name}\n\nType `Messages/{name}`; {use}; published by {publisher}. "
                      f"Provenance: {provenance}.\n\n")
         parts.append(_block(MSG_DIR / f"{name}.msg") + "\n")
+    parts.append(render_kautham())
     parts.append(render_parameters())
     return "".join(parts)
+
+
+def render_kautham() -> str:
+    """How the GUI builds a Kautham problem and applies a control path, from the docstring of
+    gui.core.build and gui.core.control_path.MAPPING (their one home)."""
+    from gui.core import build
+    from gui.core.control_path import MAPPING
+    marker = "How a problem maps to the world:\n"
+    mapping = build.__doc__.split(marker, 1)[1].strip()
+    return ("## Kautham problems and control paths\n\n"
+            "The GUI (`rosrun GUI gui`, `load_problem`, `problem_info`) builds a Kautham problem "
+            "with the services above (`gui.core.build`); `problem_info PROBLEM` shows the plan "
+            "as JSON, with what Odin does not use under `ignored`. How a problem maps to the "
+            f"world:\n\n{mapping}\n\n### Control paths\n\n{MAPPING.strip()}\n\n")
 
 
 def _value(value) -> str:

@@ -1,6 +1,7 @@
 """load_problem and run_path against a live VirtualWorld (each test with its own roscore)."""
 from __future__ import annotations
 
+import json
 import math
 import os
 import pathlib
@@ -109,3 +110,35 @@ def test_motor_goal_joint_value_and_forward_kinematics_share_one_sign(world, leg
     # the reversed sign would put the tool at y = -0.09 m; the joint readings and the link
     # poses agree to about a centimetre (the soft constraints of a chain driven by a motor)
     assert got["2D-Robot/tcp"] == pytest.approx(expected["2D-Robot/tcp"], abs=0.015)
+
+
+def test_a_control_path_drives_the_sphere_demo_to_its_goal(world, kautham_dir, tmp_path):
+    """Sphere.xml (Kautham's ODE demo) loaded, then its query's goal as control rows: each row
+    one kept Propagate; the sphere ends at the goal (x, y) and the world is paused again."""
+    problem = kautham_dir / "current_2025" / "demos" / "OMPL_ode_demos" / "Sphere" / "Sphere.xml"
+    world.run(["rosrun", "GUI", "load_problem", str(problem)], timeout=120)
+    controls = tmp_path / "controls.txt"
+    controls.write_text("# x y z duration (s)\n" + "0.426 0.578 0.4 0.3\n" * 12)
+    result = world.run(["rosrun", "GUI", "run_path", str(problem), "--controls", str(controls),
+                        "--fast"], timeout=120)
+    lines = result.stdout.splitlines()
+    assert lines[-1] == "SphereDE: 12 control rows done (3.600 s simulated)"
+    goal = np.array([-5 + 10 * 0.426, -5 + 10 * 0.578])     # sp3.cntr and <Limits>: x, y
+    start = np.array([-5 + 10 * 0.544, -5 + 10 * 0.433])
+    # "[k/12] t=... s base at [x, y, z], d m from the goal"
+    where = [np.array(json.loads(l.split(" base at ")[1].split("]")[0] + "]"))[:2]
+             for l in lines[:-1]]
+    assert len(where) == 12
+    assert np.linalg.norm(where[0] - goal) < np.linalg.norm(start - goal) - 0.2
+    assert np.linalg.norm(where[-1] - goal) < 0.02
+    from gui.ros.client import WorldClient
+    client = WorldClient()
+    assert not client.world().simulating        # as before the run: load_problem leaves it paused
+    client.close()
+    bad = tmp_path / "bad.txt"
+    bad.write_text("0.4 0.5 0.4 0.3\n0.4 1.5 0.4 0.3\n")
+    result = world.run(["rosrun", "GUI", "run_path", str(problem), "--controls", str(bad)],
+                       check=False, timeout=60)
+    # the loader's warnings (what Odin does not use), then ONE line: the error, file and line
+    errors = [l for l in result.stderr.splitlines() if not l.startswith("run_path: warning:")]
+    assert result.returncode != 0 and len(errors) == 1 and f"{bad}:2:" in errors[0]

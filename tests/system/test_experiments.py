@@ -1,6 +1,7 @@
-"""The thesis's three experiments (chapter 10) end to end: each runs its own roscore, the
-world and Viewer nodes by rosrun and this process as the GUI (tools/experiments), and its
-outcome is asserted on what the nodes published and what the Viewer drew.
+"""The thesis's three experiments (chapter 10) and Kautham's ODE sphere demo end to end: each
+runs its own roscore, the world and Viewer nodes by rosrun and this process as the GUI
+(tools/experiments), and its outcome is asserted on what the nodes published and what the
+Viewer drew.
 
 Each test runs in a forked child (rospy.init_node works once per process). The world is
 deterministic for the same calls: two runs of each experiment recorded the same figures.
@@ -114,6 +115,26 @@ def test_grasp_carries_the_can_and_releases_it_when_the_hand_opens(tmp_path, kau
     carry = facts["carry_propagated"]
     assert carry["can_where_the_run_put_it"], carry
     assert carry["simulated_s"] > 1.0 and carry["rtf"] > 0
+
+
+@pytest.mark.forked
+def test_sphere_demo_rests_on_the_ground_and_a_control_path_drives_it_to_its_goal(kautham_dir):
+    """Kautham's ODE sphere demo as the GUI loads it (tools/experiments/sphere.py)."""
+    import sphere
+    facts = sphere.run(frames=False)
+    o = facts["outcome"]
+    failed = [name for name, held in sphere.checks(o).items() if not held]
+    assert not failed, (failed, {k: v for k, v in o.items() if k != "rest"},
+                        [n for n, r in o["rest"].items() if not r["at_rest_on_the_ground"]])
+    # built at the query's start (controls 0.544 0.433 0.4 through sp3.cntr and <Limits>), not
+    # at its Home (10, 10, 0) outside the walls
+    assert o["sphere_built_at_m"] == pytest.approx([0.44, -0.67, 0.2], abs=1e-4)
+    # 8 obstacles, each a dynamic body resting on the ground plane
+    assert len(o["rest"]) == 9
+    # 22.0 m of route in 51 rows and 6 at the goal; at most 0.40 m behind the moving targets
+    # (a force that would reach each row's target if nothing else acted; a rolling sphere
+    # accelerates at 5/7 of it), 2 mm from the goal at the end
+    assert o["rows"] == 57
 
 
 def test_one_command_runs_several_experiments(kautham_dir):

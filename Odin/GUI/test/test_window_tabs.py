@@ -370,3 +370,30 @@ def test_motion_tab_forces_joints_motors_and_robot_paths(window, kautham_dir, tm
     assert "bad.txt:1" in window.last_error
     window.tabs.setCurrentWidget(window.simulation)
     screenshot(window, SHOTS / "window.png")
+
+
+def test_motion_tab_runs_a_control_path_on_the_sphere_demo(window, kautham_dir, tmp_path):
+    """Kautham's Sphere demo opened, then a control path (the query's goal, 8 rows of 0.3 s) in
+    real time: the sphere ends at the goal; a row out of [0, 1] is refused with file and line."""
+    from gui.window.testing import screenshot, wait_for
+    problem = kautham_dir / "current_2025/demos/OMPL_ode_demos/Sphere/Sphere.xml"
+    window.simulation.open_problem(str(problem))
+    wait_for(lambda: "SphereDE" in window.scene.robots and not window.simulation.building, 30,
+             "the sphere demo")
+    window.tabs.setCurrentWidget(window.motion)
+    tab = window.motion
+    tab.toolbox.setCurrentIndex(3)
+    assert tab.robot.currentText() == "SphereDE"
+    controls = tmp_path / "controls.txt"
+    controls.write_text("0.426 0.578 0.4 0.3\n" * 10)
+    tab.run_path("control", str(controls))
+    wait_for(lambda: ": row " in tab.path_status.text(), 5, "the control path running")
+    screenshot(window, SHOTS / "motion_controls.png")
+    wait_for(lambda: "control path done (10 rows)" in window.last_info, 20, "the control path")
+    goal = (-5 + 10 * 0.426, -5 + 10 * 0.578)             # sp3.cntr and <Limits>: x, y
+    position = _world().ok("get_state", objects=["SphereDE"]).bodies[0].position
+    assert math.dist(position[:2], goal) < 0.02
+    bad = tmp_path / "bad.txt"
+    bad.write_text("0.4 0.5 0.4 0.3\n0.4 0.5 0.4 -1\n")
+    tab.run_path("control", str(bad))
+    assert "bad.txt:2" in window.last_error and "not positive" in window.last_error

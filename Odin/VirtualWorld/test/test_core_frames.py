@@ -175,6 +175,54 @@ def test_a_composite_of_rotated_parts_has_their_rotated_and_moved_inertia(core):
     np.testing.assert_allclose(inertia, INERTIA, atol=1e-12)
 
 
+# a file's mass properties (a URDF <inertial>): a tensor about a centre of mass off the origin
+GIVEN_INERTIA = np.array([[0.30, 0.02, -0.01], [0.02, 0.25, 0.03], [-0.01, 0.03, 0.20]])
+GIVEN_CENTRE = np.array([0.05, -0.10, 0.20])
+
+
+def _six(i):
+    return [i[0, 0], i[1, 1], i[2, 2], i[0, 1], i[0, 2], i[1, 2]]
+
+
+def test_an_object_takes_a_given_inertia_about_a_given_centre_of_mass(core):
+    core.build_object(ObjectSpec("arm", [0.1, 0.2, 0.3], mass=2.0, inertia=_six(GIVEN_INERTIA),
+                                 center_of_mass=tuple(GIVEN_CENTRE), position=(1.0, 0, 0)))
+    mass, centre, inertia = core.mass_properties("arm")
+    assert mass == pytest.approx(2.0)
+    np.testing.assert_allclose(centre, GIVEN_CENTRE, atol=1e-12)
+    np.testing.assert_allclose(inertia, GIVEN_INERTIA, atol=1e-12)
+    # the body sits at the centre of mass: a force there (world point) gives no spin
+    core.add_body_force("arm", FORCE, (0.0, 0.0, 10.0), at_point=True,
+                        point=tuple(np.array([1.0, 0, 0]) + GIVEN_CENTRE))
+    core.step(H)
+    _, _, linear, angular = core.body_state("arm")
+    np.testing.assert_allclose(linear, (0.0, 0.0, 10.0 * H / 2.0), atol=1e-12)
+    np.testing.assert_allclose(angular, 0.0, atol=1e-12)
+
+
+def test_a_composite_takes_a_given_inertia_instead_of_its_parts_and_keeps_their_mass(core):
+    spec = composite("g_", (0.0, 0.0, 0.0))
+    spec = CompositeSpec(spec.parts, orientation=spec.orientation,
+                         inertia=_six(GIVEN_INERTIA), center_of_mass=tuple(GIVEN_CENTRE))
+    core.build_composite(spec)
+    mass, centre, inertia = core.mass_properties(composite_id("g_"))
+    assert mass == pytest.approx(TOTAL_MASS)
+    np.testing.assert_allclose(centre, GIVEN_CENTRE, atol=1e-12)
+    np.testing.assert_allclose(inertia, GIVEN_INERTIA, atol=1e-12)
+
+
+@pytest.mark.parametrize("spec,fragment", [
+    (ObjectSpec("c", [0.1], center_of_mass=(0.0, 0.0, 0.1)), "center_of_mass needs an inertia"),
+    (ObjectSpec("c", [0.1], inertia=[1, 1, 1, 0, 0, 0], center_of_mass=(0.0, 0.1)),
+     "expected 3"),
+])
+def test_a_bad_centre_of_mass_is_refused_and_builds_nothing(core, spec, fragment):
+    from virtual_world.errors import InvalidArgument
+    with pytest.raises(InvalidArgument, match=fragment):
+        core.build_object(spec)
+    assert core.object_ids() == []
+
+
 # ------------------------------------------------------------------ forces at points
 
 H = 0.01          # one step: from rest, ODE's step is exact (v = F h / m, I w = tau h)

@@ -2,14 +2,19 @@
 
 Each ``*_main(argv)`` returns the exit status; errors end with status 2 and ONE line on stderr
 saying what and where (file and line for parsed files). ``problem_info`` never imports rospy.
+What a problem holds that Odin does not use is warned about on stderr, once each
+("<tool>: warning: ..."), and listed by ``problem_info`` under ``ignored``.
 """
 from __future__ import annotations
 
 import argparse
 import json
+import logging
 import sys
 import time
 from typing import Optional, Sequence
+
+import numpy as np
 
 from gui.errors import GuiError
 
@@ -20,18 +25,88 @@ def _fail(tool: str, error: Exception) -> int:
     return 2
 
 
+def _warnings_to_stderr(tool: str) -> None:
+    """The loader's warnings (what Odin does not use) as "<tool>: warning: ..." lines."""
+    logger = logging.getLogger("gui.core")
+    if not any(getattr(h, "odin_tool", None) == tool for h in logger.handlers):
+        handler = logging.StreamHandler(sys.stderr)
+        handler.setFormatter(logging.Formatter(f"{tool}: warning: %(message)s"))
+        handler.odin_tool = tool
+        logger.addHandler(handler)
+        logger.propagate = False
+
+
+def _configuration(configuration) -> Optional[dict]:
+    if configuration is None:
+        return None
+    from gui.core.kinematics import pose_to_position_quaternion
+    position, quaternion = pose_to_position_quaternion(configuration.base_pose)
+    return dict(controls=list(configuration.controls or ()), base_position=list(position),
+                base_quaternion=list(quaternion),
+                joints=[float(v) for v in configuration.joints])
+
+
+def _robot(handle) -> dict:
+    controls = handle.instance.controls
+    return dict(name=handle.name, kind=handle.kind, joints=handle.joint_keys,
+                joint_names=handle.instance.model.joint_names(),
+                home=[float(v) for v in handle.home],
+                built_at=[float(v) for v in handle.built_at], motors=handle.motor_ids,
+                controls=list(controls.names) if controls is not None else [],
+                start=_configuration(handle.start), goal=_configuration(handle.goal))
+
+
 def describe(plan) -> dict:
-    """The JSON-ready description of a plan: bodies at Home and joints (world frame)."""
+    """The JSON-ready description of a plan: the world settings it sets, bodies where they
+    are built and joints (world frame), robots with their start and goal, and what Odin does
+    not use (``ignored``)."""
     bodies, joints = [], []
     for step in plan.steps:
         description = step.describe()
         bodies.extend(description["bodies"])
         joints.extend(description["joints"])
-    robots = [dict(name=h.name, joints=h.joint_keys, home=[float(v) for v in h.home],
-                   motors=h.motor_ids) for h in plan.robots]
-    return dict(problem=plan.problem.source, format=plan.problem.format,
+    world = None
+    if plan.world is not None:
+        world = dict(parameters={k: list(v) if isinstance(v, tuple) else v
+                                 for k, v in plan.world.parameters.items()},
+                     step=plan.world.step, steps_per_cycle=plan.world.steps_per_cycle,
+                     rate=plan.world.rate)
+    problem = plan.problem
+    return dict(problem=problem.source, format=problem.format,
+                planner=problem.planner.name if problem.planner else None,
+                physics=plan.world is not None,
                 units=dict(length="m", angle="rad", mass="kg", quaternion="w,x,y,z"),
-                bodies=bodies, joints=joints, robots=robots)
+                world=world, bodies=bodies, joints=joints,
+                robots=[_robot(h) for h in plan.robots if h.instance.role == "robot"],
+                attachments=[dict(robot=a.robot, link=a.link, obstacle=a.obstacle)
+                             for a in problem.attachments],
+                ignored=[i.describe() for i in plan.ignored])
+
+
+def _build_options(parser: argparse.ArgumentParser) -> None:
+    """The options that change how a problem is built (gui.core.build.BuildDefaults)."""
+    ground = parser.add_mutually_exclusive_group()
+    ground.add_argument("--physics", dest="ground", action="store_const", const=True,
+                        help="Kautham's ODE physics (world settings, a ground plane) for any "
+                        "problem [default: for problems with an ODE planner]")
+    ground.add_argument("--no-physics", dest="ground", action="store_const", const=False,
+                        help="no ground plane, the world as it is")
+    start = parser.add_mutually_exclusive_group()
+    start.add_argument("--at-home", dest="start_at_query", action="store_const", const=False,
+                       help="build robots at Home [default for 2012 problems]")
+    start.add_argument("--at-start", dest="start_at_query", action="store_const", const=True,
+                       help="build robots at the query's start [default for current ones]")
+    parser.add_argument("--inertia", choices=("auto", "file", "shape"), default="auto",
+                        help="links' inertia: the file's where plausible (auto), always the "
+                        "file's, or the shape's")
+
+
+def _plan(args):
+    from gui.core.build import BuildDefaults, plan_problem
+    from gui.core.kautham.problem import load_problem
+    defaults = BuildDefaults(ground=args.ground, start_at_query=args.start_at_query,
+                             inertia=args.inertia)
+    return plan_problem(load_problem(args.problem), defaults)
 
 
 def problem_info_main(argv: Optional[Sequence[str]] = None) -> int:
@@ -40,11 +115,11 @@ def problem_info_main(argv: Optional[Sequence[str]] = None) -> int:
         "(JSON on stdout; no ROS needed).")
     parser.add_argument("problem", help="problem XML file")
     parser.add_argument("--indent", type=int, default=1, help="JSON indentation (0: compact)")
+    _build_options(parser)
     args = parser.parse_args(argv)
-    from gui.core.build import plan_problem
-    from gui.core.kautham.problem import load_problem
+    _warnings_to_stderr("problem_info")
     try:
-        plan = plan_problem(load_problem(args.problem))
+        plan = _plan(args)
     except GuiError as error:
         return _fail("problem_info", error)
     json.dump(describe(plan), sys.stdout, indent=args.indent or None)
@@ -60,12 +135,12 @@ def load_problem_main(argv: Optional[Sequence[str]] = None) -> int:
                         help="add to the current scene instead of calling New Scene first")
     parser.add_argument("--timeout", type=float, default=10.0,
                         help="seconds to wait for the world's services")
+    _build_options(parser)
     args = parser.parse_args(argv)
-    from gui.core.build import plan_problem
-    from gui.core.kautham.problem import load_problem
+    _warnings_to_stderr("load_problem")
     started = time.monotonic()
     try:
-        plan = plan_problem(load_problem(args.problem))
+        plan = _plan(args)
     except GuiError as error:
         return _fail("load_problem", error)
     total = len(plan.steps)
@@ -95,6 +170,9 @@ def run_path_main(argv: Optional[Sequence[str]] = None) -> int:
     kind.add_argument("--initial", metavar="FILE", help="initial position (first row used)")
     kind.add_argument("--position", metavar="FILE", help="position path: one row per cycle")
     kind.add_argument("--velocity", metavar="FILE", help="velocity path: one row per cycle")
+    kind.add_argument("--controls", metavar="FILE", help="control path: rows of the robot's "
+                      "Kautham controls in [0, 1] and a duration (s), applied as Kautham's "
+                      "ODE environment does (docs/INTERFACE.md)")
     units = parser.add_mutually_exclusive_group()
     units.add_argument("--degrees", action="store_true",
                        help="values in degrees (mm) [default for 2012 problems]")
@@ -105,18 +183,21 @@ def run_path_main(argv: Optional[Sequence[str]] = None) -> int:
                         help="double the path precision N times (position paths)")
     parser.add_argument("--rate", type=float, default=0.0,
                         help="rows per second (default: the world's publication rate)")
+    parser.add_argument("--fast", action="store_true",
+                        help="control paths: as fast as the world steps, not in real time")
     parser.add_argument("--timeout", type=float, default=10.0)
+    _build_options(parser)
     args = parser.parse_args(argv)
-    from gui.core.build import plan_problem
-    from gui.core.kautham.problem import load_problem
+    _warnings_to_stderr("run_path")
     from gui.core.paths import DEGREES, RADIANS, load_robot_path, refine
     try:
-        plan = plan_problem(load_problem(args.problem))
-        handles = [h for h in plan.robots if args.robot in (None, h.name)]
-        if not handles:
-            raise GuiError(f"no robot named {args.robot!r} in {args.problem} (robots: "
-                           + ", ".join(h.name for h in plan.robots) + ")")
-        handle = handles[0]
+        plan = _plan(args)
+        try:
+            handle = plan.robot(args.robot)
+        except KeyError as error:
+            raise GuiError(f"{args.problem}: {error.args[0]}") from None
+        if args.controls:
+            return _run_controls(args, handle)
         unit = DEGREES if args.degrees else RADIANS if args.radians else (
             DEGREES if plan.problem.format == "2012" else RADIANS)
         file = args.initial or args.position or args.velocity
@@ -139,4 +220,27 @@ def run_path_main(argv: Optional[Sequence[str]] = None) -> int:
         print(f"{handle.name}: {len(rows)} rows at {rate:g} Hz done")
     except GuiError as error:
         return _fail("run_path", error)
+    return 0
+
+
+def _run_controls(args, handle) -> int:
+    """run_path --controls: the control path through Propagate (the world paused meanwhile);
+    one line per row: its time, the base's position and distance to the goal."""
+    from gui.core.control_path import control_size, read_control_path, run_on_client
+    rows = read_control_path(args.controls, control_size(handle))
+    from gui.ros.client import WorldClient
+    client = WorldClient(timeout=args.timeout)
+    goal = handle.goal.base_pose[:3, 3] if handle.goal is not None else None
+    elapsed = [0.0]
+
+    def progress(result):
+        elapsed[0] += result.actuation.duration
+        where = np.round(result.base_position, 3).tolist()
+        to_goal = "" if goal is None else \
+            f", {float(np.linalg.norm(result.base_position - goal)):.3f} m from the goal"
+        print(f"[{result.index}/{len(rows)}] t={elapsed[0]:.3f} s base at {where}{to_goal}",
+              flush=True)
+
+    run_on_client(client, handle, rows, real_time=not args.fast, progress=progress)
+    print(f"{handle.name}: {len(rows)} control rows done ({elapsed[0]:.3f} s simulated)")
     return 0

@@ -68,7 +68,8 @@ def object_message(spec: ObjectSpec) -> Object:
                   orientation=_floats(spec.orientation), color=_floats(spec.color),
                   fixed=bool(spec.fixed), geometry_only=bool(spec.geometry_only),
                   no_collisions=bool(spec.no_collisions), shape=int(spec.shape),
-                  surface=surface_message(spec.surface))
+                  surface=surface_message(spec.surface),
+                  center_of_mass=_floats(spec.center_of_mass))
 
 
 def object_spec(message: Object) -> ObjectSpec:
@@ -78,7 +79,8 @@ def object_spec(message: Object) -> ObjectSpec:
                       orientation=tuple(message.orientation), color=tuple(message.color),
                       fixed=message.fixed, geometry_only=message.geometry_only,
                       no_collisions=message.no_collisions, shape=message.shape,
-                      surface=surface_of(message.surface))
+                      surface=surface_of(message.surface),
+                      center_of_mass=tuple(message.center_of_mass))
 
 
 def part_message(spec: PartSpec) -> Part:
@@ -101,7 +103,8 @@ def composite_message(spec: CompositeSpec) -> Composite:
     return Composite(parts=[part_message(p) for p in spec.parts],
                      position=_floats(spec.position), orientation=_floats(spec.orientation),
                      fixed=bool(spec.fixed), geometry_only=bool(spec.geometry_only),
-                     no_collisions=bool(spec.no_collisions))
+                     no_collisions=bool(spec.no_collisions), inertia=_floats(spec.inertia),
+                     center_of_mass=_floats(spec.center_of_mass))
 
 
 def composite_spec(message: Composite) -> CompositeSpec:
@@ -109,7 +112,8 @@ def composite_spec(message: Composite) -> CompositeSpec:
                          position=tuple(message.position),
                          orientation=tuple(message.orientation), fixed=message.fixed,
                          geometry_only=message.geometry_only,
-                         no_collisions=message.no_collisions)
+                         no_collisions=message.no_collisions, inertia=tuple(message.inertia),
+                         center_of_mass=tuple(message.center_of_mass))
 
 
 def parameter_messages(parameters: Sequence[Tuple[int, int, float]]) -> list:

@@ -55,8 +55,9 @@ class ObjectSpec:
         2 cylinder radius, length (along z); 3 box sides x, y, z; a multiple of 3 >= 9 mesh
         vertices (x, y, z, ...) in the object frame, m, with ``indices`` (3 per triangle).
     mass: kg > 0 (unused for geometry_only). inertia: () for the shape's own at uniform
-        density, or [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] kg m^2 about the object's origin, object
-        axes (the centre of mass is then the origin).
+        density, or [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] kg m^2, object axes, about
+        ``center_of_mass`` ([x, y, z] m, object frame; () the object's origin), which is then
+        where the centre of mass is.
     position (m, world), orientation (w, x, y, z): the object's frame. color: RGBA in [0, 1].
     fixed: a kinematic body that forces and contacts never move. geometry_only: no body.
     no_collisions: collides with nothing (Kautham's <Collision enabled="false">).
@@ -77,6 +78,7 @@ class ObjectSpec:
     no_collisions: bool = False
     shape: int = Shape.BY_COUNT
     surface: Surface = WORLD_SURFACE
+    center_of_mass: Sequence[float] = ()
 
     @property
     def id(self) -> str:
@@ -118,13 +120,17 @@ class PartSpec:
 @dataclass(frozen=True, eq=False)
 class CompositeSpec:
     """Messages/Composite: parts on one body; the pose of the composite's frame (world).
-    Its ID is ">part1>part2..." (odin_common.interface.composite_id)."""
+    Its ID is ">part1>part2..." (odin_common.interface.composite_id). inertia: () for the
+    parts' shapes' own, or [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] kg m^2 about ``center_of_mass``
+    ([x, y, z] m, composite frame; () the origin), composite axes; the mass is the parts'."""
     parts: Sequence[PartSpec]
     position: Sequence[float] = (0.0, 0.0, 0.0)
     orientation: Sequence[float] = IDENTITY_WXYZ
     fixed: bool = False
     geometry_only: bool = False
     no_collisions: bool = False
+    inertia: Sequence[float] = ()
+    center_of_mass: Sequence[float] = ()
 
     @property
     def id(self) -> str:

@@ -35,6 +35,13 @@ def read_path(path: os.PathLike | str, n_values: Optional[int] = None) -> np.nda
     """Rows of numbers as written in the file (no unit conversion): (rows, n_values).
 
     Every row must have ``n_values`` numbers (or as many as the first row)."""
+    return read_rows(path, n_values)[0]
+
+
+def read_rows(path: os.PathLike | str, n_values: Optional[int] = None,
+              meaning: str = "one per movable joint") -> tuple:
+    """``read_path``'s rows and the line each came from; ``meaning`` says what a row holds
+    (for the error of a row of the wrong length)."""
     p = pathlib.Path(path)
     if not p.is_file():
         raise PathFileError("path file not found", p)
@@ -44,7 +51,7 @@ def read_path(path: os.PathLike | str, n_values: Optional[int] = None) -> np.nda
         lines = [(c.line, c.text) for c in _iter(root) if c.tag == "Conf"]
     else:
         lines = list(enumerate(text.splitlines(), start=1))
-    rows = []
+    rows, numbers = [], []
     for number, line in lines:
         line = line.strip()
         if not line or line.startswith("#"):
@@ -59,12 +66,13 @@ def read_path(path: os.PathLike | str, n_values: Optional[int] = None) -> np.nda
             raise PathFileError("a value is not finite", p, number)
         expected = n_values if n_values is not None else (len(rows[0]) if rows else len(row))
         if len(row) != expected:
-            raise PathFileError(f"{len(row)} values, expected {expected} (one per movable "
-                                "joint)", p, number)
+            raise PathFileError(f"{len(row)} values, expected {expected} ({meaning})", p,
+                                number)
         rows.append(row)
+        numbers.append(number)
     if not rows:
-        raise PathFileError("holds no configuration", p)
-    return np.array(rows, dtype=float)
+        raise PathFileError("holds no row of values", p)
+    return np.array(rows, dtype=float), numbers
 
 
 def _is_number(token: str) -> bool:

@@ -5,8 +5,10 @@ velocity; vectors and points in the world or the body frame. Forces and torques 
 deleted: their IDs (the world's answers) are listed for deletion. Velocities act once.
 Move joint: a force / torque per joint axis (as many magnitudes as the joint type takes), with
 the list of joint forces. Move motor: goal speeds. Move robot: initial position, velocity
-path and position path files (``gui.core.paths``), optionally refined by double path precision; a
-path runs on a worker of its own (Stop ends it) so the other tabs stay usable meanwhile.
+path and position path files (``gui.core.paths``), optionally refined by double path precision,
+and control paths (rows of the robot's Kautham controls in [0, 1] with a duration, applied as
+Kautham's ODE environment does: ``gui.core.control_path``, docs/INTERFACE.md); a path runs on a
+worker of its own (Stop ends it) so the other tabs stay usable meanwhile.
 """
 from __future__ import annotations
 
@@ -16,6 +18,7 @@ from PyQt5.QtWidgets import (QButtonGroup, QCheckBox, QComboBox, QFileDialog, QG
                              QHBoxLayout, QLabel, QListWidget, QPushButton, QRadioButton,
                              QToolBox, QVBoxLayout, QWidget)
 
+from gui.errors import GuiError
 from gui.window.fields import VectorRow, int_spin, spin
 from gui.window.scene import JOINT_TYPE_NAMES
 from odin_common.interface import JOINT_FORCE_MAGNITUDES, ForceKind
@@ -109,6 +112,9 @@ class MotionTab(QWidget):
         self.initial_button = QPushButton("Set initial position...")
         self.velocity_button = QPushButton("Velocity path...")
         self.position_button = QPushButton("Position path...")
+        self.controls_button = QPushButton("Control path...")
+        self.controls_button.setToolTip("rows of the robot's controls in [0, 1] and a duration "
+                                        "(s), applied as Kautham's ODE environment does")
         self.double = int_spin(0, 0, 6, "times the path precision is doubled (2^n finer)")
         self.stop_button = QPushButton("Stop path")
         self.stop_button.setEnabled(False)
@@ -120,6 +126,7 @@ class MotionTab(QWidget):
         grid.addWidget(self.initial_button, 2, 1)
         grid.addWidget(self.velocity_button, 3, 0)
         grid.addWidget(self.position_button, 3, 1)
+        grid.addWidget(self.controls_button, 3, 2)
         grid.addWidget(QLabel("Double path precision (times)"), 4, 0)
         grid.addWidget(self.double, 4, 1)
         grid.addWidget(self.stop_button, 5, 1)
@@ -142,6 +149,7 @@ class MotionTab(QWidget):
         self.initial_button.clicked.connect(lambda: self.choose_path("initial"))
         self.velocity_button.clicked.connect(lambda: self.choose_path("velocity"))
         self.position_button.clicked.connect(lambda: self.choose_path("position"))
+        self.controls_button.clicked.connect(lambda: self.choose_path("control"))
         self.stop_button.clicked.connect(self.stop_path)
         window.scene.changed.connect(self._scene_changed)
         self._action_changed()
@@ -292,11 +300,15 @@ class MotionTab(QWidget):
             self.run_path(kind, path)
 
     def run_path(self, kind: str, path: str) -> None:
-        """``kind``: "initial", "velocity" or "position"; runs on the path worker."""
+        """``kind``: "initial", "velocity", "position" or "control"; runs on the path
+        worker."""
         from gui.core.paths import DEGREES, RADIANS, load_robot_path, refine
         handle = self.window.scene.robots.get(self.robot.currentText())
         if handle is None:
             self.window.show_error("Move robot: open a problem with a robot first")
+            return
+        if kind == "control":
+            self.run_control_path(handle, path)
             return
         units = DEGREES if self.units.currentIndex() == 0 else RADIANS
         try:
@@ -313,7 +325,6 @@ class MotionTab(QWidget):
             rows = refine(rows, int(self.double.value()))
         rate = self.window.publication_rate or StepValues().rate
         total = len(rows)
-        name = pathlib.Path(path).name
 
         def work(client, job):
             from gui.ros.client import run_position_path, run_velocity_path
@@ -327,22 +338,47 @@ class MotionTab(QWidget):
                 raise
             return total
 
+        self._submit_path(f"{kind} path", pathlib.Path(path).name, handle.name, total, work,
+                          f" at {rate:g} Hz")
+
+    def run_control_path(self, handle, path: str) -> None:
+        """The control path file ``path`` for ``handle``'s robot, in real time on the path
+        worker (the world paused meanwhile, running again afterwards if it was)."""
+        from gui.core.control_path import control_size, read_control_path
+        try:
+            rows = read_control_path(path, control_size(handle))
+        except GuiError as error:  # a bad file is the user's: say what and where
+            self.window.show_error(f"Move robot: {error}")
+            return
+
+        def work(client, job):
+            from gui.core.control_path import run_on_client
+            run_on_client(client, handle, rows, progress=lambda r: job.progress(r.index),
+                          sleep=job.sleep)
+            return len(rows)
+
+        self._submit_path("control path", pathlib.Path(path).name, handle.name, len(rows),
+                          work)
+
+    def _submit_path(self, label: str, name: str, robot: str, total: int, work,
+                     pace: str = "") -> None:
+        """Runs ``work`` on the path worker, its progress (rows done) in the status line."""
         def progress(k):
-            self.path_status.setText(f"{kind} path {name}: row {k}/{total} at {rate:g} Hz")
+            self.path_status.setText(f"{label} {name}: row {k}/{total}{pace}")
 
         def finished(_):
             self.stop_button.setEnabled(False)
-            self.path_status.setText(f"{kind} path {name}: {total} rows done")
-            self.window.show_info(f"{handle.name}: {kind} path done ({total} rows)")
+            self.path_status.setText(f"{label} {name}: {total} rows done")
+            self.window.show_info(f"{robot}: {label} done ({total} rows)")
 
         def failed(message):
             self.stop_button.setEnabled(False)
-            self.path_status.setText(f"{kind} path {name}: {message}")
+            self.path_status.setText(f"{label} {name}: {message}")
             self.window.show_error(message)
 
         self.stop_button.setEnabled(True)
-        self.path_status.setText(f"{kind} path {name}: starting ({total} rows)")
-        self.window.path_worker.submit(f"{kind} path", work, finished, failed, progress)
+        self.path_status.setText(f"{label} {name}: starting ({total} rows)")
+        self.window.path_worker.submit(label, work, finished, failed, progress)
 
     def stop_path(self) -> None:
         self.window.path_worker.cancel()

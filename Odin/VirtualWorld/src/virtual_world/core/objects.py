@@ -77,6 +77,21 @@ def _part(what: str, given, mass: float, position, orientation) -> _Part:
                  given.parameters, given.indices, int(given.shape), surface)
 
 
+def _given_mass(what: str, mass: float, inertia, center_of_mass):
+    """The dMass of ``mass`` kg with a given ``inertia`` (6 values, kg m^2) about
+    ``center_of_mass`` ((3,) m or empty: the origin), or None when no inertia is given (a
+    centre of mass without an inertia is refused: the shape's inertia is about its own)."""
+    if not len(inertia):
+        if len(center_of_mass):
+            raise InvalidArgument(f"{what}: center_of_mass needs an inertia")
+        return None
+    i = check.vector(f"{what}: inertia", inertia, 6)
+    center = check.vector(f"{what}: center_of_mass", center_of_mass) \
+        if len(center_of_mass) else np.zeros(3)
+    matrix = np.array([[i[0], i[3], i[4]], [i[3], i[1], i[5]], [i[4], i[5], i[2]]])
+    return bodies.mass_from_parameters(mass, center.tolist(), matrix)
+
+
 def _centred(what: str, dmass) -> np.ndarray:
     """Moves ``dmass`` to its centre of mass, checks it; returns the centre (object frame)."""
     com = bodies.mass_center(dmass)
@@ -101,15 +116,10 @@ def prepare_object(spec: ObjectSpec) -> _Prepared:
     position = check.vector(f"{what}: position", spec.position)
     orientation = check.quaternion(f"{what}: orientation", spec.orientation)
     fixed = check.flag(f"{what}: fixed", spec.fixed)
-    inertia = check.vector(f"{what}: inertia", spec.inertia, 6) if len(spec.inertia) else None
+    given = _given_mass(what, mass, spec.inertia, spec.center_of_mass)
     dmass, com = None, np.zeros(3)
     if not geometry_only:
-        if inertia is not None:   # about the object's origin: the centre of mass is there
-            i = inertia
-            matrix = np.array([[i[0], i[3], i[4]], [i[3], i[1], i[5]], [i[4], i[5], i[2]]])
-            dmass = bodies.mass_from_parameters(mass, (0.0, 0.0, 0.0), matrix)
-        else:
-            dmass = shape_mass(what, part.shape, mass)
+        dmass = given if given is not None else shape_mass(what, part.shape, mass)
         com = _centred(what, dmass)
     return _Prepared(spec, name, [part], position, orientation, fixed, geometry_only,
                      no_collisions, dmass, com)
@@ -139,11 +149,16 @@ def prepare_composite(spec: CompositeSpec) -> _Prepared:
     geometry_only = check.flag("composite geometry_only", spec.geometry_only)
     no_collisions = check.flag("composite no_collisions", spec.no_collisions)
     dmass, com = None, np.zeros(3)
+    given = _given_mass(what, sum(part.mass for part in parts), spec.inertia,
+                        spec.center_of_mass)
     if not geometry_only:
-        dmass = bodies.zero_mass()
-        for part in parts:
-            bodies.add_mass(dmass, shape_mass(f"part {part.name!r}", part.shape, part.mass),
-                            part.position.tolist(), part.orientation.tolist())
+        dmass = given
+        if dmass is None:
+            dmass = bodies.zero_mass()
+            for part in parts:
+                bodies.add_mass(dmass, shape_mass(f"part {part.name!r}", part.shape,
+                                                  part.mass),
+                                part.position.tolist(), part.orientation.tolist())
         com = _centred(f"object {object_id!r}", dmass)
     return _Prepared(spec, object_id, parts, position, orientation, fixed, geometry_only,
                      no_collisions, dmass, com)

@@ -1,17 +1,51 @@
-"""Kautham's control sets: the ``<ControlSet>`` of a .rob file and the current ``.cntr`` files.
+"""Kautham's controls: reading ``<ControlSet>`` (a .rob's, or a current ``.cntr`` file) and
+mapping a control vector to a robot's configuration as Kautham does.
 
     <ControlSet> <Offset><DOF name value/>...</Offset>
                  <Control name eigValue><DOF name value/>...</Control>... </ControlSet>
 
-DOF names are joint names, in ``.cntr`` files prefixed by the robot's name ("TX90/link_1").
-Odin uses the control set only to describe a robot; paths give joint values directly.
+DOF names are the robot's link names, and X, Y, Z (the base's position) and X1, X2, X3 (its
+orientation); in ``.cntr`` files they are prefixed by the robot's name ("TX90/link_1"), in a
+.rob bare ("Shoulder").
+
+The mapping (Kautham's ``Robot::control2Parameters``, ``Robot::parameter2Pose``,
+``Robot::deNormalizeSE3``, ``Link::parameter2Value``), for a control vector c in [0, 1]^k:
+
+    p_dof = offset_dof + sum_k eigValue_k value_{dof,k} (c_k - 0.5)
+
+with offset 0.5 for every DOF the file does not list; each p is then clamped to [0, 1] (the
+controls are within bounds when no clamp was needed). Then, through the robot's limits:
+
+- a joint: q = low + p (high - low) (continuous joints: [-2 pi, 2 pi], Kautham's);
+- the base, only when the control set names one of X..X3 for the robot (otherwise the base
+  stays at Home): its position, in the Home frame, is low_H + p (high_H - low_H) per axis, the
+  ``<Limits>`` box (world frame) taken into the Home frame corner by corner (an axis whose two
+  corners agree maps to 0); its orientation is the unit quaternion of Kuffner's uniform
+  sampling, x = sqrt(p_X1) sin(2 pi p_X2), y = sqrt(p_X1) cos(2 pi p_X2),
+  z = sqrt(1 - p_X1) sin(pi p_X3), w = sqrt(1 - p_X1) cos(pi p_X3), also in the Home frame; the
+  world pose is Home times that.
 """
 from __future__ import annotations
 
+import math
 import pathlib
+from dataclasses import dataclass
+from typing import Optional, Sequence, Tuple
+
+import numpy as np
 
 from gui.core.kautham.xmlfile import Node, read_xml
-from gui.core.model import ControlSet
+from gui.core.kinematics import translation
+from gui.core.model import Configuration, Control, ControlSet, Instance
+from gui.errors import ProblemError
+from odin_common.rotations import quaternion_to_matrix
+
+BASE_DOFS = ("X", "Y", "Z", "X1", "X2", "X3")
+"""The base's DOFs in Kautham's order: position in the Home frame, then Kuffner's three."""
+OFFSET_DEFAULT = 0.5
+"""Kautham's offset of a DOF the control set does not list."""
+CONTINUOUS_LIMITS = (-2.0 * math.pi, 2.0 * math.pi)
+"""rad: the range Kautham gives a URDF continuous joint."""
 
 
 def parse_control_set(node: Node) -> ControlSet:
@@ -19,12 +53,14 @@ def parse_control_set(node: Node) -> ControlSet:
     off = node.find("Offset")
     if off is not None:
         for dof in off.findall("DOF"):
-            offset[dof.require("name")] = dof.number("value")
+            offset[dof.require("name").strip()] = dof.number("value")
     controls = []
     for control in node.findall("Control"):
-        values = {dof.require("name"): dof.number("value") for dof in control.findall("DOF")}
-        controls.append((control.get("name", ""), values))
-    return ControlSet(offset=offset, controls=controls, source=node.path)
+        values = {dof.require("name").strip(): dof.number("value")
+                  for dof in control.findall("DOF")}
+        controls.append(Control(control.get("name", ""), control.number("eigValue", 1.0),
+                                values, control.line))
+    return ControlSet(offset=offset, controls=controls, source=node.path, line=node.line)
 
 
 def read_cntr(path: pathlib.Path) -> ControlSet:
@@ -32,3 +68,151 @@ def read_cntr(path: pathlib.Path) -> ControlSet:
     if root.tag != "ControlSet":
         raise root.error(f"expected a <ControlSet> element, found <{root.tag}>")
     return parse_control_set(root)
+
+
+@dataclass(frozen=True, eq=False)
+class ControlMap:
+    """One robot's share of a control set: ``dofs`` (BASE_DOFS, then the robot's non-base
+    links by name), ``offset`` (n_dofs,), ``matrix`` (n_dofs, k) with eigValue applied, and
+    ``se3``: the set moves the base. ``names``: the k controls' names, the set's order."""
+    robot: str
+    names: Tuple[str, ...]
+    dofs: Tuple[str, ...]
+    offset: np.ndarray
+    matrix: np.ndarray
+    se3: bool
+    source: str = ""
+
+    @property
+    def size(self) -> int:
+        """k, the number of controls."""
+        return len(self.names)
+
+    def moved_base_axes(self) -> Tuple[int, ...]:
+        """Indices 0..2 (X, Y, Z) of the base position DOFs some control moves."""
+        return tuple(i for i in range(3) if np.any(self.matrix[i] != 0.0))
+
+    def parameters(self, controls: Sequence[float]) -> Tuple[np.ndarray, bool]:
+        """Normalised DOF values p (n_dofs,) in [0, 1] for controls c (k,), and whether they
+        were within bounds before clamping (Kautham's answer)."""
+        c = np.asarray(controls, dtype=float)
+        if c.shape != (self.size,):
+            raise ValueError(f"{self.robot}: {self.size} controls expected, got {c.size}")
+        p = self.offset + self.matrix @ (c - 0.5)
+        within = bool(np.all((p >= 0.0) & (p <= 1.0)))
+        return np.clip(p, 0.0, 1.0), within
+
+    def configuration(self, instance: Instance, controls: Sequence[float]) -> Configuration:
+        """The configuration controls c put ``instance`` in (module docstring)."""
+        p, _ = self.parameters(controls)
+        model = instance.model
+        index = {name: i for i, name in enumerate(self.dofs)}
+        joints = []
+        for i in model.movable_links():
+            link = model.links[i]
+            low, high = joint_limits(link)
+            joints.append(low + p[index[link.name]] * (high - low))
+        base = instance.base_pose
+        if self.se3:
+            base = base_pose(instance.base_pose, instance.limits, p[:6])
+        return Configuration(base, np.array(joints, dtype=float),
+                             tuple(float(v) for v in controls))
+
+
+def joint_limits(link) -> Tuple[float, float]:
+    """(low, high) the controls map a joint's [0, 1] onto (rad or m)."""
+    if link.limits is not None:
+        return link.limits
+    if link.continuous or link.joint == "revolute":
+        return CONTINUOUS_LIMITS
+    raise ProblemError(f"joint \"{link.name}\" has no limits for the controls to map onto",
+                       link.source, link.line)
+
+
+def home_frame_limits(home: np.ndarray, limits: dict) -> np.ndarray:
+    """(3, 2): the base's position limits in the Home frame, per axis (low, high), as
+    Kautham's ``Robot::recalculateHomeLimits`` makes them (limits not given are 0)."""
+    low_w = np.array([limits.get(a, (0.0, 0.0))[0] for a in "XYZ"], dtype=float)
+    high_w = np.array([limits.get(a, (0.0, 0.0))[1] for a in "XYZ"], dtype=float)
+    inverse = np.linalg.inv(home)
+    low_h = inverse[:3, :3] @ low_w + inverse[:3, 3]
+    high_h = inverse[:3, :3] @ high_w + inverse[:3, 3]
+    out = np.stack([low_h, high_h], axis=1)
+    out[low_h == high_h] = 0.0
+    return out
+
+
+def kuffner_quaternion(p1: float, p2: float, p3: float) -> Tuple[float, float, float, float]:
+    """(w, x, y, z) of Kautham's ``SE3Conf::setCoordinates`` from three values in [0, 1]."""
+    r1, r2 = math.sqrt(p1), math.sqrt(1.0 - p1)
+    theta1, theta2 = 2.0 * math.pi * p2, math.pi * p3
+    return (math.cos(theta2) * r2, math.sin(theta1) * r1, math.cos(theta1) * r1,
+            math.sin(theta2) * r2)
+
+
+def base_pose(home: np.ndarray, limits: dict, p: Sequence[float]) -> np.ndarray:
+    """World pose (4, 4) of the base for its six normalised DOFs (X, Y, Z, X1, X2, X3)."""
+    box = home_frame_limits(home, limits)
+    position = box[:, 0] + np.asarray(p[:3], dtype=float) * (box[:, 1] - box[:, 0])
+    local = translation(*position)
+    local[:3, :3] = quaternion_to_matrix(kuffner_quaternion(*p[3:6]))
+    return home @ local
+
+
+def control_map(instance: Instance, control_set: ControlSet, prefixed: bool,
+                names_of_robots: Optional[Sequence[str]] = None) -> Optional[ControlMap]:
+    """``instance``'s share of ``control_set`` (None when no DOF of the set is the robot's).
+
+    ``prefixed``: DOF names are "robot/dof" (a .cntr file; a name whose robot is not among
+    ``names_of_robots`` is an error, as in Kautham), else bare (a .rob's own set). A DOF name
+    that is neither a base DOF nor a link of the robot is an error naming the file and line."""
+    model = instance.model
+    links = [link.name for link in model.links[1:]]
+    dofs = BASE_DOFS + tuple(links)
+    index = {name: i for i, name in enumerate(dofs)}
+    offset = np.full(len(dofs), OFFSET_DEFAULT)
+    matrix = np.zeros((len(dofs), len(control_set.controls)))
+    mine = False
+    se3 = False
+
+    def own(name: str, line: Optional[int]) -> Optional[int]:
+        nonlocal mine, se3
+        if prefixed:
+            robot, slash, dof = name.rpartition("/")
+            if not slash:
+                raise ProblemError(f"DOF name \"{name}\" is not \"robot/dof\"",
+                                   control_set.source, line)
+            if names_of_robots is not None and robot not in names_of_robots:
+                raise ProblemError(f"DOF \"{name}\": no robot named \"{robot}\" in the "
+                                   f"problem (robots: {', '.join(names_of_robots)})",
+                                   control_set.source, line)
+            if robot != model.name and robot != instance.name:
+                return None
+        else:
+            dof = name
+        if dof not in index:
+            raise ProblemError(f"DOF \"{name}\" is neither a base DOF ({', '.join(BASE_DOFS)}) "
+                               f"nor a link of robot \"{instance.name}\"", control_set.source,
+                               line)
+        mine = True
+        se3 = se3 or dof in BASE_DOFS
+        return index[dof]
+
+    for name, value in control_set.offset.items():
+        k = own(name, control_set.line)
+        if k is not None:
+            offset[k] = value
+    for column, control in enumerate(control_set.controls):
+        for name, value in control.dofs.items():
+            k = own(name, control.line)
+            if k is not None:
+                matrix[k, column] = control.eig_value * value
+    if not mine:
+        return None
+    return ControlMap(instance.name, tuple(c.name for c in control_set.controls), dofs,
+                      offset, matrix, se3, control_set.source)
+
+
+__all__ = ["BASE_DOFS", "OFFSET_DEFAULT", "CONTINUOUS_LIMITS", "parse_control_set",
+           "read_cntr", "ControlMap", "joint_limits", "home_frame_limits",
+           "kuffner_quaternion", "base_pose", "control_map"]

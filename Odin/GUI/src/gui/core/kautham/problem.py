@@ -3,43 +3,94 @@
 2012 format (the thesis's)::
 
     <Problem> <Robot robot="x.rob|x.iv" scale> <Home X Y Z WX WY WZ TH/> <Limits/>... </Robot>
-              <Scene scene="x.iv|x.wrl|x.rob" scale> <Location .../> <Collision Enable/> </Scene>
+              <Scene scene="x.iv|x.wrl|x.rob" scale movable> <Location .../>
+                     <Collision Enable/> </Scene>
               <Planner>...</Planner> </Problem>
 
-Home and Location positions are in mm and TH in degrees; a robot file that is a bare shape is a
-free-flying robot; a scene that is a .rob is a movable obstacle, any other scene a static one.
-Paths are relative to the problem file.
+Home, Location and Limits positions are in mm and TH in degrees; a robot file that is a bare
+shape is a free-flying robot; a scene that is a .rob is a movable obstacle, any other scene a
+static one, unless ``movable`` says otherwise (the thesis's ``<Scene movable="false">``). Paths
+are relative to the problem file.
 
-Current format (Kautham 5): ``<Robot robot="x.urdf|x.dh" scale>`` and
-``<Obstacle obstacle="x.urdf|x.iv" scale>``, both placed by ``<Home>`` in m and rad;
-``<Controls robot="x.cntr"/>``. Model files are looked up in a ``models`` folder beside the
-problem or any folder above it (Kautham's demos/models), then beside the problem. An obstacle
-is a movable body when its URDF gives a mass, static geometry otherwise.
+Current format (Kautham 5): ``<Robot robot="x.urdf|x.dh" scale>`` and ``<Obstacle
+obstacle="x.urdf|x.iv" scale>``, both placed by ``<Home>`` in m and rad (``<KauthamName
+name>`` renames one, ``<Collision enabled>`` turns its collisions off), ``<Controls
+robot="x.cntr"/>``, ``<InitialAttachedObstacle robot link obstacle/>``. Model files are looked
+up in a ``models`` folder beside the problem or any folder above it (Kautham's demos/models),
+then beside the problem. An obstacle is a movable body when its URDF gives a mass, static
+geometry otherwise; under one of Kautham's ODE planners (``Problem.physics``) every obstacle is
+a body, as in Kautham's ODE environment.
 
 A file is of the current format when it has ``<Obstacle>`` or ``<Controls>`` elements or a
-.urdf/.dh robot. ``<Planner>``, ``<Queries>``, ``<Limits>``, ``<InvKinematic>``, ``<Start>``
-and ``<Goal>`` are read past: Odin does not use them, and a quirk there never stops a load.
+.urdf/.dh robot.
+
+The planner and the query: ``<Planner><Parameters><Name>`` says whether Kautham simulates the
+problem (its ODE planners) and which robot kind its environment drives; its ERP, CFM, Max
+Contacts and PropagationStepSize parameters are read (``Planner.settings``). The first
+``<Query>`` (``<Init>``/``<Goal>`` control vectors, or ``<RobotControl name init goal>``) maps
+through the controls (``gui.core.kautham.controls``) to each robot's start and goal
+configuration. In a current problem a value Odin uses that is wrong is an error naming the
+file and line; in a 2012 problem the query and the planner are informational (Odin builds it at
+Home, as the thesis's Odin did) and a quirk there is listed, never an error.
+
+Everything else a problem holds that Odin does not use is listed in ``Problem.ignored`` (and
+logged once as a warning), never dropped silently.
 """
 from __future__ import annotations
 
+import logging
 import os
 import pathlib
 import re
-from typing import Optional
+from typing import List, Optional
 
 import numpy as np
 
-from gui.errors import ProblemError
-from gui.core.kautham.controls import read_cntr
+from gui.core.kautham.controls import BASE_DOFS, control_map, read_cntr
 from gui.core.kautham.robot_rob import read_dh_robot, read_shape_robot
 from gui.core.kautham.units import LEGACY, SI, Units
 from gui.core.kautham.urdf import read_urdf
-from gui.core.kautham.xmlfile import Node, read_xml
+from gui.core.kautham.xmlfile import Node, parse_number, read_xml
 from gui.core.kinematics import pose_from_axis_angle
-from gui.core.model import Instance, Problem, RobotModel
+from gui.core.model import (CAR, FIXED_BASE, FREE_BODY, MOBILE, REVOLUTE, Attachment,
+                            Control, ControlSet, Ignored, Instance, Planner, PlannerPhysics,
+                            Problem, RobotModel, warn_once)
 from gui.core.shapes import COIN_SUFFIXES, TRIMESH_SUFFIXES
+from gui.errors import ProblemError
+
+log = logging.getLogger("gui.core.kautham")
 
 _NAME_BAD = re.compile(r"[>&]")
+
+PHYSICS_PLANNERS = {
+    "KPIECE2DPlanner": FREE_BODY, "RRT2DPlanner": FREE_BODY, "Syclop2DPlanner": FREE_BODY,
+    "KnowledgeOrientedKPIECE2DPlanner": FREE_BODY,
+    "KnowledgeOrientedRRT2DPlanner": FREE_BODY,
+    "KnowledgeOrientedSyclop2DPlanner": FREE_BODY,
+    "KPIECECarPlanner": CAR, "KPIECEChainPlanner": FIXED_BASE,
+}
+"""Kautham's ODE planners and the robot kind the environment each creates drives (its
+2D environments push a free body, CarEnvironment drives a car, PlanarChainEnvironment a chain
+with a fixed base)."""
+
+PLANNER_PHYSICS = {"Error Reduction Parameter": "erp", "Constraint Force Mixing": "cfm",
+                   "Max Contacts": "max_contacts", "PropagationStepSize": "step"}
+"""The ODE planners' parameters Odin applies (PlannerPhysics field names)."""
+
+_ROBOT_CHILDREN = {
+    "home": None, "limits": None, "kauthamname": None,
+    "invkinematic": "Kautham's inverse kinematics; Odin has none of its own",
+    "weightse3": "a planner's weights of the base in distances",
+    "viewlink": "the link Kautham's view follows",
+    "constraint": "a planner's constraint on the robot",
+    "constrainedkinematic": "Kautham's constrained kinematics",
+    "start": "a 2012 base pose for the planner's query; Odin builds the robot at <Home>",
+    "goal": "a 2012 base pose for the planner's query; Odin builds the robot at <Home>",
+}
+_OBSTACLE_CHILDREN = {"home": None, "location": None, "collision": None, "kauthamname": None,
+                      "limits": "an obstacle's control limits (obstacle controls are not "
+                                "used)"}
+_CAR_WHEELS = 3      # a car has at least this many wheels
 
 
 def load_problem(path: os.PathLike | str) -> Problem:
@@ -54,26 +105,10 @@ def load_problem(path: os.PathLike | str) -> Problem:
     current = any(True for _ in root.findall("Obstacle")) or root.find("Controls") is not None \
         or any(pathlib.PurePath(r.get("robot") or "").suffix.lower() in (".urdf", ".dh")
                for r in root.findall("Robot"))
-    units = SI if current else LEGACY
-    names = _Names()
-    instances: list[Instance] = []
-    robots = []
-    for node in root.children:
-        tag = node.tag.lower()
-        if tag == "robot":
-            inst = _robot(node, path, units, current, names)
-            robots.append(inst)
-            instances.append(inst)
-        elif tag == "scene":
-            instances.append(_obstacle(node, "scene", "Location", path, units, current, names))
-        elif tag == "obstacle":
-            instances.append(_obstacle(node, "obstacle", "Home", path, units, current, names))
-        elif tag == "controls":
-            _controls(node, path, robots, current)
-    if not robots and not instances:
-        raise root.error("has neither robots nor scene objects")
-    return Problem(source=str(path), format="current" if current else "2012",
-                   instances=instances)
+    loader = _Loader(path, root, SI if current else LEGACY, current)
+    problem = loader.load()
+    warn_once(problem.ignored, log.name)
+    return problem
 
 
 class _Names:
@@ -90,6 +125,334 @@ class _Names:
             candidate = f"{base}_{n}"
         self.used.add(candidate)
         return candidate
+
+
+class _Loader:
+    """One load: the problem's elements in file order, then controls, kinds and the query."""
+
+    def __init__(self, path: pathlib.Path, root: Node, units: Units, current: bool):
+        self.path, self.root, self.units, self.current = path, root, units, current
+        self.names = _Names()
+        self.instances: List[Instance] = []
+        self.ignored: List[Ignored] = []
+        self.cntr: Optional[ControlSet] = None
+        self.planner: Optional[Planner] = None
+        self.planner_node: Optional[Node] = None
+        self.attachment_nodes: List[Node] = []
+
+    def ignore(self, node: Node, what: str, why: str) -> None:
+        self.ignored.append(Ignored(node.path, node.line, what, why))
+
+    # -- elements ------------------------------------------------------------------------
+    def load(self) -> Problem:
+        for node in self.root.children:
+            tag = node.tag.lower()
+            if tag == "robot":
+                self.instances.append(self._robot(node))
+            elif tag == "scene":
+                self.instances.append(self._obstacle(node, "scene", "Location"))
+            elif tag == "obstacle":
+                self.instances.append(self._obstacle(node, "obstacle", "Home"))
+            elif tag == "controls":
+                self._controls(node)
+            elif tag == "planner":
+                self.planner_node = node
+            elif tag == "initialattachedobstacle":
+                self.attachment_nodes.append(node)
+            else:
+                self.ignore(node, f"<{node.tag}>", "not an element of Kautham's problems")
+        if not self.instances:
+            raise self.root.error("has neither robots nor scene objects")
+        robots = [i for i in self.instances if i.role == "robot"]
+        if self.planner_node is not None:
+            self.planner = self._planner(self.planner_node)
+        self._assign_controls(robots)
+        for robot in robots:
+            robot.kind = self._kind(robot)
+        if self.planner_node is not None:
+            self._query(self.planner_node, robots)
+        attachments = [self._attachment(node) for node in self.attachment_nodes]
+        for inst in self.instances:
+            self.ignored.extend(inst.model.ignored)
+        return Problem(source=str(self.path), format="current" if self.current else "2012",
+                       instances=self.instances, planner=self.planner,
+                       attachments=attachments, ignored=self.ignored)
+
+    def _robot(self, node: Node) -> Instance:
+        rel = node.require("robot")
+        file = _resolve(rel, node, self.path, self.current)
+        model = _read_model(file, _scale(node), self.units, node)
+        renamed = node.find("KauthamName")
+        if renamed is not None:
+            model.name = renamed.require("name").strip() or model.name
+        self._ignore_children(node, _ROBOT_CHILDREN)
+        return Instance(name=self.names.take(model.name), role="robot", model=model,
+                        base_pose=_pose(node.find("Home"), self.units), movable=True,
+                        source=str(self.path), line=node.line, limits=self._limits(node))
+
+    def _limits(self, node: Node) -> dict:
+        """{"X" | "Y" | "Z": (min, max) m}; other <Limits> (the 2012 WX..TH) are listed."""
+        out, other = {}, []
+        for lim in node.findall("Limits"):
+            name = (lim.get("name") or "").strip()
+            if name in ("X", "Y", "Z"):
+                low = lim.number("min") * self.units.length
+                high = lim.number("max") * self.units.length
+                if low > high:
+                    raise lim.error(f"min={lim.get('min')} is above max={lim.get('max')}")
+                out[name] = (low, high)
+            else:
+                other.append(lim)
+        if other:
+            self.ignore(other[0], "<Limits name=\"" + "|".join(
+                (lim.get("name") or "").strip() for lim in other) + "\">", "only the base's "
+                "X, Y and Z limits map controls (its orientation comes from X1..X3)")
+        return out
+
+    def _ignore_children(self, node: Node, known: dict) -> None:
+        for child in node.children:
+            why = known.get(child.tag.lower(), "an element Odin does not know")
+            if why is not None:
+                self.ignore(child, f"<{node.tag}> <{child.tag}>", why)
+
+    def _obstacle(self, node: Node, attr: str, pose_tag: str) -> Instance:
+        rel = node.require(attr)
+        file = _resolve(rel, node, self.path, self.current)
+        model = _read_model(file, _scale(node), self.units, node)
+        renamed = node.find("KauthamName")
+        if renamed is not None:
+            model.name = renamed.require("name").strip() or model.name
+        if model.kind == "rob":
+            movable = True               # a scene that is a robot: a movable obstacle
+        elif model.kind == "urdf":
+            movable = any(link.mass is not None for link in model.links)
+        else:
+            movable = False
+        if node.get("movable") is not None:
+            movable = node.flag("movable", movable)
+        collision = True
+        col = node.find("Collision")
+        for attribute in ("enabled", "Enable") if col is not None else ():
+            if col.get(attribute) is not None:     # current spelling, then the 2012 one
+                collision = col.flag(attribute, True)
+                break
+        pose_node = node.find(pose_tag)
+        if pose_node is None and pose_tag == "Location":
+            pose_node = node.find("Home")       # a 2012 .rob scene is placed by its <Home>
+        self._ignore_children(node, _OBSTACLE_CHILDREN)
+        return Instance(name=self.names.take(file.stem), role="obstacle", model=model,
+                        base_pose=_pose(pose_node, self.units), movable=movable,
+                        collision=collision, source=str(self.path), line=node.line)
+
+    def _controls(self, node: Node) -> None:
+        if node.get("obstacle"):
+            self.ignore(node, f"<Controls obstacle=\"{node.get('obstacle')}\">",
+                        "obstacle controls: Odin does not move obstacles by controls")
+        rel = node.get("robot")
+        if rel:
+            self.cntr = read_cntr(_resolve(rel, node, self.path, self.current))
+
+    # -- controls and kinds ---------------------------------------------------------------
+    def _assign_controls(self, robots: List[Instance]) -> None:
+        if self.cntr is not None:
+            names = [r.name for r in robots] + [r.model.name for r in robots]
+            for robot in robots:
+                robot.controls = control_map(robot, self.cntr, prefixed=True,
+                                             names_of_robots=names)
+                robot.model.controls = self.cntr
+            return
+        if self.current:
+            default = default_control_set(robots)
+            for robot in robots:
+                robot.controls = control_map(robot, default, prefixed=True)
+            return
+        for robot in robots:                 # 2012: each .rob's own set, over its controls
+            own = robot.model.controls
+            if own is not None:
+                try:
+                    robot.controls = control_map(robot, own, prefixed=False)
+                except ProblemError as error:
+                    self.ignored.append(Ignored(error.path or "", error.line,
+                                                "<ControlSet>", error.reason))
+
+    def _kind(self, robot: Instance) -> str:
+        model = robot.model
+        if len(model.links) == 1:
+            return FREE_BODY
+        planned = PHYSICS_PLANNERS.get(self.planner.name) if self.planner else None
+        if planned == CAR or is_car(model):
+            return CAR
+        if planned == FIXED_BASE:
+            return FIXED_BASE
+        if model.free_base or (robot.controls is not None and robot.controls.se3
+                               and self.current and self.cntr is not None):
+            return MOBILE
+        return FIXED_BASE
+
+    # -- the planner and the query ------------------------------------------------------------
+    def _planner(self, node: Node) -> Planner:
+        parameters = node.find("Parameters")
+        if parameters is None:
+            self.ignore(node, "<Planner>", "no <Parameters>: no planner named")
+            return Planner("", False, source=node.path, line=node.line)
+        name_node = parameters.find("Name")
+        name = name_node.text.strip() if name_node is not None else ""
+        physics = name in PHYSICS_PLANNERS
+        values, unused = {}, []
+        for parameter in parameters.findall("Parameter"):
+            pname = (parameter.get("name") or "").strip()
+            field = PLANNER_PHYSICS.get(pname) if physics else None
+            if field is None:
+                unused.append(pname)
+                continue
+            try:
+                value = parse_text_number(parameter)
+            except ProblemError:
+                if self.current:
+                    raise
+                unused.append(pname)
+                continue
+            if field == "max_contacts":
+                if value != int(value) or value < 1:
+                    raise parameter.error(f"Max Contacts {parameter.text.strip()!r} is not a "
+                                          "whole number >= 1")
+                value = int(value)
+            values[field] = value
+        if unused:
+            self.ignore(parameters, f"planner {name or '(unnamed)'} parameters "
+                        + ", ".join(f'"{u}"' for u in unused),
+                        "planning parameters: Odin simulates, it does not plan")
+        for child in parameters.children:
+            if child.tag.lower() not in ("name", "parameter"):
+                self.ignore(child, f"<Parameters> <{child.tag}>", "a planner's setting")
+        if name and not physics:
+            self.ignore(name_node, f"planner {name}", "not one of Kautham's ODE planners: "
+                        "the problem is built without Kautham's physics (no ground, "
+                        "obstacles with a mass only are bodies)")
+        return Planner(name, physics, PlannerPhysics(**values), node.path, parameters.line)
+
+    def _query(self, planner: Node, robots: List[Instance]) -> None:
+        queries = planner.find("Queries")
+        found = list(queries.findall("Query")) if queries is not None else []
+        if not found:
+            return
+        for extra in found[1:]:
+            self.ignore(extra, "a second <Query>", "the problem is built at the first query's "
+                        "start (Kautham's)")
+        try:
+            self._first_query(found[0], robots)
+        except ProblemError as error:
+            if self.current:
+                raise
+            self.ignored.append(Ignored(error.path or "", error.line, "<Query>",
+                                        f"cannot be used: {error.reason}"))
+
+    def _first_query(self, query: Node, robots: List[Instance]) -> None:
+        mapped = [r for r in robots if r.controls is not None]
+        if not mapped:
+            self.ignore(query, "<Query>", "no robot has controls to map it through")
+            return
+        size = mapped[0].controls.size
+        names = mapped[0].controls.names
+        init = goal = None
+        for child in query.children:
+            tag = child.tag.lower()
+            if tag in ("init", "goal"):
+                values = parse_text_numbers(child)
+                if len(values) != size:
+                    raise child.error(f"<{child.tag}> has {len(values)} values, the controls "
+                                      f"are {size} ({', '.join(names)})")
+                if tag == "init":
+                    init = values
+                else:
+                    goal = values
+            elif tag == "robotcontrol":
+                init, goal = self._robot_control(child, names, init, goal)
+            else:
+                self.ignore(child, f"<Query> <{child.tag}>", "obstacle controls: Odin does "
+                            "not move obstacles by controls")
+        if not self.current and len({r.controls.size for r in mapped}) > 1:
+            raise query.error("the robots' control sets differ in size")
+        for robot in mapped:
+            if init is not None:
+                robot.start = robot.controls.configuration(robot, _fill(init))
+            if goal is not None:
+                robot.goal = robot.controls.configuration(robot, _fill(goal))
+
+    def _robot_control(self, node: Node, names, init, goal):
+        name = node.require("name").strip()
+        if name not in names:
+            raise node.error(f"RobotControl \"{name}\" is not a control of the control file "
+                             f"({', '.join(names)})")
+        k = names.index(name)
+        init = list(init) if init is not None else [None] * len(names)
+        goal = list(goal) if goal is not None else [None] * len(names)
+        init[k] = node.number("init")
+        goal[k] = node.number("goal")
+        return init, goal
+
+    def _attachment(self, node: Node) -> Attachment:
+        robot_name, link_name, obstacle_name = (node.require(a).strip()
+                                                for a in ("robot", "link", "obstacle"))
+        robot = next((i for i in self.instances if i.role == "robot"
+                      and robot_name in (i.name, i.model.name)), None)
+        if robot is None:
+            raise node.error(f"no robot named \"{robot_name}\" to attach to")
+        if link_name not in [link.name for link in robot.model.links]:
+            raise node.error(f"robot \"{robot_name}\" has no link \"{link_name}\"")
+        obstacle = next((i for i in self.instances if i.role == "obstacle"
+                         and obstacle_name in (i.name, i.model.name)), None)
+        if obstacle is None:
+            raise node.error(f"no obstacle named \"{obstacle_name}\" to attach")
+        return Attachment(robot.name, link_name, obstacle.name, node.path, node.line)
+
+
+def _fill(values) -> list:
+    """A control vector from <RobotControl> elements: a control not given is 0 (Kautham's)."""
+    return [0.0 if v is None else float(v) for v in values]
+
+
+def parse_text_number(node: Node) -> float:
+    values = parse_text_numbers(node)
+    if len(values) != 1:
+        raise node.error(f"<{node.tag}> holds {len(values)} numbers, expected one")
+    return values[0]
+
+
+def parse_text_numbers(node: Node) -> list:
+    """The numbers an element's text holds (spaces between them)."""
+    return [parse_number(t, f"<{node.tag}>", node.path, node.line) for t in node.text.split()]
+
+
+def default_control_set(robots: List[Instance]) -> ControlSet:
+    """Kautham's controls when a problem names no control file (``setDefaultRobotControls``):
+    per robot, one control for each of X, Y, Z whose limits differ, X1, X2, X3 and each
+    movable joint, in that order, each moving its DOF by 1 from 0.5."""
+    controls = []
+    for robot in robots:
+        dofs = [a for a in ("X", "Y", "Z")
+                if robot.limits.get(a, (0.0, 0.0))[0] != robot.limits.get(a, (0.0, 0.0))[1]]
+        dofs += list(BASE_DOFS[3:])
+        dofs += [robot.model.links[i].name for i in robot.model.movable_links()]
+        controls += [Control(f"{robot.name}/{d}", 1.0, {f"{robot.name}/{d}": 1.0})
+                     for d in dofs]
+    return ControlSet(offset={}, controls=controls, source="(Kautham's default controls)")
+
+
+def is_car(model: RobotModel) -> bool:
+    """A base on wheels: at least three revolute joints, all on the base link, about axes
+    horizontal in the base frame, and no other movable joint."""
+    movable = model.movable_links()
+    if len(movable) < _CAR_WHEELS:
+        return False
+    for i in movable:
+        link = model.links[i]
+        if link.parent != 0 or link.joint != REVOLUTE:
+            return False
+        axis = link.pre[:3, :3] @ link.axis
+        if abs(axis[2]) > 0.1:
+            return False
+    return True
 
 
 def _resolve(rel: str, node: Node, problem: pathlib.Path, current: bool) -> pathlib.Path:
@@ -135,41 +498,5 @@ def _read_model(file: pathlib.Path, scale: float, units: Units, node: Node) -> R
     raise node.error(f"unknown kind of model file \"{file.name}\"")
 
 
-def _robot(node: Node, problem: pathlib.Path, units: Units, current: bool,
-           names: _Names) -> Instance:
-    rel = node.require("robot")
-    file = _resolve(rel, node, problem, current)
-    model = _read_model(file, _scale(node), units, node)
-    return Instance(name=names.take(model.name), role="robot", model=model,
-                    base_pose=_pose(node.find("Home"), units), movable=True,
-                    source=str(problem), line=node.line)
-
-
-def _obstacle(node: Node, attr: str, pose_tag: str, problem: pathlib.Path, units: Units,
-              current: bool, names: _Names) -> Instance:
-    rel = node.require(attr)
-    file = _resolve(rel, node, problem, current)
-    model = _read_model(file, _scale(node), units, node)
-    if model.kind == "rob":
-        movable = True               # a scene that is a robot: a movable obstacle
-    elif model.kind == "urdf":
-        movable = any(link.mass is not None for link in model.links)
-    else:
-        movable = False
-    collision = True
-    col = node.find("Collision")
-    if col is not None:
-        collision = col.flag("Enable", True)
-    return Instance(name=names.take(file.stem), role="obstacle", model=model,
-                    base_pose=_pose(node.find(pose_tag), units), movable=movable,
-                    collision=collision, source=str(problem), line=node.line)
-
-
-def _controls(node: Node, problem: pathlib.Path, robots: list, current: bool) -> None:
-    rel = node.get("robot")
-    if not rel:
-        return  # obstacle controls: Odin does not use them
-    file = _resolve(rel, node, problem, current)
-    controls = read_cntr(file)
-    if robots:
-        robots[0].model.controls = controls
+__all__ = ["load_problem", "PHYSICS_PLANNERS", "PLANNER_PHYSICS", "default_control_set",
+           "is_car", "parse_text_numbers"]

@@ -11,7 +11,11 @@
 Lengths (a, d, PreTrans X/Y/Z, prismatic limits) and the link geometry are multiplied by the
 problem's ``scale`` and the file's length unit; angles are converted to radians. A missing
 ``<Parent>`` means the previous joint (a chain); ``<Parent name="">`` the robot's base.
-``<WeightSE3>`` (planner weights) is read past.
+``<Weight>`` is a weight Kautham's planners give the joint in distances, not a mass: it is kept
+as ``LinkModel.planner_weight`` and the links get the build's default mass. ``<Weight>`` and
+``<WeightSE3>`` (planner weights) are listed in ``RobotModel.ignored``; a malformed value there
+never stops a load. ``robType="Freeflying"`` gives the robot a free base
+(``RobotModel.free_base``).
 """
 from __future__ import annotations
 
@@ -25,7 +29,7 @@ from gui.core.kautham.controls import parse_control_set
 from gui.core.kautham.units import LEGACY, SI, Units
 from gui.core.kautham.xmlfile import Node, read_xml
 from gui.core.kinematics import pose_from_axis_angle, rot_x, rot_z, translation
-from gui.core.model import FIXED, PRISMATIC, REVOLUTE, LinkModel, RobotModel
+from gui.core.model import FIXED, PRISMATIC, REVOLUTE, Ignored, LinkModel, RobotModel
 from gui.core.shapes import read_shape
 
 DH_TYPES = ("Standard", "Modified")
@@ -65,7 +69,23 @@ def read_dh_robot(path: pathlib.Path, scale: float = 1.0) -> RobotModel:
     if cs is not None:
         controls = parse_control_set(cs)
     return RobotModel(name=name, links=links, source=str(path), kind="rob", dh_type=dh_type,
-                      controls=controls)
+                      controls=controls, ignored=_planner_weights(root, joints, path),
+                      free_base=root.get("robType", "").strip().lower() == "freeflying")
+
+
+def _planner_weights(root: Node, joints: list, path: pathlib.Path) -> list:
+    """One Ignored entry per kind of planner weight the file gives."""
+    out = []
+    weights = [j.find("Weight") for j in joints if j.find("Weight") is not None]
+    if weights:
+        out.append(Ignored(str(path), weights[0].line, f"<Weight> ({len(weights)} joints)",
+                           "a planner's weight of the joint in distances, not a mass: links "
+                           "get the default mass"))
+    se3 = root.find("WeightSE3")
+    if se3 is not None:
+        out.append(Ignored(str(path), se3.line, "<WeightSE3>", "a planner's weights of the "
+                           "base in distances"))
+    return out
 
 
 def _read_link(joint: Node, k: int, links: list, index: dict, dh_type: str, units: Units,
@@ -108,12 +128,13 @@ def _read_link(joint: Node, k: int, links: list, index: dict, dh_type: str, unit
         if low > high:
             raise lim.error(f"Low={lim.get('Low')} is above Hi={lim.get('Hi')}")
         limits = (low, high)
-    mass = None
+    planner_weight = None
     weight = joint.find("Weight")
-    if weight is not None and weight.get("weight") is not None:
-        mass = weight.number("weight")
-        if mass <= 0:
-            raise weight.error(f"weight=\"{weight.get('weight')}\" must be positive")
+    if weight is not None:
+        try:
+            planner_weight = float(weight.get("weight", "").strip())
+        except ValueError:
+            planner_weight = None      # unused by Odin: a quirk there never stops a load
     parent_node = joint.find("Parent")
     if parent_node is None:
         parent = len(links) - 1 if links else None
@@ -134,7 +155,8 @@ def _read_link(joint: Node, k: int, links: list, index: dict, dh_type: str, unit
     if iv:
         shape = read_shape(path.parent / iv, length)
     return LinkModel(name=name, parent=parent, pre=pre, post=post, joint=kind,
-                     limits=limits, mass=mass, shape=shape, source=str(path), line=joint.line)
+                     limits=limits, shape=shape, source=str(path), line=joint.line,
+                     joint_name=name, planner_weight=planner_weight)
 
 
 def read_shape_robot(path: pathlib.Path, scale: float, units: Units) -> RobotModel:

@@ -1,27 +1,39 @@
 """URDF robots and obstacles (Kautham since 2021), SI units times the problem's scale.
 
-Each link's geometry is its ``<collision>`` (what the physics uses), or its ``<visual>`` when
-it has none; several geometries of a link are merged into one shape; the colour is the
-visual's material (inline ``<color>`` or a named ``<material>`` of the robot). Mesh files are
-resolved against the URDF's folder (``package://pkg/`` prefixes are dropped). Masses come from
-``<inertial><mass>``; inertias are not used (see ``gui.core.build``). Joint types: revolute and
-continuous (unlimited), prismatic, fixed; floating and planar joints are refused.
+Geometry: each link's ``<collision_checking>`` elements (Kautham's own), else its
+``<collision>`` (what the physics uses), else its ``<visual>``; several geometries of a link are
+merged into one shape; the colour is the visual's material (inline ``<color>`` or a named
+``<material>`` of the robot). Mesh files are resolved against the URDF's folder
+(``package://pkg/`` prefixes are dropped).
+
+Physics (``gui.core.model.LinkModel``): ``<inertial>`` gives the mass, the centre of mass
+frame (scaled) and the inertia tensor (times scale^2: the same mass spread over a body
+``scale`` times larger); ``<limit effort velocity>`` the joint's force and speed limits;
+``<dynamics damping friction>`` its damping and friction; ``<collision><contact_coefficients
+mu kp kd>`` (Kautham's per-link ODE contact data) and Gazebo's ``<gazebo reference="link">``
+``mu1 mu2 fdir1 kp kd`` the link's contact surface. A ``<safety_controller>`` gives the joint's
+limits, as in Kautham (its soft limits). Joint types: revolute, continuous (no limits),
+prismatic, fixed; floating and planar joints are refused. What Odin does not use
+(transmissions, mimic joints, calibration, other Gazebo settings, Kautham's joint
+``<weight>``) is listed in ``RobotModel.ignored``.
 """
 from __future__ import annotations
 
 import pathlib
-from typing import Optional
+from typing import List, Optional
 
 import numpy as np
 
-from gui.errors import ProblemError
-from gui.core.kautham.xmlfile import Node, read_xml
+from gui.core.kautham.xmlfile import Node, parse_number, read_xml
 from gui.core.kinematics import rpy_matrix
-from gui.core.model import FIXED, PRISMATIC, REVOLUTE, LinkModel, RobotModel
-from gui.core.shapes import Mesh, Primitive, Shape, read_shape
+from gui.core.model import FIXED, PRISMATIC, REVOLUTE, Ignored, Inertial, LinkModel, RobotModel
+from gui.core.shapes import Primitive, Shape, read_shape
+from odin_common.specs import WORLD_SURFACE, Surface
 
 _JOINT_KINDS = {"revolute": REVOLUTE, "continuous": REVOLUTE, "prismatic": PRISMATIC,
                 "fixed": FIXED}
+_GAZEBO_SURFACE = ("mu1", "mu2", "fdir1", "kp", "kd")
+_ROBOT_CHILDREN_USED = ("link", "joint", "material", "gazebo")
 
 
 def _origin(node: Optional[Node], scale: float) -> np.ndarray:
@@ -82,7 +94,8 @@ def _geometry(owner: Node, scale: float, urdf: pathlib.Path) -> Optional[Shape]:
 
 def _link_shape(link: Node, scale: float, urdf: pathlib.Path, materials: dict
                 ) -> Optional[Shape]:
-    owners = list(link.findall("collision")) or list(link.findall("visual"))
+    owners = list(link.findall("collision_checking")) or list(link.findall("collision")) \
+        or list(link.findall("visual"))
     shape = None
     for owner in owners:
         s = _geometry(owner, scale, urdf)
@@ -94,11 +107,132 @@ def _link_shape(link: Node, scale: float, urdf: pathlib.Path, materials: dict
     return shape
 
 
+def _inertial(link: Node, scale: float) -> Optional[Inertial]:
+    """The link's ``<inertial>`` (None without one, or with a mass that is not positive)."""
+    node = link.find("inertial")
+    if node is None or node.find("mass") is None:
+        return None
+    mass = node.find("mass").number("value")
+    if mass <= 0:
+        return None
+    tensor = None
+    inertia = node.find("inertia")
+    if inertia is not None:
+        i = {k: inertia.number(k, 0.0) for k in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")}
+        matrix = np.array([[i["ixx"], i["ixy"], i["ixz"]], [i["ixy"], i["iyy"], i["iyz"]],
+                           [i["ixz"], i["iyz"], i["izz"]]]) * scale ** 2
+        tensor = matrix if np.any(matrix != 0.0) else None
+    return Inertial(mass, _origin(node, scale), tensor)
+
+
+def _contact_surface(link: Node, gazebo: Optional[Node]) -> Surface:
+    """Kautham's ``<collision><contact_coefficients mu kp kd>``, then Gazebo's ``mu1 mu2
+    fdir1 kp kd`` for the link (Gazebo's win where both are given)."""
+    values: dict = {}
+    collision = link.find("collision")
+    coefficients = collision.find("contact_coefficients") if collision is not None else None
+    if coefficients is not None:
+        for name in ("mu", "kp", "kd"):
+            if coefficients.get(name) is not None:
+                values[name] = coefficients.number(name)
+    if gazebo is not None:
+        for name in _GAZEBO_SURFACE:
+            child = gazebo.find(name)
+            if child is None:
+                continue
+            if name == "fdir1":
+                values[name] = _text_numbers(child, 3)
+            else:
+                values["mu" if name == "mu1" else name] = _text_number(child)
+    if not values:
+        return WORLD_SURFACE
+    for name in ("mu", "mu2", "kp", "kd"):
+        if name in values and values[name] < 0:
+            raise (coefficients or gazebo).error(f"{name}={values[name]!r} is negative")
+    direction = values.get("fdir1", (1.0, 0.0, 0.0))
+    if "mu2" in values and not any(direction):
+        direction = (1.0, 0.0, 0.0)
+    stiffness = values.get("kp")
+    return Surface(friction=values.get("mu"), friction2=values.get("mu2"),
+                   friction_direction=tuple(float(v) for v in direction),
+                   stiffness=stiffness if stiffness else None,
+                   damping=values.get("kd", 0.0) if stiffness else 0.0)
+
+
+def _text_number(node: Node) -> float:
+    return parse_number(node.text, f"<{node.tag}>", node.path, node.line)
+
+
+def _text_numbers(node: Node, count: int) -> tuple:
+    parts = node.text.split()
+    if len(parts) != count:
+        raise node.error(f"<{node.tag}>{node.text.strip()}</{node.tag}> needs {count} numbers")
+    return tuple(parse_number(p, f"<{node.tag}>", node.path, node.line) for p in parts)
+
+
+def _gazebo_blocks(root: Node, link_names, path: pathlib.Path, ignored: List[Ignored]) -> dict:
+    """{link name: its <gazebo reference> block}; whatever else Gazebo blocks hold is
+    listed as ignored."""
+    blocks = {}
+    for block in root.findall("gazebo"):
+        reference = block.get("reference")
+        if reference is None or reference not in link_names:
+            ignored.append(Ignored(str(path), block.line, "<gazebo>" if reference is None else
+                                   f"<gazebo reference=\"{reference}\">",
+                                   "Gazebo settings of no link of this robot (plugins, "
+                                   "joints): Odin does not use them"))
+            continue
+        blocks[reference] = block
+        for child in block.children:
+            if child.tag.lower() not in _GAZEBO_SURFACE:
+                ignored.append(Ignored(str(path), child.line,
+                                       f"<gazebo reference=\"{reference}\"><{child.tag}>",
+                                       "Gazebo setting Odin does not use"))
+    return blocks
+
+
+def _joint_limits(joint: Node, kind: str, scale: float) -> tuple:
+    """(limits (low, high) or None, effort or None, velocity or None) of a joint."""
+    lim = joint.find("limit")
+    if lim is None or kind == FIXED:
+        return None, None, None
+    factor = scale if kind == PRISMATIC else 1.0
+    effort = lim.number("effort", 0.0)
+    velocity = lim.number("velocity", 0.0) * factor
+    if effort < 0 or velocity < 0:
+        raise lim.error("effort and velocity limits cannot be negative")
+    limits = None
+    if joint.get("type") != "continuous":
+        soft = joint.find("safety_controller")
+        if soft is not None and soft.get("soft_lower_limit") is not None:
+            low = soft.number("soft_lower_limit", 0.0)
+            high = soft.number("soft_upper_limit", 0.0)
+            where = soft
+        else:
+            low, high, where = lim.number("lower", 0.0), lim.number("upper", 0.0), lim
+        limits = (low * factor, high * factor)
+        if limits[0] > limits[1]:
+            raise where.error("lower is above upper")
+    return limits, effort or None, velocity or None
+
+
+def _joint_ignored(joint: Node, path: pathlib.Path, ignored: List[Ignored]) -> None:
+    for tag, why in (("mimic", "a mimic joint moves on its own in Odin"),
+                     ("calibration", "calibration references are not simulated"),
+                     ("weight", "Kautham's planner weight of the joint, not a physical "
+                                "quantity")):
+        node = joint.find(tag)
+        if node is not None:
+            ignored.append(Ignored(str(path), node.line,
+                                   f"<joint name=\"{joint.get('name', '')}\"><{tag}>", why))
+
+
 def read_urdf(path: pathlib.Path, scale: float = 1.0) -> RobotModel:
     root = read_xml(path, "URDF file")
     if root.tag != "robot":
         raise root.error(f"expected a <robot> element, found <{root.tag}>")
     name = root.get("name") or path.stem
+    ignored: List[Ignored] = []
     materials = {}
     for mat in root.findall("material"):
         col = mat.find("color")
@@ -112,6 +246,11 @@ def read_urdf(path: pathlib.Path, scale: float = 1.0) -> RobotModel:
         link_nodes[lname] = link
     if not link_nodes:
         raise root.error("has no <link>")
+    for child in root.children:
+        if child.tag.lower() not in _ROBOT_CHILDREN_USED:
+            ignored.append(Ignored(str(path), child.line, f"<{child.tag}>",
+                                   "not simulated by Odin (transmissions and the like)"))
+    gazebo = _gazebo_blocks(root, link_nodes, path, ignored)
     joint_of_child = {}
     for joint in root.findall("joint"):
         jtype = joint.require("type")
@@ -141,17 +280,14 @@ def read_urdf(path: pathlib.Path, scale: float = 1.0) -> RobotModel:
     links = []
     for lname in order:
         node = link_nodes[lname]
-        mass = None
-        inertial = node.find("inertial")
-        if inertial is not None and inertial.find("mass") is not None:
-            mass = inertial.find("mass").number("value")
-            if mass <= 0:
-                mass = None
-        shape = _link_shape(node, scale, path, materials)
+        inertial = _inertial(node, scale)
+        common = dict(mass=inertial.mass if inertial else None, inertial=inertial,
+                      shape=_link_shape(node, scale, path, materials),
+                      surface=_contact_surface(node, gazebo.get(lname)), source=str(path))
         joint = joint_of_child.get(lname)
         if joint is None:
             links.append(LinkModel(name=lname, parent=None, pre=np.eye(4), post=np.eye(4),
-                                   mass=mass, shape=shape, source=str(path), line=node.line))
+                                   line=node.line, **common))
             continue
         kind = _JOINT_KINDS[joint.get("type")]
         axis = np.array([1.0, 0.0, 0.0])
@@ -162,15 +298,18 @@ def read_urdf(path: pathlib.Path, scale: float = 1.0) -> RobotModel:
         if kind != FIXED and norm == 0.0:
             raise (ax or joint).error("joint axis is zero")
         axis = axis / norm if norm else np.array([1.0, 0.0, 0.0])
-        limits = None
-        lim = joint.find("limit")
-        if lim is not None and joint.get("type") != "continuous" and kind != FIXED:
-            factor = scale if kind == PRISMATIC else 1.0
-            limits = (lim.number("lower", 0.0) * factor, lim.number("upper", 0.0) * factor)
-            if limits[0] > limits[1]:
-                raise lim.error("lower is above upper")
+        limits, effort, velocity = _joint_limits(joint, kind, scale)
+        damping = friction = 0.0
+        dynamics = joint.find("dynamics")
+        if dynamics is not None and kind != FIXED:
+            damping, friction = dynamics.number("damping", 0.0), dynamics.number("friction", 0.0)
+            if damping < 0 or friction < 0:
+                raise dynamics.error("damping and friction cannot be negative")
+        _joint_ignored(joint, path, ignored)
         links.append(LinkModel(
             name=lname, parent=index[joint.find("parent").get("link")],
             pre=_origin(joint, scale), post=np.eye(4), joint=kind, axis=axis, limits=limits,
-            mass=mass, shape=shape, source=str(path), line=joint.line))
-    return RobotModel(name=name, links=links, source=str(path), kind="urdf")
+            line=joint.line, joint_name=joint.get("name", lname),
+            continuous=joint.get("type") == "continuous", effort=effort, velocity=velocity,
+            damping=damping, friction=friction, **common))
+    return RobotModel(name=name, links=links, source=str(path), kind="urdf", ignored=ignored)

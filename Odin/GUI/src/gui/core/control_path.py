@@ -1,0 +1,295 @@
+"""Control paths: rows of Kautham controls, each applied for its duration to a robot the way
+Kautham's ODE environment for that robot's kind does (ROS-free).
+
+A control path file is plain text, one control step per line: the k control values c in
+[0, 1] (the robot's controls in its control file's order), then the step's duration in
+seconds, separated by spaces, tabs or commas; blank lines and lines starting with '#' are
+skipped. A car's rows have two controls (steering, wheel speed), whatever its control file.
+
+``MAPPING`` (below) says what a row does; docs/INTERFACE.md shows it (tools/interface_doc.py).
+``run_control_path(port, handle, rows)`` applies rows through a ``ControlPort``: the world calls
+a row needs (servo targets, forces for its duration) and the state they depend on.
+``ClientPort`` is one over a ``gui.ros.client.WorldClient``: each row is one Propagate of the
+world (paused) for its duration, kept, as Kautham's propagation steps its ODE world.
+"""
+from __future__ import annotations
+
+import math
+import os
+import pathlib
+import time
+from dataclasses import dataclass, field
+from typing import Callable, Dict, List, Optional, Protocol, Sequence, Tuple
+
+import numpy as np
+
+from gui.core.kautham import environment
+from gui.core.model import CAR, FREE_BODY, MOBILE
+from gui.core.paths import read_rows
+from gui.errors import PathFileError
+from odin_common.interface import SERVO_MAX_SPEED, ForceKind
+from odin_common.rotations import quaternion_to_matrix
+
+MAPPING = """\
+A control path is a list of rows, each k control values c in [0, 1] and a duration in
+seconds (`rosrun GUI run_path PROBLEM --controls FILE`, the Motion tab's "Control path...").
+Each row maps to the robot as Kautham maps a control sample (`Robot::control2Parameters`,
+`parameter2Pose`): normalised DOF values p = offset + sum_k eigValue_k map_k (c_k - 0.5) from
+the control file (`.cntr`, or the `.rob`'s `<ControlSet>`; a DOF it does not list has offset 0.5
+and no map), each clamped to [0, 1], then through the robot's limits: a joint's value
+q = low + p (high - low) (a continuous joint's range is [-2 pi, 2 pi]); the base's position
+low + p (high - low) per axis of the problem's `<Limits>` box taken into the Home frame, and
+its orientation from X1, X2, X3 by Kuffner's uniform quaternion (w = sqrt(1 - p1) cos(pi p3),
+x = sqrt(p1) sin(2 pi p2), y = sqrt(p1) cos(2 pi p2), z = sqrt(1 - p1) sin(pi p3)), both in the
+Home frame. The query's `<Init>` and `<Goal>` map the same way to the start the problem is built
+at and the goal.
+
+For the row's duration the robot is then driven the way Kautham's ODE environment drives that
+kind of robot:
+- joints (a fixed-base chain, or a mobile robot's arm): Set Servo on each joint's motor toward
+  q (the joint's URDF velocity limit as the servo's speed limit, its effort limit as the
+  motor's force limit; Odin's servo defaults without them): Kautham's PlanarChainEnvironment
+  sets motor speeds under a torque limit, which a servo does each step;
+- a free body (Kautham's 2D environments push the robot with a force): along each base axis
+  the controls move, the constant force F = m (2 (x* - x0 - v0 d) / d^2), which would carry
+  the base (mass m, at x0 with velocity v0 when the row starts) to the row's position x* in
+  its duration d were nothing else acting, each component limited to m times
+  `ControlDefaults.max_acceleration`; the base's orientation is not driven (Kautham's
+  twoDRobotEnvironment samples the force itself, in [-20, 20] N per axis; a row here is a
+  configuration, as Kautham's control samples through the `.cntr` are, and the force the one
+  that reaches it);
+- a car (two controls, CarEnvironment's): steering angle -0.5 + c1 rad, reached by each wheel
+  hinge-2's first axis at a rate of 1/s per radian of error under 2 N m (a servo of gain 1),
+  and wheel speed -5 + 15 c2 rad/s on its second axis under 50 N m.
+
+The last row's servo settings stay in force after it (its forces act only for its duration).
+A row whose values leave [0, 1] is refused with its file and line.
+"""
+
+
+@dataclass(frozen=True)
+class ControlDefaults:
+    """``max_acceleration``: m/s^2, a free body's control force limit per kg. ``servo_gain``:
+    1/s (None: odin_common's default)."""
+    max_acceleration: float = 10.0
+    servo_gain: Optional[float] = None
+
+
+@dataclass(frozen=True)
+class ControlRow:
+    """One control step: ``controls`` (k values in [0, 1]) for ``duration`` s."""
+    controls: Tuple[float, ...]
+    duration: float
+
+
+@dataclass(frozen=True)
+class ServoCommand:
+    """Set Servo's lists, one value per motor axis (motors in order)."""
+    motors: Tuple[str, ...]
+    targets: Tuple[float, ...]
+    rates: Tuple[float, ...] = ()
+    gains: Tuple[float, ...] = ()
+    max_speeds: Tuple[float, ...] = ()
+    max_forces: Tuple[float, ...] = ()
+
+
+@dataclass(frozen=True)
+class Actuation:
+    """What one row asks of the world: a servo command (or None) and forces (body ID, (3,) N,
+    world frame) acting for ``duration`` s."""
+    duration: float
+    servo: Optional[ServoCommand] = None
+    forces: Tuple[Tuple[str, Tuple[float, float, float]], ...] = ()
+
+
+BodyState = Tuple[np.ndarray, np.ndarray, np.ndarray]
+"""(position (3,) m of the object's frame, quaternion (w, x, y, z), linear velocity (3,) m/s
+of the centre of mass), world frame."""
+
+
+class ControlPort(Protocol):
+    """What running a control path needs of the world."""
+
+    def body_state(self, body_id: str) -> BodyState: ...
+
+    def set_servo(self, command: ServoCommand) -> None: ...
+
+    def advance(self, duration: float, forces: Sequence[Tuple[str, Sequence[float]]]) -> None: ...
+
+
+def control_size(handle) -> int:
+    """How many controls a row of ``handle``'s robot has."""
+    if handle.kind == CAR:
+        return 2
+    controls = handle.instance.controls
+    if controls is None:
+        raise PathFileError(f"robot {handle.name} has no controls (no control file and no "
+                            "query to build them from)")
+    return controls.size
+
+
+def read_control_path(path: os.PathLike | str, size: int) -> List[ControlRow]:
+    """The rows of a control path file for a robot of ``size`` controls (module docstring)."""
+    p = pathlib.Path(path)
+    rows, lines = read_rows(p, size + 1, f"{size} controls and a duration")
+    out = []
+    for values, line in zip(rows, lines):
+        controls, duration = values[:size], float(values[size])
+        if not np.all((controls >= 0.0) & (controls <= 1.0)):
+            raise PathFileError(f"control values {controls.tolist()} are not all in [0, 1]",
+                                p, line)
+        if duration <= 0.0:
+            raise PathFileError(f"duration {duration:g} s is not positive (the last value of "
+                                "a row)", p, line)
+        out.append(ControlRow(tuple(float(v) for v in controls), duration))
+    return out
+
+
+def actuation(handle, row: ControlRow, state: Optional[BodyState],
+              defaults: ControlDefaults = ControlDefaults()) -> Actuation:
+    """What ``row`` asks of the world for ``handle``'s robot; ``state``: its base body's when
+    the row starts (needed for a free base)."""
+    if handle.kind == CAR:
+        return Actuation(row.duration, servo=_car_servo(handle, row.controls))
+    controls = handle.instance.controls
+    target = controls.configuration(handle.instance, row.controls)
+    servo = _joint_servo(handle, target.joints, defaults) if handle.motor_ids else None
+    forces = ()
+    if handle.kind in (FREE_BODY, MOBILE) and controls.se3 and controls.moved_base_axes():
+        forces = (_base_force(handle, target.base_pose, state, row.duration,
+                              controls.moved_base_axes(), defaults),)
+    return Actuation(row.duration, servo, forces)
+
+
+def _joint_servo(handle, targets: np.ndarray, defaults: ControlDefaults) -> ServoCommand:
+    relative = np.asarray(targets, dtype=float) - handle.built_at
+    speeds = tuple(float(v) if v else SERVO_MAX_SPEED for v in handle.max_speeds)
+    gains = (defaults.servo_gain,) * len(relative) if defaults.servo_gain else ()
+    return ServoCommand(tuple(handle.motor_ids), tuple(float(v) for v in relative),
+                        gains=gains, max_speeds=speeds)
+
+
+def _car_servo(handle, controls: Sequence[float]) -> ServoCommand:
+    low, high = environment.STEERING_RANGE
+    turn = low + controls[0] * (high - low)
+    low, high = environment.WHEEL_SPEED_RANGE
+    speed = low + controls[1] * (high - low)
+    wheels = len(handle.motor_ids)
+    low, high = environment.STEERING_RANGE      # the steering error is never above this:
+    steer_speed = environment.STEERING_GAIN * (high - low)   # the rate is never capped
+    return ServoCommand(
+        tuple(handle.motor_ids), (turn, 0.0) * wheels, rates=(0.0, speed) * wheels,
+        gains=(environment.STEERING_GAIN, 0.0) * wheels,
+        max_speeds=(steer_speed, abs(speed)) * wheels,
+        max_forces=(environment.STEERING_MAX_TORQUE, environment.WHEEL_MAX_TORQUE) * wheels)
+
+
+def _base_force(handle, target_pose: np.ndarray, state: Optional[BodyState], duration: float,
+                axes: Sequence[int], defaults: ControlDefaults) -> Tuple[str, tuple]:
+    if state is None:
+        raise ValueError(f"{handle.name}: a free base needs its state to be driven")
+    position, quaternion, velocity = state
+    body = handle.bodies[0]
+    pose = np.eye(4)
+    pose[:3, :3] = quaternion_to_matrix(quaternion)
+    pose[:3, 3] = position
+    base = (pose @ np.linalg.inv(body.offset))[:3, 3]        # the base link's origin
+    mass = handle.base_mass
+    force = np.zeros(3)
+    limit = mass * defaults.max_acceleration
+    for i in axes:
+        wanted = mass * 2.0 * (target_pose[i, 3] - base[i] - velocity[i] * duration) \
+            / duration ** 2
+        force[i] = max(-limit, min(limit, wanted))
+    return body.body_id, tuple(float(v) for v in force)
+
+
+@dataclass
+class RowResult:
+    """After one row: its index, the base's position (m, world) and the actuation used."""
+    index: int
+    base_position: np.ndarray
+    actuation: Actuation
+
+
+def run_control_path(port: ControlPort, handle, rows: Sequence[ControlRow],
+                     defaults: ControlDefaults = ControlDefaults(),
+                     progress: Optional[Callable[[RowResult], None]] = None) -> List[RowResult]:
+    """Applies ``rows`` in order to ``handle``'s robot through ``port``; returns the base's
+    position after each row."""
+    size = control_size(handle)
+    for k, row in enumerate(rows, start=1):
+        if len(row.controls) != size:
+            raise PathFileError(f"row {k} has {len(row.controls)} controls, robot "
+                                f"{handle.name} takes {size}")
+    base_id = handle.bodies[0].body_id
+    results = []
+    for k, row in enumerate(rows, start=1):
+        state = port.body_state(base_id)
+        act = actuation(handle, row, state, defaults)
+        if act.servo is not None:
+            port.set_servo(act.servo)
+        port.advance(row.duration, act.forces)
+        result = RowResult(k, port.body_state(base_id)[0], act)
+        results.append(result)
+        if progress is not None:
+            progress(result)
+    return results
+
+
+@dataclass
+class ClientPort:
+    """A ControlPort over a ``gui.ros.client.WorldClient``: each row is one Propagate, kept
+    (the world must be paused: ``run_on_client`` pauses it). ``real_time``: each row takes at
+    least its duration of wall-clock time, so that a Viewer shows the motion at its pace."""
+    client: object
+    real_time: bool = True
+    sleep: Callable[[float], None] = time.sleep
+    _states: Dict[str, BodyState] = field(default_factory=dict)
+
+    def body_state(self, body_id: str) -> BodyState:
+        if body_id not in self._states:
+            # Set Servo and Get State have no typed method on WorldClient yet: call() takes the
+            # request's fields (plain lists) and answers the response
+            response = self.client.call("get_state", objects=[body_id])
+            b = response.bodies[0]
+            self._states[body_id] = (np.array(b.position), np.array(b.orientation),
+                                     np.array(b.linear))
+        return self._states[body_id]
+
+    def set_servo(self, command: ServoCommand) -> None:
+        self.client.call("set_servo", motors=list(command.motors),
+                         targets=list(command.targets), rates=list(command.rates),
+                         gains=list(command.gains), max_speeds=list(command.max_speeds),
+                         max_forces=list(command.max_forces))
+
+    def advance(self, duration: float, forces) -> None:
+        started = time.monotonic()
+        result = self.client.propagate(duration, forces=[
+            dict(object_id=body, kind=ForceKind.FORCE, vector=list(vector))
+            for body, vector in forces], keep=True)
+        self._states = {i: (np.array(p), np.array(q), np.array(v))
+                        for i, (p, q, v, _) in result.states.items()}
+        if self.real_time:
+            self.sleep(max(0.0, duration - (time.monotonic() - started)))
+
+
+def run_on_client(client, handle, rows: Sequence[ControlRow], real_time: bool = True,
+                  progress: Optional[Callable[[RowResult], None]] = None,
+                  sleep: Callable[[float], None] = time.sleep) -> List[RowResult]:
+    """``run_control_path`` through a ``ClientPort``, the world paused meanwhile (and running
+    again afterwards if it was)."""
+    running = client.world().simulating
+    if running:
+        client.pause()
+    try:
+        return run_control_path(ClientPort(client, real_time, sleep), handle, rows,
+                                progress=progress)
+    finally:
+        if running:
+            client.start()
+
+
+__all__ = ["MAPPING", "ControlDefaults", "ControlRow", "ServoCommand", "Actuation",
+           "ControlPort", "control_size", "read_control_path", "actuation",
+           "run_control_path", "RowResult", "ClientPort", "run_on_client"]
