@@ -56,6 +56,8 @@ void dWorldSetMaxAngularSpeed(dWorldID w, dReal max_speed);
 
 /* spaces and joint groups */
 dSpaceID dHashSpaceCreate(dSpaceID space);
+dSpaceID dSweepAndPruneSpaceCreate(dSpaceID space, int axisorder);
+#define dSAP_AXES_XYZ 36
 void dSpaceDestroy(dSpaceID);
 void dSpaceSetCleanup(dSpaceID space, int mode);
 int dSpaceGetNumGeoms(dSpaceID);

@@ -262,7 +262,7 @@ static void read_contact_forces(OdinWorld *w) {
 }
 
 /* Creates the pass's contact joints, pair by pair in serial order: the same scene gives the
- * same constraints in the same order, whatever order the hash space found the pairs in. While
+ * same constraints in the same order, whatever order the broad phase found the pairs in. While
  * recording, the contacts of recorded pairs get joint feedback (read_contact_forces). */
 static void make_contacts(OdinWorld *w, double h) {
     if (!w->unordered && w->n_pairs > 1) sort_pairs(w);
