@@ -252,7 +252,7 @@ void dJointSetAMotorAxis(dJointID, int anum, int rel, dReal x, dReal y, dReal z)
 void dJointSetLMotorNumAxes(dJointID, int num);
 void dJointSetLMotorAxis(dJointID, int anum, int rel, dReal x, dReal y, dReal z);
 
-/* Category and collide bits (the hash space skips pairs whose bits do not meet). */
+/* Category and collide bits (the space skips pairs whose bits do not meet). */
 void dGeomSetCategoryBits(dGeomID, unsigned long bits);
 unsigned long dGeomGetCategoryBits(dGeomID);
 void dGeomSetCollideBits(dGeomID, unsigned long bits);

@@ -1,4 +1,4 @@
-/* Odin's per-step hot work in C (see odin_step.h): the hash-space near-callback with contact
+/* Odin's per-step hot work in C (see odin_step.h): the broad phase's near-callback with contact
  * creation and pair recording, persistent forces, joint forces and motor goals, the step loop,
  * the vectorised pose read-out and ODE's message routing. */
 #include "odin_step.h"

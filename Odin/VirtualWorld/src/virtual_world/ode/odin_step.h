@@ -1,8 +1,9 @@
 /* Odin's per-step C code, compiled into the _odin_ode extension.
  *
  * One OdinWorld (allocated by Python with ffi.new, so Python owns its memory) gathers what the
- * hot loop needs: the ODE world, space (broad phase) and contact group, the contact settings, and arrays
- * of persistent body forces, joint forces and motor goals that Python rebuilds when they change.
+ * hot loop needs: the ODE world, space (broad phase) and contact group, the contact settings,
+ * and arrays of persistent body forces, joint forces and motor goals that Python rebuilds when
+ * they change.
  * odin_world_step() runs the whole count-loop (collide, forces, motors, step, empty contacts) in
  * C; nothing is created or destroyed in it except contact joints in the contact group.
  * The only memory this file allocates is the collision-record buffer (odin_world_free_buffers).

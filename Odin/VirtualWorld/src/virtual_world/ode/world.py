@@ -1,5 +1,5 @@
-"""One ODE world as odin_step.c runs it: the world, its space (sweep and prune) and contact group, the
-contact settings, and the arrays of persistent actions the C step loop applies.
+"""One ODE world as odin_step.c runs it: the world, its space (sweep and prune) and contact
+group, the contact settings, and the arrays of persistent actions the C step loop applies.
 
 ``CWorld`` owns an ``OdinWorld`` struct (memory Python's, allocated with ffi.new) and the three
 scene handles; the arrays of body forces, joint forces and motor goals are rebuilt from plain
