@@ -17,7 +17,7 @@ round, and a round's ratio is Odin's steps/s over the best peer's in that round.
                             does (native/rest_scene.c), run in the same rounds
   per_body_us_rest<N>_<engine>  the per-body step cost (µs) behind the plot
 The rounds' numbers go to out_dir/peers.json, and peers/plot.py draws per-body cost against
-body count for all four (out_dir/peers_scaling.png; docs/peers_scaling.png is a copy).
+body count for all four (out_dir/peers_scaling.png; docs/images/peers_scaling.png is a copy).
 ODIN_BENCH_ROUNDS sets the rounds (default 5; the 10,000-body scene runs at most 2: MuJoCo
 compiles it in over a minute).
 """
