@@ -3,7 +3,7 @@ SHELL := /bin/bash
 ROOT  := $(CURDIR)
 ENV   := set -eo pipefail; source $(ROOT)/setup.bash;
 
-.PHONY: setup build demo test bench experiments lint mutants clean
+.PHONY: setup bench-setup build demo test bench experiments lint mutants clean
 
 setup:
 	@tools/install.sh
@@ -19,7 +19,11 @@ demo: setup
 test: setup
 	@$(ENV) python -m pytest -p no:cacheprovider
 
-bench: setup
+# the peer engines (MuJoCo, PyBullet) in their own venv, .venv-bench: benchmarks only
+bench-setup:
+	@tools/install.sh --bench
+
+bench: setup bench-setup
 	@$(ENV) python tools/bench/run.py
 
 experiments: setup

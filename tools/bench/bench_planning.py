@@ -3,7 +3,7 @@
   determinism_cost_ratio    what ordering contacts costs (deterministic stepping): steps per
                             second of a 100-sphere pile in four walls with contacts made in
                             the geoms' creation order, over the same without the ordering
-                            (the hash space's order, as before; a benchmark-only switch of the
+                            (the broad phase's order, as before; a benchmark-only switch of the
                             C world). Paired rounds, the order alternated, median of the
                             ratios; each side in a process of its own. Goal >= 0.95.
   pool_propagate_speedup_2  throughput of a pool of 2 world nodes over a pool of 1 (this

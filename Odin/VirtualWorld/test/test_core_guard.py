@@ -1,5 +1,5 @@
 """The divergence guard and the sane ranges of requests: no input may bring ODE to a state that
-ends the process (a body whose bounds overflow the hash space makes ODE abort in collide()).
+ends the process (a body whose bounds overflow ODE's broad phase makes ODE abort in collide()).
 A body that goes wrong anyway is parked after the step that broke a bound, reported once, and
 the world goes on."""
 import math

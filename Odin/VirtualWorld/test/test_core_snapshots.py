@@ -58,7 +58,7 @@ def test_the_same_pile_is_bit_identical_after_new_scene_cycles(core):
     pile(core)
     core.step(H, 1500)
     first = state_bytes(core)
-    for k in range(3):   # other scenes in between: other memory, other hash-space order
+    for k in range(3):   # other scenes in between: other memory, other broad-phase order
         core.new_scene()
         core.build_object(ObjectSpec(f"junk{k}", [0.3], position=(5, 5, 5)))
         pile(core, n=20 + k)

@@ -1,6 +1,7 @@
 /* Native baseline for bench_core.py: the same scene and step loop as the Odin Core, in plain C
- * over libode. Usage: core_scene MODE STEPS NFORCES NMOTORS [CHECKPOINT...] (MODE 0 spheres on a
- * plane, 1 pile inside four walls). Prints the seconds spent in the step loop and the last
+ * over libode (the same broad phase, contacts made in the same order: ordered_contacts.h).
+ * Usage: core_scene MODE STEPS NFORCES NMOTORS [CHECKPOINT...] (MODE 0 spheres on a plane,
+ * 1 pile inside four walls). Prints the seconds spent in the step loop and the last
  * step's contacts on one line, then the final pose of each of the 100 bodies, one a line:
  * x y z qw qx qy qz (%.17g, which reads back as the same double), for bench_core.py and
  * bench_portal.py to compare with Odin's. Before that, after each CHECKPOINT-th step, a line
@@ -12,28 +13,11 @@
 #include <stdlib.h>
 #include <time.h>
 
+#include "ordered_contacts.h"
+
 static dWorldID world;
 static dJointGroupID group;
 static int contacts_last;
-
-static void near_cb(void *data, dGeomID o1, dGeomID o2) {
-    (void)data;
-    long t1 = (long)(intptr_t)dGeomGetData(o1);
-    if (t1 && t1 == (long)(intptr_t)dGeomGetData(o2)) return;
-    dBodyID b1 = dGeomGetBody(o1), b2 = dGeomGetBody(o2);
-    if (b1 == b2) return;
-    if (b1 && b2 && dAreConnectedExcluding(b1, b2, dJointTypeContact)) return;
-    dContact c[3];
-    int n = dCollide(o1, o2, 3, &c[0].geom, sizeof(dContact));
-    for (int i = 0; i < n; ++i) {
-        c[i].surface.mode = dContactApprox1;
-        c[i].surface.mu = 1.0;
-        c[i].surface.bounce = 0;
-        c[i].surface.bounce_vel = 0.1;
-        dJointAttach(dJointCreateContact(world, group, &c[i]), b1, b2);
-    }
-    contacts_last += n > 0 ? n : 0;
-}
 
 static void print_poses(dBodyID *bodies) {
     for (int i = 0; i < 100; ++i) {
@@ -44,6 +28,7 @@ static void print_poses(dBodyID *bodies) {
 
 static void wall(dSpaceID space, double x, double y, double z, double lx, double ly, double lz) {
     dGeomID g = dCreateBox(space, lx, ly, lz);
+    number_geom(g);
     dGeomSetPosition(g, x, y, z);
 }
 
@@ -52,7 +37,7 @@ int main(int argc, char **argv) {
     int mode = atoi(argv[1]), steps = atoi(argv[2]), nforces = atoi(argv[3]), nmotors = atoi(argv[4]);
     dInitODE2(0);
     world = dWorldCreate();
-    dSpaceID space = dHashSpaceCreate(0);
+    dSpaceID space = odin_space();
     group = dJointGroupCreate(0);
     dWorldSetGravity(world, 0, 0, -9.81);
     dWorldSetERP(world, 0.2);
@@ -79,6 +64,7 @@ int main(int argc, char **argv) {
         dBodySetMass(b, &m);
         dBodySetPosition(b, x, y, z);
         dGeomID g = dCreateSphere(space, 0.1);
+        number_geom(g);
         dGeomSetBody(g, b);
         bodies[i] = b;
     }
@@ -95,8 +81,7 @@ int main(int argc, char **argv) {
     struct timespec t0, t1;
     clock_gettime(CLOCK_MONOTONIC, &t0);
     for (int s = 0; s < steps; ++s) {
-        contacts_last = 0;
-        dSpaceCollide(space, 0, &near_cb);
+        contacts_last = collide_in_order(world, space, group);
         for (int i = 0; i < nforces; ++i) dBodyAddForce(bodies[i % 100], 0.0, 0.0, 0.5);
         for (int i = 0; i < nmotors; ++i) dJointSetAMotorParam(motors[i], dParamVel, 0.5);
         dWorldQuickStep(world, 0.001);

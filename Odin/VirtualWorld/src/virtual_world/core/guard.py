@@ -1,6 +1,6 @@
 """The divergence guard's Python side: which bodies C checks after every step (the dynamic
 ones not parked), and what it found (odin_step.c parks a body that went wrong before ODE's
-collision code can see it: a body whose bounds overflow the hash space makes ODE end the
+collision code can see it: a body whose bounds overflow ODE's broad phase makes ODE end the
 process).
 
 A divergence is reported once, as a Divergence: the object, why (not finite, too fast,

@@ -219,7 +219,7 @@ def build(scene: Scene, prepared: _Prepared, tag: int = 0) -> Built:
         obj.geometries.append(_build_geometry(scene, p, part, body, tag))
     scene.objects[p.object_id] = obj
     if body is not None and not p.fixed:
-        guard.refresh(scene)
+        scene.c.add_guarded(body.ptr)
     drain_messages()
     return Built(p.object_id, _built_geometries(obj.geometries))
 

@@ -177,7 +177,7 @@ def set_geom_tag(geom_owner, tag: int) -> None:
 
 
 def exclude_from_collisions(geom) -> None:
-    """The hash space never pairs a geom whose category and collide bits are all clear."""
+    """The space never pairs a geom whose category and collide bits are all clear."""
     lib.dGeomSetCategoryBits(geom, 0)
     lib.dGeomSetCollideBits(geom, 0)
 

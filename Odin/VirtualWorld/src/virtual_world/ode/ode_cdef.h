@@ -56,6 +56,8 @@ void dWorldSetMaxAngularSpeed(dWorldID w, dReal max_speed);
 
 /* spaces and joint groups */
 dSpaceID dHashSpaceCreate(dSpaceID space);
+dSpaceID dSweepAndPruneSpaceCreate(dSpaceID space, int axisorder);
+#define dSAP_AXES_XYZ 36
 void dSpaceAdd(dSpaceID, dGeomID);
 void dSpaceRemove(dSpaceID, dGeomID);
 void dSpaceDestroy(dSpaceID);
@@ -252,7 +254,7 @@ void dJointSetAMotorAxis(dJointID, int anum, int rel, dReal x, dReal y, dReal z)
 void dJointSetLMotorNumAxes(dJointID, int num);
 void dJointSetLMotorAxis(dJointID, int anum, int rel, dReal x, dReal y, dReal z);
 
-/* Category and collide bits (the hash space skips pairs whose bits do not meet). */
+/* Category and collide bits (the space skips pairs whose bits do not meet). */
 void dGeomSetCategoryBits(dGeomID, unsigned long bits);
 unsigned long dGeomGetCategoryBits(dGeomID);
 void dGeomSetCollideBits(dGeomID, unsigned long bits);

@@ -1,4 +1,4 @@
-/* Odin's per-step hot work in C (see odin_step.h): the hash-space near-callback with contact
+/* Odin's per-step hot work in C (see odin_step.h): the broad phase's near-callback with contact
  * creation and pair recording, persistent forces, joint forces and motor goals, the step loop,
  * the vectorised pose read-out and ODE's message routing. */
 #include "odin_step.h"
@@ -262,7 +262,7 @@ static void read_contact_forces(OdinWorld *w) {
 }
 
 /* Creates the pass's contact joints, pair by pair in serial order: the same scene gives the
- * same constraints in the same order, whatever order the hash space found the pairs in. While
+ * same constraints in the same order, whatever order the broad phase found the pairs in. While
  * recording, the contacts of recorded pairs get joint feedback (read_contact_forces). */
 static void make_contacts(OdinWorld *w, double h) {
     if (!w->unordered && w->n_pairs > 1) sort_pairs(w);

@@ -1,8 +1,9 @@
 /* Odin's per-step C code, compiled into the _odin_ode extension.
  *
  * One OdinWorld (allocated by Python with ffi.new, so Python owns its memory) gathers what the
- * hot loop needs: the ODE world, hash space and contact group, the contact settings, and arrays
- * of persistent body forces, joint forces and motor goals that Python rebuilds when they change.
+ * hot loop needs: the ODE world, space (broad phase) and contact group, the contact settings,
+ * and arrays of persistent body forces, joint forces and motor goals that Python rebuilds when
+ * they change.
  * odin_world_step() runs the whole count-loop (collide, forces, motors, step, empty contacts) in
  * C; nothing is created or destroyed in it except contact joints in the contact group.
  * The only memory this file allocates is the collision-record buffer (odin_world_free_buffers).
@@ -128,7 +129,7 @@ typedef struct OdinWorld {
     /* outputs */
     int last_step_contacts;
     int record_every_step;   /* contact policy: record the pairs of every step, not the last */
-    int unordered;           /* benchmarks only: contacts made as the hash space finds them
+    int unordered;           /* benchmarks only: contacts made as the broad phase finds them
                                 (not deterministic), to measure what the ordering costs */
     /* the divergence guard: after every step each guarded body must be finite, slower than
      * max_speed (m/s) and max_spin (rad/s) and within extent (m) of the origin on every axis;

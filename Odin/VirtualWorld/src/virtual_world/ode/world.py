@@ -1,5 +1,5 @@
-"""One ODE world as odin_step.c runs it: the world, its hash space and contact group, the
-contact settings, and the arrays of persistent actions the C step loop applies.
+"""One ODE world as odin_step.c runs it: the world, its space (sweep and prune) and contact
+group, the contact settings, and the arrays of persistent actions the C step loop applies.
 
 ``CWorld`` owns an ``OdinWorld`` struct (memory Python's, allocated with ffi.new) and the three
 scene handles; the arrays of body forces, joint forces and motor goals are rebuilt from plain
@@ -127,8 +127,20 @@ class CWorld:
 
     def set_guarded(self, bodies: Sequence) -> None:
         """The bodies the divergence guard checks after every step (the dynamic ones)."""
-        array = ffi.new("dBodyID[]", list(bodies) or 1)
+        array = ffi.new("dBodyID[]", max(2 * len(bodies), 16))
+        array[0:len(bodies)] = list(bodies)
         self._install("guarded", array, len(bodies))
+
+    def add_guarded(self, body) -> None:
+        """One more body for the guard, at the end of the list: amortised O(1) (the array
+        doubles when full), so building n bodies costs O(n), not O(n^2)."""
+        s, array = self.struct, self._arrays.get("guarded")
+        count = int(s.n_guarded)
+        if array is None or count >= len(array):
+            self.set_guarded([s.guarded[i] for i in range(count)] + [body])
+            return
+        array[count] = body
+        s.n_guarded = count + 1
 
     def divergences(self) -> List[Divergence]:
         """The bodies the guard parked since the last call (body address, reason, value,
