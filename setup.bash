@@ -13,6 +13,13 @@ source "$_odin_root/build/ws/devel/setup.bash"
 export ODIN_ROOT="$_odin_root"
 export ODIN_KAUTHAM_DIR="${ODIN_KAUTHAM_DIR:-$(cd "$_odin_root/.." && pwd)/shared/kautham}"
 export PYOPENGL_PLATFORM=osmesa
+# ROS 1 has no authentication: whoever reaches a node's port can call its services. Unless the
+# user names an address (ROS_IP or ROS_HOSTNAME, docs/SECURITY.md), nodes listen and advertise
+# on the loopback address only, and the master is looked for there.
+if [ -z "${ROS_IP:-}${ROS_HOSTNAME:-}" ]; then
+  export ROS_IP=127.0.0.1
+  export ROS_MASTER_URI="${ROS_MASTER_URI:-http://127.0.0.1:11311}"
+fi
 # no display (CI, Docker, ssh): Qt draws off-screen
 if [ -z "${DISPLAY:-}${WAYLAND_DISPLAY:-}" ]; then
   export QT_QPA_PLATFORM="${QT_QPA_PLATFORM:-offscreen}"

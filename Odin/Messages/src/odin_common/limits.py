@@ -33,6 +33,10 @@ MAX_GRAVITY = 1e4
 MAX_MESH_TRIANGLES = 2_000_000
 """Triangles of one mesh, by default (ResourceLimits.max_mesh_triangles)."""
 
+MAX_INPUT_FILE_MB = 256
+"""MB: the largest file the GUI reads (a problem, robot, URDF, control, path or geometry file);
+a larger one is refused before it is read. The real Kautham corpus's largest is under 10 MB."""
+
 MAX_STEPS_PER_CALL = 1_000_000
 """Steps one call may ask for (a Step Once, a Propagate): the node answers nothing else
 meanwhile, so a longer run is asked for in pieces (at 1 ms steps, 1,000 s of simulated time)."""

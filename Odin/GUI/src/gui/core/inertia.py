@@ -76,6 +76,8 @@ def shape_inertia(shape: Shape, mass: float) -> Optional[np.ndarray]:
 
 def rigid_body_problem(tensor: np.ndarray) -> Optional[str]:
     """Why ``tensor`` is no rigid body's inertia (None when it is one)."""
+    if not np.all(np.isfinite(tensor)):
+        return "not finite"
     if not np.allclose(tensor, tensor.T):
         return "not symmetric"
     moments = np.linalg.eigvalsh(tensor)
@@ -105,7 +107,7 @@ def choose(link: LinkModel, owner: str, mass: float, offset: np.ndarray, mode: s
                              "is used")
     if mode == AUTO:
         own = shape_inertia(link.shape, mass)
-        if own is not None:
+        if own is not None and rigid_body_problem(own) is None:   # else nothing to compare
             given = np.linalg.eigvalsh(inertial.origin[:3, :3] @ tensor
                                        @ inertial.origin[:3, :3].T)
             expected = np.linalg.eigvalsh(own)

@@ -38,6 +38,8 @@ import numpy as np
 
 from gui.errors import ShapeError
 from gui.core.kinematics import rot_x
+from gui.core.sizes import check_file_size
+from odin_common.limits import MAX_MESH_TRIANGLES
 
 COIN_SUFFIXES = (".wrl", ".iv", ".vrml")
 TRIMESH_SUFFIXES = (".stl", ".obj", ".ply", ".off", ".glb", ".gltf", ".dae")
@@ -48,6 +50,12 @@ class ShapeDefaults:
     """Tunables of shape reading."""
     merge_tolerance: float = 1e-6   # m: vertices closer than about this are merged
     default_color: tuple = (0.0, 0.0, 0.0, 0.0)  # all zero: the Viewer's default colour
+    # a file holding more is refused: the world refuses such a mesh anyway, and a VRML file's
+    # DEF/USE instancing can make a few lines expand into billions of triangles
+    max_triangles: int = MAX_MESH_TRIANGLES
+    # VRML/Inventor shape nodes (each costs Python work, ~0.3 ms): real models hold a handful
+    # (the public Kautham corpus at most 6), an instancing bomb billions
+    max_shape_nodes: int = 10_000
 
 
 DEFAULTS = ShapeDefaults()
@@ -165,7 +173,7 @@ def read_shape(path: os.PathLike | str, scale: float = 1.0,
     key = (str(p.resolve()) if p.exists() else str(p), float(scale), defaults)
     shape = _CACHE.get(key)
     if shape is None:
-        raw = _read_raw(p)
+        raw = _read_raw(p, defaults)
         shape = _finish(raw, scale, defaults, str(p))
         _CACHE[key] = shape
     return shape
@@ -176,6 +184,7 @@ class _Raw:
     corners: np.ndarray                  # (M, 3, 3) file units
     tri_colors: list                     # [(count, color)]
     primitives: list                     # [(kind, dims (file units), pose 4x4 file units, color)]
+    shape_nodes: int = 0                 # VRML/Inventor shape nodes traversed
 
 
 def _finish(raw: _Raw, scale: float, defaults: ShapeDefaults, source: str) -> Shape:
@@ -198,13 +207,36 @@ def _finish(raw: _Raw, scale: float, defaults: ShapeDefaults, source: str) -> Sh
     return shape
 
 
-def _read_raw(p: pathlib.Path) -> _Raw:
+def _read_raw(p: pathlib.Path, defaults: ShapeDefaults) -> _Raw:
     if not p.is_file():
         raise ShapeError("geometry file not found", p)
+    check_file_size(p, "geometry file", ShapeError)
     suffix = p.suffix.lower()
-    if suffix in TRIMESH_SUFFIXES:
-        return _read_trimesh(p)
-    return _read_coin(p)
+    max_triangles = defaults.max_triangles
+    if suffix == ".stl":
+        _check_stl_count(p, max_triangles)
+    raw = _read_trimesh(p) if suffix in TRIMESH_SUFFIXES else _read_coin(p, defaults)
+    if raw.shape_nodes > defaults.max_shape_nodes:
+        raise ShapeError(f"holds more than {defaults.max_shape_nodes:,} shape nodes (a "
+                         f"model holds a handful; instancing can make billions)", p)
+    if len(raw.corners) > max_triangles or len(raw.primitives) > max_triangles:
+        raise ShapeError(f"holds more than {max_triangles:,} triangles or primitives (the "
+                         f"limit of one mesh)", p)
+    return raw
+
+
+def _check_stl_count(p: pathlib.Path, max_triangles: int) -> None:
+    """A binary STL says its triangle count in bytes 80-84 and holds 50 bytes per triangle:
+    a count over the limit is refused before the file is loaded (an ASCII STL, or a file whose
+    size does not match its count, is bounded by the file size check)."""
+    with open(p, "rb") as f:
+        head = f.read(84)
+    if len(head) < 84:
+        return
+    count = int.from_bytes(head[80:84], "little")
+    if count > max_triangles and p.stat().st_size == 84 + 50 * count:
+        raise ShapeError(f"holds {count:,} triangles, more than the {max_triangles:,} of one "
+                         f"mesh", p)
 
 
 def _read_trimesh(p: pathlib.Path) -> _Raw:
@@ -256,7 +288,7 @@ def _captured_stderr():
             captured["text"] = tmp.read().decode(errors="replace")
 
 
-def _read_coin(p: pathlib.Path) -> _Raw:
+def _read_coin(p: pathlib.Path, defaults: ShapeDefaults) -> _Raw:
     coin = _coin_module()
     inp = coin.SoInput()
     with _captured_stderr() as err:
@@ -273,7 +305,7 @@ def _read_coin(p: pathlib.Path) -> _Raw:
                          int(match.group(1)) if match else None)
     root.ref()
     try:
-        return _collect(coin, root)
+        return _collect(coin, root, defaults.max_triangles, defaults.max_shape_nodes)
     finally:
         root.unref()
 
@@ -281,11 +313,15 @@ def _read_coin(p: pathlib.Path) -> _Raw:
 _PRIMITIVE_TYPES = ("SoSphere", "SoCylinder", "SoCube")
 
 
-def _collect(coin, root) -> _Raw:
+def _collect(coin, root, max_triangles: int, max_shape_nodes: int) -> _Raw:
+    """The triangles (file units, world frame of the file) and primitives of Coin's scene graph.
+    Past ``max_triangles`` (or as many primitives) or ``max_shape_nodes`` collection stops: the
+    traversal is aborted at the next shape and the result holds more than the limit, for the
+    caller to refuse."""
     tris: list = []
     tri_colors: list = []
     prims: list = []
-    current = {"color": DEFAULTS.default_color, "start": 0, "pose": np.eye(4)}
+    current = {"color": DEFAULTS.default_color, "start": 0, "pose": np.eye(4), "shape_nodes": 0}
     lazy = coin.SoLazyElement
 
     def color_of(action):
@@ -299,7 +335,17 @@ def _collect(coin, root) -> _Raw:
         rows = np.array(m.getValue(), dtype=np.float64)
         return rows.T  # Coin's matrices act on row vectors
 
+    def over_limit():
+        return (len(tris) > max_triangles or len(prims) > max_triangles
+                or current["shape_nodes"] > max_shape_nodes)
+
+    def shape_node():
+        current["shape_nodes"] += 1
+        return over_limit()
+
     def on_primitive(_data, action, node):
+        if shape_node():
+            return coin.SoCallbackAction.ABORT
         T = model_pose(action)
         R = T[:3, :3]
         s = np.linalg.norm(R, axis=0)
@@ -323,6 +369,8 @@ def _collect(coin, root) -> _Raw:
     runs: list = []   # (first triangle, end, model pose (4, 4), colour) per shape node
 
     def on_shape(_data, action, node):
+        if shape_node():
+            return coin.SoCallbackAction.ABORT
         _close_run()
         current["color"] = color_of(action)
         current["pose"] = model_pose(action)
@@ -337,6 +385,8 @@ def _collect(coin, root) -> _Raw:
         current["start"] = len(tris)
 
     def on_triangle(_data, _action, v1, v2, v3):
+        if over_limit():         # Coin finishes this shape's triangles; keep none of them
+            return
         # SoCallbackAction gives the corners in the shape's object space.
         tris.append((v1.getPoint().getValue(), v2.getPoint().getValue(),
                      v3.getPoint().getValue()))
@@ -353,4 +403,4 @@ def _collect(coin, root) -> _Raw:
         if not np.allclose(pose, np.eye(4)):
             block = corners[start:end]
             corners[start:end] = block @ pose[:3, :3].T + pose[:3, 3]
-    return _Raw(corners, tri_colors, prims)
+    return _Raw(corners, tri_colors, prims, current["shape_nodes"])

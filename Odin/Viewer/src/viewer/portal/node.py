@@ -50,6 +50,7 @@ from Services.srv import (SaveSnapshot, SaveSnapshotResponse, SetCamera, SetCame
                           ViewerNewScene, ViewerNewSceneResponse, ViewerRemoveObject,
                           ViewerRemoveObjectResponse, ViewObject, ViewObjectResponse)
 from odin_common import OdinError
+from odin_common.tool import init_ros_node
 from viewer.core.camera import Camera
 from viewer.errors import ViewerError
 from viewer.core.loop import RenderLoop
@@ -215,7 +216,7 @@ class Portal:
 
 
 def main() -> None:
-    rospy.init_node("viewer")
+    init_ros_node("viewer")
     try:
         portal = Portal()
     except OdinError as error:

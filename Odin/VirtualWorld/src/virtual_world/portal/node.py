@@ -60,6 +60,7 @@ from Services import srv
 from odin_common import OdinError
 from odin_common.interface import WORLD_SERVICES
 from odin_common.limits import ResourceLimits
+from odin_common.tool import init_ros_node
 from odin_common.world_parameters import PARAMETERS
 from virtual_world.core import Core, step_values
 from virtual_world.core.loop import CycleReport, RealTimeFactor, WorldLoop
@@ -244,7 +245,7 @@ class Portal:
         return {name: (positions[i], quaternions[i]) for i, name in enumerate(names)}
 
 def main() -> None:
-    rospy.init_node("virtual_world")
+    init_ros_node("virtual_world")
     try:
         portal = Portal()
     except OdinError as error:

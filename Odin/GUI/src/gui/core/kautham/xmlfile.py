@@ -3,6 +3,13 @@
 ElementTree forgets where an element was; error messages must name the file and the line,
 so the tree is built here from expat directly. Free text inside elements (Kautham's files
 have plenty) is kept but never needed.
+
+Every XML file the GUI reads (problems, robots, URDF, control and path files) comes through
+here, and any of them may come from someone else, so the parser is hardened as defusedxml
+hardens expat: a DTD may not declare entities (a "billion laughs" file expands a few lines
+into gigabytes; Kautham's files declare none), external entities and parameter entities are
+never resolved (an external entity would read another file, or a URL, into the problem), and
+a file larger than odin_common.limits.MAX_INPUT_FILE_MB is refused before it is read.
 """
 from __future__ import annotations
 
@@ -13,6 +20,7 @@ import xml.parsers.expat
 from dataclasses import dataclass, field
 from typing import Iterator, Optional
 
+from gui.core.sizes import check_file_size
 from gui.errors import ProblemError
 
 
@@ -105,6 +113,7 @@ def read_xml(path: os.PathLike | str, what: str = "file") -> Node:
     """Parses ``path`` into a ``Node`` tree; a missing or malformed file is a ``ProblemError``
     naming the file and (for malformed XML) the line."""
     p = pathlib.Path(path)
+    check_file_size(p, what, ProblemError)
     try:
         data = p.read_bytes()
     except FileNotFoundError:
@@ -114,8 +123,38 @@ def read_xml(path: os.PathLike | str, what: str = "file") -> Node:
     return parse_xml_bytes(data, str(p))
 
 
+class _Refused(Exception):
+    """Raised inside an expat handler; carries the line where the parse was refused."""
+
+    def __init__(self, reason: str, line: int):
+        super().__init__(reason)
+        self.reason, self.line = reason, line
+
+
+def _harden(parser) -> None:
+    """Entity declarations refused, external and parameter entities never read."""
+    def entity_declared(name, is_parameter, *_rest):
+        kind = "parameter entity" if is_parameter else "entity"
+        raise _Refused(f"declares the {kind} {name!r}: XML entities are refused (they can "
+                       f"expand without bound or read other files)", parser.CurrentLineNumber)
+
+    def unparsed_entity(name, *_rest):
+        raise _Refused(f"declares the unparsed entity {name!r}: XML entities are refused",
+                       parser.CurrentLineNumber)
+
+    def external_reference(_context, _base, system_id, _public_id):
+        raise _Refused(f"refers to the external entity {system_id!r}: external entities "
+                       f"are never read", parser.CurrentLineNumber)
+
+    parser.SetParamEntityParsing(xml.parsers.expat.XML_PARAM_ENTITY_PARSING_NEVER)
+    parser.EntityDeclHandler = entity_declared
+    parser.UnparsedEntityDeclHandler = unparsed_entity
+    parser.ExternalEntityRefHandler = external_reference
+
+
 def parse_xml_bytes(data: bytes, path: str) -> Node:
     parser = xml.parsers.expat.ParserCreate()
+    _harden(parser)
     stack: list[Node] = []
     root: list[Node] = []
 
@@ -143,6 +182,10 @@ def parse_xml_bytes(data: bytes, path: str) -> Node:
         reason = xml.parsers.expat.ErrorString(error.code)
         raise ProblemError(f"malformed XML: {reason} (column {error.offset + 1})", path,
                            error.lineno) from None
+    except _Refused as refused:
+        raise ProblemError(refused.reason, path, refused.line) from None
+    except (LookupError, ValueError) as error:   # an unknown or wrong encoding="..."
+        raise ProblemError(f"malformed XML: {error}", path, parser.CurrentLineNumber) from None
     if not root:
         raise ProblemError("no XML element", path)
     return root[0]

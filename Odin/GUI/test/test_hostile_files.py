@@ -1,0 +1,238 @@
+"""Hostile files: every file the GUI reads may come from someone else. XML entities are refused
+(a "billion laughs" file, external entities reading other files), absurd sizes are refused
+before anything is loaded (files, binary STL counts, VRML instancing bombs), and a fuzz of the
+public Kautham corpus (truncated and mutated copies) gets one clear error or a valid plan from
+``problem_info``, never a traceback or a hang."""
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import random
+import shutil
+import signal
+import sys
+
+import pytest
+
+from gui.cli import problem_info_main
+from gui.core import shapes
+from gui.core.kautham.urdf import read_urdf
+from gui.core.kautham.xmlfile import read_xml
+from gui.core.shapes import ShapeDefaults, read_shape
+from gui.errors import ProblemError, ShapeError
+from odin_common.limits import MAX_INPUT_FILE_MB
+
+LAUGHS = """<?xml version="1.0"?>
+<!DOCTYPE Problem [
+ <!ENTITY lol "lol">
+ <!ENTITY lol1 "&lol;&lol;&lol;&lol;&lol;&lol;&lol;&lol;&lol;&lol;">
+ <!ENTITY lol2 "&lol1;&lol1;&lol1;&lol1;&lol1;&lol1;&lol1;&lol1;&lol1;&lol1;">
+ <!ENTITY lol3 "&lol2;&lol2;&lol2;&lol2;&lol2;&lol2;&lol2;&lol2;&lol2;&lol2;">
+ <!ENTITY lol9 "&lol3;&lol3;&lol3;&lol3;&lol3;&lol3;&lol3;&lol3;&lol3;&lol3;">
+]>
+<Problem name="&lol9;"><Scene scene="a.iv"/></Problem>
+"""
+
+
+def problem_info(path):
+    """problem_info's exit status, stdout and stderr, run in this process."""
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        status = problem_info_main([str(path), "--indent", "0"])
+    return status, out.getvalue(), err.getvalue()
+
+
+def one_error_line(err: str) -> str:
+    lines = [line for line in err.splitlines() if ": warning: " not in line]
+    assert len(lines) == 1 and lines[0].startswith("problem_info: error: "), err
+    assert "Traceback" not in err
+    return lines[0]
+
+
+def test_a_billion_laughs_problem_is_refused_at_its_first_entity(tmp_path):
+    f = tmp_path / "laughs.xml"
+    f.write_text(LAUGHS)
+    status, out, err = problem_info(f)
+    assert status == 2 and out == ""
+    line = one_error_line(err)
+    assert f"{f}:3:" in line and "entity 'lol'" in line and "refused" in line
+
+
+def test_an_external_entity_never_reads_the_file_it_names(tmp_path):
+    secret = tmp_path / "secret.txt"
+    secret.write_text("SECRET-TOKEN")
+    for name, text in (
+            ("external.xml", f'<!DOCTYPE Problem [<!ENTITY x SYSTEM "file://{secret}">]>'
+                             f'<Problem name="&x;">&x;</Problem>'),
+            ("parameter.xml", f'<!DOCTYPE Problem [<!ENTITY % x SYSTEM "file://{secret}">%x;]>'
+                              f'<Problem/>'),
+            ("dtd.xml", f'<!DOCTYPE Problem SYSTEM "file://{secret}"><Problem/>')):
+        f = tmp_path / name
+        f.write_text(text)
+        status, out, err = problem_info(f)
+        assert status == 2, (name, out, err)
+        assert "SECRET-TOKEN" not in out + err
+        one_error_line(err)
+    with pytest.raises(ProblemError, match="external.xml:1: declares the entity 'x'"):
+        read_xml(tmp_path / "external.xml")
+
+
+def test_a_robots_urdf_with_entities_is_refused_naming_the_urdf(tmp_path):
+    urdf = tmp_path / "r.urdf"
+    urdf.write_text(LAUGHS.replace("Problem", "robot"))
+    with pytest.raises(ProblemError, match=r"r\.urdf:3: declares the entity"):
+        read_urdf(urdf)
+
+
+def test_files_larger_than_the_limit_are_refused_before_they_are_read(tmp_path):
+    size = (MAX_INPUT_FILE_MB + 1) * 2 ** 20
+    for name in ("huge.xml", "huge.wrl"):
+        with open(tmp_path / name, "wb") as f:
+            f.truncate(size)              # sparse: nothing is written
+    status, out, err = problem_info(tmp_path / "huge.xml")
+    assert status == 2 and f"larger than the {MAX_INPUT_FILE_MB} MB" in one_error_line(err)
+    with pytest.raises(ShapeError, match="larger than the"):
+        read_shape(tmp_path / "huge.wrl")
+
+
+def test_a_binary_stl_announcing_too_many_triangles_is_refused_unread(tmp_path):
+    count = 50_000
+    f = tmp_path / "big.stl"
+    with open(f, "wb") as out:
+        out.write(b"\0" * 80 + count.to_bytes(4, "little"))
+        out.truncate(84 + 50 * count)
+    with pytest.raises(ShapeError, match="holds 50,000 triangles, more than the 1,000"):
+        read_shape(f, defaults=ShapeDefaults(max_triangles=1_000))
+
+
+def instancing_bomb(path, levels=12):
+    """An Inventor file of 10**levels one-triangle shapes in a few lines (DEF/USE)."""
+    lines = ["#Inventor V2.1 ascii", "Separator {",
+             " DEF a0 Separator { Coordinate3 { point [0 0 0, 1 0 0, 0 1 0] }"
+             " IndexedFaceSet { coordIndex [0, 1, 2, -1] } }"]
+    for k in range(1, levels + 1):
+        use = " ".join([f"Translation {{ translation 0 0 1 }} USE a{k - 1}"] * 10)
+        lines.append(f" DEF a{k} Separator {{ {use} }}")
+    path.write_text("\n".join(lines + ["}"]) + "\n")
+    return path
+
+
+def test_a_vrml_instancing_bomb_stops_at_the_shape_and_triangle_limits(tmp_path):
+    bomb = instancing_bomb(tmp_path / "bomb.iv")
+    with pytest.raises(ShapeError, match="more than 500 shape nodes"):
+        read_shape(bomb, defaults=ShapeDefaults(max_shape_nodes=500))
+    many = tmp_path / "many.iv"
+    many.write_text("#Inventor V2.1 ascii\nSeparator { Coordinate3 { point [0 0 0, 1 0 0, "
+                    "0 1 0, 1 1 0] } IndexedFaceSet { coordIndex ["
+                    + ", ".join(["0, 1, 2, -1, 1, 3, 2, -1"] * 300) + "] } }\n")
+    with pytest.raises(ShapeError, match="more than 100 triangles"):
+        read_shape(many, defaults=ShapeDefaults(max_triangles=100))
+    assert read_shape(many).mesh is not None     # the defaults hold it
+
+
+# ------------------------------------------------------------------ fuzzing the corpus
+
+MUTATIONS_PER_FILE = 3
+
+
+class Hang(Exception):
+    pass
+
+
+@contextlib.contextmanager
+def time_limit(seconds):
+    def expired(*_):
+        raise Hang()
+    previous = signal.signal(signal.SIGALRM, expired)
+    signal.alarm(seconds)
+    try:
+        yield
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)
+
+
+def mutate(data: bytes, rng: random.Random) -> bytes:
+    """One of: cut short, bytes flipped, a line dropped or doubled, a number made absurd."""
+    kind = rng.randrange(5)
+    if kind == 0:
+        return data[:rng.randrange(len(data))]
+    if kind == 1:
+        out = bytearray(data)
+        for _ in range(rng.randint(1, 8)):
+            out[rng.randrange(len(out))] = rng.randrange(256)
+        return bytes(out)
+    lines = data.split(b"\n")
+    k = rng.randrange(len(lines))
+    if kind == 2:
+        return b"\n".join(lines[:k] + lines[k + 1:])
+    if kind == 3:
+        return b"\n".join(lines[:k + 1] + lines[k:])
+    import re
+    numbers = list(re.finditer(rb"-?\d+(\.\d+)?", data))
+    if not numbers:
+        return data[:len(data) // 2]
+    m = rng.choice(numbers)
+    absurd = rng.choice([b"nan", b"1e400", b"-1", b"0", b"1e30", b"abc", b""])
+    return data[:m.start()] + absurd + data[m.end():]
+
+
+def opened_files(problem, root):
+    """problem_info's status on ``problem`` and the other files under ``root`` it opened."""
+    opened, recording = [], [True]
+
+    def record(event, args):
+        if (recording[0] and event == "open" and isinstance(args[0], str)
+                and args[0].startswith(str(root))):
+            opened.append(args[0])
+    shapes._CACHE.clear()
+    sys.addaudithook(record)   # cannot be removed: the test runs forked, and stops recording
+    try:
+        status, _, _ = problem_info(problem)
+    finally:
+        recording[0] = False
+    return status, [type(problem)(p) for p in sorted(set(opened) - {str(problem)})]
+
+
+@pytest.mark.forked
+def test_mutated_and_truncated_corpus_files_get_one_clear_error_or_a_plan(kautham_dir,
+                                                                          tmp_path):
+    copy = tmp_path / "kautham"
+    shutil.copytree(kautham_dir, copy)
+    problems = sorted(p for p in copy.rglob("*.xml") if b"<Problem" in p.read_bytes()[:4000])
+    assert len(problems) >= 5
+    rng = random.Random(20261123)
+    runs = 0
+    for problem in problems:
+        status, dependencies = opened_files(problem, copy)
+        if status != 0:
+            continue                       # a problem Odin refuses as it is: nothing to fuzz
+        for target in [problem] + [p for p in dependencies if p.suffix.lower() != ".stl"]:
+            original = target.read_bytes()
+            for _ in range(MUTATIONS_PER_FILE):
+                target.write_bytes(mutate(original, rng))
+                shapes._CACHE.clear()
+                try:
+                    with time_limit(60):
+                        status, out, err = problem_info(problem)
+                except Hang:
+                    pytest.fail(f"problem_info hung on {problem} with {target} mutated")
+                except Exception as error:     # what the test is for: nothing escapes
+                    pytest.fail(f"{type(error).__name__} escaped problem_info on {problem} "
+                                f"with {target} mutated: {error}")
+                runs += 1
+                if status == 0:
+                    json.loads(out)
+                else:
+                    assert status == 2, err
+                    one_error_line(err)
+            target.write_bytes(original)
+    assert runs >= 50
+
+
+def test_an_unknown_encoding_is_one_clear_error(tmp_path):
+    f = tmp_path / "encoding.xml"
+    f.write_text('<?xml version="1.0" encoding="UTF0"?>\n<Problem/>\n')
+    status, _, err = problem_info(f)
+    assert status == 2 and "malformed XML" in one_error_line(err)

@@ -1,0 +1,53 @@
+"""How every Odin executable ends: quietly on a closed pipe and on Ctrl-C, with the usual codes.
+
+``rosrun GUI problem_info FILE | head`` closes the pipe after ten lines; Python would then
+print a BrokenPipeError traceback (twice: once more when it flushes stdout at exit). A shell
+user expects what a C tool does: stop, print nothing, exit 128 + SIGPIPE (141). Ctrl-C likewise
+ends with 128 + SIGINT (130) and no traceback. Every script in Odin/*/scripts and nodes/ runs
+its main through ``run``.
+"""
+from __future__ import annotations
+
+import os
+import signal
+import sys
+from typing import Callable, Optional
+
+EXIT_BROKEN_PIPE = 128 + signal.SIGPIPE
+EXIT_INTERRUPTED = 128 + signal.SIGINT
+
+
+def run(main: Callable[[], Optional[int]]) -> None:
+    """Calls ``main()`` and exits with its status (None: 0), 141 when stdout was closed under
+    it, 130 on Ctrl-C."""
+    try:
+        status = main()
+        sys.stdout.flush()
+    except BrokenPipeError:
+        _silence_stdout()
+        sys.exit(EXIT_BROKEN_PIPE)
+    except KeyboardInterrupt:
+        sys.exit(EXIT_INTERRUPTED)
+    sys.exit(status or 0)
+
+
+def _silence_stdout() -> None:
+    """Points stdout at /dev/null, so the interpreter's flush at exit has nowhere to fail."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
+
+
+def init_ros_node(name: str) -> None:
+    """``rospy.init_node(name)`` with rospy's own signal handling, except that Ctrl-C while
+    the node still waits for its master ends it like any tool (130, no traceback): rospy
+    turns that Ctrl-C into a ROSInitException ("Failed to initialize time")."""
+    import rospy   # here, not at the top: the tools that use ``run`` alone never load rospy
+    try:
+        rospy.init_node(name)
+    except rospy.ROSInitException:
+        if rospy.core.is_shutdown_requested():
+            raise KeyboardInterrupt from None
+        raise
