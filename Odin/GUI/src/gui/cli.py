@@ -173,6 +173,13 @@ def run_path_main(argv: Optional[Sequence[str]] = None) -> int:
     kind.add_argument("--controls", metavar="FILE", help="control path: rows of the robot's "
                       "Kautham controls in [0, 1] and a duration (s), applied as Kautham's "
                       "ODE environment does (docs/INTERFACE.md)")
+    kind.add_argument("--tracked", metavar="FILE", help="a Kautham plan (.kps solution, task "
+                      "file, OMPL rows or raw rows), timed within the joints' limits and "
+                      "followed by the joint servos under full physics (docs/INTERFACE.md)")
+    parser.add_argument("--summary", metavar="OUT.json", help="tracked: write the execution's "
+                        "summary (goal and tracking errors, collisions, per-joint series)")
+    parser.add_argument("--plot", metavar="OUT.png", help="tracked: plot target against "
+                        "actual per joint")
     units = parser.add_mutually_exclusive_group()
     units.add_argument("--degrees", action="store_true",
                        help="values in degrees (mm) [default for 2012 problems]")
@@ -184,7 +191,8 @@ def run_path_main(argv: Optional[Sequence[str]] = None) -> int:
     parser.add_argument("--rate", type=float, default=0.0,
                         help="rows per second (default: the world's publication rate)")
     parser.add_argument("--fast", action="store_true",
-                        help="control paths: as fast as the world steps, not in real time")
+                        help="control and tracked paths: as fast as the world steps, not in "
+                        "real time")
     parser.add_argument("--timeout", type=float, default=10.0)
     _build_options(parser)
     args = parser.parse_args(argv)
@@ -198,6 +206,8 @@ def run_path_main(argv: Optional[Sequence[str]] = None) -> int:
             raise GuiError(f"{args.problem}: {error.args[0]}") from None
         if args.controls:
             return _run_controls(args, handle)
+        if args.tracked:
+            return _run_tracked(args, plan)
         unit = DEGREES if args.degrees else RADIANS if args.radians else (
             DEGREES if plan.problem.format == "2012" else RADIANS)
         file = args.initial or args.position or args.velocity
@@ -221,6 +231,59 @@ def run_path_main(argv: Optional[Sequence[str]] = None) -> int:
     except GuiError as error:
         return _fail("run_path", error)
     return 0
+
+
+def _run_tracked(args, plan) -> int:
+    """run_path --tracked: the plan read and checked whole, then executed in the running world
+    (paused meanwhile); one line per simulated second, then the figures."""
+    from gui.core.execution import run_tracked_on_client
+    from gui.core.kautham.solutions import read_solution
+    from gui.core.paths import DEGREES, RADIANS
+    units = DEGREES if args.degrees else RADIANS if args.radians else None
+    solution = read_solution(args.tracked, plan.problem, args.robot, units)
+    from gui.ros.client import WorldClient
+    client = WorldClient(timeout=args.timeout)
+    _record_world_ids(client, plan)
+    shown = [0]
+
+    def progress(t: float, total: float) -> None:
+        if t >= shown[0] + 1.0 or t >= total - 1e-9:
+            shown[0] = int(t)
+            print(f"t={t:.2f}/{total:.2f} s", flush=True)
+
+    report = run_tracked_on_client(client, plan, solution, progress=progress,
+                                   real_time=not args.fast)
+    print(f"{solution.format} path of {solution.waypoint_count} waypoints: goal error "
+          f"{report.goal_error:.3g}, tracking error max {report.tracking_error_max:.3g}, "
+          f"{report.duration_s:.2f} s simulated, {len(report.collisions)} colliding pairs")
+    if args.summary:
+        with open(args.summary, "w") as out:
+            json.dump(report.to_json(), out, indent=1)
+    if args.plot:
+        _save_plot(report, args.plot)
+    return 0
+
+
+def _record_world_ids(client, plan) -> None:
+    """The world's joint and motor IDs for the plan's robots: the ones it holds that the plan
+    predicts (the scene was built by load_problem, whose answers are not at hand here)."""
+    inventory = client.world()
+    for handle in plan.robots:
+        missing = [i for i in list(handle.joint_ids) + list(handle.motor_ids)
+                   if i not in inventory.joints + inventory.motors]
+        if missing:
+            raise GuiError(f"the world holds no {missing[0]!r} of robot {handle.name}: build "
+                           f"the problem first (rosrun GUI load_problem {plan.problem.source})")
+
+
+def _save_plot(report, path: str) -> None:
+    import os
+    os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+    from PyQt5.QtGui import QGuiApplication
+    from gui.window.tracking_plot import save_png
+    application = QGuiApplication.instance() or QGuiApplication(["run_path"])
+    save_png(report, path)
+    del application
 
 
 def _run_controls(args, handle) -> int:

@@ -1,0 +1,441 @@
+"""Tracked execution: a Kautham plan (``gui.core.kautham.solutions``) timed within the joints'
+limits (``gui.core.trajectory``) and followed by the world's joint servos under full physics,
+with a report of how well it was followed (ROS-free).
+
+Every ``period`` s of simulated time (a multiple of the world's step, 0.01 s by default):
+each robot's servos get the trajectory's target at the middle of the coming period and, as
+feed-forward, its mean rate over the period (Set Servo; the servo's speed is
+clamp(rate + gain (target - q), +-limit) each step, under the joint's effort limit); a
+free-flying base gets the velocity rate + ``base_gain`` error (linear and angular, world frame)
+and a force cancelling gravity on the robot's mass, as a velocity servo of its own; then the
+world runs the period with contacts on (one kept Propagate), and the joints are read.
+Attach/detach events become a FIXED joint between the link's body and the obstacle's, made and
+removed at their waypoint's time (the robot is at rest there). The path starts from where the
+robot is: its present configuration is the first waypoint. After the last waypoint the
+targets are held ``settle`` s; the servos stay on afterwards (they hold the goal).
+
+The report: ``goal_error`` (largest joint error from the last waypoint when execution ends,
+rad or m; a base's position error in m and its rotation error in rad count as joints),
+``tracking_error_max`` (the largest along the way, against the trajectory's value at the same
+time), ``duration_s`` (simulated, trajectory and settling), the collisions met (pairs of
+geometries, first time, deepest depth) and per-joint series of target, actual and error.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Callable, Dict, List, Optional, Protocol, Sequence, Tuple
+
+import numpy as np
+
+from gui.core.control_path import ServoCommand
+from gui.core.kautham.solutions import ATTACH, Solution
+from gui.core.model import PRISMATIC
+from gui.core.trajectory import BaseLimits, Trajectory, rotation_error
+from gui.errors import PathFileError
+from odin_common.interface import SERVO_GAIN, SERVO_MAX_SPEED, JointType
+from odin_common.rotations import quaternion_to_matrix
+from odin_common.specs import JointSpec
+
+
+@dataclass(frozen=True)
+class TrackingDefaults:
+    """How a path is timed and followed. ``speed_fraction``: of each joint's speed limit the
+    trajectory uses (the rest is the servo's room to correct); ``acceleration``: rad/s^2 or
+    m/s^2 per joint; ``gain``: the servos' position gain, 1/s; the free-flying base's limits
+    (m/s, m/s^2, rad/s, rad/s^2) and ``base_gain`` (1/s); ``period``: s between servo updates
+    (rounded to whole world steps); ``settle``: s the last target is held."""
+    speed_fraction: float = 0.8
+    acceleration: float = 2.0
+    gain: float = SERVO_GAIN
+    base_speed: float = 0.5
+    base_acceleration: float = 1.0
+    base_angular_speed: float = 1.0
+    base_angular_acceleration: float = 2.0
+    base_gain: float = 10.0
+    period: float = 0.01
+    settle: float = 0.5
+
+    def base_limits(self) -> BaseLimits:
+        return BaseLimits(self.base_speed, self.base_acceleration, self.base_angular_speed,
+                          self.base_angular_acceleration)
+
+
+Collision = Tuple[str, str, float, float]
+"""(first geometry, second geometry, depth m, time first seen s)."""
+BodyState = Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+"""(position (3,) m, quaternion (w, x, y, z), linear (3,) m/s, angular (3,) rad/s), world."""
+
+
+class TrackingPort(Protocol):
+    """What tracked execution needs of the world."""
+
+    def step(self) -> float: ...
+
+    def gravity(self) -> np.ndarray: ...
+
+    def masses(self, body_ids: Sequence[str]) -> float: ...
+
+    def joint_positions(self, joint_ids: Sequence[str]) -> np.ndarray: ...
+
+    def body_state(self, body_id: str) -> BodyState: ...
+
+    def set_servo(self, command: ServoCommand) -> None: ...
+
+    def set_body_velocity(self, body_id: str, linear, angular) -> None: ...
+
+    def advance(self, duration: float,
+                forces: Sequence[Tuple[str, Sequence[float]]]) -> Sequence[Collision]: ...
+
+    def attach(self, body1: str, body2: str) -> str: ...
+
+    def detach(self, joint_id: str) -> None: ...
+
+
+@dataclass
+class _Robot:
+    """One robot of the run: its handle, its columns in the stacked joint vector, its base's
+    index among the free-flying bases (None: base not driven)."""
+    handle: object
+    columns: slice
+    base: Optional[int]
+
+
+@dataclass
+class _Event:
+    time: float
+    action: str
+    link_body: str
+    obstacle_body: str
+    label: str
+
+
+@dataclass
+class TrackingReport:
+    """What a tracked execution did (module docstring); ``to_json()`` for the summary."""
+    source: str
+    format: str
+    goal_error: float
+    tracking_error_max: float
+    duration_s: float
+    trajectory_s: float
+    settle_s: float
+    period_s: float
+    wall_time_s: float
+    collisions: List[dict]
+    events: List[dict]
+    names: List[str]
+    units: List[str]
+    times: np.ndarray
+    targets: np.ndarray               # (ticks, channels)
+    actuals: np.ndarray
+
+    @property
+    def errors(self) -> np.ndarray:
+        return self.actuals - self.targets
+
+    @property
+    def real_time_factor(self) -> float:
+        return self.duration_s / self.wall_time_s if self.wall_time_s > 0 else math.inf
+
+    def to_json(self) -> dict:
+        return dict(
+            source=self.source, format=self.format, goal_error=self.goal_error,
+            tracking_error_max=self.tracking_error_max, duration_s=self.duration_s,
+            trajectory_s=self.trajectory_s, settle_s=self.settle_s, period_s=self.period_s,
+            wall_time_s=self.wall_time_s, real_time_factor=self.real_time_factor,
+            collisions=self.collisions, events=self.events,
+            units=dict(angle="rad", length="m", time="s"),
+            series=dict(time=self.times.tolist(), joints=[
+                dict(name=n, unit=u, target=self.targets[:, k].tolist(),
+                     actual=self.actuals[:, k].tolist(), error=self.errors[:, k].tolist())
+                for k, (n, u) in enumerate(zip(self.names, self.units))]))
+
+
+def _channels(robots: Sequence[_Robot]) -> Tuple[List[str], List[str]]:
+    names, units = [], []
+    for r in robots:
+        model = r.handle.instance.model
+        for i, joint in zip(model.movable_links(), model.joint_names()):
+            names.append(f"{r.handle.name}/{joint}")
+            units.append("m" if model.links[i].joint == PRISMATIC else "rad")
+        if r.base is not None:
+            names += [f"{r.handle.name}/base {a}" for a in "xyz"] + \
+                [f"{r.handle.name}/base rotation"]
+            units += ["m", "m", "m", "rad"]
+    return names, units
+
+
+def _events(plan, solution: Solution, times: np.ndarray) -> List[_Event]:
+    """The solution's events with their times (waypoint k of the file is k + 1 here: the
+    present configuration comes first) and bodies, all checked before anything runs."""
+    bodies = {_instance_of(b): b.id for b in plan.bodies()}
+    out = []
+    for e in solution.events:
+        handle = plan.robot(e.robot)
+        names = [link.name for link in handle.instance.model.links]
+        link_body = handle.bodies[names.index(e.link)].body_id
+        if e.obstacle not in bodies:
+            raise PathFileError(f"obstacle \"{e.obstacle}\" is static geometry in this build: "
+                                "it cannot be attached", solution.source, e.line)
+        out.append(_Event(float(times[e.index + 1]), e.action, link_body, bodies[e.obstacle],
+                          f"{e.action} {e.obstacle} to {e.robot}/{e.link}"))
+    return out
+
+
+def _instance_of(body) -> str:
+    """The instance a planned body belongs to: an object's name, a composite's parts'
+    ("name#k", gui.core.build's naming)."""
+    if hasattr(body, "name"):
+        return body.name
+    return body.parts[0].name.split("#")[0]
+
+
+def _present(port: TrackingPort, robot: _Robot) -> Tuple[np.ndarray, Optional[np.ndarray]]:
+    """A robot's joint values (rad / m) and base pose (4, 4 world) now."""
+    h = robot.handle
+    joints = np.asarray(h.built_at, dtype=float).copy()
+    if len(joints):
+        joints = joints + port.joint_positions(h.joint_ids)
+    base = None
+    if robot.base is not None:
+        position, quaternion, _, _ = port.body_state(h.bodies[0].body_id)
+        body = np.eye(4)
+        body[:3, :3] = quaternion_to_matrix(quaternion)
+        body[:3, 3] = position
+        base = body @ np.linalg.inv(h.bodies[0].offset)
+    return joints, base
+
+
+def plan_tracking(port: TrackingPort, plan, solution: Solution,
+                  defaults: TrackingDefaults = TrackingDefaults()):
+    """(robots, trajectory, events) for ``solution`` from the robots' present state."""
+    robots, columns, start, waypoints, bases, base_start = [], 0, [], [], [], []
+    speeds = []
+    for name, path in solution.paths.items():
+        handle = plan.robot(name)
+        n = path.joints.shape[1]
+        if n and len(handle.motor_ids) != n:
+            raise PathFileError(f"robot {name} has {len(handle.motor_ids)} motors for {n} "
+                                "joints: it cannot be servoed", solution.source)
+        base = None
+        if path.base_poses is not None:
+            base = len(bases)
+            bases.append(path.base_poses)
+        robot = _Robot(handle, slice(columns, columns + n), base)
+        robots.append(robot)
+        columns += n
+        joints, base_pose = _present(port, robot)
+        start.append(joints)
+        if base_pose is not None:
+            base_start.append(base_pose)
+        waypoints.append(path.joints)
+        speeds += [defaults.speed_fraction * (v or SERVO_MAX_SPEED) for v in
+                   (handle.max_speeds or [None] * n)]
+    q = np.vstack([np.concatenate(start)[None, :], np.hstack(waypoints)])
+    base_poses = None
+    if bases:
+        base_poses = np.concatenate([np.array(base_start)[None], np.stack(bases, axis=1)])
+    trajectory = Trajectory.of(q, speeds, [defaults.acceleration] * q.shape[1], base_poses,
+                               defaults.base_limits())
+    return robots, trajectory, _events(plan, solution, trajectory.times)
+
+
+def execute_tracked(port: TrackingPort, plan, solution: Solution,
+                    defaults: TrackingDefaults = TrackingDefaults(),
+                    progress: Optional[Callable[[float, float], None]] = None,
+                    real_time: bool = False, sleep: Callable[[float], None] = time.sleep
+                    ) -> TrackingReport:
+    """Runs ``solution`` on ``plan``'s robots through ``port`` (module docstring).
+    ``progress(t, duration)`` after each period; ``real_time``: each period takes at least
+    its simulated time of wall-clock time."""
+    robots, trajectory, events = plan_tracking(port, plan, solution, defaults)
+    step = port.step()
+    period = step * max(1, round(defaults.period / step))
+    ticks = int(math.ceil((trajectory.duration + defaults.settle) / period - 1e-9))
+    names, units = _channels(robots)
+    weights = _base_weights(port, robots)
+    gravity = port.gravity()
+    made: Dict[Tuple[str, str], str] = {}
+    collisions: Dict[Tuple[str, str], List[float]] = {}
+    times, targets, actuals = [], [], []
+    pending = sorted(events, key=lambda e: e.time)
+    started = time.monotonic()
+    for k in range(ticks):
+        t = k * period
+        while pending and pending[0].time <= t + 1e-9:
+            _apply(port, pending.pop(0), made)
+        middle, end = trajectory.sample(t + 0.5 * period), trajectory.sample(t + period)
+        rates = (end.joints - trajectory.sample(t).joints) / period
+        forces = []
+        for r in robots:
+            if r.columns.stop > r.columns.start:
+                port.set_servo(_servo(r.handle, middle.joints[r.columns],
+                                      rates[r.columns], defaults))
+            if r.base is not None:
+                forces.append(_drive_base(port, r, middle, end, weights[r.handle.name],
+                                          gravity, defaults))
+        wall = time.monotonic()
+        for first, second, depth, when in port.advance(period, forces):
+            seen = collisions.setdefault((first, second), [t + (when if math.isfinite(when)
+                                                                 else 0.0), depth])
+            seen[1] = max(seen[1], depth)
+        if real_time:
+            sleep(max(0.0, period - (time.monotonic() - wall)))
+        target, actual = _compare(port, robots, end)
+        times.append(t + period)
+        targets.append(target)
+        actuals.append(actual)
+        if progress is not None:
+            progress(t + period, ticks * period)
+    wall_time = time.monotonic() - started
+    targets, actuals = np.array(targets), np.array(actuals)
+    errors = np.abs(actuals - targets)
+    final = trajectory.sample(trajectory.duration)
+    goal_target, goal_actual = _compare(port, robots, final)
+    return TrackingReport(
+        solution.source, solution.format,
+        goal_error=float(np.max(np.abs(goal_actual - goal_target), initial=0.0)),
+        tracking_error_max=float(np.max(errors, initial=0.0)),
+        duration_s=ticks * period, trajectory_s=trajectory.duration,
+        settle_s=ticks * period - trajectory.duration, period_s=period, wall_time_s=wall_time,
+        collisions=[dict(first=a, second=b, first_time_s=v[0], depth_m=v[1])
+                    for (a, b), v in sorted(collisions.items(), key=lambda i: i[1][0])],
+        events=[dict(time_s=e.time, what=e.label) for e in events],
+        names=names, units=units, times=np.array(times), targets=targets, actuals=actuals)
+
+
+def _servo(handle, targets: np.ndarray, rates: np.ndarray,
+           defaults: TrackingDefaults) -> ServoCommand:
+    relative = targets - np.asarray(handle.built_at, dtype=float)
+    speeds = [float(v) if v else SERVO_MAX_SPEED for v in
+              (handle.max_speeds or [None] * len(relative))]
+    return ServoCommand(tuple(handle.motor_ids), tuple(float(v) for v in relative),
+                        rates=tuple(float(v) for v in rates),
+                        gains=(defaults.gain,) * len(relative), max_speeds=tuple(speeds))
+
+
+def _base_weights(port: TrackingPort, robots: Sequence[_Robot]) -> Dict[str, float]:
+    return {r.handle.name: port.masses([b.body_id for b in r.handle.bodies])
+            for r in robots if r.base is not None}
+
+
+def _drive_base(port: TrackingPort, robot: _Robot, middle, end, mass: float,
+                gravity: np.ndarray, defaults: TrackingDefaults) -> Tuple[str, tuple]:
+    """Sets the base body's velocity toward its target; returns the gravity-cancelling force
+    (the robot's whole mass, on the base body)."""
+    body = robot.handle.bodies[0]
+    position, quaternion, _, _ = port.body_state(body.body_id)
+    target = middle.base_pose[robot.base] @ body.offset
+    R_now = quaternion_to_matrix(quaternion)
+    linear = end.base_linear[robot.base] + defaults.base_gain * (target[:3, 3] - position)
+    angular = end.base_angular[robot.base] + defaults.base_gain * rotation_error(
+        target[:3, :3], R_now)
+    port.set_body_velocity(body.body_id, linear, angular)
+    return body.body_id, tuple(float(v) for v in -mass * gravity)
+
+
+def _compare(port: TrackingPort, robots: Sequence[_Robot], sample) -> Tuple[np.ndarray,
+                                                                            np.ndarray]:
+    """(target, actual) per channel: joints, then per driven base x y z and the rotation
+    (target's entry 0, actual's entry the angle between them)."""
+    target, actual = [], []
+    for r in robots:
+        joints, base = _present(port, r)
+        target.append(sample.joints[r.columns])
+        actual.append(joints)
+        if r.base is not None:
+            wanted = sample.base_pose[r.base]
+            angle = float(np.linalg.norm(rotation_error(wanted[:3, :3], base[:3, :3])))
+            target.append(np.concatenate([wanted[:3, 3], [0.0]]))
+            actual.append(np.concatenate([base[:3, 3], [angle]]))
+    return np.concatenate(target), np.concatenate(actual)
+
+
+def _apply(port: TrackingPort, event: _Event, made: Dict[Tuple[str, str], str]) -> None:
+    key = (event.link_body, event.obstacle_body)
+    if event.action == ATTACH:
+        if key not in made:
+            made[key] = port.attach(*key)
+    elif key in made:
+        port.detach(made.pop(key))
+
+
+# -- the world through gui.ros.client.WorldClient ---------------------------------------------
+@dataclass
+class ClientTrackingPort:
+    """A TrackingPort over a ``gui.ros.client.WorldClient``: each period one kept Propagate
+    (the world paused: ``run_tracked_on_client`` pauses it)."""
+    client: object
+    _step: Optional[float] = None
+    _states: Dict[str, BodyState] = field(default_factory=dict)
+
+    def step(self) -> float:
+        if self._step is None:
+            self._step = float(self.client.step_values().step)
+        return self._step
+
+    def gravity(self) -> np.ndarray:
+        return np.asarray(self.client.world_parameters().gravity, dtype=float)
+
+    def masses(self, body_ids: Sequence[str]) -> float:
+        return float(sum(self.client.call("get_state", objects=list(body_ids)).masses))
+
+    def joint_positions(self, joint_ids: Sequence[str]) -> np.ndarray:
+        response = self.client.call("get_state", joints=list(joint_ids))
+        return np.array([j.positions[0] for j in response.joints], dtype=float)
+
+    def body_state(self, body_id: str) -> BodyState:
+        if body_id not in self._states:
+            b = self.client.call("get_state", objects=[body_id]).bodies[0]
+            self._states[body_id] = (np.array(b.position), np.array(b.orientation),
+                                     np.array(b.linear), np.array(b.angular))
+        return self._states[body_id]
+
+    def set_servo(self, command: ServoCommand) -> None:
+        self.client.call("set_servo", motors=list(command.motors),
+                         targets=list(command.targets), rates=list(command.rates),
+                         gains=list(command.gains), max_speeds=list(command.max_speeds),
+                         max_forces=list(command.max_forces))
+
+    def set_body_velocity(self, body_id: str, linear, angular) -> None:
+        self.client.set_body_velocity(body_id, linear=list(linear), angular=list(angular))
+        self._states.pop(body_id, None)
+
+    def advance(self, duration: float, forces) -> List[Collision]:
+        from odin_common.interface import ForceKind
+        result = self.client.propagate(duration, forces=[
+            dict(object_id=body, kind=ForceKind.FORCE, vector=list(vector))
+            for body, vector in forces], keep=True)
+        self._states = {i: tuple(np.array(v) for v in s) for i, s in result.states.items()}
+        return [(a, b, float(depth), float(when) - result.start_time)
+                for a, b, depth, when in result.collisions]
+
+    def attach(self, body1: str, body2: str) -> str:
+        return self.client.add_joint(JointSpec(type=JointType.FIXED, body1=body1,
+                                               body2=body2))
+
+    def detach(self, joint_id: str) -> None:
+        self.client.remove_joint(joint_id)
+
+
+def run_tracked_on_client(client, plan, solution: Solution,
+                          defaults: TrackingDefaults = TrackingDefaults(),
+                          progress: Optional[Callable[[float, float], None]] = None,
+                          real_time: bool = False) -> TrackingReport:
+    """``execute_tracked`` through a ``ClientTrackingPort``, the world paused meanwhile (and
+    running again afterwards if it was)."""
+    running = client.world().simulating
+    if running:
+        client.pause()
+    try:
+        return execute_tracked(ClientTrackingPort(client), plan, solution, defaults,
+                               progress=progress, real_time=real_time)
+    finally:
+        if running:
+            client.start()
+
+
+__all__ = ["TrackingDefaults", "TrackingPort", "TrackingReport", "plan_tracking",
+           "execute_tracked", "ClientTrackingPort", "run_tracked_on_client"]

@@ -1,0 +1,417 @@
+"""Kautham's plans as paths Odin can execute: one path of waypoints per robot, in SI joint
+space, with the attach/detach events of a task (ROS-free).
+
+``read_solution(path, problem, robot=None, units=None)`` recognises the file by its content:
+
+- a legacy solution file (``.kps``, Kautham 2012's ``Planner::saveData``): a root ``<Planner>``
+  holding ``<SampleSet>`` (``<Sample>`` rows of normalised control values in [0, 1]) and
+  ``<Queries>``; the first ``<Query Solved="True">``'s ``<Result name="Path">`` lists sample
+  indices. Each sample maps through every robot's controls and limits as the query's
+  ``<Init>`` does (``gui.core.kautham.controls``);
+- a task file (current Kautham, ``PlannerWidget::saveDataOMPL`` / ``taskmotionPathLoad``): a
+  root ``<Task>`` of ``<Transit>``, ``<Transfer object robot link>`` and ``<MultiTransfer
+  numobjects object1.. robot link>`` sections holding ``<Conf>`` rows. ``robot`` and ``link``
+  are indices (the problem's robot order, the robot's link order with the base as 0) or
+  names. The object is attached at the section's first row and detached at its last.
+  ``<Initialstate>`` (obstacle poses) is refused: Odin builds obstacles where the problem
+  puts them;
+- OMPL's path output (``PathGeometric::printAsMatrix``, Kautham's ``getPath``): plain rows;
+- raw rows of one robot's movable joints (the thesis's path files, ``gui.core.paths``).
+
+A ``<Conf>`` row and an OMPL row are a mapped configuration of every robot in the problem's
+order (Kautham's ``loadSampleFromLine``): for a robot whose controls move its base (Kautham's
+``isSE3Enabled``), 7 values x y z (m, world) qx qy qz qw (its base's orientation, world,
+x y z w as Kautham and OMPL write it); then one value per joint of the robot (rad or m), every
+link but the base counted, fixed ones too (Kautham's ``getNumJoints``; the values of fixed
+joints are read and dropped). A row with only the movable joints' values per robot is read
+too. Plain rows of a 2012 problem are raw rows (degrees and mm unless ``units`` says
+otherwise); of a current problem, OMPL rows when their length is the problem's layout, raw
+rows of ``robot`` otherwise.
+
+Any malformed or mismatched file raises ``PathFileError`` naming the file and the row's line;
+nothing is returned in part.
+"""
+from __future__ import annotations
+
+import math
+import os
+import pathlib
+from dataclasses import dataclass
+from typing import Dict, List, Optional, Sequence, Tuple
+
+import numpy as np
+
+from gui.core.kautham.xmlfile import Node, read_xml
+from gui.core.model import Instance, Problem
+from gui.core.paths import DEGREES, RADIANS, read_rows, to_si
+from gui.errors import PathFileError, ProblemError
+from odin_common.rotations import quaternion_to_matrix
+
+KPS, TASK, OMPL, ROWS = "kps", "task", "ompl", "rows"
+SE3_VALUES = 7
+"""x y z qx qy qz qw: a robot's base in a mapped configuration row."""
+ATTACH, DETACH = "attach", "detach"
+
+
+@dataclass(frozen=True, eq=False)
+class RobotWaypoints:
+    """One robot's path: ``joints`` (n, d) rad or m, its movable joints in
+    ``RobotModel.movable_links()`` order; ``base_poses`` (n, 4, 4) world poses of its base
+    (None: the file does not move the base); ``lines`` the file line of each waypoint."""
+    robot: str
+    joints: np.ndarray
+    base_poses: Optional[np.ndarray]
+    lines: Tuple[int, ...]
+
+
+@dataclass(frozen=True)
+class AttachEvent:
+    """At waypoint ``index`` (the same index in every robot's path), ``action`` (ATTACH or
+    DETACH) ``obstacle`` to / from ``link`` of ``robot`` (instance and link names)."""
+    index: int
+    action: str
+    robot: str
+    link: str
+    obstacle: str
+    line: int
+
+
+@dataclass(frozen=True, eq=False)
+class Solution:
+    """What a plan file holds: ``format`` (KPS, TASK, OMPL or ROWS), one ``RobotWaypoints``
+    per robot it moves (same number of waypoints each), and its attach/detach events."""
+    source: str
+    format: str
+    paths: Dict[str, RobotWaypoints]
+    events: Tuple[AttachEvent, ...] = ()
+
+    @property
+    def waypoint_count(self) -> int:
+        return len(next(iter(self.paths.values())).joints)
+
+
+def read_solution(path: os.PathLike | str, problem: Problem, robot: Optional[str] = None,
+                  units: Optional[str] = None) -> Solution:
+    """The plan in ``path`` for ``problem`` (module docstring); ``robot``: the robot raw rows
+    drive (default: the first); ``units``: DEGREES or RADIANS for raw rows (default: degrees
+    for 2012 problems, radians otherwise)."""
+    p = pathlib.Path(path)
+    if not p.is_file():
+        raise PathFileError("path file not found", p)
+    if not problem.robots:
+        raise PathFileError(f"problem {problem.source} has no robot to move", p)
+    text = p.read_text(errors="replace")
+    if text.lstrip().startswith("<"):
+        root = _read_xml(p)
+        if root.tag == "Planner" or root.find("SampleSet") is not None:
+            return _read_kps(p, root, problem)
+        if root.tag == "Task":
+            return _read_task(p, root, problem)
+        raise PathFileError(f"root element <{root.tag}> is neither a Kautham solution "
+                            "(<Planner> with <SampleSet>) nor a task file (<Task>)", p,
+                            root.line)
+    return _read_plain_rows(p, problem, robot, units)
+
+
+def _read_xml(p: pathlib.Path) -> Node:
+    try:
+        return read_xml(p, "path file")
+    except PathFileError:
+        raise
+    except ProblemError as error:
+        raise PathFileError(error.reason, p, error.line) from None
+
+
+# -- legacy .kps ---------------------------------------------------------------------------------
+def _read_kps(p: pathlib.Path, root: Node, problem: Problem) -> Solution:
+    sample_set = root.find("SampleSet")
+    if sample_set is None:
+        raise PathFileError("<Planner> holds no <SampleSet>: no configuration", p, root.line)
+    samples = list(sample_set.findall("Sample"))
+    result = _kps_path_result(p, root)
+    try:
+        indices = [int(t) for t in result.text.split()]
+    except ValueError:
+        raise PathFileError(f"<Result name=\"Path\"> holds {result.text.strip()!r}, not "
+                            "sample indices", p, result.line) from None
+    if not indices:
+        raise PathFileError("<Result name=\"Path\"> lists no sample", p, result.line)
+    robots = _mapped_robots(p, problem)
+    size = robots[0].controls.size
+    vectors, lines = [], []
+    for index in indices:
+        if not 0 <= index < len(samples):
+            raise PathFileError(f"sample index {index} is not in the <SampleSet> (0.."
+                                f"{len(samples) - 1})", p, result.line)
+        sample = samples[index]
+        values = _numbers(p, sample)
+        if len(values) != size:
+            raise PathFileError(f"<Sample> {index} has {len(values)} values, the controls are "
+                                f"{size} ({', '.join(robots[0].controls.names)})", p,
+                                sample.line)
+        if not all(0.0 <= v <= 1.0 for v in values):
+            raise PathFileError(f"<Sample> {index} holds values outside [0, 1] (normalised "
+                                "controls)", p, sample.line)
+        vectors.append(values)
+        lines.append(sample.line)
+    paths = {}
+    for instance in robots:
+        configurations = [instance.controls.configuration(instance, v) for v in vectors]
+        base = None
+        if instance.controls.se3:
+            base = np.array([c.base_pose for c in configurations])
+        paths[instance.name] = RobotWaypoints(
+            instance.name, np.array([c.joints for c in configurations], dtype=float), base,
+            tuple(lines))
+    return Solution(str(p), KPS, paths)
+
+
+def _kps_path_result(p: pathlib.Path, root: Node) -> Node:
+    queries = root.find("Queries")
+    found = list(queries.findall("Query")) if queries is not None else []
+    if not found:
+        raise PathFileError("holds no configuration: no <Queries>/<Query> with a "
+                            "<Result name=\"Path\">", p, root.line)
+    for query in found:
+        if query.get("Solved", "True").strip().lower() == "false":
+            continue
+        for result in query.findall("Result"):
+            if result.get("name", "").strip() == "Path":
+                return result
+    raise PathFileError("no solved <Query> has a <Result name=\"Path\">", p, found[0].line)
+
+
+def _mapped_robots(p: pathlib.Path, problem: Problem) -> List[Instance]:
+    robots = [r for r in problem.robots if r.controls is not None]
+    if not robots:
+        raise PathFileError(f"no robot of {problem.source} has controls to map the file's "
+                            "normalised samples through", p)
+    if len({r.controls.size for r in robots}) > 1:
+        raise PathFileError("the robots' control sets differ in size: a sample cannot map "
+                            "through all of them", p)
+    return robots
+
+
+def _numbers(p: pathlib.Path, node: Node) -> List[float]:
+    out = []
+    for token in node.text.split():
+        try:
+            value = float(token)
+        except ValueError:
+            raise PathFileError(f"{token!r} is not a number in <{node.tag}>", p,
+                                node.line) from None
+        if not math.isfinite(value):
+            raise PathFileError(f"a value of <{node.tag}> is not finite", p, node.line)
+        out.append(value)
+    return out
+
+
+# -- task files ----------------------------------------------------------------------------------
+def _read_task(p: pathlib.Path, root: Node, problem: Problem) -> Solution:
+    layout = RowLayout.of(problem)
+    rows, lines, events = [], [], []
+    for section in root.children:
+        if section.tag == "Transit":
+            objects: List[str] = []
+        elif section.tag == "Transfer":
+            objects = [_required(p, section, "object")]
+        elif section.tag == "MultiTransfer":
+            objects = _multi_objects(p, section)
+        elif section.tag == "Initialstate":
+            raise PathFileError("<Initialstate> (obstacle poses) is not supported: Odin "
+                                "builds obstacles where the problem puts them", p,
+                                section.line)
+        else:
+            raise PathFileError(f"<{section.tag}> in a <Task>: expected <Transit>, "
+                                "<Transfer> or <MultiTransfer>", p, section.line)
+        confs = [c for c in section.children if c.tag == "Conf"]
+        if not confs:
+            raise PathFileError(f"<{section.tag}> holds no <Conf>", p, section.line)
+        first = len(rows)
+        for conf in confs:
+            rows.append(_numbers(p, conf))
+            lines.append(conf.line)
+        if objects:
+            robot, link = _transfer_target(p, section, problem)
+            for name in objects:
+                _check_obstacle(p, section, problem, name)
+                events.append(AttachEvent(first, ATTACH, robot, link, name, section.line))
+                events.append(AttachEvent(len(rows) - 1, DETACH, robot, link, name,
+                                          section.line))
+    if not rows:
+        raise PathFileError("<Task> holds no <Conf> row", p, root.line)
+    return Solution(str(p), TASK, layout.split(p, rows, lines), tuple(events))
+
+
+def _required(p: pathlib.Path, node: Node, name: str) -> str:
+    value = node.get(name)
+    if value is None or not value.strip():
+        raise PathFileError(f"<{node.tag}> has no {name}=\"...\"", p, node.line)
+    return value.strip()
+
+
+def _multi_objects(p: pathlib.Path, node: Node) -> List[str]:
+    raw = _required(p, node, "numobjects")
+    if not raw.isdigit() or int(raw) < 1:
+        raise PathFileError(f"numobjects=\"{raw}\" is not a positive count", p, node.line)
+    return [_required(p, node, f"object{k}") for k in range(1, int(raw) + 1)]
+
+
+def _transfer_target(p: pathlib.Path, node: Node, problem: Problem) -> Tuple[str, str]:
+    """(robot instance name, link name) of a Transfer: indices (Kautham's) or names."""
+    robots = problem.robots
+    raw = _required(p, node, "robot")
+    if raw.isdigit():
+        if int(raw) >= len(robots):
+            raise PathFileError(f"robot=\"{raw}\": the problem has {len(robots)} robots", p,
+                                node.line)
+        instance = robots[int(raw)]
+    else:
+        instance = next((r for r in robots if raw in (r.name, r.model.name)), None)
+        if instance is None:
+            raise PathFileError(f"robot=\"{raw}\": no such robot (robots: "
+                                + ", ".join(r.name for r in robots) + ")", p, node.line)
+    links = instance.model.links
+    raw = _required(p, node, "link")
+    if raw.isdigit():
+        if int(raw) >= len(links):
+            raise PathFileError(f"link=\"{raw}\": robot {instance.name} has {len(links)} "
+                                "links", p, node.line)
+        return instance.name, links[int(raw)].name
+    if raw not in [link.name for link in links]:
+        raise PathFileError(f"link=\"{raw}\": robot {instance.name} has no such link", p,
+                            node.line)
+    return instance.name, raw
+
+
+def _check_obstacle(p: pathlib.Path, node: Node, problem: Problem, name: str) -> None:
+    if not any(name in (o.name, o.model.name) for o in problem.obstacles):
+        raise PathFileError(f"object \"{name}\": no such obstacle (obstacles: "
+                            + ", ".join(o.name for o in problem.obstacles) + ")", p, node.line)
+
+
+# -- mapped configuration rows (task files, OMPL) ------------------------------------------------
+@dataclass(frozen=True)
+class RowLayout:
+    """How a mapped configuration row splits per robot: (instance, SE3 prefix?, joint count
+    written, indices of the movable joints among them)."""
+    robots: Tuple[Tuple[Instance, bool, int, Tuple[int, ...]], ...]
+
+    @staticmethod
+    def of(problem: Problem, movable_only: bool = False) -> "RowLayout":
+        entries = []
+        for instance in problem.robots:
+            se3 = instance.controls is not None and instance.controls.se3
+            model = instance.model
+            movable = model.movable_links()
+            if movable_only:
+                entries.append((instance, se3, len(movable), tuple(range(len(movable)))))
+            else:               # every link but the base: movable link i is value i - 1
+                entries.append((instance, se3, len(model.links) - 1,
+                                tuple(i - 1 for i in movable)))
+        return RowLayout(tuple(entries))
+
+    @property
+    def size(self) -> int:
+        return sum((SE3_VALUES if se3 else 0) + n for _, se3, n, _ in self.robots)
+
+    def describe(self) -> str:
+        return " + ".join(f"{i.name}: " + ("7 (x y z qx qy qz qw) + " if se3 else "")
+                          + f"{n} joints" for i, se3, n, _ in self.robots)
+
+    def split(self, p: pathlib.Path, rows: Sequence[Sequence[float]],
+              lines: Sequence[int]) -> Dict[str, RobotWaypoints]:
+        """One RobotWaypoints per robot from rows of this layout (the other layout, movable
+        joints only, is tried when a row's length is not this one's)."""
+        layout = self
+        if rows and len(rows[0]) != self.size:
+            alternative = RowLayout(tuple((i, se3, len(m), tuple(range(len(m))))
+                                          for i, se3, _, m in self.robots))
+            if len(rows[0]) == alternative.size:
+                layout = alternative
+        bases: Dict[str, list] = {i.name: [] for i, *_ in layout.robots}
+        joints: Dict[str, list] = {i.name: [] for i, *_ in layout.robots}
+        for row, line in zip(rows, lines):
+            if len(row) != layout.size:
+                raise PathFileError(f"{len(row)} values, expected {layout.size} "
+                                    f"({layout.describe()})", p, line)
+            k = 0
+            for instance, se3, n, movable in layout.robots:
+                if se3:
+                    bases[instance.name].append(_se3_pose(p, row[k:k + SE3_VALUES], line))
+                    k += SE3_VALUES
+                values = np.asarray(row[k:k + n], dtype=float)
+                joints[instance.name].append(values[list(movable)])
+                k += n
+        out = {}
+        for instance, se3, _, movable in layout.robots:
+            _check_limits(p, instance, joints[instance.name], lines)
+            out[instance.name] = RobotWaypoints(
+                instance.name, np.array(joints[instance.name], dtype=float).reshape(
+                    len(rows), len(movable)),
+                np.array(bases[instance.name]) if se3 else None, tuple(lines))
+        return out
+
+
+def _se3_pose(p: pathlib.Path, values: Sequence[float], line: int) -> np.ndarray:
+    x, y, z, qx, qy, qz, qw = values
+    norm = math.sqrt(qx * qx + qy * qy + qz * qz + qw * qw)
+    if norm < 1e-6:
+        raise PathFileError("the base's quaternion (values 4..7, qx qy qz qw) is zero", p, line)
+    pose = np.eye(4)
+    pose[:3, :3] = quaternion_to_matrix(np.array([qw, qx, qy, qz]) / norm)
+    pose[:3, 3] = (x, y, z)
+    return pose
+
+
+LIMIT_SLACK = 1e-6
+"""rad or m: how far past a joint's limit a file value may be (rounding in the file)."""
+
+
+def _check_limits(p: pathlib.Path, instance: Instance, rows: Sequence[np.ndarray],
+                  lines: Sequence[int]) -> None:
+    model = instance.model
+    for k, i in enumerate(model.movable_links()):
+        link = model.links[i]
+        if link.limits is None:
+            continue
+        low, high = link.limits
+        for row, line in zip(rows, lines):
+            if not low - LIMIT_SLACK <= row[k] <= high + LIMIT_SLACK:
+                raise PathFileError(f"{instance.name} joint {link.name} = {row[k]:g} is "
+                                    f"outside its limits [{low:g}, {high:g}]", p, line)
+
+
+# -- plain rows ----------------------------------------------------------------------------------
+def _read_plain_rows(p: pathlib.Path, problem: Problem, robot: Optional[str],
+                     units: Optional[str]) -> Solution:
+    instance = _robot(p, problem, robot)
+    movable = len(instance.model.movable_links())
+    if problem.format == "2012":
+        raw, lines = read_rows(p, movable)
+    else:
+        layout = RowLayout.of(problem)
+        first, _ = read_rows(p, None)
+        if first.shape[1] in (layout.size, RowLayout.of(problem, movable_only=True).size) \
+                and robot is None:
+            raw, lines = read_rows(p, first.shape[1], f"a configuration: {layout.describe()}")
+            return Solution(str(p), OMPL, layout.split(p, raw.tolist(), lines))
+        raw, lines = read_rows(p, movable, f"one per movable joint of {instance.name}")
+    unit = units or (DEGREES if problem.format == "2012" else RADIANS)
+    kinds = [instance.model.links[i].joint for i in instance.model.movable_links()]
+    joints = to_si(raw, kinds, unit)
+    _check_limits(p, instance, list(joints), lines)
+    return Solution(str(p), ROWS, {instance.name: RobotWaypoints(
+        instance.name, joints, None, tuple(lines))})
+
+
+def _robot(p: pathlib.Path, problem: Problem, name: Optional[str]) -> Instance:
+    for instance in problem.robots:
+        if name in (None, instance.name):
+            return instance
+    raise PathFileError(f"no robot named {name!r} (robots: "
+                        + ", ".join(r.name for r in problem.robots) + ")", p)
+
+
+__all__ = ["KPS", "TASK", "OMPL", "ROWS", "ATTACH", "DETACH", "SE3_VALUES", "RobotWaypoints",
+           "AttachEvent", "Solution", "RowLayout", "read_solution"]

@@ -1,0 +1,63 @@
+"""run_path --tracked against a live VirtualWorld (each test with its own roscore): Kautham's
+public 2DRR_obstacle solution (.kps) followed by the joint servos to its goal."""
+from __future__ import annotations
+
+import json
+
+import pytest
+
+pytestmark = pytest.mark.forked
+
+
+@pytest.fixture
+def world(ros_master):
+    node = ros_master.rosrun("VirtualWorld", "virtualWorld")
+    ros_master.wait_for_service("/virtual_world/set_servo")
+    yield ros_master
+    assert node.poll() is None, "virtualWorld died:\n" + ros_master.log_text(node)[-3000:]
+
+
+def test_the_2drr_kps_solution_runs_to_its_goal_with_a_summary_and_a_plot(world, kautham_dir,
+                                                                         tmp_path):
+    tro = kautham_dir / "legacy_2012" / "examples" / "TRO"
+    problem, solution = tro / "2DRR_obstacle.xml", tro / "2DRR_obstacle_sol.kps"
+    world.run(["rosrun", "GUI", "load_problem", str(problem), "--at-start"], timeout=120)
+    from gui.ros.client import WorldClient
+    from odin_common.interface import Solver
+    client = WorldClient()
+    # the exact solver: QuickStep's 20 iterations let this 1 kg-per-link chain shake under
+    # gravity near the goal (the GUI's Settings tab offers the same choice)
+    client.set_world(solver=Solver.WORLDSTEP)
+    summary, plot = tmp_path / "summary.json", tmp_path / "plot.png"
+    result = world.run(["rosrun", "GUI", "run_path", str(problem), "--at-start", "--tracked",
+                        str(solution), "--fast", "--summary", str(summary), "--plot",
+                        str(plot)], timeout=180)
+    assert "kps path of 4 waypoints" in result.stdout.splitlines()[-1]
+    report = json.loads(summary.read_text())
+    assert report["goal_error"] <= 0.01
+    assert 0.0 < report["tracking_error_max"] < 0.05
+    assert report["duration_s"] > report["trajectory_s"] > 1.0
+    joints = report["series"]["joints"]
+    assert [j["name"] for j in joints] == ["2D-Robot/link1", "2D-Robot/link2", "2D-Robot/tcp"]
+    assert len(joints[0]["actual"]) == len(report["series"]["time"])
+    # the first sample of the path is the query's Init, the last its Goal
+    assert joints[0]["target"][-1] == pytest.approx(-0.4335, abs=1e-3)
+    assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert not client.world().simulating
+    client.close()
+
+
+def test_a_mismatched_plan_is_one_error_line_and_runs_nothing(world, kautham_dir, tmp_path):
+    tro = kautham_dir / "legacy_2012" / "examples" / "TRO"
+    problem = tro / "2DRR_obstacle.xml"
+    world.run(["rosrun", "GUI", "load_problem", str(problem)], timeout=120)
+    bad = tmp_path / "bad.kps"
+    bad.write_text('<?xml version="1.0"?>\n<Planner>\n <Queries>\n  <Query Solved="True">\n'
+                   '   <Result name="Path">0 1</Result>\n  </Query>\n </Queries>\n'
+                   ' <SampleSet dim="2" size="2">\n  <Sample>0.5 0.5</Sample>\n'
+                   '  <Sample>0.5 0.5 0.5</Sample>\n </SampleSet>\n</Planner>\n')
+    result = world.run(["rosrun", "GUI", "run_path", str(problem), "--tracked", str(bad)],
+                       check=False, timeout=60)
+    errors = [l for l in result.stderr.splitlines() if not l.startswith("run_path: warning:")]
+    assert result.returncode != 0 and len(errors) == 1 and f"{bad}:10:" in errors[0]
+    assert "3 values" in errors[0]
