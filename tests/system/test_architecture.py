@@ -32,8 +32,10 @@ RULES = {
     "virtual_world.pool": QT + ("virtual_world.core", "virtual_world.ode",
                                 "virtual_world.portal", "viewer", "gui"),
 }
-# the generated message classes are allowed in odin_common.messages only
-EXCEPTIONS = {"odin_common.messages": ("Messages.msg",)}
+# the generated message classes are allowed in odin_common.messages only, rospy in
+# odin_common.node only (what every node's Portal does with rospy: start, outlive its master)
+EXCEPTIONS = {"odin_common.messages": ("Messages.msg",),
+              "odin_common.node": ("rospy", "rosgraph")}
 # Qt tabs talk to the world through gui.ros' typed client only
 TAB_RULE = ROS + MESSAGES
 

@@ -90,6 +90,17 @@ class RosMaster:
             self._use_port(free_port())
         raise RuntimeError("roscore did not come up: " + "; ".join(failures))
 
+    def restart_master(self) -> None:
+        """Kills roscore (SIGKILL, as a crash would) and starts a new one on the same port:
+        the new master knows no node, no parameter (a fault drill, tests/nodes)."""
+        old = next(p for p in self._processes if p.args[:1] == ["roscore"])
+        _stop_group(old, signal_first=signal.SIGKILL)
+        self._processes.remove(old)
+        roscore = self.popen(["roscore", "-p", str(self.port)], log_name="roscore")
+        failure = self._wait_for_master(roscore)
+        if failure is not None:
+            raise RuntimeError(f"roscore did not come back on port {self.port}: {failure}")
+
     def _wait_for_master(self, roscore: subprocess.Popen) -> str | None:
         """None once the master answers, else why it will not."""
         deadline = time.monotonic() + self._startup_timeout
@@ -174,14 +185,14 @@ class RosMaster:
                                    + self.log_text(process)[-3000:])
 
 
-def _stop_group(process: subprocess.Popen) -> None:
-    """SIGINT to the process's group, then SIGKILL to the group and to every descendant:
-    roslaunch starts its nodes (rosmaster, rosout, rostest's nodes) in sessions of their own,
-    and a hung rosmaster outlives a killed roscore."""
+def _stop_group(process: subprocess.Popen, signal_first: int = signal.SIGINT) -> None:
+    """``signal_first`` to the process's group, then SIGKILL to the group and to every
+    descendant: roslaunch starts its nodes (rosmaster, rosout, rostest's nodes) in sessions of
+    their own, and a hung rosmaster outlives a killed roscore."""
     tree = _descendants(process.pid)
     if process.poll() is None:
         try:
-            os.killpg(process.pid, signal.SIGINT)
+            os.killpg(process.pid, signal_first)
             process.wait(timeout=8)
         except (ProcessLookupError, subprocess.TimeoutExpired):
             pass

@@ -39,15 +39,3 @@ def _silence_stdout() -> None:
     except (OSError, ValueError):
         pass
 
-
-def init_ros_node(name: str) -> None:
-    """``rospy.init_node(name)`` with rospy's own signal handling, except that Ctrl-C while
-    the node still waits for its master ends it like any tool (130, no traceback): rospy
-    turns that Ctrl-C into a ROSInitException ("Failed to initialize time")."""
-    import rospy   # here, not at the top: the tools that use ``run`` alone never load rospy
-    try:
-        rospy.init_node(name)
-    except rospy.ROSInitException:
-        if rospy.core.is_shutdown_requested():
-            raise KeyboardInterrupt from None
-        raise

@@ -50,7 +50,7 @@ from Services.srv import (SaveSnapshot, SaveSnapshotResponse, SetCamera, SetCame
                           ViewerNewScene, ViewerNewSceneResponse, ViewerRemoveObject,
                           ViewerRemoveObjectResponse, ViewObject, ViewObjectResponse)
 from odin_common import OdinError
-from odin_common.tool import init_ros_node
+from odin_common.node import MasterWatch, init_ros_node
 from viewer.core.camera import Camera
 from viewer.errors import ViewerError
 from viewer.core.loop import RenderLoop
@@ -217,6 +217,7 @@ class Portal:
 
 def main() -> None:
     init_ros_node("viewer")
+    MasterWatch()
     try:
         portal = Portal()
     except OdinError as error:

@@ -60,7 +60,7 @@ from Services import srv
 from odin_common import OdinError
 from odin_common.interface import WORLD_SERVICES
 from odin_common.limits import ResourceLimits
-from odin_common.tool import init_ros_node
+from odin_common.node import MasterWatch, init_ros_node
 from odin_common.world_parameters import PARAMETERS
 from virtual_world.core import Core, step_values
 from virtual_world.core.loop import CycleReport, RealTimeFactor, WorldLoop
@@ -246,6 +246,7 @@ class Portal:
 
 def main() -> None:
     init_ros_node("virtual_world")
+    MasterWatch()
     try:
         portal = Portal()
     except OdinError as error:
