@@ -132,3 +132,45 @@ def test_the_viewer_image_shows_in_the_window(ros_master):
         screenshot(window, ROOT / "out" / "gui" / "viewer.png")
     finally:
         window.shutdown()
+
+
+def test_a_restarted_world_is_offered_the_last_problem_again(ros_master, kautham_dir):
+    """The world dies under a built problem and a new one starts empty: the window says so,
+    offers the last problem (it never rebuilds unasked), and one click builds it again."""
+    os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+    import rospy
+    from gui.window.main_window import MainWindow
+    from gui.window.testing import app, click, screenshot, wait_for
+    app()
+    node = ros_master.rosrun("VirtualWorld", "virtualWorld")
+    rospy.init_node("gui", anonymous=False, disable_signals=True)
+    window = MainWindow(poll_period=0.2)
+    window.show()
+    problem = kautham_dir / "legacy_2012" / "examples" / "TRO" / "2DRR_obstacle.xml"
+    try:
+        wait_for(lambda: window.connected, 30, "the window to find the world")
+        built = []
+        window.simulation.problem_built.connect(built.append)
+        window.simulation.open_problem(str(problem))
+        wait_for(lambda: len(built) == 1, 60, "the problem built", lambda: window.errors)
+        assert window.simulation.rebuild_button.isHidden()
+
+        os.killpg(node.pid, signal.SIGKILL)       # a crash, not a shutdown
+        node.wait(10)
+        wait_for(lambda: not window.connected, 15, "the window to see the world gone")
+        assert window.simulation.rebuild_button.isHidden()
+        ros_master.rosrun("VirtualWorld", "virtualWorld")
+        wait_for(lambda: window.connected, 30, "the window to reconnect")
+        wait_for(lambda: window.simulation.rebuild_button.isVisible(), 5, "the offer")
+        assert "2DRR_obstacle.xml" in window.simulation.rebuild_button.text()
+        assert "restarted" in window.last_info
+        assert len(built) == 1                    # offered, not rebuilt unasked
+        screenshot(window, ROOT / "out" / "gui" / "rebuild_offer.png")
+
+        click(window.simulation.rebuild_button)
+        wait_for(lambda: len(built) == 2, 60, "the problem built again", lambda: window.errors)
+        assert window.simulation.rebuild_button.isHidden()
+        from gui.ros.client import WorldClient
+        assert len(WorldClient().world().objects) > 0
+    finally:
+        window.shutdown()

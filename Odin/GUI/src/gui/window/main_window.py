@@ -45,6 +45,7 @@ class MainWindow(QMainWindow):
         self.last_info = ""
         self.errors: list = []
         self.connected = False
+        self._lost_world = False          # a world was connected once and went away
         self.last_update_time = 0.0
         self.updates = 0
 
@@ -142,7 +143,10 @@ class MainWindow(QMainWindow):
         if connected and not was:
             self.show_info(text)
             self.settings.refresh()
+            if self._lost_world:
+                self.simulation.offer_rebuild()
         elif was and not connected:
+            self._lost_world = True
             self.show_error(text)
             self.simulation.set_simulating(False)
             self.scene.forget_world()

@@ -14,6 +14,7 @@ from __future__ import annotations
 import os
 import pathlib
 import time
+from typing import Optional
 
 from PyQt5.QtCore import Qt, pyqtSignal
 from PyQt5.QtWidgets import (QCheckBox, QFileDialog, QHBoxLayout, QLabel, QPushButton,
@@ -38,6 +39,7 @@ class SimulationTab(QWidget):
         self._advancing = 0
         self.building = False
         self.last_build_seconds = None
+        self.last_problem: Optional[str] = None      # the last problem built, to offer again
 
         self.tree = QTreeWidget()
         self.tree.setHeaderLabels(["Element", "World ID"])
@@ -52,6 +54,10 @@ class SimulationTab(QWidget):
         self.simulate_button.setStyleSheet(PAUSED_STYLE)
         self.status = QLabel("No problem loaded.")
         self.status.setWordWrap(True)
+        self.rebuild_button = QPushButton()
+        self.rebuild_button.setToolTip("The world restarted empty: build the last problem again")
+        self.rebuild_button.setStyleSheet("QPushButton { color: #b71c1c; font-weight: bold; }")
+        self.rebuild_button.hide()
 
         row = QHBoxLayout()
         row.addWidget(self.open_button)
@@ -61,13 +67,37 @@ class SimulationTab(QWidget):
         layout = QVBoxLayout(self)
         layout.addWidget(self.tree, 1)
         layout.addWidget(self.status)
+        layout.addWidget(self.rebuild_button)
         layout.addLayout(row)
         layout.addWidget(self.simulate_button)
 
         self.open_button.clicked.connect(self.choose_problem)
         self.new_scene_button.clicked.connect(self.new_scene)
         self.simulate_button.clicked.connect(self.toggle_simulation)
+        self.rebuild_button.clicked.connect(self.rebuild)
+        self.problem_built.connect(self._remember)
         self._groups: dict = {}
+
+    # -- a world that came back -------------------------------------------------------------
+    def _remember(self, path: str) -> None:
+        self.last_problem = path
+        self.rebuild_button.hide()
+
+    def offer_rebuild(self) -> None:
+        """After the world was lost and came back (empty: a new node): offer the last problem
+        built, never rebuild unasked (the user may want the empty world)."""
+        if self.last_problem is None:
+            return
+        name = pathlib.Path(self.last_problem).name
+        self.rebuild_button.setText(f"Rebuild {name} in the new world")
+        self.rebuild_button.show()
+        self.status.setText(f"The world restarted empty; {name} can be built again.")
+        self.window.show_info(f"The world restarted: 'Rebuild {name}' builds it again")
+
+    def rebuild(self) -> None:
+        if self.last_problem is not None:
+            self.rebuild_button.hide()
+            self.open_problem(self.last_problem)
 
     # -- open ---------------------------------------------------------------------------------
     def choose_problem(self) -> None:

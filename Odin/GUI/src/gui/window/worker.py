@@ -21,6 +21,7 @@ import queue
 import threading
 import time
 import traceback
+import xmlrpc.client
 from dataclasses import dataclass, field
 from typing import Any, Callable, Optional
 
@@ -28,6 +29,8 @@ from PyQt5.QtCore import QThread, pyqtSignal
 
 from gui.errors import GuiError, WorldError
 from odin_common.interface import WORLD_NAMESPACE
+
+PING_TIMEOUT = 2.0      # s: a world that does not answer its pid in this long is absent
 
 
 class Cancelled(GuiError):
@@ -200,13 +203,21 @@ class WorldWorker(QThread):
             self.busy.emit("")
 
     def _service_registered(self) -> bool:
+        """Whether the world's services are registered AND their node answers: a world that
+        crashed (SIGKILL, a segfault) never unregisters, so the master alone would call it
+        alive. The node is asked its pid over its XML-RPC API, as ``rosnode ping`` does."""
         import rosgraph
         import rospy
+        service = f"{self.namespace}/set_joint_force"
         try:
             master = rosgraph.Master(rospy.get_name() or "/gui")
-            master.lookupService(f"{self.namespace}/set_joint_force")
+            providers = dict(master.getSystemState()[2]).get(service, [])
+            if not providers:
+                return False
+            api = master.lookupNode(providers[0])
+            xmlrpc.client.ServerProxy(api, transport=_QuickTransport()).getPid(master.caller_id)
             return True
-        except Exception:  # master down, or service not registered
+        except Exception:  # master down, service not registered, node gone or not answering
             return False
 
     def _check_connection(self) -> None:
@@ -239,3 +250,12 @@ class WorldWorker(QThread):
             except Exception:
                 pass
         self._client = None
+
+
+class _QuickTransport(xmlrpc.client.Transport):
+    """XML-RPC over HTTP that gives up after PING_TIMEOUT s: a hung node is an absent one."""
+
+    def make_connection(self, host):
+        connection = super().make_connection(host)
+        connection.timeout = PING_TIMEOUT
+        return connection
