@@ -3,7 +3,7 @@ SHELL := /bin/bash
 ROOT  := $(CURDIR)
 ENV   := set -eo pipefail; source $(ROOT)/setup.bash;
 
-.PHONY: setup bench-setup build demo test bench experiments lint mutants clean
+.PHONY: setup bench-setup build demo test bench experiments lint mutants soak clean
 
 setup:
 	@tools/install.sh
@@ -36,6 +36,11 @@ lint: setup
 # out/mutants/report.json and report.md, prints the survivors, exits 0 (docs/MUTANTS.md)
 mutants: setup
 	@$(ENV) python tools/mutants/run.py
+
+# ten minutes of four clients' mixed calls against a simulating world, the Viewer rendering and
+# a recorder subscribed; not part of `make test`; figures in out/soak/results.json
+soak: setup
+	@$(ENV) python tools/soak/run.py
 
 clean:
 	rm -rf build out .pytest_cache
