@@ -277,7 +277,7 @@ def render_parameters() -> str:
     lines += ["", f"### `{VIEWER_NAMESPACE}`", ""]
     lines += _node_table(VIEWER_PARAMETERS)
     lines += ["", "Meshes of more than 2,000 triangles are drawn with their vertices clustered "
-              "at 1 mm (`viewer.core.geometry.DISPLAY_TOLERANCE`); the world's collision meshes "
+              "at 1 mm (`odin_common.meshes.DISPLAY_TOLERANCE`); the world's collision meshes "
               "are not affected.", "", "### `/gui`", ""]
     lines += _node_table(GUI_PARAMETERS)
     return "\n".join(lines) + "\n"
