@@ -25,6 +25,8 @@ NODE_PARAMETERS: Tuple[NodeParameter, ...] = (
     NodeParameter("record", "", "-", "a rosbag file to record every state-changing request "
                   "and every advance into (`rosrun VirtualWorld replay FILE` re-runs it); "
                   "empty: no recording"),
+    NodeParameter("push_speed", 0.5, "m/s", "velocity an interactive marker's Push adds to an "
+                  "object (RViz, docs/ROS.md)"),
 )
 """The world node's parameters besides the world parameters, in documentation order."""
 

@@ -1,0 +1,122 @@
+"""The world in the form the standard ROS tools read it (tf2, RViz, robot_state_publisher).
+
+Published by the world node, every publication (``~rate``), from the WorldMirror:
+
+  ``/tf``                 tf2_msgs/TFMessage: ``world`` -> every object's frame that moves
+                          (odin_common.interface.frame_id of its ID; a robot's links:
+                          "<namespace>/<link>"), stamped with the world clock; not sent again
+                          while the clock stands still (tf refuses a repeated stamp);
+  ``/tf_static``          tf2_msgs/TFMessage, latched: ``world`` -> every static object's frame
+                          (built ``geometry_only``), sent again only when they change;
+  ``~markers``            visualization_msgs/MarkerArray: every geometry (portal.markers),
+                          only what changed; a new subscriber first gets all of them (latched
+                          too, so a late one also gets the last change);
+  ``<ns>/joint_states``   sensor_msgs/JointState per robot declared with Set Robot: its own
+                          joint names, positions (rad or m) and rates (rad/s or m/s);
+  ``<ns>/robot_description`` (a parameter, not a topic): the robot's URDF, set while the
+                          robot is declared, deleted when it goes.
+"""
+from __future__ import annotations
+
+import logging
+from typing import Dict, Iterable
+
+import rospy
+from sensor_msgs.msg import JointState
+from tf2_msgs.msg import TFMessage
+from visualization_msgs.msg import MarkerArray
+
+from virtual_world.portal.mirror import WorldMirror
+from virtual_world.portal.tf_writer import TfWriter
+
+_log = logging.getLogger("rosout")
+
+
+class _FullMarkersOnSubscribe(rospy.SubscribeListener):
+    """Sends every marker to each new subscriber of ``~markers`` (the latched message alone is
+    only the last change)."""
+
+    def __init__(self, full_markers):
+        super().__init__()
+        self._full_markers = full_markers
+
+    def peer_subscribe(self, topic_name, topic_publish, peer_publish) -> None:
+        try:
+            peer_publish(self._full_markers())
+        except Exception as error:   # the world stopping: the subscriber gets nothing more
+            _log.warning("virtual_world: no markers for a new subscriber of %s: %s",
+                         topic_name, error)
+
+
+class StandardTopics:
+    """The publishers above; ``publish`` runs on the world's loop thread."""
+
+    def __init__(self, mirror: WorldMirror, full_markers):
+        """``full_markers()``: every marker, computed on the loop thread (the Portal's
+        ``loop.call(mirror.markers.full)``)."""
+        self.mirror = mirror
+        self.pub_tf = rospy.Publisher("/tf", TFMessage, queue_size=100)
+        self.pub_tf_static = rospy.Publisher("/tf_static", TFMessage, queue_size=10, latch=True)
+        self.pub_markers = rospy.Publisher(
+            "~markers", MarkerArray, queue_size=100, latch=True,
+            subscriber_listener=_FullMarkersOnSubscribe(full_markers))
+        self._tf = TfWriter()
+        self._tf_static = TfWriter()
+        self._static_published = None
+        self._last_tf_stamp = None
+        self._joint_states: Dict[str, rospy.Publisher] = {}
+
+    def publish(self, stamp: rospy.Time, moving, static, joint_states,
+                colliding: Iterable[str]) -> None:
+        """One publication: the frames' poses (ObjectFrames.poses: moving and static), the
+        Core's joint states, the geometries to draw grey."""
+        self._apply_robot_changes()
+        if stamp != self._last_tf_stamp:
+            self._last_tf_stamp = stamp
+            if moving[0]:
+                self.pub_tf.publish(self._tf.message(*moving, stamp))
+        self._publish_static(static, stamp)
+        self.mirror.markers.set_colliding(colliding)
+        changes = self.mirror.markers.take_changes()
+        if changes is not None:
+            self.pub_markers.publish(changes)
+        for robot, joint_names, values, rates in self.mirror.robots.joint_states(joint_states):
+            message = JointState(name=joint_names, position=values, velocity=rates)
+            message.header.stamp = stamp
+            publisher = self._joint_states.get(robot.namespace)
+            if publisher is not None:
+                publisher.publish(message)
+
+    def _publish_static(self, static, stamp) -> None:
+        frames, positions, quaternions = static
+        key = (tuple(frames), positions.tobytes(), quaternions.tobytes())
+        if key == self._static_published:
+            return
+        self._static_published = key
+        self.pub_tf_static.publish(self._tf_static.message(frames, positions, quaternions,
+                                                           stamp))
+
+    def _apply_robot_changes(self) -> None:
+        """Each robot set or removed since the last publication: its joint_states publisher
+        and its robot_description parameter."""
+        for change, robot in self.mirror.take_robot_changes():
+            namespace = f"/{robot.namespace}"
+            old = self._joint_states.pop(robot.namespace, None)
+            if old is not None:
+                old.unregister()
+            try:
+                if change == "set":
+                    self._joint_states[robot.namespace] = rospy.Publisher(
+                        f"{namespace}/joint_states", JointState, queue_size=10)
+                    rospy.set_param(f"{namespace}/robot_description", robot.description)
+                elif rospy.has_param(f"{namespace}/robot_description"):
+                    rospy.delete_param(f"{namespace}/robot_description")
+            except Exception as error:   # the master gone: the node goes on
+                _log.warning("virtual_world: robot %s: parameter server: %s", robot.name, error)
+
+    def close(self) -> None:
+        for robot in list(self.mirror.robots):
+            try:
+                rospy.delete_param(f"/{robot.namespace}/robot_description")
+            except Exception:   # master gone at shutdown
+                pass
