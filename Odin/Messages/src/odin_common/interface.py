@@ -285,7 +285,10 @@ WORLD_FRAME = "world"
 _NAME_CHARACTER = re.compile(r"[A-Za-z0-9_]")
 
 
-def _ros_segment(text: str) -> str:
+def name_segment(text: str) -> str:
+    """``text`` with every character other than a letter, a digit or '_' replaced by '_' (one
+    segment of a ROS name or tf frame; the rule robot_namespace and generated robot
+    descriptions use)."""
     return "".join(c if _NAME_CHARACTER.fullmatch(c) else "_" for c in text)
 
 
@@ -324,7 +327,7 @@ def robot_namespace(robot_name: str) -> str:
     graph names must); "TX90 SAHand Right" is "TX90_SAHand_Right", "2DRR" is "robot_2DRR"."""
     if not isinstance(robot_name, str) or not robot_name:
         raise InvalidArgument(f"robot name {robot_name!r} must be a non-empty string")
-    name = _ros_segment(robot_name)
+    name = name_segment(robot_name)
     return name if name[0].isalpha() and name[0].isascii() else "robot_" + name
 
 
@@ -389,6 +392,6 @@ __all__ = ["NodeParameter", "SERVO_GAIN", "SERVO_MAX_SPEED", "JointType", "Joint
            "Shape", "SHAPE_BY_PARAMETER_COUNT", "SHAPE_PARAMETERS", "shape_of",
            "shape_kind", "COMPOSITE_MARK", "composite_id",
            "is_composite_id", "WORLD_NAMESPACE", "VIEWER_NAMESPACE", "WORLD_SERVICES",
-           "VIEWER_SERVICES", "WORLD_FRAME", "frame_id", "unique_frame", "robot_namespace",
+           "VIEWER_SERVICES", "WORLD_FRAME", "frame_id", "unique_frame", "name_segment", "robot_namespace",
            "robot_link_frame", "DEFAULT_COLOR", "COLLIDING_COLOR", "PLANE_DRAWN_SIZE",
            "PLANE_DRAWN_THICKNESS"]

@@ -149,7 +149,8 @@ class Portal:
 
     def _handler(self, name: str) -> Callable:
         """The service's handler, which also notes that a state-changing request succeeded
-        (the world clock) and records it (``~record``)."""
+        (the world clock), puts robots' descriptions on the parameter server at once (Set
+        Robot, removals, New Scene) and records it (``~record``)."""
         handle = getattr(self.services, name)
         if name in READ_ONLY:
             return handle
@@ -157,6 +158,7 @@ class Portal:
         def handle_and_note(request) -> dict:
             fields = handle(request)
             self.mirror.changed = True
+            self.topics.apply_robot_changes()
             if self.recorder is not None:
                 self.recorder.request(name, request)
             return fields

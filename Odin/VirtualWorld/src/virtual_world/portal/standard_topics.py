@@ -5,7 +5,9 @@ Published by the world node, every publication (``~rate``), from the WorldMirror
   ``/tf``                 tf2_msgs/TFMessage: ``world`` -> every object's frame that moves
                           (odin_common.interface.frame_id of its ID; a robot's links:
                           "<namespace>/<link>"), stamped with the world clock; not sent again
-                          while the clock stands still (tf refuses a repeated stamp);
+                          while the clock stands still (tf refuses a repeated stamp), but a
+                          new subscriber gets the last one at once (RViz started while the
+                          world is paused sees every frame);
   ``/tf_static``          tf2_msgs/TFMessage, latched: ``world`` -> every static object's frame
                           (built ``geometry_only``), sent again only when they change;
   ``~markers``            visualization_msgs/MarkerArray: every geometry (portal.markers),
@@ -48,6 +50,19 @@ class _FullMarkersOnSubscribe(rospy.SubscribeListener):
                          topic_name, error)
 
 
+class _LastTfOnSubscribe(rospy.SubscribeListener):
+    """Sends the last /tf message to each new subscriber: while paused the world sends none."""
+
+    def __init__(self):
+        super().__init__()
+        self.last = None
+
+    def peer_subscribe(self, topic_name, topic_publish, peer_publish) -> None:
+        last = self.last
+        if last is not None:
+            peer_publish(last)
+
+
 class StandardTopics:
     """The publishers above; ``publish`` runs on the world's loop thread."""
 
@@ -55,7 +70,9 @@ class StandardTopics:
         """``full_markers()``: every marker, computed on the loop thread (the Portal's
         ``loop.call(mirror.markers.full)``)."""
         self.mirror = mirror
-        self.pub_tf = rospy.Publisher("/tf", TFMessage, queue_size=100)
+        self._tf_listener = _LastTfOnSubscribe()
+        self.pub_tf = rospy.Publisher("/tf", TFMessage, queue_size=100,
+                                      subscriber_listener=self._tf_listener)
         self.pub_tf_static = rospy.Publisher("/tf_static", TFMessage, queue_size=10, latch=True)
         self.pub_markers = rospy.Publisher(
             "~markers", MarkerArray, queue_size=100, latch=True,
@@ -70,11 +87,13 @@ class StandardTopics:
                 colliding: Iterable[str]) -> None:
         """One publication: the frames' poses (ObjectFrames.poses: moving and static), the
         Core's joint states, the geometries to draw grey."""
-        self._apply_robot_changes()
+        self.apply_robot_changes()
         if stamp != self._last_tf_stamp:
             self._last_tf_stamp = stamp
             if moving[0]:
-                self.pub_tf.publish(self._tf.message(*moving, stamp))
+                message = self._tf.message(*moving, stamp)
+                self._tf_listener.last = message
+                self.pub_tf.publish(message)
         self._publish_static(static, stamp)
         self.mirror.markers.set_colliding(colliding)
         changes = self.mirror.markers.take_changes()
@@ -96,9 +115,10 @@ class StandardTopics:
         self.pub_tf_static.publish(self._tf_static.message(frames, positions, quaternions,
                                                            stamp))
 
-    def _apply_robot_changes(self) -> None:
-        """Each robot set or removed since the last publication: its joint_states publisher
-        and its robot_description parameter."""
+    def apply_robot_changes(self) -> None:
+        """Each robot set or removed since the last call: its joint_states publisher and its
+        robot_description parameter (the Portal calls this after every service that changed
+        the world, so the parameter is there when Set Robot answers, and at publications)."""
         for change, robot in self.mirror.take_robot_changes():
             namespace = f"/{robot.namespace}"
             old = self._joint_states.pop(robot.namespace, None)
