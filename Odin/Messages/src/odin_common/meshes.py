@@ -63,6 +63,17 @@ def display_mesh(vertices: np.ndarray, indices: Sequence[int]) -> Tuple[np.ndarr
     return vertices, indices
 
 
+def facing_outwards(vertices: np.ndarray, indices: Sequence[int]) -> np.ndarray:
+    """``indices`` (3 t,) with every triangle's winding reversed when the mesh's signed volume
+    is negative (a mesh wound clockwise, as some Kautham VRML files are): renderers that light
+    one side only (RViz's TRIANGLE_LIST) then light the outside. An open mesh is judged by the
+    same sum, which is right for a mostly consistent one."""
+    triangles = np.asarray(indices, dtype=np.int64).reshape(-1, 3)
+    corners = np.asarray(vertices, dtype=float).reshape(-1, 3)[triangles]
+    volume = np.einsum("ij,ij->i", corners[:, 0], np.cross(corners[:, 1], corners[:, 2])).sum()
+    return (triangles[:, ::-1] if volume < 0 else triangles).reshape(-1)
+
+
 def capsule_mesh(radius: float, length: float, slices: int = 32, stacks: int = 8
                  ) -> Tuple[np.ndarray, np.ndarray]:
     """A capsule as one closed mesh: a cylinder of ``length`` m along z with hemispheres of

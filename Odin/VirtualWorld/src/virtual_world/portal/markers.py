@@ -3,7 +3,8 @@
 One marker per geometry (a composite part by part), in namespace ``MARKER_NAMESPACE``, drawn
 as the Viewer draws it: a sphere, cylinder or box as RViz's own SPHERE, CYLINDER and CUBE; a
 mesh or a capsule as a TRIANGLE_LIST (meshes simplified for display as the Viewer does,
-odin_common.meshes.display_mesh); a plane as a thin square floor of PLANE_DRAWN_SIZE. Colours
+odin_common.meshes.display_mesh, and wound to face outwards: RViz lights one side only);
+a plane as a thin square floor of PLANE_DRAWN_SIZE. Colours
 are the Viewer's: the object's colour, DEFAULT_COLOR for an all-zero one, COLLIDING_COLOR while
 the world reports the geometry colliding (the contact-less policy's Collided, as the Viewer).
 
@@ -27,7 +28,7 @@ from visualization_msgs.msg import Marker, MarkerArray
 
 from odin_common.interface import (COLLIDING_COLOR, DEFAULT_COLOR, PLANE_DRAWN_SIZE,
                                    PLANE_DRAWN_THICKNESS, Shape, shape_of)
-from odin_common.meshes import capsule_mesh, display_mesh
+from odin_common.meshes import capsule_mesh, display_mesh, facing_outwards
 from odin_common.rotations import compose_poses, wxyz_to_xyzw
 
 MARKER_NAMESPACE = "odin"
@@ -80,6 +81,7 @@ def marker_shape(parameters: Sequence[float], indices: Sequence[int], shape: int
         vertices, triangles = capsule_mesh(params[0], params[1])
     else:
         vertices, triangles = display_mesh(params.reshape(-1, 3), indices)
+        triangles = facing_outwards(vertices, triangles)   # RViz lights the front side only
     corners = np.ascontiguousarray(vertices[triangles], dtype="<f8")
     return _Shape(Marker.TRIANGLE_LIST, (1.0, 1.0, 1.0), identity, corners.tobytes(),
                   len(corners))
