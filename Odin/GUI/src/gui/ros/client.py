@@ -201,7 +201,7 @@ class WorldClient:
                               tuple(r.entities), tuple(r.joints), tuple(r.motors),
                               tuple(r.body_forces), tuple(r.joint_forces), tuple(r.snapshots),
                               tuple(r.frames), tuple(
-                                  WorldRobot(b.name, b.namespace, tuple(b.links),
+                                  WorldRobot(b.name, b.ros_namespace, tuple(b.links),
                                              tuple(b.objects), tuple(b.joint_names),
                                              tuple(b.joints)) for b in r.robots),
                               float(r.clock))
@@ -397,7 +397,7 @@ class WorldClient:
                         link_orientations=_floats(d.link_orientations),
                         joint_names=list(d.joint_names), joints=list(d.joints),
                         joint_offsets=_floats(d.joint_offsets))
-        return self.call("set_robot", robot=message).namespace
+        return self.call("set_robot", robot=message).ros_namespace
 
     def remove_robot(self, name: str) -> None:
         """Set Robot with ``remove``: the world forgets the robot (its objects stay)."""

@@ -120,7 +120,7 @@ def robot_of(message: RobotMessage) -> Robot:
 
 def robot_message(robot: Robot) -> RobotMessage:
     return RobotMessage(
-        name=robot.name, namespace=robot.namespace, description=robot.description,
+        name=robot.name, ros_namespace=robot.namespace, description=robot.description,
         links=[link.link for link in robot.links],
         objects=[link.object_id for link in robot.links],
         link_positions=[v for link in robot.links for v in link.position],

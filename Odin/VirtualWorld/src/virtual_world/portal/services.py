@@ -211,10 +211,10 @@ class WorldServices:
     def set_robot(self, request) -> dict:
         if request.remove:
             robot = self.mirror.remove_robot(request.robot.name)
-            return {"namespace": robot.namespace, "message": f"forgot robot {robot.name!r}"}
+            return {"ros_namespace": robot.namespace, "message": f"forgot robot {robot.name!r}"}
         robot = robot_of(request.robot)
         self.mirror.set_robot(robot, {s.id: s.type for s in self.core.joint_states()})
-        return {"namespace": robot.namespace,
+        return {"ros_namespace": robot.namespace,
                 "message": f"robot {robot.name!r} in namespace /{robot.namespace}: "
                            f"{len(robot.links)} links, {len(robot.joints)} joints"}
 

@@ -118,16 +118,16 @@ class StandardTopics:
     def apply_robot_changes(self) -> None:
         """Each robot set or removed since the last call: its joint_states publisher and its
         robot_description parameter (the Portal calls this after every service that changed
-        the world, so the parameter is there when Set Robot answers, and at publications)."""
+        the world, so the parameter is there when Set Robot answers, and at publications).
+        A namespace's publisher stays once made (it is silent while no robot uses it): a
+        subscriber stays connected across New Scene and a reload of the same robot."""
         for change, robot in self.mirror.take_robot_changes():
             namespace = f"/{robot.namespace}"
-            old = self._joint_states.pop(robot.namespace, None)
-            if old is not None:
-                old.unregister()
             try:
                 if change == "set":
-                    self._joint_states[robot.namespace] = rospy.Publisher(
-                        f"{namespace}/joint_states", JointState, queue_size=10)
+                    if robot.namespace not in self._joint_states:
+                        self._joint_states[robot.namespace] = rospy.Publisher(
+                            f"{namespace}/joint_states", JointState, queue_size=10)
                     rospy.set_param(f"{namespace}/robot_description", robot.description)
                 elif rospy.has_param(f"{namespace}/robot_description"):
                     rospy.delete_param(f"{namespace}/robot_description")
