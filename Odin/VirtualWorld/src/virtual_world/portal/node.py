@@ -100,7 +100,7 @@ class Portal:
         record = rospy.get_param("~record", DEFAULTS["record"])
         self.recorder = Recorder(record, self.core.world_parameters, values) if record else None
         self._advertise()
-        self.topics = StandardTopics(self.mirror, lambda: self.loop.call(self.mirror.markers.full))
+        self.topics = StandardTopics(self.mirror, self.loop.call)
         self._serve()
         self.interaction = InteractiveObjects(
             self.mirror, self.serve, float(rospy.get_param("~push_speed",

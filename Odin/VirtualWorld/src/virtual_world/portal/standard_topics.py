@@ -21,6 +21,7 @@ Published by the world node, every publication (``~rate``), from the WorldMirror
 from __future__ import annotations
 
 import logging
+import threading
 from typing import Dict, Iterable
 
 import rospy
@@ -36,16 +37,25 @@ _log = logging.getLogger("rosout")
 
 class _FullMarkersOnSubscribe(rospy.SubscribeListener):
     """Sends every marker to each new subscriber of ``~markers`` (the latched message alone is
-    only the last change)."""
+    only the last change). The markers are computed on the world's loop thread, and rospy calls
+    this on the thread that accepts every connection of the node (services too): so the work
+    goes to a thread of its own, and a loop that is busy or not started yet never blocks the
+    node's services. The markers are sent from the loop thread too, so that they reach the
+    subscriber in order with the changes the loop publishes."""
 
-    def __init__(self, full_markers):
+    def __init__(self, markers, on_loop):
         super().__init__()
-        self._full_markers = full_markers
+        self._markers = markers
+        self._on_loop = on_loop
 
     def peer_subscribe(self, topic_name, topic_publish, peer_publish) -> None:
+        threading.Thread(target=self._send, args=(topic_name, peer_publish),
+                         name="markers-to-new-subscriber", daemon=True).start()
+
+    def _send(self, topic_name, peer_publish) -> None:
         try:
-            peer_publish(self._full_markers())
-        except Exception as error:   # the world stopping: the subscriber gets nothing more
+            self._on_loop(lambda: peer_publish(self._markers.full()))
+        except Exception as error:   # the world stopping, the subscriber gone
             _log.warning("virtual_world: no markers for a new subscriber of %s: %s",
                          topic_name, error)
 
@@ -66,9 +76,9 @@ class _LastTfOnSubscribe(rospy.SubscribeListener):
 class StandardTopics:
     """The publishers above; ``publish`` runs on the world's loop thread."""
 
-    def __init__(self, mirror: WorldMirror, full_markers):
-        """``full_markers()``: every marker, computed on the loop thread (the Portal's
-        ``loop.call(mirror.markers.full)``)."""
+    def __init__(self, mirror: WorldMirror, on_loop):
+        """``on_loop(function)``: runs ``function`` on the world's loop thread (the Portal's
+        ``loop.call``)."""
         self.mirror = mirror
         self._tf_listener = _LastTfOnSubscribe()
         self.pub_tf = rospy.Publisher("/tf", TFMessage, queue_size=100,
@@ -76,7 +86,7 @@ class StandardTopics:
         self.pub_tf_static = rospy.Publisher("/tf_static", TFMessage, queue_size=10, latch=True)
         self.pub_markers = rospy.Publisher(
             "~markers", MarkerArray, queue_size=100, latch=True,
-            subscriber_listener=_FullMarkersOnSubscribe(full_markers))
+            subscriber_listener=_FullMarkersOnSubscribe(mirror.markers, on_loop))
         self._tf = TfWriter()
         self._tf_static = TfWriter()
         self._static_published = None
