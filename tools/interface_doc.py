@@ -84,6 +84,11 @@ SERVICES = {
                    "bounce: 0.5, bounce_velocity: 0.05}}"),
     "GetState": ("new (past the thesis): states, masses, joint reactions (ODE's feedback) and "
                  "motor goals", "{objects: [ball], joints: ['1:ball&']}"),
+    "SetRobot": ("new (past the thesis, issue 19): a robot's namespace, robot_description, "
+                 "joint names and link frames for tf, robot_state_publisher and RViz "
+                 "(docs/ROS.md)",
+                 "{robot: {name: pendulum, links: [bob], objects: [ball], joint_names: [swing], "
+                 "joints: ['1:ball&']}}"),
     "SaveState": (f"{PLANNING}; the whole dynamic state, bit for bit", "{name: start}"),
     "RestoreState": (f"{PLANNING}; refused when the contents changed", "{name: start}"),
     "Reset": (f"{PLANNING}; the state right after the last build or removal", None),
@@ -120,7 +125,8 @@ MESSAGES = {
     "JointData": ("element of JointsData", "-",
                   f"positions and speeds of joints published {KNOWN} (thesis 5.6); fields "
                   f"{RECON}"),
-    "JointsData": ("/virtual_world/joint_data (also sensor_msgs/JointState on /joint_states)",
+    "JointsData": ("/virtual_world/joint_data (also sensor_msgs/JointState on "
+                   "/virtual_world/joint_states)",
                    "VirtualWorld, every cycle", RECON),
     "Object": ("in Build Object and Build Entity", "-",
                f"the odinObject fields {KNOWN} (evidence); inertia, geometry_only {RECON}"),
@@ -139,6 +145,8 @@ MESSAGES = {
                     "VirtualWorld, once", "new"),
     "ServoStates": ("/virtual_world/servo_states", "VirtualWorld, every cycle with a servo",
                     "new"),
+    "Robot": ("in Set Robot and Get World", "-",
+              "new (issue 19): a robot over the world's objects and joints (docs/ROS.md)"),
     "Advance": ("`/odin/record/advance` in a recording (`rosrun VirtualWorld replay BAG` "
                 "compares its poses bit for bit)", "VirtualWorld, every advance", "new"),
 }
@@ -172,7 +180,7 @@ because the original .msg/.srv files are not public.
 
 | node | executable | serves | publishes | calls |
 |---|---|---|---|---|
-| `/virtual_world` | `rosrun VirtualWorld virtualWorld` | the 15 world services and 6 of Odin's own | `~world_update`, `~collided`, `~contacts`, `~joint_data`, `~real_time_factor`, `/joint_states`, `/clock` | the Viewer's services (optional) |
+| `/virtual_world` | `rosrun VirtualWorld virtualWorld` | the 15 world services and Odin's own | `~world_update`, `~collided`, `~contacts`, `~joint_data`, `~joint_states`, `~real_time_factor`, `~servo_states`, `~markers`, `~interactive/*`, `/tf`, `/tf_static`, `/clock`, `/diagnostics`, `<robot>/joint_states` (docs/ROS.md) | the Viewer's services (optional) |
 | `/viewer` | `rosrun Viewer viewer` | View Object, Viewer Remove Object, New Scene, Save Snapshot, Set Camera | `~image` (sensor_msgs/Image, rgb8, 25 Hz) | - |
 | `/gui` | `rosrun GUI gui` (window), `problem_info`, `load_problem`, `run_path` | - | - | the world's services |
 
@@ -292,7 +300,7 @@ def render_parameters() -> str:
     lines += ["", f"### `{VIEWER_NAMESPACE}`", ""]
     lines += _node_table(VIEWER_PARAMETERS)
     lines += ["", "Meshes of more than 2,000 triangles are drawn with their vertices clustered "
-              "at 1 mm (`viewer.core.geometry.DISPLAY_TOLERANCE`); the world's collision meshes "
+              "at 1 mm (`odin_common.meshes.DISPLAY_TOLERANCE`); the world's collision meshes "
               "are not affected.", "", "### `/gui`", ""]
     lines += _node_table(GUI_PARAMETERS)
     return "\n".join(lines) + "\n"

@@ -201,7 +201,7 @@ def test_joints_motors_and_forces_are_named_and_removed_in_cascade(world):
 def _joint_states() -> dict:
     import rospy
     from sensor_msgs.msg import JointState
-    message = rospy.wait_for_message("/joint_states", JointState, timeout=5)
+    message = rospy.wait_for_message("/virtual_world/joint_states", JointState, timeout=5)
     return dict(zip(message.name, message.position))
 
 

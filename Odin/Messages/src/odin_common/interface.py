@@ -6,6 +6,7 @@ rule, the composite-ID rule, and the services each node offers with their types.
 """
 from __future__ import annotations
 
+import re
 from enum import IntEnum
 from typing import Any, Dict, NamedTuple, Sequence, Tuple
 
@@ -276,6 +277,78 @@ def is_composite_id(object_id: str) -> bool:
     return object_id.startswith(COMPOSITE_MARK)
 
 
+# ---------------------------------------------------------------------------------- ROS names
+
+WORLD_FRAME = "world"
+"""The fixed tf frame every pose is given in (REP 103: x forward, y left, z up)."""
+
+_NAME_CHARACTER = re.compile(r"[A-Za-z0-9_]")
+
+
+def name_segment(text: str) -> str:
+    """``text`` with every character other than a letter, a digit or '_' replaced by '_' (one
+    segment of a ROS name or tf frame; the rule robot_namespace and generated robot
+    descriptions use)."""
+    return "".join(c if _NAME_CHARACTER.fullmatch(c) else "_" for c in text)
+
+
+def frame_id(object_id: str) -> str:
+    """The tf frame of a world object (Odin's rule, docs/ROS.md): the object's ID with every
+    character other than a letter, a digit, '_' or '/' replaced by '_', and every '/' that
+    would start or end the name or follow another '/' replaced by '_' too; so "TX90 SAHand
+    Right/Palm" is "TX90_SAHand_Right/Palm" and the composite ">table#0>table#1" is
+    "_table_0_table_1". The result is a valid tf frame ID (non-empty, no leading '/', no
+    empty segment, only ROS name characters). A frame already taken in the world (by another
+    object, a robot's link or ``WORLD_FRAME``) gets the first free suffix "_2", "_3"... (the
+    world then answers the frame it chose in Get World's ``frames``)."""
+    if not isinstance(object_id, str) or not object_id:
+        raise InvalidArgument(f"object ID {object_id!r} must be a non-empty string")
+    last = len(object_id) - 1
+    return "".join(
+        c if _NAME_CHARACTER.fullmatch(c) or (c == "/" and 0 < i < last
+                                               and object_id[i - 1] != "/") else "_"
+        for i, c in enumerate(object_id))
+
+
+def unique_frame(frame: str, taken) -> str:
+    """``frame``, or ``frame`` + "_2", "_3"... the first that is not in ``taken``."""
+    if frame not in taken:
+        return frame
+    n = 2
+    while f"{frame}_{n}" in taken:
+        n += 1
+    return f"{frame}_{n}"
+
+
+def robot_namespace(robot_name: str) -> str:
+    """A robot's ROS namespace (its robot_description, joint_states and link frames live
+    under it): the robot's name with every character other than a letter, a digit or '_'
+    replaced by '_', and "robot_" put before a name that does not start with a letter (ROS
+    graph names must); "TX90 SAHand Right" is "TX90_SAHand_Right", "2DRR" is "robot_2DRR"."""
+    if not isinstance(robot_name, str) or not robot_name:
+        raise InvalidArgument(f"robot name {robot_name!r} must be a non-empty string")
+    name = name_segment(robot_name)
+    return name if name[0].isalpha() and name[0].isascii() else "robot_" + name
+
+
+def robot_link_frame(namespace: str, link: str) -> str:
+    """The tf frame of a robot's link: "<namespace>/<link>" (what RViz's RobotModel and
+    robot_state_publisher look up with the namespace as their tf prefix)."""
+    return f"{namespace}/{link}"
+
+
+# ---------------------------------------------------------------------------------- display
+
+DEFAULT_COLOR = (0.62, 0.70, 0.82, 1.0)
+"""(r, g, b, a): how an object sent with an all-zero colour is drawn (Viewer and markers)."""
+COLLIDING_COLOR = (0.35, 0.35, 0.35, 1.0)
+"""(r, g, b, a): an object while the world reports it colliding (thesis 6.4.1: dark grey)."""
+PLANE_DRAWN_SIZE = 60.0
+"""m: a plane (infinite in the world) is drawn as a square floor this wide..."""
+PLANE_DRAWN_THICKNESS = 0.002
+"""m: ...and this thin, its top face on the plane."""
+
+
 # ---------------------------------------------------------------------------------- services
 
 WORLD_NAMESPACE = "/virtual_world"
@@ -290,7 +363,7 @@ WORLD_SERVICES: Dict[str, str] = {
     "set_external_force": "SetExternalForce", "set_joint_force": "SetJointForce",
     "get_world": "GetWorld", "get_state": "GetState", "save_state": "SaveState", "restore_state": "RestoreState",
     "reset": "Reset", "propagate": "Propagate", "check_collision": "CheckCollision",
-    "set_surface": "SetSurface", "set_servo": "SetServo",
+    "set_surface": "SetSurface", "set_servo": "SetServo", "set_robot": "SetRobot",
 }
 """The VirtualWorld's services: name under ``~`` -> type in the Services package (the
 thesis's 15, then Odin's own)."""
@@ -319,4 +392,6 @@ __all__ = ["NodeParameter", "SERVO_GAIN", "SERVO_MAX_SPEED", "JointType", "Joint
            "Shape", "SHAPE_BY_PARAMETER_COUNT", "SHAPE_PARAMETERS", "shape_of",
            "shape_kind", "COMPOSITE_MARK", "composite_id",
            "is_composite_id", "WORLD_NAMESPACE", "VIEWER_NAMESPACE", "WORLD_SERVICES",
-           "VIEWER_SERVICES"]
+           "VIEWER_SERVICES", "WORLD_FRAME", "frame_id", "unique_frame", "name_segment", "robot_namespace",
+           "robot_link_frame", "DEFAULT_COLOR", "COLLIDING_COLOR", "PLANE_DRAWN_SIZE",
+           "PLANE_DRAWN_THICKNESS"]

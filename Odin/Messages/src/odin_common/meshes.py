@@ -10,9 +10,19 @@ fast-simplification package) strayed 7 mm at 3,000 triangles and 16 mm at 900.
 """
 from __future__ import annotations
 
-from typing import Tuple
+import math
+from typing import Sequence, Tuple
 
 import numpy as np
+
+DISPLAY_TOLERANCE = 0.001
+"""m: meshes of more than DISPLAY_DETAIL_TRIANGLES triangles are drawn (by the Viewer, and in
+the world's RViz markers) with their vertices clustered on a grid of this size: detail finer
+than a millimetre is below a pixel at the distances a robot scene is watched from, and CAD
+meshes of hands carry a lot of it (the SAH hand's 150k triangles become about half). The
+world's collision mesh has a tolerance of its own (the world parameter
+collision_mesh_tolerance)."""
+DISPLAY_DETAIL_TRIANGLES = 2000
 
 
 def cluster_vertices(vertices: np.ndarray, indices: np.ndarray,
@@ -38,3 +48,55 @@ def cluster_vertices(vertices: np.ndarray, indices: np.ndarray,
     triangles = triangles[keep]
     _, first = np.unique(np.sort(triangles, axis=1), axis=0, return_index=True)
     return merged, triangles[np.sort(first)].reshape(-1)
+
+
+def display_mesh(vertices: np.ndarray, indices: Sequence[int]) -> Tuple[np.ndarray, np.ndarray]:
+    """The mesh as it is drawn: clustered at DISPLAY_TOLERANCE when it has more than
+    DISPLAY_DETAIL_TRIANGLES triangles (a mesh smaller than the tolerance keeps its triangles).
+    Returns (vertices (k, 3) float64 m, indices (3 t,) int64)."""
+    vertices = np.asarray(vertices, dtype=float).reshape(-1, 3)
+    indices = np.asarray(indices, dtype=np.int64).reshape(-1)
+    if indices.size > 3 * DISPLAY_DETAIL_TRIANGLES:
+        simple_vertices, simple_indices = cluster_vertices(vertices, indices, DISPLAY_TOLERANCE)
+        if simple_indices.size:
+            return simple_vertices, simple_indices
+    return vertices, indices
+
+
+def facing_outwards(vertices: np.ndarray, indices: Sequence[int]) -> np.ndarray:
+    """``indices`` (3 t,) with every triangle's winding reversed when the mesh's signed volume
+    is negative (a mesh wound clockwise, as some Kautham VRML files are): renderers that light
+    one side only (RViz's TRIANGLE_LIST) then light the outside. An open mesh is judged by the
+    same sum, which is right for a mostly consistent one."""
+    triangles = np.asarray(indices, dtype=np.int64).reshape(-1, 3)
+    corners = np.asarray(vertices, dtype=float).reshape(-1, 3)[triangles]
+    volume = np.einsum("ij,ij->i", corners[:, 0], np.cross(corners[:, 1], corners[:, 2])).sum()
+    return (triangles[:, ::-1] if volume < 0 else triangles).reshape(-1)
+
+
+def capsule_mesh(radius: float, length: float, slices: int = 32, stacks: int = 8
+                 ) -> Tuple[np.ndarray, np.ndarray]:
+    """A capsule as one closed mesh: a cylinder of ``length`` m along z with hemispheres of
+    ``radius`` m at both ends. Returns (vertices (n, 3) m, indices (3 t,) int64), triangles
+    counter-clockwise seen from outside."""
+    rings = []   # (z, ring radius) between the poles, from the bottom up
+    for k in range(1, stacks + 1):       # bottom hemisphere, to the equator
+        a = -math.pi / 2 + k * math.pi / 2 / stacks
+        rings.append((-length / 2 + radius * math.sin(a), radius * math.cos(a)))
+    for k in range(stacks):              # top hemisphere, from the equator
+        a = k * math.pi / 2 / stacks
+        rings.append((length / 2 + radius * math.sin(a), radius * math.cos(a)))
+    angles = np.linspace(0.0, 2 * math.pi, slices, endpoint=False)
+    top = len(rings) * slices + 1
+    vertices = np.array([(0.0, 0.0, -length / 2 - radius)]
+                        + [(r * math.cos(t), r * math.sin(t), z) for z, r in rings
+                           for t in angles] + [(0.0, 0.0, length / 2 + radius)])
+    triangles = []
+    for k in range(slices):              # the poles' fans, counter-clockwise seen outside
+        triangles += [(0, 1 + (k + 1) % slices, 1 + k),
+                      (top, top - slices + k, top - slices + (k + 1) % slices)]
+    for ring in range(len(rings) - 1):
+        for k in range(slices):
+            a, b = 1 + ring * slices + k, 1 + ring * slices + (k + 1) % slices
+            triangles += [(a, b, b + slices), (a, b + slices, a + slices)]
+    return vertices, np.array(triangles, dtype=np.int64).reshape(-1)

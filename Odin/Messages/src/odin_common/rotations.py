@@ -117,5 +117,41 @@ def pose_matrix(position: Sequence[float], quaternion_wxyz: Sequence[float]) -> 
     return T
 
 
+def compose_poses(position_a: np.ndarray, quaternion_a: np.ndarray, position_b: np.ndarray,
+                  quaternion_b: np.ndarray) -> tuple:
+    """Pose a then b, for arrays of poses: positions (n, 3) m, quaternions (n, 4) (w, x, y, z)
+    (or single poses (3,), (4,)). With a = frame B in A and b = frame C in B, the result is
+    frame C in A: (p_a + R(q_a) p_b, q_a q_b). Quaternions are not renormalised."""
+    pa, qa = np.asarray(position_a, float), np.asarray(quaternion_a, float)
+    pb, qb = np.asarray(position_b, float), np.asarray(quaternion_b, float)
+    w1, x1, y1, z1 = np.moveaxis(qa, -1, 0)
+    w2, x2, y2, z2 = np.moveaxis(qb, -1, 0)
+    q = np.stack([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
+                  w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+                  w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
+                  w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2], axis=-1)
+    u = qa[..., 1:]
+    t = 2.0 * np.cross(u, pb)
+    return pa + pb + qa[..., :1] * t + np.cross(u, t), q
+
+
+def invert_pose(position: Sequence[float], quaternion_wxyz: Sequence[float]) -> tuple:
+    """The inverse of one pose (frame B in A -> frame A in B): ((3,) m, (4,) (w, x, y, z))."""
+    q = np.asarray(quaternion_wxyz, dtype=float)
+    conjugate = q * np.array([1.0, -1.0, -1.0, -1.0])
+    return -(quaternion_to_matrix(conjugate) @ np.asarray(position, dtype=float)), conjugate
+
+
+def wxyz_to_xyzw(quaternion_wxyz) -> np.ndarray:
+    """Odin's (w, x, y, z) -> ROS geometry_msgs' (x, y, z, w); works on (..., 4) arrays."""
+    return np.roll(np.asarray(quaternion_wxyz, dtype=float), -1, axis=-1)
+
+
+def xyzw_to_wxyz(quaternion_xyzw) -> np.ndarray:
+    """ROS geometry_msgs' (x, y, z, w) -> Odin's (w, x, y, z); works on (..., 4) arrays."""
+    return np.roll(np.asarray(quaternion_xyzw, dtype=float), 1, axis=-1)
+
+
 __all__ = ["QUATERNION_TOLERANCE", "IDENTITY_WXYZ", "unit_quaternion", "quaternion_to_matrix",
-           "matrix_to_quaternion", "quaternion_multiply", "axis_angle_matrix", "pose_matrix"]
+           "matrix_to_quaternion", "quaternion_multiply", "axis_angle_matrix", "pose_matrix",
+           "compose_poses", "invert_pose", "wxyz_to_xyzw", "xyzw_to_wxyz"]

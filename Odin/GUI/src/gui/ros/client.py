@@ -7,8 +7,9 @@ go in as odin_common specs, enums and plain values (SI units, world frame, quate
 (w, x, y, z)), answers come back as IDs, ``WorldParameters`` or ``StepValues``. A refusal
 (``success: false``) or a broken connection raises ``gui.errors.WorldError`` carrying the
 world's message. ``execute(plan)`` sends a ``gui.core.build.BuildPlan`` (each step sends
-itself); ``run_position_path`` / ``run_velocity_path`` drive a robot. Messages are built only
-by ``odin_common.messages`` and here.
+itself, then declares each robot it built with Set Robot: its robot_description, namespace and
+joint names, gui.core.robot_description); ``run_position_path`` / ``run_velocity_path`` drive a
+robot. Messages are built only by ``odin_common.messages`` and here.
 
 The Qt window must not call these from its GUI thread (each call blocks until the world
 answers): run them in a worker thread and signal the results back (gui.window.worker).
@@ -18,12 +19,14 @@ importing this module does not import rospy (only the generated message classes)
 """
 from __future__ import annotations
 
+import os
 import time
 from typing import Callable, Dict, NamedTuple, Optional, Sequence, Tuple
 
 import numpy as np
 
 from gui.core.build import BuildPlan, BuiltIds, RobotHandle
+from gui.core.robot_description import RobotDescription, describe_robot
 from gui.errors import WorldError
 from odin_common.errors import InvalidArgument
 from odin_common.interface import WORLD_NAMESPACE, WORLD_SERVICES, ForceKind, SetJointAction
@@ -65,8 +68,20 @@ def _world_parameters(response) -> WorldParameters:
     return WorldParameters(**values)
 
 
+class WorldRobot(NamedTuple):
+    """A robot the world holds (declared with Set Robot): its ROS namespace, its links' world
+    objects and its joints' own names with their world joints."""
+    name: str
+    namespace: str
+    links: Tuple[str, ...]
+    objects: Tuple[str, ...]
+    joint_names: Tuple[str, ...]
+    joints: Tuple[str, ...]
+
+
 class WorldInventory(NamedTuple):
-    """Get World's answer: the values in force and the IDs of what the world holds."""
+    """Get World's answer: the values in force and the IDs of what the world holds (``frames``:
+    each object's tf frame; ``clock``: s, the world clock of its last publication)."""
     parameters: WorldParameters
     step_values: StepValues
     sim_time: float
@@ -78,6 +93,9 @@ class WorldInventory(NamedTuple):
     body_forces: Tuple[str, ...]
     joint_forces: Tuple[str, ...]
     snapshots: Tuple[str, ...]
+    frames: Tuple[str, ...] = ()
+    robots: Tuple[WorldRobot, ...] = ()
+    clock: float = 0.0
 
 
 class PropagationResult(NamedTuple):
@@ -181,7 +199,12 @@ class WorldClient:
         return WorldInventory(world_parameters_of(r.parameters), _step_values(r),
                               float(r.sim_time), bool(r.simulating), tuple(r.objects),
                               tuple(r.entities), tuple(r.joints), tuple(r.motors),
-                              tuple(r.body_forces), tuple(r.joint_forces), tuple(r.snapshots))
+                              tuple(r.body_forces), tuple(r.joint_forces), tuple(r.snapshots),
+                              tuple(r.frames), tuple(
+                                  WorldRobot(b.name, b.ros_namespace, tuple(b.links),
+                                             tuple(b.objects), tuple(b.joint_names),
+                                             tuple(b.joints)) for b in r.robots),
+                              float(r.clock))
 
     def world_parameters(self) -> WorldParameters:
         """The world parameters in force."""
@@ -363,11 +386,32 @@ class WorldClient:
         in order), every link placed by forward kinematics."""
         return self.check_collision(handle.situations(values))
 
+    def set_robot(self, description: RobotDescription) -> str:
+        """Set Robot: declares a robot over objects and joints the world holds (its
+        robot_description, link frames and joint names; gui.core.robot_description); returns
+        its ROS namespace."""
+        from Messages.msg import Robot
+        d = description
+        message = Robot(name=d.name, description=d.urdf, links=list(d.links),
+                        objects=list(d.objects), link_positions=_floats(d.link_positions),
+                        link_orientations=_floats(d.link_orientations),
+                        joint_names=list(d.joint_names), joints=list(d.joints),
+                        joint_offsets=_floats(d.joint_offsets))
+        return self.call("set_robot", robot=message).ros_namespace
+
+    def remove_robot(self, name: str) -> None:
+        """Set Robot with ``remove``: the world forgets the robot (its objects stay)."""
+        from Messages.msg import Robot
+        self.call("set_robot", robot=Robot(name=name), remove=True)
+
     def execute(self, plan: BuildPlan,
-                progress: Optional[Callable[[int, object, str], None]] = None) -> dict:
-        """Sends every step of ``plan`` in order; returns the world's IDs:
-        {"bodies": {planned body ID: world ID}, "joints": {joint key: world ID},
-        "motors": {joint key: world motor ID}}. ``progress(k, step, answer)`` after each.
+                progress: Optional[Callable[[int, object, str], None]] = None,
+                mesh_dir: Optional[str] = None) -> dict:
+        """Sends every step of ``plan`` in order, then declares each robot it built (Set
+        Robot); returns the world's IDs: {"bodies": {planned body ID: world ID}, "joints":
+        {joint key: world ID}, "motors": {joint key: world motor ID}, "robots": {robot name:
+        namespace}}. ``progress(k, step, answer)`` after each step. ``mesh_dir``: where
+        generated robot descriptions' meshes go (default ``robot_mesh_dir()``).
 
         Joint and motor IDs the world returns replace the predicted ones in ``plan.robots``.
         Stops at the first refusal (``WorldError``); what was built before stays built."""
@@ -377,7 +421,18 @@ class WorldClient:
             if progress is not None:
                 progress(k, step, answer)
         plan.record_world_ids(ids)
-        return ids.as_dict()
+        folder = robot_mesh_dir() if mesh_dir is None else mesh_dir
+        namespaces = {handle.name: self.set_robot(describe_robot(handle, folder))
+                      for handle in plan.robots}
+        return {**ids.as_dict(), "robots": namespaces}
+
+
+def robot_mesh_dir() -> str:
+    """Where generated robot descriptions' meshes are written: ``$ROS_HOME/odin/robot_meshes``
+    (``~/.ros`` without ROS_HOME). Their ``file://`` URIs resolve on this machine only
+    (docs/ROS.md: several machines)."""
+    import rospkg
+    return os.path.join(rospkg.get_ros_home(), "odin", "robot_meshes")
 
 
 def run_position_path(client: WorldClient, handle: RobotHandle, rows: np.ndarray,

@@ -2,14 +2,14 @@
 
 Modules: ``main_window`` (the window, message log, connection state), one module per tab
 (``simulation_tab``, ``settings_tab``, ``objects_tab``, ``motion_tab``, ``joints_tab``),
-``plot_panel`` (joint positions and speeds from /joint_states), ``viewer_panel`` (the Viewer's
+``plot_panel`` (joint positions and speeds from the world's ~joint_states), ``viewer_panel`` (the Viewer's
 image), ``worker`` (service calls on a QThread, never the GUI thread), ``ros_link`` (topics ->
 Qt signals), ``scene`` (what the window knows of the scene), ``fields`` (input limits).
 
 Node ``gui``; parameters: ``~world`` ("/virtual_world": namespace of the world's services and
 topics), ``~viewer`` ("/viewer": namespace of the Viewer's image topic).
 Services called: every ``<~world>/*`` service. Topics read: ``<~world>/world_update``,
-``<~world>/joint_data``, ``/joint_states``, ``<~viewer>/image``.
+``<~world>/joint_data``, ``<~world>/joint_states``, ``<~viewer>/image``.
 """
 from __future__ import annotations
 

@@ -4,7 +4,7 @@ message (an image into a ``QImage`` copy) and emit a signal, which Qt queues to 
 Topics subscribed (names are relative to the world's and Viewer's namespaces):
   ``<world>/world_update`` Messages/SpaceDistribution -> ``world_update(msg)``;
   ``<world>/joint_data``   Messages/JointsData -> ``joint_data(msg)``;
-  ``/joint_states``        sensor_msgs/JointState -> ``joint_states(msg)``;
+  ``<world>/joint_states`` sensor_msgs/JointState (world joint IDs) -> ``joint_states(msg)``;
   ``<viewer>/image``       sensor_msgs/Image (rgb8 / bgr8 / mono8) -> ``image(QImage)``.
 
 Only the latest image is ever queued: a frame arriving while the previous one has not been
@@ -60,7 +60,7 @@ class RosLink(QObject):
                              self.world_update.emit, queue_size=2),
             rospy.Subscriber(f"{world}/joint_data", JointsData, self.joint_data.emit,
                              queue_size=2),
-            rospy.Subscriber("/joint_states", JointState, self.joint_states.emit,
+            rospy.Subscriber(f"{world}/joint_states", JointState, self.joint_states.emit,
                              queue_size=2),
             rospy.Subscriber(f"{viewer.rstrip('/')}/image", Image, self._on_image,
                              queue_size=1, buff_size=4 << 20),

@@ -20,6 +20,7 @@ from PyQt5.QtCore import Qt, pyqtSignal
 from PyQt5.QtWidgets import (QCheckBox, QFileDialog, QHBoxLayout, QLabel, QPushButton,
                              QTreeWidget, QTreeWidgetItem, QVBoxLayout, QWidget)
 
+from odin_common.limits import MIN_STEP
 from odin_common.specs import CompositeSpec
 
 RUNNING_STYLE = "QPushButton { background: #2e7d32; color: white; font-weight: bold; }"
@@ -256,7 +257,9 @@ class SimulationTab(QWidget):
         last, self._last_stamp = self._last_stamp, stamp
         if last is None or time.monotonic() < self._ignore_stamps_until:
             return
-        if stamp != last:
+        # a step moves the stamp by at least MIN_STEP; a change while paused (a build, Set
+        # Position) moves it by a nanosecond only (the world clock, docs/ROS.md)
+        if stamp - last >= MIN_STEP:
             self._same_stamps = 0
             self._advancing += 1
             if not self.simulating and self._advancing >= 2:

@@ -18,8 +18,9 @@ from typing import Sequence
 import numpy as np
 
 from odin_common.errors import InvalidArgument
-from odin_common.interface import SHAPE_PARAMETERS, Shape, shape_of
-from odin_common.meshes import cluster_vertices
+from odin_common.interface import (PLANE_DRAWN_SIZE, PLANE_DRAWN_THICKNESS, SHAPE_PARAMETERS,
+                                   Shape, shape_of)
+from odin_common.meshes import DISPLAY_TOLERANCE, capsule_mesh, display_mesh  # noqa: F401
 from odin_common.rotations import quaternion_to_matrix, unit_quaternion
 from viewer.errors import ViewerError
 
@@ -96,10 +97,8 @@ def _positive(values: Sequence[float], names: Sequence[str], shape: str) -> list
     return out
 
 
-#: m: a plane (infinite in the world) is drawn as a square floor this wide, this thin, its
-#: top face on the plane
-PLANE_DRAWN_SIZE = 60.0
-PLANE_DRAWN_THICKNESS = 0.002
+# PLANE_DRAWN_SIZE, PLANE_DRAWN_THICKNESS (m): a plane (infinite in the world) is drawn as a
+# square floor this wide, this thin, its top face on the plane (odin_common.interface)
 
 
 def geometry_from_parameters(parameters: Sequence[float], indices: Sequence[int] = (),
@@ -137,28 +136,8 @@ def geometry_from_parameters(parameters: Sequence[float], indices: Sequence[int]
 def capsule_geometry(radius: float, length: float, slices: int = 32, stacks: int = 8
                      ) -> Geometry:
     """A capsule: a cylinder of ``length`` along z with hemispheres of ``radius`` at both
-    ends, as one closed mesh (m)."""
-    rings = []   # (z, ring radius) between the poles, from the bottom up
-    for k in range(1, stacks + 1):       # bottom hemisphere, to the equator
-        a = -math.pi / 2 + k * math.pi / 2 / stacks
-        rings.append((-length / 2 + radius * math.sin(a), radius * math.cos(a)))
-    for k in range(stacks):              # top hemisphere, from the equator
-        a = k * math.pi / 2 / stacks
-        rings.append((length / 2 + radius * math.sin(a), radius * math.cos(a)))
-    angles = np.linspace(0.0, 2 * math.pi, slices, endpoint=False)
-    top = len(rings) * slices + 1
-    vertices = np.array([(0.0, 0.0, -length / 2 - radius)]
-                        + [(r * math.cos(t), r * math.sin(t), z) for z, r in rings
-                           for t in angles] + [(0.0, 0.0, length / 2 + radius)])
-    triangles = []
-    for k in range(slices):              # the poles' fans, counter-clockwise seen outside
-        triangles += [(0, 1 + (k + 1) % slices, 1 + k),
-                      (top, top - slices + k, top - slices + (k + 1) % slices)]
-    for ring in range(len(rings) - 1):
-        for k in range(slices):
-            a, b = 1 + ring * slices + k, 1 + ring * slices + (k + 1) % slices
-            triangles += [(a, b, b + slices), (a, b + slices, a + slices)]
-    return mesh_geometry(vertices, np.array(triangles).reshape(-1))
+    ends, as one closed mesh (m; odin_common.meshes.capsule_mesh)."""
+    return mesh_geometry(*capsule_mesh(radius, length, slices, stacks))
 
 
 #: corners whose face turns more than this from the smoothed vertex normal get a vertex of
@@ -166,14 +145,8 @@ def capsule_geometry(radius: float, length: float, slices: int = 32, stacks: int
 CREASE_ANGLE = math.radians(40.0)
 
 
-#: m: meshes of more than DISPLAY_DETAIL_TRIANGLES triangles are drawn with their vertices
-#: clustered on a grid of this size (detail finer than a millimetre is below a pixel at the
-#: distances a robot scene is watched from, and CAD meshes of hands carry a lot of it: the SAH
-#: hand's 150k triangles become about half; :func:`odin_common.meshes.cluster_vertices`). The
-#: world's collision mesh has a tolerance of its own (the world parameter
-#: collision_mesh_tolerance).
-DISPLAY_TOLERANCE = 0.001
-DISPLAY_DETAIL_TRIANGLES = 2000
+# Meshes of more than DISPLAY_DETAIL_TRIANGLES triangles are drawn with their vertices clustered
+# at DISPLAY_TOLERANCE (odin_common.meshes.display_mesh, shared with the world's RViz markers).
 
 
 def mesh_geometry(vertices_B: np.ndarray, indices: Sequence[int]) -> Geometry:
@@ -193,10 +166,7 @@ def mesh_geometry(vertices_B: np.ndarray, indices: Sequence[int]) -> Geometry:
         raise ViewerError(f"mesh index {int(idx[bad][0])} out of range: the mesh has "
                           f"{len(vertices)} vertices")
     closed = _closed_and_outward(idx.reshape(-1, 3), vertices[idx].reshape(-1, 3, 3))
-    if idx.size > 3 * DISPLAY_DETAIL_TRIANGLES:
-        simple_vertices, simple_idx = cluster_vertices(vertices, idx, DISPLAY_TOLERANCE)
-        if simple_idx.size:  # a mesh smaller than the tolerance keeps its triangles
-            vertices, idx = simple_vertices, simple_idx
+    vertices, idx = display_mesh(vertices, idx)
     corners = vertices[idx].reshape(-1, 3, 3)
     area_normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
     lengths = np.linalg.norm(area_normals, axis=1, keepdims=True)

@@ -18,14 +18,13 @@ from typing import Iterable, Optional, Sequence
 
 import numpy as np
 
+# DEFAULT_COLOR: an object sent with an all-zero colour; COLLIDING_COLOR: while reported as
+# colliding (thesis 6.4.1: "dark gray"); shared with the world's RViz markers
+from odin_common.interface import COLLIDING_COLOR, DEFAULT_COLOR
 from viewer.core.camera import Camera
 from viewer.errors import ViewerError
 from viewer.core.geometry import Geometry, geometry_from_parameters, pose_matrix
 
-#: colour (r, g, b, a) of an object that was sent with an all-zero colour
-DEFAULT_COLOR = (0.62, 0.70, 0.82, 1.0)
-#: colour of an object while reported as colliding (thesis 6.4.1: "dark gray")
-COLLIDING_COLOR = (0.35, 0.35, 0.35, 1.0)
 #: default background (r, g, b)
 DEFAULT_BACKGROUND = (0.93, 0.94, 0.96)
 

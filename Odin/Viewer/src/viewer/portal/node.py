@@ -11,6 +11,9 @@ Subscribed topics
     ``<~world>/collided`` (Messages/Collided): geometries drawn dark grey until the second
         world update after the message (grey after an update exactly when listed since the
         previous one, thesis 6.4.2).
+    ``<~world>/markers`` (visualization_msgs/MarkerArray): geometries the Viewer does not hold
+        are added from the world's markers, so a rosbag played back drives the Viewer with no
+        world running (viewer.portal.markers).
 
 Published topics
     ``~image`` (sensor_msgs/Image): every rendered frame, rgb8, ``~width`` x ``~height``,
@@ -44,6 +47,7 @@ from typing import Optional
 import rospy
 import rospkg
 from sensor_msgs.msg import Image
+from visualization_msgs.msg import MarkerArray
 
 from Messages.msg import Collided, SpaceDistribution
 from Services.srv import (SaveSnapshot, SaveSnapshotResponse, SetCamera, SetCameraResponse,
@@ -55,6 +59,7 @@ from viewer.core.camera import Camera
 from viewer.errors import ViewerError
 from viewer.core.loop import RenderLoop
 from viewer.core.scene import Scene, prepare_view
+from viewer.portal.markers import IDENTITY, MarkerIntake
 from viewer.portal.parameters import DEFAULTS
 from viewer.core.snapshots import FrameWriter, snapshot_path, write_png
 
@@ -115,6 +120,8 @@ class Portal:
         rospy.Subscriber(f"{world}/world_update", SpaceDistribution, self._world_update,
                          queue_size=10)
         rospy.Subscriber(f"{world}/collided", Collided, self._collided, queue_size=10)
+        self._marker_intake = MarkerIntake()
+        rospy.Subscriber(f"{world}/markers", MarkerArray, self._markers, queue_size=10)
         rospy.loginfo("viewer: rendering %dx%d at %.1f Hz, world %s, snapshots in %s",
                       camera.width, camera.height, rate, world, self.snapshot_dir)
 
@@ -139,6 +146,20 @@ class Portal:
     def _world_update(self, msg: SpaceDistribution) -> None:
         situations = [(s.name, tuple(s.position), tuple(s.orientation)) for s in msg.situations]
         self.loop.post(lambda scene, _: scene.update(situations))
+
+    def _markers(self, msg: MarkerArray) -> None:
+        def apply(scene: Scene, _) -> None:
+            views, removals = self._marker_intake.changes(msg.markers, scene.__contains__)
+            for object_id in removals:
+                if object_id in scene:
+                    scene.remove_object(object_id)
+            for object_id, parameters, indices, shape, color in views:
+                try:
+                    scene.view(prepare_view(object_id, parameters, indices, *IDENTITY, color,
+                                            shape))
+                except OdinError as error:   # a marker that is no geometry the Viewer takes
+                    rospy.logwarn("viewer: marker %r not drawn: %s", object_id, error)
+        self.loop.post(apply)
 
     def _collided(self, msg: Collided) -> None:
         names = list(msg.names)

@@ -13,7 +13,9 @@ Services (odin_common.interface.WORLD_SERVICES; Services/*, each answering ``suc
 force), ``~save_state``, ``~restore_state``, ``~reset`` (snapshots), ``~propagate`` (run under
 controls without publishing, then back) and ``~check_collision`` (a synchronous query).
 
-Topics published (every cycle, or at ``~rate`` per wall-clock second under ``~free_run``):
+Topics published (every cycle, or at ``~rate`` per wall-clock second under ``~free_run``),
+all stamped with the world clock (portal.clock: simulated time that never goes back, also
+across New Scene, Restore State and Reset):
   ``~world_update``      Messages/SpaceDistribution: pose of every geometry (m, world frame,
                          quaternion (w, x, y, z));
   ``~collided``          Messages/Collided: contact-less policy only, the pairs that touched
@@ -22,22 +24,25 @@ Topics published (every cycle, or at ``~rate`` per wall-clock second under ``~fr
   ``~contacts``          Messages/Collided: contact policy only, pairs in contact in the last
                          step;
   ``~joint_data``        Messages/JointsData: every joint's positions and rates per axis;
-  ``/joint_states``      sensor_msgs/JointState: the same, one name per joint axis
+  ``~joint_states``      sensor_msgs/JointState: the same, one name per joint axis
                          (``<joint id>`` for one-axis joints, ``<joint id>/<axis>`` otherwise);
-  ``/clock``             rosgraph_msgs/Clock: simulated time, for nodes with use_sim_time;
+  ``/clock``             rosgraph_msgs/Clock: the world clock, for nodes with use_sim_time;
   ``~real_time_factor``  std_msgs/Float64: simulated s per wall-clock s over the last second;
   ``~servo_states``     Messages/ServoStates: every servo's targets, positions and errors
                          (while there is a servo);
   ``/diagnostics``       diagnostic_msgs/DiagnosticArray: an ERROR for each body the divergence
-                         guard parked (the object, why, its values), when it happens.
+                         guard parked (the object, why, its values), when it happens;
+  ``/tf``, ``/tf_static``, ``~markers``, ``<robot>/joint_states`` and the
+                         ``<robot>/robot_description`` parameters: portal.standard_topics;
+  ``~interactive/*``     interactive markers of the movable objects: portal.interaction.
 
 Services called: ``<~viewer>/view_object``, ``/remove_object``, ``/new_scene`` (optional: see
 ``viewer_link``).
 
 Parameters (read at start): the node's own (``virtual_world.portal.parameters``: ``~rate``,
 ``~step``, ``~steps_per_cycle``, ``~simulate``, ``~free_run``, ``~viewer``, ``~record``: a
-rosbag of what changed the world, see ``recorder``; the resource limits ``~max_objects``,
-``~max_mesh_triangles``, ``~max_snapshots``, ``~max_request_mb``) and every world
+rosbag of what changed the world, see ``recorder``; ``~push_speed``; the resource limits
+``~max_objects``, ``~max_mesh_triangles``, ``~max_snapshots``, ``~max_request_mb``) and every world
 parameter under its own name (``~gravity``, ``~erp``, ... odin_common.world_parameters), with
 units and defaults in docs/parameters.md.
 """
@@ -65,9 +70,12 @@ from odin_common.world_parameters import PARAMETERS
 from virtual_world.core import Core, step_values
 from virtual_world.core.loop import CycleReport, RealTimeFactor, WorldLoop
 from virtual_world.portal import conversions, message_cap
+from virtual_world.portal.interaction import InteractiveObjects
+from virtual_world.portal.mirror import WorldMirror
 from virtual_world.portal.parameters import DEFAULTS, RESOURCE_PARAMETERS
 from virtual_world.portal.recorder import Recorder
 from virtual_world.portal.services import READ_ONLY, WorldServices
+from virtual_world.portal.standard_topics import StandardTopics
 from virtual_world.portal.viewer_link import ViewerLink
 
 _log = logging.getLogger("rosout")
@@ -93,11 +101,16 @@ class Portal:
         self._writer = conversions.SpaceDistributionWriter()
         self.viewer = ViewerLink(rospy.get_param("~viewer", DEFAULTS["viewer"]),
                                  self._viewer_poses)
-        self.services = WorldServices(self.core, self.loop, self.viewer)
+        self.mirror = WorldMirror()
+        self.services = WorldServices(self.core, self.loop, self.viewer, self.mirror)
         record = rospy.get_param("~record", DEFAULTS["record"])
         self.recorder = Recorder(record, self.core.world_parameters, values) if record else None
         self._advertise()
+        self.topics = StandardTopics(self.mirror, self.loop.call)
         self._serve()
+        self.interaction = InteractiveObjects(
+            self.mirror, self.serve, float(rospy.get_param("~push_speed",
+                                                           DEFAULTS["push_speed"])))
 
     # -- start-up ---------------------------------------------------------------------------
     @staticmethod
@@ -121,7 +134,7 @@ class Portal:
         self.pub_collided = rospy.Publisher("~collided", Collided, queue_size=1000)
         self.pub_contacts = rospy.Publisher("~contacts", Collided, queue_size=1000)
         self.pub_joints = rospy.Publisher("~joint_data", JointsData, queue_size=10)
-        self.pub_joint_states = rospy.Publisher("/joint_states", JointState, queue_size=10)
+        self.pub_joint_states = rospy.Publisher("~joint_states", JointState, queue_size=10)
         self.pub_clock = rospy.Publisher("/clock", Clock, queue_size=10)
         self.pub_rtf = rospy.Publisher("~real_time_factor", Float64, queue_size=10)
         self.pub_diagnostics = rospy.Publisher("/diagnostics", DiagnosticArray, queue_size=10)
@@ -130,23 +143,32 @@ class Portal:
     def _serve(self) -> None:
         """One server per world service, each answered by the method of the same name."""
         self.servers = []
+        self._answers: dict = {}
         for name, type_name in WORLD_SERVICES.items():
             service_class = getattr(srv, type_name)
-            self.servers.append(rospy.Service(
-                f"~{name}", service_class, self._guarded(service_class, self._handler(name))))
+            self._answers[name] = self._guarded(service_class, self._handler(name))
+            self.servers.append(rospy.Service(f"~{name}", service_class, self._answers[name]))
+
+    def serve(self, name: str, request):
+        """Answers ``request`` as the service ``name`` does over ROS (any thread)."""
+        return self._answers[name](request)
 
     def _handler(self, name: str) -> Callable:
-        """The service's handler, which also records a state-changing request that
-        succeeded (``~record``)."""
+        """The service's handler, which also notes that a state-changing request succeeded
+        (the world clock), puts robots' descriptions on the parameter server at once (Set
+        Robot, removals, New Scene) and records it (``~record``)."""
         handle = getattr(self.services, name)
-        if self.recorder is None or name in READ_ONLY:
+        if name in READ_ONLY:
             return handle
 
-        def handle_and_record(request) -> dict:
+        def handle_and_note(request) -> dict:
             fields = handle(request)
-            self.recorder.request(name, request)
+            self.mirror.changed = True
+            self.topics.apply_robot_changes()
+            if self.recorder is not None:
+                self.recorder.request(name, request)
             return fields
-        return handle_and_record
+        return handle_and_note
 
     def _guarded(self, service_class, handler: Callable) -> Callable:
         """Runs ``handler(request) -> dict`` on the loop thread and turns the outcome into the
@@ -178,6 +200,8 @@ class Portal:
         finally:
             if self.recorder is not None:
                 self.recorder.close()
+            self.topics.close()
+            self.interaction.close()
             self.viewer.close()
             self.core.close()
 
@@ -200,7 +224,7 @@ class Portal:
             _log.error("virtual_world: %s diverged at %.6g s (%s, %s); parked",
                        event.id, event.time, event.reason, event.value)
         self.pub_diagnostics.publish(conversions.divergence_diagnostics(
-            found, rospy.Time.from_sec(self.core.sim_time)))
+            found, rospy.Time.from_sec(self.mirror.clock.now(self.core.sim_time))))
         if self.core.world_parameters.divergence_policy == 1:
             self.loop.simulate = False
 
@@ -208,7 +232,9 @@ class Portal:
         rtf = self._rtf.add(report.wall_time, report.sim_time)
         if not report.publish_due:
             return
-        stamp = rospy.Time.from_sec(report.sim_time)
+        stamp = rospy.Time(*self.mirror.clock.stamp(
+            report.sim_time, self.loop.step_values.step, self.mirror.changed))
+        self.mirror.changed = False
         names, positions, quaternions = self.core.poses()
         with self._poses_lock:
             self._poses_for_viewer = (names, positions.copy(), quaternions.copy())
@@ -221,19 +247,34 @@ class Portal:
             self.pub_collided.publish(conversions.collided_message(collisions, stamp))
         elif self.pub_contacts.get_num_connections() > 0:
             self.pub_contacts.publish(conversions.collided_message(collisions, stamp))
-        self._publish_joints(stamp)
+        states = self._publish_joints(stamp)
         servos = self.core.servo_states()
         if servos:
             self.pub_servos.publish(conversions.servo_states_message(servos, stamp))
         self.pub_clock.publish(Clock(clock=stamp))
         self.pub_rtf.publish(Float64(rtf))
+        self._publish_standard(stamp, names, positions, quaternions, states,
+                               collisions if contact_less else ())
 
-    def _publish_joints(self, stamp) -> None:
+    def _publish_joints(self, stamp) -> list:
         states = self.core.joint_states()
         message = JointsData(joints=conversions.joint_data(states))
         message.header.stamp = stamp
         self.pub_joints.publish(message)
         self.pub_joint_states.publish(conversions.joint_state_message(states, stamp))
+        return states
+
+    def _publish_standard(self, stamp, names, positions, quaternions, states,
+                          collisions) -> None:
+        """tf, markers, robots' joint states, interactive markers (portal.standard_topics,
+        portal.interaction)."""
+        moving, static = self.mirror.frames.poses(names, positions, quaternions)
+        colliding = {n for c in collisions for n in (c.first, c.second)}
+        self.topics.publish(stamp, moving, static, states, colliding)
+        movable = self.mirror.movable_objects()
+        by_frame = {frame: (p, q) for frame, p, q in zip(*moving)}
+        self.interaction.sync({o: by_frame[f] for o, f in zip(
+            movable, self.mirror.frames.frames(movable)) if f in by_frame})
 
     def _viewer_poses(self) -> dict:
         """{geometry id: (position, orientation)} as of the last publication (any thread)."""

@@ -27,6 +27,8 @@ NODE_PARAMETERS: Tuple[NodeParameter, ...] = (
     NodeParameter("record", "", "-", "a rosbag file to record every state-changing request "
                   "and every advance into (`rosrun VirtualWorld replay FILE` re-runs it); "
                   "empty: no recording"),
+    NodeParameter("push_speed", 0.5, "m/s", "velocity an interactive marker's Push adds to an "
+                  "object (RViz, docs/ROS.md)"),
     NodeParameter("max_objects", _RESOURCES.max_objects, "-",
                   "objects the world may hold (a composite counts once); more are refused"),
     NodeParameter("max_mesh_triangles", _RESOURCES.max_mesh_triangles, "-",

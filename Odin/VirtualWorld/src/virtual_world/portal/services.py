@@ -4,7 +4,9 @@ generated message classes; every rule is the Core's (a refusal is its OdinError)
 
 ``WorldServices`` needs a loop (the step values in force, ``simulate``, ``step_cycles``,
 ``sim_time``: virtual_world.core.loop.WorldLoop or a replay's stand-in) and a viewer sink
-(``view``, ``remove``, ``new_scene``: the Portal's ViewerLink, or nothing for replay).
+(``view``, ``remove``, ``new_scene``: the Portal's ViewerLink, or nothing for replay). Every
+build, removal and New Scene that succeeded also goes to the ``mirror`` (portal.mirror: frames,
+markers and robots for tf, RViz and the robots' topics), which Set Robot declares robots in.
 """
 from __future__ import annotations
 
@@ -17,6 +19,8 @@ from odin_common.world_parameters import set_world_flags
 from virtual_world.core import Core, step_values
 from virtual_world.errors import InvalidArgument
 from virtual_world.portal import conversions
+from virtual_world.portal.mirror import WorldMirror
+from virtual_world.portal.robots import robot_message, robot_of
 
 #: Set World request flags -> the world parameters each applies (value fields follow it).
 WORLD_FIELDS = set_world_flags()
@@ -44,10 +48,17 @@ class WorldServices:
     """One method per world service (odin_common.interface.WORLD_SERVICES): request message ->
     the response's fields (``success`` aside)."""
 
-    def __init__(self, core: Core, loop, viewer=NoViewer()):
+    def __init__(self, core: Core, loop, viewer=NoViewer(), mirror: WorldMirror = None):
         self.core = core
         self.loop = loop
         self.viewer = viewer
+        self.mirror = WorldMirror() if mirror is None else mirror
+
+    def _built(self, *built) -> None:
+        """Objects the Core built (core.Built each): to the Viewer and the mirror."""
+        for member in built:
+            self.viewer.view(conversions.view_requests(member.geometries))
+            self.mirror.built(member.id, self.core.object_spec(member.id), member.geometries)
 
     def step_fields(self) -> dict:
         """The step values in force, as Set Step and Get World answer them."""
@@ -58,6 +69,7 @@ class WorldServices:
     def new_scene(self, request) -> dict:
         self.core.new_scene()
         self.viewer.new_scene()
+        self.mirror.cleared()
         self._sync_loop_time()
         return {"message": "new scene"}
 
@@ -87,12 +99,12 @@ class WorldServices:
 
     def build_object(self, request) -> dict:
         built = self.core.build_object(messages.object_spec(request.object))
-        self.viewer.view(conversions.view_requests(built.geometries))
+        self._built(built)
         return {"id": built.id}
 
     def build_composite(self, request) -> dict:
         built = self.core.build_composite(messages.composite_spec(request.composite))
-        self.viewer.view(conversions.view_requests(built.geometries))
+        self._built(built)
         return {"id": built.id}
 
     def build_entity(self, request) -> dict:
@@ -100,12 +112,13 @@ class WorldServices:
             request.name, [messages.object_spec(o) for o in request.objects],
             [messages.composite_spec(c) for c in request.composites],
             request.internal_collisions))
-        self.viewer.view(conversions.view_requests(built.geometries))
+        self._built(*built.members)
         return {"id": built.name, "ids": built.ids}
 
     def remove_object(self, request) -> dict:
         removed = self.core.remove_object(request.id)
         self.viewer.remove(removed.geometries)
+        self.mirror.removed(request.id, removed.joints)
         also = [*removed.joints, *removed.motors, *removed.forces]
         return {"message": f"removed {request.id}" + (f" and {', '.join(also)}" if also else "")}
 
@@ -122,6 +135,7 @@ class WorldServices:
             return {"id": request.id, "message": f"set {len(parameters)} parameter(s)"}
         if request.action == SetJointAction.REMOVE:
             removed = self.core.remove_joint(request.id)
+            self.mirror.removed(joint_ids=[request.id, *removed.joints])
             also = [*removed.motors, *removed.forces]
             return {"id": request.id,
                     "message": f"removed {request.id}" + (f" and {', '.join(also)}" if also else "")}
@@ -189,7 +203,20 @@ class WorldServices:
                 "entities": list(core.entities()), "joints": core.joint_ids(),
                 "motors": core.motor_ids(), "body_forces": core.body_force_ids(),
                 "joint_forces": core.joint_force_ids(), "snapshots": core.snapshot_names(),
+                "frames": self.mirror.frames.frames(core.object_ids()),
+                "robots": [robot_message(r) for r in self.mirror.robots],
+                "clock": self.mirror.clock.now(core.sim_time),
                 "message": f"{len(core.object_ids())} objects at {core.sim_time:g} s"}
+
+    def set_robot(self, request) -> dict:
+        if request.remove:
+            robot = self.mirror.remove_robot(request.robot.name)
+            return {"ros_namespace": robot.namespace, "message": f"forgot robot {robot.name!r}"}
+        robot = robot_of(request.robot)
+        self.mirror.set_robot(robot, {s.id: s.type for s in self.core.joint_states()})
+        return {"ros_namespace": robot.namespace,
+                "message": f"robot {robot.name!r} in namespace /{robot.namespace}: "
+                           f"{len(robot.links)} links, {len(robot.joints)} joints"}
 
     def get_state(self, request) -> dict:
         bodies, joints, motors = self.core.state(request.objects, request.joints,

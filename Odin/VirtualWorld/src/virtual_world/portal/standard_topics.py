@@ -1,0 +1,152 @@
+"""The world in the form the standard ROS tools read it (tf2, RViz, robot_state_publisher).
+
+Published by the world node, every publication (``~rate``), from the WorldMirror:
+
+  ``/tf``                 tf2_msgs/TFMessage: ``world`` -> every object's frame that moves
+                          (odin_common.interface.frame_id of its ID; a robot's links:
+                          "<namespace>/<link>"), stamped with the world clock; not sent again
+                          while the clock stands still (tf refuses a repeated stamp), but a
+                          new subscriber gets the last one at once (RViz started while the
+                          world is paused sees every frame);
+  ``/tf_static``          tf2_msgs/TFMessage, latched: ``world`` -> every static object's frame
+                          (built ``geometry_only``), sent again only when they change;
+  ``~markers``            visualization_msgs/MarkerArray: every geometry (portal.markers),
+                          only what changed; a new subscriber first gets all of them (latched
+                          too, so a late one also gets the last change);
+  ``<ns>/joint_states``   sensor_msgs/JointState per robot declared with Set Robot: its own
+                          joint names, positions (rad or m) and rates (rad/s or m/s);
+  ``<ns>/robot_description`` (a parameter, not a topic): the robot's URDF, set while the
+                          robot is declared, deleted when it goes.
+"""
+from __future__ import annotations
+
+import logging
+import threading
+from typing import Dict, Iterable
+
+import rospy
+from sensor_msgs.msg import JointState
+from tf2_msgs.msg import TFMessage
+from visualization_msgs.msg import MarkerArray
+
+from virtual_world.portal.mirror import WorldMirror
+from virtual_world.portal.tf_writer import TfWriter
+
+_log = logging.getLogger("rosout")
+
+
+class _FullMarkersOnSubscribe(rospy.SubscribeListener):
+    """Sends every marker to each new subscriber of ``~markers`` (the latched message alone is
+    only the last change). The markers are computed on the world's loop thread, and rospy calls
+    this on the thread that accepts every connection of the node (services too): so the work
+    goes to a thread of its own, and a loop that is busy or not started yet never blocks the
+    node's services. The markers are sent from the loop thread too, so that they reach the
+    subscriber in order with the changes the loop publishes."""
+
+    def __init__(self, markers, on_loop):
+        super().__init__()
+        self._markers = markers
+        self._on_loop = on_loop
+
+    def peer_subscribe(self, topic_name, topic_publish, peer_publish) -> None:
+        threading.Thread(target=self._send, args=(topic_name, peer_publish),
+                         name="markers-to-new-subscriber", daemon=True).start()
+
+    def _send(self, topic_name, peer_publish) -> None:
+        try:
+            self._on_loop(lambda: peer_publish(self._markers.full()))
+        except Exception as error:   # the world stopping, the subscriber gone
+            _log.warning("virtual_world: no markers for a new subscriber of %s: %s",
+                         topic_name, error)
+
+
+class _LastTfOnSubscribe(rospy.SubscribeListener):
+    """Sends the last /tf message to each new subscriber: while paused the world sends none."""
+
+    def __init__(self):
+        super().__init__()
+        self.last = None
+
+    def peer_subscribe(self, topic_name, topic_publish, peer_publish) -> None:
+        last = self.last
+        if last is not None:
+            peer_publish(last)
+
+
+class StandardTopics:
+    """The publishers above; ``publish`` runs on the world's loop thread."""
+
+    def __init__(self, mirror: WorldMirror, on_loop):
+        """``on_loop(function)``: runs ``function`` on the world's loop thread (the Portal's
+        ``loop.call``)."""
+        self.mirror = mirror
+        self._tf_listener = _LastTfOnSubscribe()
+        self.pub_tf = rospy.Publisher("/tf", TFMessage, queue_size=100,
+                                      subscriber_listener=self._tf_listener)
+        self.pub_tf_static = rospy.Publisher("/tf_static", TFMessage, queue_size=10, latch=True)
+        self.pub_markers = rospy.Publisher(
+            "~markers", MarkerArray, queue_size=100, latch=True,
+            subscriber_listener=_FullMarkersOnSubscribe(mirror.markers, on_loop))
+        self._tf = TfWriter()
+        self._tf_static = TfWriter()
+        self._static_published = None
+        self._last_tf_stamp = None
+        self._joint_states: Dict[str, rospy.Publisher] = {}
+
+    def publish(self, stamp: rospy.Time, moving, static, joint_states,
+                colliding: Iterable[str]) -> None:
+        """One publication: the frames' poses (ObjectFrames.poses: moving and static), the
+        Core's joint states, the geometries to draw grey."""
+        self.apply_robot_changes()
+        if stamp != self._last_tf_stamp:
+            self._last_tf_stamp = stamp
+            if moving[0]:
+                message = self._tf.message(*moving, stamp)
+                self._tf_listener.last = message
+                self.pub_tf.publish(message)
+        self._publish_static(static, stamp)
+        self.mirror.markers.set_colliding(colliding)
+        changes = self.mirror.markers.take_changes()
+        if changes is not None:
+            self.pub_markers.publish(changes)
+        for robot, joint_names, values, rates in self.mirror.robots.joint_states(joint_states):
+            message = JointState(name=joint_names, position=values, velocity=rates)
+            message.header.stamp = stamp
+            publisher = self._joint_states.get(robot.namespace)
+            if publisher is not None:
+                publisher.publish(message)
+
+    def _publish_static(self, static, stamp) -> None:
+        frames, positions, quaternions = static
+        key = (tuple(frames), positions.tobytes(), quaternions.tobytes())
+        if key == self._static_published:
+            return
+        self._static_published = key
+        self.pub_tf_static.publish(self._tf_static.message(frames, positions, quaternions,
+                                                           stamp))
+
+    def apply_robot_changes(self) -> None:
+        """Each robot set or removed since the last call: its joint_states publisher and its
+        robot_description parameter (the Portal calls this after every service that changed
+        the world, so the parameter is there when Set Robot answers, and at publications).
+        A namespace's publisher stays once made (it is silent while no robot uses it): a
+        subscriber stays connected across New Scene and a reload of the same robot."""
+        for change, robot in self.mirror.take_robot_changes():
+            namespace = f"/{robot.namespace}"
+            try:
+                if change == "set":
+                    if robot.namespace not in self._joint_states:
+                        self._joint_states[robot.namespace] = rospy.Publisher(
+                            f"{namespace}/joint_states", JointState, queue_size=10)
+                    rospy.set_param(f"{namespace}/robot_description", robot.description)
+                elif rospy.has_param(f"{namespace}/robot_description"):
+                    rospy.delete_param(f"{namespace}/robot_description")
+            except Exception as error:   # the master gone: the node goes on
+                _log.warning("virtual_world: robot %s: parameter server: %s", robot.name, error)
+
+    def close(self) -> None:
+        for robot in list(self.mirror.robots):
+            try:
+                rospy.delete_param(f"/{robot.namespace}/robot_description")
+            except Exception:   # master gone at shutdown
+                pass
