@@ -85,6 +85,63 @@ def _ompl():
     return ob, oc, ou
 
 
+class _Callbacks:
+    """The propagator and validity checker OMPL calls. They hold the back end and the
+    problem, never the OMPL objects: a reference from a callback back to the SpaceInformation
+    holding it would be a cycle through C++ that Python's collector cannot see."""
+
+    def __init__(self, backend, world_size: int):
+        self.backend = backend
+        self.problem = backend.problem
+        self.world_size = world_size
+        self.error: Optional[BaseException] = None
+
+    # -- state <-> vectors ---------------------------------------------------------------------
+    def _vector(self, state) -> np.ndarray:
+        world = state[1]
+        return np.fromiter((world[i] for i in range(self.world_size - 1)), float,
+                           self.world_size - 1)
+
+    def write(self, state, vector: np.ndarray, backend_outcome) -> None:
+        robot, world = state[0], state[1]
+        if backend_outcome is None:
+            position, velocity = self.backend.base_state(vector)
+            flag = 0.0
+        else:
+            position, velocity = backend_outcome.position, backend_outcome.velocity
+            flag = 1.0 if self.problem.forbidden_contacts(backend_outcome.collisions) else 0.0
+        for i in range(3):
+            robot[i] = float(position[i])
+            robot[3 + i] = float(velocity[i])
+        for i, v in enumerate(vector.tolist()):
+            world[i] = v
+        world[self.world_size - 1] = flag
+
+    # -- OMPL's callbacks (an exception must not cross into C++: kept and re-raised) -----------
+    def propagate(self, start, control, duration, result) -> None:
+        try:
+            steps = max(1, round(duration / self.problem.step))
+            values = self.problem.controls(
+                [control[i] for i in range(len(self.problem.searched))])
+            vector = self._vector(start)
+            outcome = None
+            for _ in range(steps):
+                outcome = self.backend.propagate([(vector, values)])[0]
+                vector = outcome.state
+            self.write(result, vector, outcome)
+        except BaseException as error:      # noqa: B902 - handed back to plan()
+            self.error = self.error or error
+            self.write(result, self._vector(start), None)
+            result[1][self.world_size - 1] = 1.0   # invalid: the search stops using it
+
+    def valid(self, state) -> bool:
+        robot = state[0]
+        position = [robot[0], robot[1], robot[2]]
+        velocity = [robot[3], robot[4], robot[5]]
+        return state[1][self.world_size - 1] == 0.0 and self.problem.in_bounds(position,
+                                                                                velocity)
+
+
 class _Setup:
     """The OMPL objects of one search, kept together (OMPL holds raw pointers between them)."""
 
@@ -125,78 +182,33 @@ class _Setup:
         self.si.setPropagationStepSize(problem.step)
         self.si.setMinMaxControlDuration(settings.min_control_steps,
                                          settings.max_control_steps)
-        self.si.setStatePropagator(self._propagate)
-        self.si.setStateValidityChecker(self._valid)
+        self.callbacks = _Callbacks(backend, self.world_size)
+        self.si.setStatePropagator(self.callbacks.propagate)
+        self.si.setStateValidityChecker(self.callbacks.valid)
         self.si.setup()
         self.goal = _goal_region(ob, self.si, problem)
         self.setup = oc.SimpleSetup(self.si)
         start = self.si.allocState()
-        self._write(start, self.start, backend_outcome=None)
+        self.callbacks.write(start, self.start, backend_outcome=None)
         self.setup.setStartState(start)
         self.setup.setGoal(self.goal)
         self.planner = _planner(oc, self.si, planner, settings.goal_bias)
         self.setup.setPlanner(self.planner)
-        self.error: Optional[BaseException] = None
-
-    # -- state <-> vectors ---------------------------------------------------------------------
-    def _vector(self, state) -> np.ndarray:
-        world = state[1]
-        return np.fromiter((world[i] for i in range(self.world_size - 1)), float,
-                           self.world_size - 1)
-
-    def _write(self, state, vector: np.ndarray, backend_outcome) -> None:
-        robot, world = state[0], state[1]
-        if backend_outcome is None:
-            position, velocity = self.backend.base_state(vector)
-            flag = 0.0
-        else:
-            position, velocity = backend_outcome.position, backend_outcome.velocity
-            flag = 1.0 if self.problem.forbidden_contacts(backend_outcome.collisions) else 0.0
-        for i in range(3):
-            robot[i] = float(position[i])
-            robot[3 + i] = float(velocity[i])
-        for i, v in enumerate(vector.tolist()):
-            world[i] = v
-        world[self.world_size - 1] = flag
-
-    # -- OMPL's callbacks (an exception must not cross into C++: kept and re-raised) -----------
-    def _propagate(self, start, control, duration, result) -> None:
-        try:
-            steps = max(1, round(duration / self.problem.step))
-            values = self.problem.controls(
-                [control[i] for i in range(len(self.problem.searched))])
-            vector = self._vector(start)
-            outcome = None
-            for _ in range(steps):
-                outcome = self.backend.propagate([(vector, values)])[0]
-                vector = outcome.state
-            self._write(result, vector, outcome)
-        except BaseException as error:      # noqa: B902 - handed back to plan()
-            self.error = self.error or error
-            self._write(result, self._vector(start), None)
-            result[1][self.world_size - 1] = 1.0   # invalid: the search stops using it
-
-    def _valid(self, state) -> bool:
-        robot = state[0]
-        position = [robot[0], robot[1], robot[2]]
-        velocity = [robot[3], robot[4], robot[5]]
-        return state[1][self.world_size - 1] == 0.0 and self.problem.in_bounds(position,
-                                                                                velocity)
-
 
 def _goal_region(ob, si, problem):
     class GoalXY(ob.GoalRegion):
         """The query's goal: the base within the tolerance, in the plane."""
 
-        def __init__(self):
+        def __init__(self, si, problem):
             super().__init__(si)
+            self.problem = problem
             self.setThreshold(problem.settings.goal_tolerance)
 
         def distanceGoal(self, state) -> float:
             robot = state[0]
-            return problem.goal_distance((robot[0], robot[1]))
+            return self.problem.goal_distance((robot[0], robot[1]))
 
-    return GoalXY()
+    return GoalXY(si, problem)
 
 
 def _planner(oc, si, name: str, goal_bias: float):
@@ -234,8 +246,9 @@ def plan(backend, planner: str = "KPIECE1", time_limit: float = 10.0,
     status = setup.setup.solve(time_limit)
     elapsed = time.perf_counter() - started
     propagations = _propagations(backend) - before
-    if setup.error is not None:
-        raise PlanningError(f"propagation failed: {setup.error}") from setup.error
+    if setup.callbacks.error is not None:
+        error = setup.callbacks.error
+        raise PlanningError(f"propagation failed: {error}") from error
     rows: List[ControlRow] = []
     if setup.setup.haveSolutionPath():
         rows = _rows(setup.setup.getSolutionPath(), setup.problem)
