@@ -1,4 +1,4 @@
-"""The GUI's headless tools: ``problem_info``, ``load_problem`` and ``run_path``.
+"""The GUI's headless tools: ``problem_info``, ``load_problem``, ``run_path`` and ``plan``.
 
 Each ``*_main(argv)`` returns the exit status; errors end with status 2 and ONE line on stderr
 saying what and where (file and line for parsed files). ``problem_info`` never imports rospy.
@@ -268,14 +268,10 @@ def plan_main(argv: Optional[Sequence[str]] = None) -> int:
     parser.add_argument("--seed", type=int, default=None, help="OMPL's random seed")
     parser.add_argument("--backend", choices=("core", "pool"), default="core",
                         help="core: the world in this process [default]; pool: world nodes "
-                        "over ROS (--worlds), propagations fanned out")
-    parser.add_argument("--worlds", nargs="+", default=["/virtual_world"], metavar="NS",
-                        help="pool: the world nodes' namespaces [/virtual_world]")
+                        "over ROS (not yet: docs/PLANNING.md)")
     parser.add_argument("--robot", help="robot name (default: the first robot)")
     parser.add_argument("--goal-tolerance", type=float, default=None, metavar="M",
                         help="goal region radius in the plane, m [0.25]")
-    parser.add_argument("--timeout", type=float, default=30.0,
-                        help="pool: seconds to wait for the world nodes [30]")
     _build_options(parser)
     args = parser.parse_args(argv)
     _warnings_to_stderr("plan")
@@ -311,8 +307,8 @@ def _planning_backend(args):
         SearchSettings(goal_tolerance=args.goal_tolerance)
     plan = _plan(args)
     problem = planning_problem(plan, args.robot, settings)
-    if args.backend == "core":
-        from gui.planning.backend import CoreBackend
-        return CoreBackend(plan, problem)
-    from gui.pool_backend import PoolBackend
-    return PoolBackend(plan, problem, args.worlds, timeout=args.timeout)
+    if args.backend == "pool":
+        raise GuiError("--backend pool: not available yet (Propagate cannot start from a "
+                       "planner's state vector; docs/PLANNING.md): use --backend core")
+    from gui.planning.backend import CoreBackend
+    return CoreBackend(plan, problem)

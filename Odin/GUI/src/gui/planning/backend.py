@@ -10,7 +10,7 @@ the n rows of the control path it becomes (one kept Propagate per row), so that 
 plan replays bit for bit in a fresh world.
 
 ``CoreBackend``: the VirtualWorld's Core in this process, built from the problem's plan
-(fastest: no messages). ``gui.pool_backend.PoolBackend``: world nodes over ROS.
+(fastest: no messages).
 """
 from __future__ import annotations
 
