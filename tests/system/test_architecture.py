@@ -27,6 +27,10 @@ RULES = {
     "gui.core": ROS + MESSAGES + QT + ("gui.ros", "gui.window", "virtual_world", "viewer",
                                        "odin_common.messages"),
     "gui.ros": QT + ("gui.window", "virtual_world", "viewer"),
+    # the planning bridge runs the Core in process; its ROS back end lives outside it
+    "gui.planning": ROS + MESSAGES + QT + ("gui.ros", "gui.window", "virtual_world.portal",
+                                           "virtual_world.ode", "virtual_world.pool", "viewer",
+                                           "odin_common.messages"),
     "virtual_world.portal": QT + ("viewer", "gui", "virtual_world.ode"),
     "viewer.portal": QT + ("virtual_world", "gui"),
     "virtual_world.pool": QT + ("virtual_world.core", "virtual_world.ode",

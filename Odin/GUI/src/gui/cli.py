@@ -1,4 +1,4 @@
-"""The GUI's headless tools: ``problem_info``, ``load_problem`` and ``run_path``.
+"""The GUI's headless tools: ``problem_info``, ``load_problem``, ``run_path`` and ``plan``.
 
 Each ``*_main(argv)`` returns the exit status; errors end with status 2 and ONE line on stderr
 saying what and where (file and line for parsed files). ``problem_info`` never imports rospy.
@@ -307,3 +307,71 @@ def _run_controls(args, handle) -> int:
     run_on_client(client, handle, rows, real_time=not args.fast, progress=progress)
     print(f"{handle.name}: {len(rows)} control rows done ({elapsed[0]:.3f} s simulated)")
     return 0
+
+
+# ------------------------------------------------------------------------------ plan (issue 17)
+
+def plan_main(argv: Optional[Sequence[str]] = None) -> int:
+    """``rosrun GUI plan PROBLEM --planner NAME --time S --out PATH``: plans the problem's
+    query with one of OMPL's control planners through Odin's physics (gui.planning), writes
+    the solution as a Kautham control path (``run_path --controls`` runs it), prints the
+    search's statistics as JSON; exits 1 with one line when no solution was found in time,
+    2 on bad input."""
+    from gui.planning.bridge import PLANNERS
+    parser = argparse.ArgumentParser(
+        prog="plan", description="Plan a Kautham physics problem's query with an OMPL control "
+        "planner through Odin's world; write the solution as a control path.")
+    parser.add_argument("problem", help="the problem XML file")
+    parser.add_argument("--planner", default="KPIECE1",
+                        help=f"OMPL control planner: {', '.join(PLANNERS)} [KPIECE1]")
+    parser.add_argument("--time", type=float, default=10.0, metavar="S",
+                        help="wall-clock seconds the planner may search [10]")
+    parser.add_argument("--out", required=True, metavar="PATH",
+                        help="control path file to write (rows: controls, duration s)")
+    parser.add_argument("--seed", type=int, default=None, help="OMPL's random seed")
+    parser.add_argument("--backend", choices=("core", "pool"), default="core",
+                        help="core: the world in this process [default]; pool: world nodes "
+                        "over ROS (not yet: docs/PLANNING.md)")
+    parser.add_argument("--robot", help="robot name (default: the first robot)")
+    parser.add_argument("--goal-tolerance", type=float, default=None, metavar="M",
+                        help="goal region radius in the plane, m [0.25]")
+    _build_options(parser)
+    args = parser.parse_args(argv)
+    _warnings_to_stderr("plan")
+    backend = None
+    try:
+        backend = _planning_backend(args)
+        from gui.planning.bridge import plan
+        result = plan(backend, args.planner, args.time, args.seed)
+        print(json.dumps(result.statistics(), indent=1), flush=True)
+        if not result.solved:
+            return _fail("plan", GuiError(
+                f"{args.problem}: no solution within {args.time:g} s ({args.planner}, seed "
+                f"{args.seed}): the closest plan ends {result.goal_distance:.3f} m from the "
+                "goal")) - 1
+        from gui.core.control_path import write_control_path
+        write_control_path(args.out, result.rows, comments=(
+            f"control path planned by rosrun GUI plan {args.problem}",
+            f"planner {args.planner}, seed {args.seed}, {result.time_s:.2f} s, "
+            f"ends {result.goal_distance:.4f} m from the goal",
+            "each row: the robot's controls in [0, 1], then the duration (s)"))
+        print(f"plan: {len(result.rows)} rows ({result.duration:.3f} s) written to {args.out}")
+    except (GuiError, OSError) as error:
+        return _fail("plan", error)
+    finally:
+        if backend is not None:
+            backend.close()
+    return 0
+
+
+def _planning_backend(args):
+    from gui.planning.problem import SearchSettings, planning_problem
+    settings = SearchSettings() if args.goal_tolerance is None else \
+        SearchSettings(goal_tolerance=args.goal_tolerance)
+    plan = _plan(args)
+    problem = planning_problem(plan, args.robot, settings)
+    if args.backend == "pool":
+        raise GuiError("--backend pool: not available yet (Propagate cannot start from a "
+                       "planner's state vector; docs/PLANNING.md): use --backend core")
+    from gui.planning.backend import CoreBackend
+    return CoreBackend(plan, problem)

@@ -48,3 +48,8 @@ class WorldError(GuiError):
         self.service = service
         self.world_message = message
         super().__init__(f"{service}: {message}")
+
+
+class PlanningError(GuiError):
+    """A problem the planner cannot take (its robot's kind, a missing goal, a bad setting),
+    or a back end that failed while planning."""

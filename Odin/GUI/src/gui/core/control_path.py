@@ -145,6 +145,27 @@ def read_control_path(path: os.PathLike | str, size: int) -> List[ControlRow]:
     return out
 
 
+def write_control_path(path: os.PathLike | str, rows: Sequence[ControlRow],
+                       comments: Sequence[str] = ()) -> None:
+    """Writes ``rows`` as a control path file (module docstring) that ``read_control_path``
+    reads back exactly: each value in Python's shortest round-trip form; ``comments`` first,
+    each a '#' line. Refuses rows of different sizes or with values out of range before
+    writing anything."""
+    if not rows:
+        raise PathFileError("no rows to write", path)
+    size = len(rows[0].controls)
+    for k, row in enumerate(rows, start=1):
+        if len(row.controls) != size:
+            raise PathFileError(f"row {k} has {len(row.controls)} controls, row 1 {size}",
+                                path)
+        if not all(0.0 <= float(c) <= 1.0 for c in row.controls) or not row.duration > 0:
+            raise PathFileError(f"row {k}: controls {list(row.controls)} not all in [0, 1] "
+                                f"or duration {row.duration!r} s not positive", path)
+    lines = [f"# {line}" for text in comments for line in str(text).splitlines()]
+    lines += [" ".join(repr(float(v)) for v in (*row.controls, row.duration)) for row in rows]
+    pathlib.Path(path).write_text("\n".join(lines) + "\n")
+
+
 def actuation(handle, row: ControlRow, state: Optional[BodyState],
               defaults: ControlDefaults = ControlDefaults()) -> Actuation:
     """What ``row`` asks of the world for ``handle``'s robot; ``state``: its base body's when
@@ -291,5 +312,5 @@ def run_on_client(client, handle, rows: Sequence[ControlRow], real_time: bool = 
 
 
 __all__ = ["MAPPING", "ControlDefaults", "ControlRow", "ServoCommand", "Actuation",
-           "ControlPort", "control_size", "read_control_path", "actuation",
+           "ControlPort", "control_size", "read_control_path", "write_control_path", "actuation",
            "run_control_path", "RowResult", "ClientPort", "run_on_client"]

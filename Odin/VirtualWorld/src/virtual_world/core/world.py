@@ -411,6 +411,38 @@ class Core:
         return snapshot
 
     @_locked
+    def body_state_vector(self) -> np.ndarray:
+        """The bodies' dynamic state as one flat float64 vector, for planners that keep
+        states themselves (OMPL): ODE's random generator state (QuickStep's constraint order),
+        then per body with a body (object order) its raw record (position, quaternion wxyz,
+        rotation matrix, linear and angular velocity, enabled: ``BODY_STATE_SIZE`` values,
+        m, m/s, rad/s, world frame). ``set_body_state_vector`` puts it back bit for bit.
+        Motors, servos and persistent forces are not in it: they stay as they are."""
+        scene = self._scene
+        ptrs = [o.body.ptr for o in scene.objects.values() if o.body is not None]
+        return np.concatenate(([float(scene.c.rand_seed)], bodies.read_states(ptrs).ravel()))
+
+    @_changes_state
+    def set_body_state_vector(self, vector: Sequence[float]) -> None:
+        """Puts back a vector read by ``body_state_vector`` (the same objects), bit for bit:
+        stepping on from it gives the results stepping on from when it was read gave."""
+        scene = self._scene
+        ptrs = [o.body.ptr for o in scene.objects.values() if o.body is not None]
+        vector = np.asarray(vector, dtype=np.float64)
+        size = 1 + len(ptrs) * bodies.BODY_STATE_SIZE
+        if vector.shape != (size,) or not np.all(np.isfinite(vector)):
+            raise InvalidArgument(f"a body state vector of this world has {size} finite "
+                                  f"values (1 + {bodies.BODY_STATE_SIZE} per body); got "
+                                  f"shape {vector.shape}")
+        seed = vector[0]
+        if seed != int(seed) or not 0 <= seed < 2 ** 32:
+            raise InvalidArgument(f"random generator state {seed!r} is not a 32-bit integer")
+        bodies.write_states(ptrs, vector[1:].reshape(len(ptrs), bodies.BODY_STATE_SIZE))
+        scene.c.clear_records()
+        scene.carried = {}
+        scene.c.rand_seed = int(seed)
+
+    @_locked
     def reset(self) -> None:
         """Back to the state right after the last build or removal (of an object, joint or
         motor): the poses, velocities, parameters, goals, forces and simulated time the world

@@ -1,0 +1,176 @@
+"""Back ends of the planning bridge: where propagations run (ROS-free here).
+
+A ``Backend`` propagates a batch of requests, each (state, control): put the world in the
+state (``Core.body_state_vector``'s layout), apply the control for one propagation step as a
+control path row (``gui.core.control_path.actuation``: for a free body, the force that would
+carry the base to the control's position in the step), step, and answer the state reached,
+the robot base's position and velocity, and the pairs that collided on the way. A planner's
+propagation of a control for n steps is n such calls in a row, exactly as ``run_path`` runs
+the n rows of the control path it becomes (one kept Propagate per row), so that the written
+plan replays bit for bit in a fresh world.
+
+``CoreBackend``: the VirtualWorld's Core in this process, built from the problem's plan
+(fastest: no messages).
+"""
+from __future__ import annotations
+
+from typing import List, NamedTuple, Protocol, Sequence, Tuple
+
+import numpy as np
+
+from gui.core.build import BuildPlan, BuiltIds
+from gui.core.control_path import ControlRow, ServoCommand, actuation
+from gui.planning.problem import PlanningProblem
+from odin_common.interface import ForceKind
+from odin_common.step_values import StepValues
+
+
+class Outcome(NamedTuple):
+    """After one propagation step: ``state`` the world's body state vector; ``position`` (3,) m
+    and ``velocity`` (3,) m/s of the robot's base (world frame); ``collisions``: the pairs
+    (names) that collided during the step."""
+    state: np.ndarray
+    position: np.ndarray
+    velocity: np.ndarray
+    collisions: Tuple[Tuple[str, str], ...]
+
+
+class Backend(Protocol):
+    """Where propagations run; every back end answers the same outcomes for the same
+    requests (the worlds are deterministic)."""
+    problem: PlanningProblem
+
+    def start_state(self) -> np.ndarray:
+        """The body state vector of the world as the problem built it."""
+
+    def base_state(self, state: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+        """The robot base's position (3,) m and velocity (3,) m/s in a body state vector."""
+
+    def propagate(self, requests: Sequence[Tuple[np.ndarray, Sequence[float]]]
+                  ) -> List[Outcome]:
+        """One propagation step per (state vector, control in [0, 1]^k); outcomes in order."""
+
+    def close(self) -> None: ...
+
+
+class CoreWorld:
+    """A VirtualWorld Core behind the WorldClient methods a build plan calls (``execute``
+    sends the whole plan), and ``step_values``, the Set Step values in force."""
+
+    def __init__(self):
+        from virtual_world.core import Core
+        self.core = Core()
+        self.step_values = StepValues()
+
+    def close(self) -> None:
+        self.core.close()
+
+    def set_world(self, **changes):
+        return self.core.set_world_parameters(**changes)
+
+    def set_step(self, step=None, steps_per_cycle=None, cycle_time=None, rate=None):
+        self.step_values = StepValues(step, steps_per_cycle, rate)
+        return self.step_values
+
+    def build_entity(self, spec):
+        return self.core.build_entity(spec)
+
+    def build_object(self, spec) -> str:
+        return self.core.build_object(spec).id
+
+    def build_composite(self, spec) -> str:
+        return self.core.build_composite(spec).id
+
+    def add_joint(self, spec) -> str:
+        return self.core.add_joint(spec)
+
+    def add_motor(self, spec) -> str:
+        return self.core.add_motor(spec)
+
+    def set_joint_parameters(self, joint_id, parameters) -> None:
+        self.core.set_joint_parameters(joint_id, parameters)
+
+    def execute(self, plan: BuildPlan) -> dict:
+        ids = BuiltIds()
+        for step in plan.steps:
+            step.send(self, ids)
+        plan.record_world_ids(ids)
+        return ids.as_dict()
+
+
+class CorePort:
+    """gui.core.control_path.ControlPort over a CoreWorld: each row one kept propagation, as
+    ``run_path``'s ClientPort runs it on a world node."""
+
+    def __init__(self, world: CoreWorld):
+        self.world = world
+
+    def body_state(self, body_id: str):
+        position, quaternion, linear, _ = self.world.core.body_state(body_id)
+        return np.asarray(position), np.asarray(quaternion), np.asarray(linear)
+
+    def set_servo(self, command: ServoCommand) -> None:
+        core = self.world.core
+        servos = {m: {} for m in command.motors}
+        for name in ("targets", "rates", "gains", "max_speeds", "max_forces"):
+            values = getattr(command, name)
+            if name == "targets" or len(values):
+                for motor, split in core.split_per_axis(list(command.motors), list(values),
+                                                        name).items():
+                    servos[motor][name] = split
+        core.set_servos(servos)
+
+    def advance(self, duration: float, forces):
+        return self.world.core.propagate(duration, self.world.step_values.step,
+                                         body_forces=force_requests(forces), keep=True)
+
+
+def force_requests(forces) -> list:
+    """An actuation's forces as Propagate's body forces (keyword arguments of add_body_force)."""
+    return [dict(object_id=body, kind=ForceKind.FORCE, vector=tuple(vector))
+            for body, vector in forces]
+
+
+class CoreBackend:
+    """The problem's world built in a Core of this process; propagations one after another."""
+
+    def __init__(self, plan: BuildPlan, problem: PlanningProblem):
+        self.problem = problem
+        self.world = CoreWorld()
+        try:
+            self.world.execute(plan)
+            self._start = self.world.core.body_state_vector()
+        except Exception:
+            self.world.close()
+            raise
+        self.port = CorePort(self.world)
+        self.propagations = 0
+
+    def start_state(self) -> np.ndarray:
+        return self._start.copy()
+
+    def base_state(self, state):
+        self.world.core.set_body_state_vector(state)
+        position, _, linear, _ = self.world.core.body_state(self.problem.base_body)
+        return np.asarray(position), np.asarray(linear)
+
+    def propagate(self, requests):
+        return [self._one(state, control) for state, control in requests]
+
+    def _one(self, state, control) -> Outcome:
+        core, problem = self.world.core, self.problem
+        core.set_body_state_vector(state)
+        base = self.port.body_state(problem.base_body)
+        act = actuation(problem.handle, ControlRow(tuple(control), problem.step), base)
+        result = core.propagate(problem.step, self.world.step_values.step,
+                                body_forces=force_requests(act.forces), keep=True)
+        self.propagations += 1
+        position, _, linear, _ = core.body_state(problem.base_body)
+        return Outcome(core.body_state_vector(), np.asarray(position), np.asarray(linear),
+                       tuple((c.first, c.second) for c in result.collisions))
+
+    def close(self) -> None:
+        self.world.close()
+
+
+__all__ = ["Outcome", "Backend", "CoreWorld", "CorePort", "CoreBackend", "force_requests"]

@@ -1,0 +1,288 @@
+"""OMPL's control planners over an Odin back end (ROS-free; OMPL 2 from PyPI).
+
+The OMPL problem (``gui.planning.problem`` says what each part means):
+- state space: a compound of the robot base's position and velocity (6 values: x, y, z m,
+  vx, vy, vz m/s, world frame; bounds from the problem's limits and ``max_speed``; weight 1:
+  planners measure distances and cells here) and the whole world's body state vector
+  (``Core.body_state_vector``, weight 0: carried, never measured) with one value appended,
+  1 when the step into the state touched an obstacle the robot must not;
+- control space: [0, 1]^k, the robot's `.cntr` controls (those searched); a control lasts ``min_control_steps``
+  to ``max_control_steps`` propagation steps of ``step`` s;
+- propagator: the back end's (restore, apply the row, step, read);
+- validity: the base in bounds and no forbidden contact on the way in;
+- goal region: the base within ``goal_tolerance`` of the query's goal, in the plane;
+- projection (KPIECE1's grid): the base's x and y, cells of a quarter of the goal region.
+
+``plan(backend, planner, time_limit, seed)`` solves and answers a ``PlanResult`` whose
+``rows`` are the control path (one row per propagation step). The planner classes the wheel's
+bindings construct are in ``PLANNERS``; OMPL 2.0.1's wheel defines no constructor for SST and
+PDST (``UNCONSTRUCTIBLE``).
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from typing import List, Optional, Tuple
+
+import numpy as np
+
+from gui.core.control_path import ControlRow
+from gui.errors import PlanningError
+
+PLANNERS = ("KPIECE1", "RRT", "EST")
+"""Control planners of OMPL's Python wheel that construct from a SpaceInformation."""
+UNCONSTRUCTIBLE = ("SST", "PDST")
+"""Control planners the wheel names but cannot construct ("no constructor defined")."""
+
+ROBOT_VALUES = 6
+"""The robot component: base position (3, m) then velocity (3, m/s), world frame."""
+WORLD_BOUND = 1e10
+"""The world component's bounds: its values are never sampled for use, only carried (ODE's
+random generator state, below 2^32, is its largest value)."""
+
+
+@dataclass(frozen=True)
+class PlanResult:
+    """What a search found. ``solved``: an exact solution (the base in the goal region);
+    ``rows``: the control path (the best approximate one when not solved; empty when the
+    planner found nothing); ``final_position`` (3,) m, world: where the base ends when the
+    rows are run from the start in the back end's world; ``goal_distance``: m, in the plane;
+    ``propagations``: propagation steps the search ran; ``time_s``: wall-clock seconds of the
+    search; ``status``: OMPL's planner status."""
+    planner: str
+    seed: Optional[int]
+    solved: bool
+    status: str
+    rows: Tuple[ControlRow, ...]
+    final_position: np.ndarray
+    goal_distance: float
+    propagations: int
+    time_s: float
+
+    @property
+    def duration(self) -> float:
+        """s, simulated: the plan's length."""
+        return sum(row.duration for row in self.rows)
+
+    def statistics(self) -> dict:
+        return {"planner": self.planner, "seed": self.seed, "solved": self.solved,
+                "status": self.status, "time_s": round(self.time_s, 3),
+                "propagations": self.propagations,
+                "propagations_per_s": round(self.propagations / self.time_s, 1)
+                if self.time_s > 0 else None,
+                "rows": len(self.rows), "plan_duration_s": round(self.duration, 4),
+                "final_position_m": [round(float(v), 4) for v in self.final_position],
+                "goal_distance_m": round(self.goal_distance, 4)}
+
+
+def _ompl():
+    try:
+        from ompl import base as ob, control as oc, util as ou
+    except ImportError as error:
+        raise PlanningError(f"OMPL's Python bindings are missing ({error}): tools/install.sh "
+                            "installs the pinned wheel (tools/requirements.txt)") from None
+    return ob, oc, ou
+
+
+class _Callbacks:
+    """The propagator and validity checker OMPL calls. They hold the back end and the
+    problem, never the OMPL objects: a reference from a callback back to the SpaceInformation
+    holding it would be a cycle through C++ that Python's collector cannot see."""
+
+    def __init__(self, backend, world_size: int):
+        self.backend = backend
+        self.problem = backend.problem
+        self.world_size = world_size
+        self.error: Optional[BaseException] = None
+
+    # -- state <-> vectors ---------------------------------------------------------------------
+    def _vector(self, state) -> np.ndarray:
+        world = state[1]
+        return np.fromiter((world[i] for i in range(self.world_size - 1)), float,
+                           self.world_size - 1)
+
+    def write(self, state, vector: np.ndarray, backend_outcome) -> None:
+        robot, world = state[0], state[1]
+        if backend_outcome is None:
+            position, velocity = self.backend.base_state(vector)
+            flag = 0.0
+        else:
+            position, velocity = backend_outcome.position, backend_outcome.velocity
+            flag = 1.0 if self.problem.forbidden_contacts(backend_outcome.collisions) else 0.0
+        for i in range(3):
+            robot[i] = float(position[i])
+            robot[3 + i] = float(velocity[i])
+        for i, v in enumerate(vector.tolist()):
+            world[i] = v
+        world[self.world_size - 1] = flag
+
+    # -- OMPL's callbacks (an exception must not cross into C++: kept and re-raised) -----------
+    def propagate(self, start, control, duration, result) -> None:
+        try:
+            steps = max(1, round(duration / self.problem.step))
+            values = self.problem.controls(
+                [control[i] for i in range(len(self.problem.searched))])
+            vector = self._vector(start)
+            outcome = None
+            for _ in range(steps):
+                outcome = self.backend.propagate([(vector, values)])[0]
+                vector = outcome.state
+            self.write(result, vector, outcome)
+        except BaseException as error:      # noqa: B902 - handed back to plan()
+            self.error = self.error or error
+            self.write(result, self._vector(start), None)
+            result[1][self.world_size - 1] = 1.0   # invalid: the search stops using it
+
+    def valid(self, state) -> bool:
+        robot = state[0]
+        position = [robot[0], robot[1], robot[2]]
+        velocity = [robot[3], robot[4], robot[5]]
+        return state[1][self.world_size - 1] == 0.0 and self.problem.in_bounds(position,
+                                                                                velocity)
+
+
+class _Setup:
+    """The OMPL objects of one search, kept together (OMPL holds raw pointers between them)."""
+
+    def __init__(self, backend, planner: str):
+        ob, oc, ou = _ompl()
+        ou.setLogLevel(ou.LOG_WARN)
+        problem = backend.problem
+        settings = problem.settings
+        self.backend = backend
+        self.problem = problem
+        self.start = backend.start_state()
+        self.world_size = self.start.size + 1            # + the forbidden-contact flag
+        self.robot_space = ob.RealVectorStateSpace(ROBOT_VALUES)
+        bounds = ob.RealVectorBounds(ROBOT_VALUES)
+        for axis in range(3):
+            bounds.setLow(axis, float(problem.base_bounds[axis, 0]))
+            bounds.setHigh(axis, float(problem.base_bounds[axis, 1]))
+            bounds.setLow(3 + axis, -settings.max_speed)
+            bounds.setHigh(3 + axis, settings.max_speed)
+        self.robot_space.setBounds(bounds)
+        cell = settings.goal_tolerance / 2
+        self.robot_space.registerDefaultProjection(
+            ob.RealVectorOrthogonalProjectionEvaluator(self.robot_space, [cell, cell], [0, 1]))
+        self.world_space = ob.RealVectorStateSpace(self.world_size)
+        wide = ob.RealVectorBounds(self.world_size)
+        wide.setLow(-WORLD_BOUND)
+        wide.setHigh(WORLD_BOUND)
+        self.world_space.setBounds(wide)
+        self.space = ob.CompoundStateSpace([self.robot_space, self.world_space], [1.0, 0.0])
+        self.space.registerDefaultProjection(ob.SubspaceProjectionEvaluator(self.space, 0))
+        searched = len(problem.searched)
+        self.control_space = oc.RealVectorControlSpace(self.space, searched)
+        unit = ob.RealVectorBounds(searched)
+        unit.setLow(0.0)
+        unit.setHigh(1.0)
+        self.control_space.setBounds(unit)
+        self.si = oc.SpaceInformation(self.space, self.control_space)
+        self.si.setPropagationStepSize(problem.step)
+        self.si.setMinMaxControlDuration(settings.min_control_steps,
+                                         settings.max_control_steps)
+        self.callbacks = _Callbacks(backend, self.world_size)
+        self.si.setStatePropagator(self.callbacks.propagate)
+        self.si.setStateValidityChecker(self.callbacks.valid)
+        self.si.setup()
+        self.goal = _goal_region(ob, self.si, problem)
+        self.setup = oc.SimpleSetup(self.si)
+        start = self.si.allocState()
+        self.callbacks.write(start, self.start, backend_outcome=None)
+        self.setup.setStartState(start)
+        self.setup.setGoal(self.goal)
+        self.planner = _planner(oc, self.si, planner, settings.goal_bias)
+        self.setup.setPlanner(self.planner)
+
+def _goal_region(ob, si, problem):
+    class GoalXY(ob.GoalRegion):
+        """The query's goal: the base within the tolerance, in the plane."""
+
+        def __init__(self, si, problem):
+            super().__init__(si)
+            self.problem = problem
+            self.setThreshold(problem.settings.goal_tolerance)
+
+        def distanceGoal(self, state) -> float:
+            robot = state[0]
+            return self.problem.goal_distance((robot[0], robot[1]))
+
+    return GoalXY(si, problem)
+
+
+def _planner(oc, si, name: str, goal_bias: float):
+    if name in UNCONSTRUCTIBLE:
+        raise PlanningError(f"planner {name}: OMPL's Python wheel defines no constructor for "
+                            f"it; use one of {', '.join(PLANNERS)}")
+    if name not in PLANNERS:
+        raise PlanningError(f"unknown planner {name!r}: one of {', '.join(PLANNERS)}")
+    planner = getattr(oc, name)(si)
+    if hasattr(planner, "setGoalBias"):
+        planner.setGoalBias(goal_bias)
+    return planner
+
+
+def seed_ompl(seed: int) -> None:
+    """Seeds OMPL's random generators; effective for a process's first search only (OMPL
+    seeds each generator from one master it makes once)."""
+    _, _, ou = _ompl()
+    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 < seed < 2 ** 32:
+        raise PlanningError(f"seed {seed!r} must be an integer in [1, 2^32)")
+    ou.RNG.setSeed(seed)
+
+
+def plan(backend, planner: str = "KPIECE1", time_limit: float = 10.0,
+         seed: Optional[int] = None) -> PlanResult:
+    """Searches ``backend.problem`` with ``planner`` for at most ``time_limit`` s of wall
+    clock (``seed``: OMPL's seed, see ``seed_ompl``)."""
+    if not (math.isfinite(time_limit) and time_limit > 0):
+        raise PlanningError(f"time {time_limit!r} s must be positive")
+    if seed is not None:
+        seed_ompl(seed)
+    setup = _Setup(backend, planner)
+    before = _propagations(backend)
+    started = time.perf_counter()
+    status = setup.setup.solve(time_limit)
+    elapsed = time.perf_counter() - started
+    propagations = _propagations(backend) - before
+    if setup.callbacks.error is not None:
+        error = setup.callbacks.error
+        raise PlanningError(f"propagation failed: {error}") from error
+    rows: List[ControlRow] = []
+    if setup.setup.haveSolutionPath():
+        rows = _rows(setup.setup.getSolutionPath(), setup.problem)
+    final = replay(backend, rows)
+    distance = backend.problem.goal_distance(final)
+    return PlanResult(planner, seed, bool(setup.setup.haveExactSolutionPath()
+                                          and backend.problem.in_goal(final)),
+                      str(status), tuple(rows), final, distance, propagations, elapsed)
+
+
+def _rows(path, problem) -> List[ControlRow]:
+    rows = []
+    for k in range(path.getControlCount()):
+        control = path.getControl(k)
+        values = problem.controls([control[i] for i in range(len(problem.searched))])
+        steps = max(1, round(path.getControlDuration(k) / problem.step))
+        rows += [ControlRow(values, problem.step)] * steps
+    return rows
+
+
+def replay(backend, rows) -> np.ndarray:
+    """(3,) m: where the base ends when ``rows`` run from the start state in the back end."""
+    vector = backend.start_state()
+    position = None
+    for row in rows:
+        outcome = backend.propagate([(vector, row.controls)])[0]
+        vector, position = outcome.state, outcome.position
+    if position is None:
+        position = backend.base_state(vector)[0]
+    return np.asarray(position)
+
+
+def _propagations(backend) -> int:
+    return int(getattr(backend, "propagations", 0))
+
+
+__all__ = ["PLANNERS", "UNCONSTRUCTIBLE", "PlanResult", "plan", "replay", "seed_ompl"]
