@@ -6,6 +6,8 @@ Figures:
                                    (goal 0); also ..._median_ms and ..._p99_ms latencies.
   portal_publish_1000_cpu          share of one core the paused node spends over 10 s with
                                    1,000 objects published at 25 Hz to a subscriber (goal <= 0.1).
+  portal_publish_10000_cpu         the same with 10,000 objects (goal <= 0.25); rss_mb_10000 the
+                                   node's resident memory meanwhile (reported).
   portal_rtf_spheres100            real-time factor of the 100-sphere scene of bench_core run
                                    back to back (~free_run), divided by the native C program's
                                    steps per second times the step size, measured alternately
@@ -18,10 +20,12 @@ every round (measured so on 2026-11-22), else refused (report.Refused) with the 
 """
 from __future__ import annotations
 
+import math
 import multiprocessing
 import os
 import pathlib
 import statistics
+import struct
 import subprocess
 import sys
 import time
@@ -144,32 +148,54 @@ def calls_under_load() -> dict:
 
 
 # -- publication cost ------------------------------------------------------------------------
-def publish_1000_cpu() -> dict:
+def _rss_mb(pid: int) -> float:
+    for line in pathlib.Path(f"/proc/{pid}/status").read_text().splitlines():
+        if line.startswith("VmRSS:"):
+            return int(line.split()[1]) / 1024.0
+    raise RuntimeError(f"no VmRSS for process {pid}")
+
+
+def _situations(buff: bytes) -> int:
+    """The number of situations of a serialised SpaceDistribution (after its Header)."""
+    frame_length = struct.unpack_from("<I", buff, 12)[0]
+    return struct.unpack_from("<I", buff, 16 + frame_length)[0]
+
+
+def publish_cpu(count: int) -> dict:
+    """The paused node publishing ``count`` static boxes (a grid 0.2 m apart) at 25 Hz to one
+    subscriber: its share of a core over CPU_WINDOW, the updates received per second, and its
+    resident memory (MB) with them built."""
     with RosMaster() as master:
         master.apply_to_this_process()
         node = _start_world(master)
         import rospy
-        from Messages.msg import SpaceDistribution
         from world_client import WorldClient, box
         rospy.init_node("bench_portal", anonymous=True, disable_signals=True)
         client = WorldClient()
+        side = math.ceil(math.sqrt(count))
         client.ok("build_entity", name="crowd", objects=[
-            box(f"b{i}", (0.1, 0.1, 0.1), (i % 40 * 0.2, i // 40 * 0.2, 0.05),
-                geometry_only=True) for i in range(1000)])
+            box(f"b{i}", (0.1, 0.1, 0.1), (i % side * 0.2, i // side * 0.2, 0.05),
+                geometry_only=True) for i in range(count)])
+        # raw bytes (AnyMsg): deserialising 10,000 situations in Python would make the
+        # subscriber, not the node, set the rate
         received = []
-        subscriber = rospy.Subscriber("/virtual_world/world_update", SpaceDistribution,
-                                      lambda m: received.append(len(m.situations)))
+        subscriber = rospy.Subscriber("/virtual_world/world_update", rospy.AnyMsg,
+                                      lambda m: received.append(_situations(m._buff)))
         time.sleep(2.0)
         pid = _node_pid(master, node)
         cpu0, wall0, count0 = _cpu_seconds(pid), time.monotonic(), len(received)
         time.sleep(CPU_WINDOW)
         cpu1, wall1, count1 = _cpu_seconds(pid), time.monotonic(), len(received)
+        rss = _rss_mb(pid)
         subscriber.unregister()
         client.close()
     rate = (count1 - count0) / (wall1 - wall0)
-    print(f"  received {rate:.1f} updates/s of {received[-1]} situations")
-    return {"portal_publish_1000_cpu": (cpu1 - cpu0) / (wall1 - wall0),
-            "portal_publish_1000_rate_hz": rate}
+    print(f"  received {rate:.1f} updates/s of {received[-1]} situations, node {rss:.0f} MB")
+    figures = {f"portal_publish_{count}_cpu": (cpu1 - cpu0) / (wall1 - wall0),
+               f"portal_publish_{count}_rate_hz": rate}
+    if count == 10_000:
+        figures["rss_mb_10000"] = rss
+    return figures
 
 
 # -- real-time factor against native C ----------------------------------------------------------
@@ -263,7 +289,8 @@ def rtf_spheres100(out_dir: pathlib.Path) -> dict:
 
 def run(out_dir: pathlib.Path) -> dict:
     figures = {}
-    figures.update(in_child(publish_1000_cpu))
+    figures.update(in_child(publish_cpu, 1000))
+    figures.update(in_child(publish_cpu, 10_000))
     figures.update(in_child(rtf_spheres100, out_dir))
     figures.update(in_child(calls_under_load))
     return figures

@@ -16,6 +16,10 @@ import pytest
 from virtual_world.core import Core, FORCE, ObjectSpec, WorldParameters
 
 G = 9.81
+# Coulomb's law within 0.2 %: the default auto solver takes a box on the ground (a dozen
+# constraint rows) to dWorldStep, whose friction at mu = 1 reads 0.12 % weaker than mu m g
+# (QuickStep's within 0.1 %)
+FRICTION_REL = 2e-3
 
 
 def world(**parameters):
@@ -75,7 +79,7 @@ def test_a_sliding_box_decelerates_at_mu_g_and_stops_at_v0_squared_over_2_mu_g(m
         # while it slides, v(t) = v0 - mu g t: a straight line of slope -mu g
         sliding = speeds > 0.1 * v0
         slope, intercept = np.polyfit(times[sliding], speeds[sliding], 1)
-        assert slope == pytest.approx(-mu * G, rel=1e-3)
+        assert slope == pytest.approx(-mu * G, rel=FRICTION_REL)
         assert intercept == pytest.approx(v0, rel=1e-3)
         # it stops after v0 / (mu g), at v0^2 / (2 mu g). Semi-implicit Euler moves with the
         # velocity at the end of each step, so it covers v0 h / 2 less than the integral:
@@ -114,7 +118,7 @@ def test_infinite_friction_holds_a_box_a_push_of_2_m_g_would_slide(friction, sli
         core.step(H, round(t / H))
         position, _, velocity, spin = core.body_state("slab")
         if slides:
-            assert velocity[0] == pytest.approx(G * t, rel=1e-3)
+            assert velocity[0] == pytest.approx(G * t, rel=FRICTION_REL)
             assert position[0] - start[0] == pytest.approx(G * t * t / 2, rel=1e-2)
         else:
             assert np.linalg.norm(position - start) < 1e-3

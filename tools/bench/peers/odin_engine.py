@@ -1,5 +1,6 @@
-"""The peers' scenes (scenes.py) in Odin's Core, with its defaults (QuickStep, 20 iterations,
-sweep and prune, 3 contacts a pair, mu 1): the plane a static PLANE geometry, the spheres
+"""The peers' scenes (scenes.py) in Odin's Core, with its defaults (the auto solver: dWorldStep
+on the arm's and the grasp's few constraint rows, QuickStep of 20 iterations on the spheres'
+many; sweep and prune, 3 contacts a pair, mu 1): the plane a static PLANE geometry, the spheres
 objects, the arm's links capsules on hinges held by servos (Set Servo: position targets,
 motors of MOTOR_MAX_TORQUE), the fingers boxes on sliders squeezing with FINGER_FORCE."""
 from __future__ import annotations
@@ -8,7 +9,7 @@ import math
 
 import scenes
 from measure import rotate
-from odin_common.interface import JointType, MotorKind, Shape
+from odin_common.interface import JointType, MotorKind, Shape, Solver
 from virtual_world.core import Core, ObjectSpec
 
 #: the capsule's z turned onto x: (w, x, y, z), a quarter turn about y
@@ -19,8 +20,8 @@ class Sim:
     def __init__(self, scene: str):
         self.core = Core()
         self.bodies = 0
-        self.settings = {"solver": "QuickStep", "iterations":
-                         self.core.world_parameters.quickstep_iterations}
+        self.settings = {"solver": Solver(self.core.world_parameters.solver).name,
+                         "iterations": self.core.world_parameters.quickstep_iterations}
         if scene.startswith(("spheres", "pile", "rest")):
             self._spheres(scene)
         else:

@@ -82,6 +82,15 @@ class Solver(IntEnum):
     """Services/SetWorld ``solver``."""
     QUICKSTEP = 0        # dWorldQuickStep: iterative, handles piles
     WORLDSTEP = 1        # dWorldStep: the thesis's exact "big matrix" solver
+    AUTO = 2             # per step: dWorldStep while the constraint rows to solve are at most
+    #                      AUTO_SOLVER_MAX_ROWS (an arm held by its motors: exact and faster),
+    #                      QuickStep above (piles, many contacts); the default
+
+
+AUTO_SOLVER_MAX_ROWS = 120
+"""Solver.AUTO's bound: the most constraint rows (counted per joint at most: 6 for a hinge,
+slider or fixed joint, 3 for a contact, ball or motor) a step may have to be solved by
+dWorldStep; measured in docs/PERFORMANCE.md (where dWorldStep stops being the faster)."""
 
 
 # ---------------------------------------------------------------------------------- joints
@@ -385,7 +394,7 @@ class NodeParameter(NamedTuple):
 
 
 __all__ = ["NodeParameter", "SERVO_GAIN", "SERVO_MAX_SPEED", "JointType", "JointParameter", "SetJointAction", "MotorKind", "AxisFrame",
-           "ForceKind", "Solver", "JOINT_AXES_USED", "JOINT_USES_ANCHOR",
+           "ForceKind", "Solver", "AUTO_SOLVER_MAX_ROWS", "JOINT_AXES_USED", "JOINT_USES_ANCHOR",
            "JOINT_NEEDS_TWO_BODIES", "JOINT_AXIS2_ON_BODY2", "JOINT_FORCE_MAGNITUDES", "JOINT_STATE_AXES", "JOINT_PARAMETERS",
            "JOINT_PARAMETER_AXES", "MOTOR_PARAMETERS", "UNIT_PARAMETERS",
            "NON_NEGATIVE_PARAMETERS", "joint_type", "default_joint_id", "MOTOR_PREFIX", "default_motor_id", "motor_joint",

@@ -71,7 +71,9 @@ PARAMETERS: Tuple[ParameterInfo, ...] = (
                   "set_bounce", 0),
     ParameterInfo("solver", "int", "-",
                   "0 QuickStep (iterative, handles piles), 1 dWorldStep (the thesis's exact "
-                  "solver, cubic in the constraints)", "set_solver", 0, 1),
+                  "solver, cubic in the constraints), 2 auto (each step: dWorldStep while its "
+                  "constraint rows are at most odin_common.interface.AUTO_SOLVER_MAX_ROWS, "
+                  "QuickStep above)", "set_solver", 0, 2),
     ParameterInfo("quickstep_iterations", "int", "-", "iterations of QuickStep", "set_solver",
                   1, 100000),
     ParameterInfo("contact_less", "bool", "-",
@@ -122,7 +124,7 @@ class WorldParameters:
     friction: float = 1.0
     bounce: float = 0.0
     bounce_velocity: float = 0.1
-    solver: int = Solver.QUICKSTEP
+    solver: int = Solver.AUTO
     quickstep_iterations: int = 20
     contact_less: bool = False
     collision_mesh_tolerance: float = 0.0

@@ -46,9 +46,10 @@ SCALARS = {
          "afterwards)", 4, 0.001, None),
     ],
 }
-SOLVER_NAMES = {Solver.QUICKSTEP: "QuickStep", Solver.WORLDSTEP: "WorldStep"}
+SOLVER_NAMES = {Solver.QUICKSTEP: "QuickStep", Solver.WORLDSTEP: "WorldStep", Solver.AUTO: "Auto"}
 SOLVER_ITEMS = {Solver.QUICKSTEP: "QuickStep (iterative, handles piles)",
-                Solver.WORLDSTEP: "WorldStep (exact, the thesis's)"}
+                Solver.WORLDSTEP: "WorldStep (exact, the thesis's)",
+                Solver.AUTO: "Auto (WorldStep on few constraints, else QuickStep)"}
 
 
 def _unit(name: str) -> str:

@@ -32,7 +32,7 @@ BALL, HINGE, SLIDER, PISTON, UNIVERSAL, HINGE2, PR, PU, FIXED, PLANE2D = JointTy
  FUDGE_FACTOR, VELOCITY, MAX_FORCE) = JointParameter
 ANGULAR, LINEAR = MotorKind
 FORCE, TORQUE = ForceKind
-QUICKSTEP, WORLDSTEP = Solver
+QUICKSTEP, WORLDSTEP, AUTO_SOLVER = Solver
 
 __all__ = ["Core", "ObjectSpec", "PartSpec", "CompositeSpec", "EntitySpec", "JointSpec",
            "MotorSpec", "Built", "BuiltEntity", "BuiltGeometry", "Removed", "JointState",
@@ -41,4 +41,5 @@ __all__ = ["Core", "ObjectSpec", "PartSpec", "CompositeSpec", "EntitySpec", "Joi
            "BALL", "HINGE", "SLIDER", "PISTON", "UNIVERSAL", "HINGE2", "PR", "PU", "FIXED",
            "PLANE2D", "LO_STOP", "HI_STOP", "BOUNCE", "CFM", "ERP", "STOP_ERP", "STOP_CFM",
            "SUSPENSION_ERP", "SUSPENSION_CFM", "FUDGE_FACTOR", "VELOCITY", "MAX_FORCE",
-           "ANGULAR", "LINEAR", "FORCE", "TORQUE", "QUICKSTEP", "WORLDSTEP"]
+           "ANGULAR", "LINEAR", "FORCE", "TORQUE", "QUICKSTEP", "WORLDSTEP",
+           "AUTO_SOLVER"]

@@ -21,7 +21,7 @@ from typing import Dict, List, Mapping, Optional, Sequence, Tuple
 
 import numpy as np
 
-from odin_common.interface import ForceKind, JointType, MotorKind
+from odin_common.interface import ForceKind, JointType, MotorKind, Solver
 from odin_common.limits import ResourceLimits
 from odin_common.specs import CompositeSpec, EntitySpec, JointSpec, MotorSpec, ObjectSpec
 from odin_common.world_parameters import WorldParameters
@@ -585,6 +585,11 @@ class Core:
     def last_step_contacts(self) -> int:
         """Contact joints created in the last step."""
         return self._scene.c.last_step_contacts
+
+    @property
+    def last_step_solver(self) -> Solver:
+        """The solver the last step used: QUICKSTEP or WORLDSTEP (the auto solver's choice)."""
+        return Solver(self._scene.c.last_solver)
 
     @_locked
     def poses(self) -> Tuple[List[str], np.ndarray, np.ndarray]:

@@ -502,6 +502,47 @@ void odin_world_clear_divergences(OdinWorld *w) { w->n_diverged = 0; }
 
 /* ---------------------------------------------------------------- step (thesis 5.5) */
 
+/* The rows a joint adds to ODE's constraint system at most (its getInfo1's m with a limit or
+ * motor active): the auto solver's measure of the work a step asks for. */
+static int joint_rows(dJointID j) {
+    switch (dJointGetType(j)) {
+    case dJointTypeContact: case dJointTypeBall: case dJointTypePlane2D:
+    case dJointTypeAMotor: case dJointTypeLMotor:
+        return 3;
+    case dJointTypeDBall: case dJointTypeTransmission:
+        return 1;
+    default:                  /* hinge, slider, universal, hinge-2, fixed, PR, PU, piston... */
+        return 6;
+    }
+}
+
+/* The constraint rows of the step about to be taken, counting stops above `bound`. Each joint
+ * is counted at its first dynamic body (a parked body is kinematic, hence fixed). */
+static int constraint_rows(const OdinWorld *w, int bound) {
+    int rows = 0;
+    for (int i = 0; i < w->n_guarded; ++i) {
+        dBodyID b = w->guarded[i];
+        int n = dBodyGetNumJoints(b);
+        for (int k = 0; k < n; ++k) {
+            dJointID j = dBodyGetJoint(b, k);
+            dBodyID first = dJointGetBody(j, 0);
+            if (!first || dBodyIsKinematic(first)) first = dJointGetBody(j, 1);
+            if (first != b || !dJointIsEnabled(j)) continue;
+            if ((rows += joint_rows(j)) > bound) return rows;
+        }
+    }
+    return rows;
+}
+
+/* 0 QuickStep or 1 dWorldStep for this step. Auto chooses by the rows to solve: on a small
+ * system (an arm held by its motors) the exact solver is both exact and faster than
+ * QuickStep's iterations, which let such an arm sag; on a large one (piles, thousands of
+ * contacts) its cubic cost loses. The choice depends on the state only: deterministic. */
+static int step_solver(const OdinWorld *w) {
+    if (w->solver != 2) return w->solver;
+    return constraint_rows(w, w->auto_rows) <= w->auto_rows;
+}
+
 int odin_world_step(OdinWorld *w, double h, int count) {
     int s;
     for (s = 0; s < count; ++s) {
@@ -518,7 +559,8 @@ int odin_world_step(OdinWorld *w, double h, int count) {
         apply_body_forces(w);                         /* 2. forces and torques on bodies */
         apply_joint_forces(w);                        /* 3. joint forces and motor goals */
         apply_motor_goals(w);
-        if (w->solver == 0) {                         /* 4. step */
+        w->last_solver = step_solver(w);
+        if (w->last_solver == 0) {                    /* 4. step */
             dRandSetSeed(w->rand_seed);
             dWorldQuickStep(w->world, h);
             w->rand_seed = dRandGetSeed();

@@ -118,7 +118,10 @@ typedef struct OdinWorld {
     double bounce;           /* 0 = no dContactBounce */
     double bounce_vel;
     int contact_less;        /* 1: record pairs only, never create contacts */
-    int solver;              /* 0 QuickStep, 1 dWorldStep */
+    int solver;              /* 0 QuickStep, 1 dWorldStep, 2 auto: dWorldStep while a step's
+                                constraint rows are at most auto_rows, QuickStep above */
+    int auto_rows;           /* auto's bound (rows; joint_rows() counts them) */
+    int last_solver;         /* output: the solver the last step used (0 or 1) */
     unsigned long rand_seed; /* the world's own state of ODE's random generator, which QuickStep
                                 uses to reorder constraints: set before each QuickStep and read
                                 back after, so no other world (or process history) changes it */

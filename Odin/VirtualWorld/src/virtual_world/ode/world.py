@@ -12,6 +12,7 @@ from typing import List, Sequence, Tuple
 
 import numpy as np
 
+from odin_common.interface import AUTO_SOLVER_MAX_ROWS
 from odin_common.world_parameters import WorldParameters
 from virtual_world.ode import handles
 from virtual_world.ode.bindings import ffi, lib
@@ -59,6 +60,7 @@ class CWorld:
         s.bounce_vel = p.bounce_velocity
         s.contact_less = int(p.contact_less)
         s.solver = int(p.solver)
+        s.auto_rows = AUTO_SOLVER_MAX_ROWS
         s.max_speed = p.divergence_speed
         s.max_spin = p.divergence_angular_speed
         s.extent = p.world_extent
@@ -76,6 +78,11 @@ class CWorld:
     @rand_seed.setter
     def rand_seed(self, value: int) -> None:
         self.struct.rand_seed = value
+
+    @property
+    def last_solver(self) -> int:
+        """The solver the last step used: 0 QuickStep, 1 dWorldStep."""
+        return int(self.struct.last_solver)
 
     @property
     def step_count(self) -> int:
