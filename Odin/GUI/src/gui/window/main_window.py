@@ -64,7 +64,9 @@ class MainWindow(QMainWindow):
                            (self.objects, "Objects"), (self.motion, "Motion"),
                            (self.joints, "Joints")]:
             self.tabs.addTab(tab, title)
-        self.viewer_panel = ViewerPanel()
+        self.viewer_panel = ViewerPanel(viewer=viewer if ros else None,
+                                        frame_points=self.scene.robot_points)
+        self.viewer_panel.message.connect(self.show_error)
         self.plot = JointPlotPanel()
         self.log = QPlainTextEdit()
         self.log.setReadOnly(True)
@@ -242,6 +244,7 @@ class MainWindow(QMainWindow):
         if self.link is not None:
             self.link.close()
             self.link = None
+        self.viewer_panel.close_link()
         self.path_worker.stop()
         self.worker.stop()
 

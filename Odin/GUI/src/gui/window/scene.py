@@ -18,7 +18,7 @@ from typing import Optional
 
 from PyQt5.QtCore import QObject, pyqtSignal
 
-from odin_common.interface import JointType, motor_joint
+from odin_common.interface import COMPOSITE_MARK, JointType, is_composite_id, motor_joint
 
 JOINT_TYPE_NAMES = {
     JointType.BALL: "Ball", JointType.HINGE: "Hinge", JointType.SLIDER: "Slider",
@@ -131,6 +131,14 @@ class SceneModel(QObject):
     def pose_of(self, object_id: str) -> Optional[tuple]:
         """(position, quaternion) of an object as last reported (None for composites)."""
         return self.poses.get(object_id)
+
+    def robot_points(self) -> list:
+        """Origins (m, world frame) of the robots' links as last reported; of every object
+        when the world holds no robot (what "Frame the robot" aims at)."""
+        wanted = {o for r in self.world_robots for o in r.objects} or set(self.objects)
+        names = {part for o in wanted for part in
+                 (o.split(COMPOSITE_MARK)[1:] if is_composite_id(o) else [o])}
+        return [self.poses[n][0] for n in sorted(names) if n in self.poses]
 
     def joint_owner(self, joint_id: str) -> Optional[tuple]:
         """(robot name, the robot's own joint name) of a world joint, or None."""
