@@ -8,8 +8,9 @@ list (Set parameters). A motor can be put on the chosen joint (then driven from 
 """
 from __future__ import annotations
 
+from PyQt5.QtCore import Qt
 from PyQt5.QtWidgets import (QComboBox, QGridLayout, QGroupBox, QHBoxLayout, QLabel,
-                             QListWidget, QPushButton, QVBoxLayout, QWidget)
+                             QListWidget, QListWidgetItem, QPushButton, QVBoxLayout, QWidget)
 
 from gui.window.fields import InputError, VectorRow, checked_spin, int_spin
 from gui.window.scene import JOINT_TYPE_NAMES
@@ -137,17 +138,21 @@ class JointsTab(QWidget):
                 if current in scene.objects:
                     combo.setCurrentText(current)
                 combo.blockSignals(False)
-        elif what == "joints":
+        elif what in ("joints", "robots"):
             current = self.selected()
             self.list.clear()
-            names = sorted(scene.joints)
-            self.list.addItems(names)
-            if current in names:
-                self.list.setCurrentRow(names.index(current))
+            for row, (label, joint_id) in enumerate(scene.grouped(scene.joints,
+                                                                  scene.joint_label)):
+                item = QListWidgetItem(label if label == joint_id else f"{label}   [{joint_id}]")
+                item.setData(Qt.UserRole, joint_id)
+                self.list.addItem(item)
+                if joint_id == current:
+                    self.list.setCurrentRow(row)
 
     def selected(self):
+        """The world ID of the joint chosen in the list (None: none)."""
         item = self.list.currentItem()
-        return item.text() if item is not None else None
+        return item.data(Qt.UserRole) if item is not None else None
 
     def parameters(self) -> list:
         """(JointParameter, axis, value) of the checked parameters."""
@@ -182,7 +187,6 @@ class JointsTab(QWidget):
 
         def done(joint_id):
             self._clear_checks()
-            self.window.simulation.add_built("Joints", joint_id, joint_id)
             self.window.show_info(f"Built joint {joint_id}")
 
         self.window.call("Create Joint", lambda client, job: client.add_joint(spec), done)
@@ -212,11 +216,8 @@ class JointsTab(QWidget):
             self.window.show_error("Remove: choose a joint in the list")
             return
 
-        def done(_):
-            self.window.simulation.remove_built(joint_id)
-            self.window.show_info(f"Removed {joint_id}")
-
-        self.window.call("Remove Joint", lambda client, job: client.remove_joint(joint_id), done)
+        self.window.call("Remove Joint", lambda client, job: client.remove_joint(joint_id),
+                         lambda _: self.window.show_info(f"Removed {joint_id}"))
 
     def add_motor(self) -> None:
         joint_id = self.selected()
@@ -229,7 +230,6 @@ class JointsTab(QWidget):
 
         def done(motor_id):
             self.window.scene.add_motor(motor_id, axes)
-            self.window.simulation.add_built("Motors", motor_id, motor_id)
             self.window.show_info(f"Built motor {motor_id}")
 
         self.window.call("Add motor", lambda client, job: client.add_motor(

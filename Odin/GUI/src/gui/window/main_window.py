@@ -29,6 +29,8 @@ from odin_common.interface import VIEWER_NAMESPACE, WORLD_NAMESPACE
 
 SLOW_AFTER = 1.0        # s: a call taking longer makes the status bar say the world is slow
 SILENT_AFTER = 2.0      # s: no world_update for this long while connected: "not publishing"
+REFRESH_PERIOD = 1.0    # s: Get World again while idle (motors, forces and robots have no topic)
+READ_WORLD = "Get World"    # the label of the window's own reads (not "busy" unless slow)
 
 
 class MainWindow(QMainWindow):
@@ -48,6 +50,9 @@ class MainWindow(QMainWindow):
         self._lost_world = False          # a world was connected once and went away
         self.last_update_time = 0.0
         self.updates = 0
+        self.world_reads = 0              # Get World answers taken in
+        self._reading_world = False       # a Get World is queued or running
+        self._read_again = False          # ... and something changed since it was asked
 
         self.tabs = QTabWidget()
         self.simulation = SimulationTab(self)
@@ -59,7 +64,9 @@ class MainWindow(QMainWindow):
                            (self.objects, "Objects"), (self.motion, "Motion"),
                            (self.joints, "Joints")]:
             self.tabs.addTab(tab, title)
-        self.viewer_panel = ViewerPanel()
+        self.viewer_panel = ViewerPanel(viewer=viewer if ros else None,
+                                        frame_points=self.scene.robot_points)
+        self.viewer_panel.message.connect(self.show_error)
         self.plot = JointPlotPanel()
         self.log = QPlainTextEdit()
         self.log.setReadOnly(True)
@@ -97,6 +104,10 @@ class MainWindow(QMainWindow):
         self._health = QTimer(self)
         self._health.timeout.connect(self._check_health)
         self._health.start(250)
+        self.scene.stale.connect(self.refresh_world)
+        self._refresh = QTimer(self)
+        self._refresh.timeout.connect(self._poll_world)
+        self._refresh.start(int(REFRESH_PERIOD * 1000))
 
         self.link = None
         if ros:
@@ -114,13 +125,60 @@ class MainWindow(QMainWindow):
              on_error: Optional[Callable] = None, quiet: bool = False):
         """Runs ``fn(client, job)`` on the worker; ``on_done(result)`` in the GUI thread;
         a failure goes to ``on_error`` or to the log (``quiet``: not logged)."""
+        def finished(result) -> None:
+            self.refresh_world()
+            if on_done is not None:
+                on_done(result)
+
         def failed(message: str) -> None:
+            self.refresh_world()        # a refusal half-way may have changed the world
             if on_error is not None:
                 on_error(message)
             elif not quiet:
                 self.show_error(message)
 
-        return self.worker.submit(label, fn, on_done, failed)
+        return self.worker.submit(label, fn, finished, failed)
+
+    # -- what the world holds -----------------------------------------------------------------
+    def refresh_world(self) -> None:
+        """Asks Get World (on the worker) and shows its answer: the object tree, lists and
+        menus; one request at a time, and another after it when asked again meanwhile."""
+        if not self.connected:
+            return
+        if self._reading_world:
+            self._read_again = True
+            return
+        self._reading_world, self._read_again = True, False
+        known = set(self.scene.motors)
+
+        def read(client, job):
+            inventory = client.world()
+            new = [m for m in inventory.motors if m not in known]
+            axes = {}
+            if new:     # a motor's axes are in Get State only
+                state = client.call("get_state", motors=new)
+                axes = dict(zip(state.motors, (int(a) for a in state.motor_axes)))
+            return inventory, axes
+
+        self.worker.submit(READ_WORLD, read, self._world_read, self._world_unread)
+
+    def _world_read(self, answer) -> None:
+        inventory, axes = answer
+        self._reading_world = False
+        self.world_reads += 1
+        self.scene.on_inventory(inventory, axes)
+        self.simulation.show_world(inventory)
+        if self._read_again:
+            self.refresh_world()
+
+    def _world_unread(self, message: str) -> None:
+        self._reading_world = False
+        if self._read_again:
+            self.refresh_world()
+
+    def _poll_world(self) -> None:
+        if self.worker.current is None and self.worker.pending() == 0:
+            self.refresh_world()
 
     def show_error(self, message: str) -> None:
         text = " ".join(str(message).split())
@@ -143,6 +201,7 @@ class MainWindow(QMainWindow):
         if connected and not was:
             self.show_info(text)
             self.settings.refresh()
+            self.refresh_world()
             if self._lost_world:
                 self.simulation.offer_rebuild()
         elif was and not connected:
@@ -165,7 +224,7 @@ class MainWindow(QMainWindow):
         text = ""
         if job is not None and job.started and now - job.started > SLOW_AFTER:
             text = f"World slow: waiting for {job.label} ({now - job.started:.1f} s)"
-        elif self.worker.pending() > 0 or job is not None:
+        elif self.worker.pending() > 0 or (job is not None and job.label != READ_WORLD):
             text = f"busy: {job.label if job else ''} (+{self.worker.pending()} queued)"
         elif self.connected and self.updates and now - self.last_update_time > SILENT_AFTER:
             text = "World not publishing"
@@ -185,6 +244,7 @@ class MainWindow(QMainWindow):
         if self.link is not None:
             self.link.close()
             self.link = None
+        self.viewer_panel.close_link()
         self.path_worker.stop()
         self.worker.stop()
 

@@ -158,25 +158,28 @@ class MotionTab(QWidget):
     # -- lists ----------------------------------------------------------------------------
     @staticmethod
     def _refill(combo: QComboBox, items) -> None:
-        current = combo.currentText()
+        """``items``: IDs, or (label, ID) pairs; ``currentData()`` is the chosen ID."""
+        pairs = [i if isinstance(i, tuple) else (i, i) for i in items]
+        current = combo.currentData()
         combo.blockSignals(True)
         combo.clear()
-        combo.addItems(list(items))
-        if current in items:
-            combo.setCurrentText(current)
+        for label, item_id in pairs:
+            combo.addItem(label, item_id)
+            if item_id == current:
+                combo.setCurrentIndex(combo.count() - 1)
         combo.blockSignals(False)
 
     def _scene_changed(self, what: str) -> None:
         scene = self.window.scene
         if what == "objects":
             self._refill(self.object, scene.objects)
-        elif what == "joints":
-            self._refill(self.joint, sorted(scene.joints))
+        if what in ("joints", "robots"):    # a robot's joints and motors by its names
+            self._refill(self.joint, scene.grouped(scene.joints, scene.joint_label))
             self._joint_changed()
-        elif what == "motors":
-            self._refill(self.motor, sorted(scene.motors))
+        if what in ("motors", "robots"):
+            self._refill(self.motor, scene.grouped(scene.motors, scene.motor_label))
             self._motor_changed()
-        elif what == "forces":
+        if what == "forces":
             self.forces.clear()
             self.forces.addItems(scene.forces)
             self.joint_forces.clear()
@@ -197,7 +200,7 @@ class MotionTab(QWidget):
                                  else "Set velocity")
 
     def _joint_changed(self) -> None:
-        joint_type = self.window.scene.joints.get(self.joint.currentText())
+        joint_type = self.window.scene.joints.get(self.joint.currentData())
         magnitudes = JOINT_FORCE_MAGNITUDES.get(joint_type, ())
         count = len(magnitudes) if joint_type is not None else 3
         for k, box in enumerate(self.magnitudes.boxes):
@@ -209,13 +212,13 @@ class MotionTab(QWidget):
                 + (f" ({', '.join(magnitudes)})" if magnitudes else ""))
 
     def _motor_changed(self) -> None:
-        axes = self.window.scene.motors.get(self.motor.currentText(), 1)
+        axes = self.window.scene.motors.get(self.motor.currentData(), 1)
         for k, box in enumerate(self.motor_speeds.boxes):
             box.setEnabled(k < axes)
 
     # -- objects --------------------------------------------------------------------------
     def move_object(self) -> None:
-        object_id = self.object.currentText()
+        object_id = self.object.currentData()
         if not object_id:
             self.window.show_error("Move object: choose an object (build one first)")
             return
@@ -259,7 +262,7 @@ class MotionTab(QWidget):
 
     # -- joints ---------------------------------------------------------------------------
     def add_joint_force(self) -> None:
-        joint_id = self.joint.currentText()
+        joint_id = self.joint.currentData()
         if not joint_id:
             self.window.show_error("Move joint: choose a joint (build one first)")
             return
@@ -282,7 +285,7 @@ class MotionTab(QWidget):
 
     # -- motors ---------------------------------------------------------------------------
     def set_motor_velocity(self) -> None:
-        motor_id = self.motor.currentText()
+        motor_id = self.motor.currentData()
         if not motor_id:
             self.window.show_error("Move motor: choose a motor (load a robot or add one in "
                                    "the Joints tab)")
@@ -303,7 +306,7 @@ class MotionTab(QWidget):
         """``kind``: "initial", "velocity", "position" or "control"; runs on the path
         worker."""
         from gui.core.paths import DEGREES, RADIANS, load_robot_path, refine
-        handle = self.window.scene.robots.get(self.robot.currentText())
+        handle = self.window.scene.robots.get(self.robot.currentData())
         if handle is None:
             self.window.show_error("Move robot: open a problem with a robot first")
             return

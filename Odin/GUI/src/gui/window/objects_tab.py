@@ -5,7 +5,7 @@ parameter page comes up in a stacked widget with presets, mass (> 0), fixed or s
 position and orientation (a non-zero quaternion, normalised before sending). A mesh file is read
 on the worker: STL/OBJ/PLY through trimesh, .wrl/.iv through Coin (``gui.core.shapes.read_shape``);
 a file holding primitives too becomes a composite (``gui.core.build.shape_to_body``).
-The list below shows every object in the world (from ``world_update``).
+The list below shows every object in the world, whoever built it (Get World).
 """
 from __future__ import annotations
 
@@ -192,18 +192,13 @@ class ObjectsTab(QWidget):
         except InputError as error:
             self.window.show_error(str(error))
             return
-        scene = self.window.scene
-
         def work(client, job):
             if isinstance(request, tuple):
                 return _build_mesh(client, *request[1:])
             return client.build_object(request), None
 
         def done(result):
-            object_id, parts = result
-            if parts:
-                scene.add_composite(object_id, parts)
-            self.window.simulation.add_built("Objects", object_id, object_id)
+            object_id, _ = result
             self.window.show_info(f"Built object {object_id}")
             self.name.clear()
 
@@ -229,12 +224,9 @@ class ObjectsTab(QWidget):
             self.window.show_error("Remove: select an object in the list")
             return
 
-        def done(_):
-            self.window.simulation.remove_built(object_id)
-            self.window.show_info(f"Removed {object_id}")
-
         self.window.call("Remove Object",
-                         lambda client, job: client.remove_object(object_id), done)
+                         lambda client, job: client.remove_object(object_id),
+                         lambda _: self.window.show_info(f"Removed {object_id}"))
 
     def set_transformation(self) -> None:
         object_id = self.selected()

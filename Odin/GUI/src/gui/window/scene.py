@@ -1,11 +1,16 @@
-"""What the window knows of the scene: the objects, joints, motors, forces and robots.
+"""What the window knows of the world: its objects, joints, motors, forces and robots.
 
-The world is the authority: objects come from ``world_update`` (a composite counts as present
-while its parts are reported) and joints from ``joint_data``, so a scene changed by another
-client shows up too; motors, forces and robots are what this window built (the world has no
-topic listing them). ``SceneModel`` emits ``changed(str what)`` with ``what`` one of
-"objects", "joints", "motors", "forces", "robots" only when the set really changes, so the
-25 Hz topics cost the GUI thread a set comparison, not a list rebuild.
+The world is the authority, whoever built what it holds. Get World (``on_inventory``, a
+``gui.ros.client.WorldInventory``) gives the IDs of the objects, joints, motors and forces and
+the robots declared with Set Robot (their links and their own joint names); ``joint_data`` gives
+each joint's type and ``world_update`` the poses. The 25 Hz topics also tell when the world
+changed under the window (a geometry or a joint came or went: ``stale`` is emitted, and the
+window asks Get World again). ``SceneModel`` emits ``changed(str what)`` with ``what`` one of
+"objects", "joints", "motors", "forces", "robots" only when that set really changes, so the
+topics cost the GUI thread a set comparison, not a list rebuild.
+
+``robots`` are the kinematic handles (``gui.core.build.RobotHandle``) of the robots this window
+built (paths need them); ``world_robots`` every robot the world holds.
 """
 from __future__ import annotations
 
@@ -13,7 +18,7 @@ from typing import Optional
 
 from PyQt5.QtCore import QObject, pyqtSignal
 
-from odin_common.interface import JointType, motor_joint
+from odin_common.interface import COMPOSITE_MARK, JointType, is_composite_id, motor_joint
 
 JOINT_TYPE_NAMES = {
     JointType.BALL: "Ball", JointType.HINGE: "Hinge", JointType.SLIDER: "Slider",
@@ -27,113 +32,140 @@ odin_common.interface's joint tables)."""
 
 class SceneModel(QObject):
     changed = pyqtSignal(str)
+    stale = pyqtSignal()            # the topics show a change Get World has not told yet
 
     def __init__(self, parent=None):
         super().__init__(parent)
-        self.composites: dict = {}      # composite ID -> tuple of part names
         self.geometries: set = set()    # geometry names of the last world_update
         self.poses: dict = {}           # geometry name -> (position, quaternion wxyz)
         self.objects: list = []         # object IDs in the world, sorted
-        self.joints: dict = {}          # joint ID -> JointType value (from joint_data)
+        self.joints: dict = {}          # joint ID -> JointType value (None: type not known yet)
         self.motors: dict = {}          # motor ID -> number of axes
         self.forces: list = []          # external force / torque IDs
         self.joint_forces: list = []    # joint force IDs
-        self.robots: dict = {}          # robot name -> gui.core.build.RobotHandle
+        self.world_robots: tuple = ()   # gui.ros.client.WorldRobot of every robot declared
+        self.robots: dict = {}          # robot name -> RobotHandle, robots this window built
         self.problem_format: Optional[str] = None
+        self.inventory = None           # the last Get World answer
+        self._joint_types: dict = {}    # joint ID -> JointType value, from joint_data
+
+    # -- from Get World ----------------------------------------------------------------------
+    def on_inventory(self, inventory, motor_axes: dict) -> None:
+        """Get World's answer; ``motor_axes``: motor ID -> axes of motors not known before."""
+        self.inventory = inventory
+        self._set("objects", sorted(inventory.objects))
+        self._set("joints", {j: self._joint_types.get(j) for j in inventory.joints})
+        self._set("motors", {m: self.motors.get(m) or motor_axes.get(m, 1)
+                             for m in inventory.motors})
+        self._set("forces", (list(inventory.body_forces), list(inventory.joint_forces)))
+        robots = {r.name for r in inventory.robots}
+        handles = {name: h for name, h in self.robots.items() if name in robots}
+        if inventory.robots != self.world_robots or handles != self.robots:
+            self.world_robots = inventory.robots
+            self.robots = handles
+            if not handles:
+                self.problem_format = None
+            self.changed.emit("robots")
+
+    def _set(self, what: str, value) -> None:
+        if what == "forces":
+            if value != (self.forces, self.joint_forces):
+                self.forces, self.joint_forces = value
+                self.changed.emit(what)
+        elif value != getattr(self, what):
+            setattr(self, what, value)
+            self.changed.emit(what)
+
+    def new_motors(self, motor_ids) -> list:
+        """The motor IDs of ``motor_ids`` whose number of axes the window does not know."""
+        return [m for m in motor_ids if m not in self.motors]
 
     # -- from the world's topics -------------------------------------------------------------
     def on_world_update(self, msg) -> None:
-        names = set()
-        poses = {}
-        for s in msg.situations:
-            names.add(s.name)
-            poses[s.name] = (tuple(s.position), tuple(s.orientation))
+        poses = {s.name: (tuple(s.position), tuple(s.orientation)) for s in msg.situations}
         self.poses = poses
-        if names == self.geometries:
-            return
-        self.geometries = names
-        parts = set()
-        objects = []
-        for cid, members in self.composites.items():
-            if members and all(m in names for m in members):
-                objects.append(cid)
-                parts.update(members)
-        objects.extend(n for n in names if n not in parts)
-        objects.sort()
-        if objects != self.objects:
-            self.objects = objects
-            present = set(objects)
-            self._prune_forces(present)
-            self.changed.emit("objects")
+        if poses.keys() != self.geometries:
+            self.geometries = set(poses)
+            self.stale.emit()
 
     def on_joint_data(self, msg) -> None:
-        joints = {j.id: int(j.type) for j in msg.joints}
-        if joints != self.joints:
-            self.joints = joints
-            motors = {m: n for m, n in self.motors.items() if motor_joint(m) in joints
-                      or not motor_joint(m)}
-            stale = [f for f in self.joint_forces if f.split(":", 1)[1].rsplit(":", 1)[0]
-                     not in joints]
-            self.changed.emit("joints")
-            if motors != self.motors:
-                self.motors = motors
-                self.changed.emit("motors")
-            if stale:
-                self.joint_forces = [f for f in self.joint_forces if f not in stale]
-                self.changed.emit("forces")
+        types = {j.id: int(j.type) for j in msg.joints}
+        if types == self._joint_types:
+            return
+        self._joint_types = types
+        if set(types) != set(self.joints):
+            self.stale.emit()
+        self._set("joints", {j: types.get(j) for j in self.joints})
 
-    def _prune_forces(self, present: set) -> None:
-        kept = [f for f in self.forces if f.split(":", 1)[1].rsplit(":", 1)[0] in present]
-        if kept != self.forces:
-            self.forces = kept
-            self.changed.emit("forces")
-
-    # -- what this window built ---------------------------------------------------------------
-    def add_composite(self, cid: str, parts) -> None:
-        self.composites[cid] = tuple(parts)
-
+    # -- what this window built (shown at once; the next Get World confirms it) --------------
     def add_motor(self, motor_id: str, axes: int = 1) -> None:
-        self.motors[motor_id] = axes
-        self.changed.emit("motors")
+        self._set("motors", {**self.motors, motor_id: axes})
 
     def add_force(self, force_id: str) -> None:
-        self.forces.append(force_id)
-        self.changed.emit("forces")
-
-    def remove_force(self, force_id: str) -> None:
-        if force_id in self.forces:
-            self.forces.remove(force_id)
-        if force_id in self.joint_forces:
-            self.joint_forces.remove(force_id)
-        self.changed.emit("forces")
+        self._set("forces", (self.forces + [force_id], self.joint_forces))
 
     def add_joint_force(self, force_id: str) -> None:
-        self.joint_forces.append(force_id)
-        self.changed.emit("forces")
+        self._set("forces", (self.forces, self.joint_forces + [force_id]))
+
+    def remove_force(self, force_id: str) -> None:
+        self._set("forces", ([f for f in self.forces if f != force_id],
+                             [f for f in self.joint_forces if f != force_id]))
 
     def add_robot(self, handle, problem_format: str) -> None:
         self.robots[handle.name] = handle
         self.problem_format = problem_format
         self.changed.emit("robots")
 
-    def clear(self) -> None:
-        """New Scene: forget everything (the world's topics refill objects and joints)."""
-        self.composites.clear()
-        self.motors.clear()
-        self.forces.clear()
-        self.joint_forces.clear()
-        self.robots.clear()
-        self.problem_format = None
-        for what in ("motors", "forces", "robots"):
-            self.changed.emit(what)
-
     def forget_world(self) -> None:
         """The world went away: a world that comes back starts empty."""
-        self.geometries, self.poses, self.objects, self.joints = set(), {}, [], {}
-        self.changed.emit("objects")
-        self.changed.emit("joints")
-        self.clear()
+        self.geometries, self.poses, self._joint_types = set(), {}, {}
+        self.inventory = None
+        for what, empty in [("objects", []), ("joints", {}), ("motors", {}),
+                            ("forces", ([], []))]:
+            self._set(what, empty)
+        if self.robots or self.world_robots:
+            self.robots, self.world_robots, self.problem_format = {}, (), None
+            self.changed.emit("robots")
 
+    # -- names --------------------------------------------------------------------------------
     def pose_of(self, object_id: str) -> Optional[tuple]:
         """(position, quaternion) of an object as last reported (None for composites)."""
         return self.poses.get(object_id)
+
+    def robot_points(self) -> list:
+        """Origins (m, world frame) of the robots' links as last reported; of every object
+        when the world holds no robot (what "Frame the robot" aims at)."""
+        wanted = {o for r in self.world_robots for o in r.objects} or set(self.objects)
+        names = {part for o in wanted for part in
+                 (o.split(COMPOSITE_MARK)[1:] if is_composite_id(o) else [o])}
+        return [self.poses[n][0] for n in sorted(names) if n in self.poses]
+
+    def joint_owner(self, joint_id: str) -> Optional[tuple]:
+        """(robot name, the robot's own joint name) of a world joint, or None."""
+        for robot in self.world_robots:
+            if joint_id in robot.joints:
+                return robot.name, robot.joint_names[robot.joints.index(joint_id)]
+        return None
+
+    def joint_label(self, joint_id: str) -> str:
+        """How menus name a joint: "<robot>: <its joint name>" for a robot's joint, else the
+        world ID."""
+        owner = self.joint_owner(joint_id)
+        return f"{owner[0]}: {owner[1]}" if owner else joint_id
+
+    def motor_label(self, motor_id: str) -> str:
+        """How menus name a motor: by its joint's robot name and joint name when it has one."""
+        owner = self.joint_owner(motor_joint(motor_id))
+        return f"{owner[0]}: {owner[1]} (motor)" if owner else motor_id
+
+    def grouped(self, ids, label) -> list:
+        """(label, ID) of ``ids``, robots' first (in robot and joint order), then by ID."""
+        order = {j: k for k, j in enumerate(j for r in self.world_robots for j in r.joints)}
+        owned = [(label(i), i) for i in ids if _joint_of(i) in order]
+        owned.sort(key=lambda pair: order[_joint_of(pair[1])])
+        return owned + sorted((i, i) for i in ids if _joint_of(i) not in order)
+
+
+def _joint_of(element_id: str) -> str:
+    """The joint a joint ID or a default motor ID is about."""
+    return motor_joint(element_id) or element_id

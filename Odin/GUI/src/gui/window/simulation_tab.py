@@ -1,9 +1,14 @@
 """First tab (thesis 7.1): open a Kautham problem, New Scene, the tree of what was built and
 the Simulate / Pause button.
 
+The tree shows what the world holds, whoever built it (Get World, ``show_world``): each robot
+declared with Set Robot with its Links (the robot's link names), Joints and Motors (the robot's
+own joint names), then the Scene objects (under the Kautham instance that made them when this
+window built them), the Joints and Motors of no robot, and the Forces.
+
 Opening runs on the worker: the problem is read and planned (``gui.core.build.plan_problem``) and
-sent step by step (``WorldClient.execute``); each answer adds the step's entries to the tree as
-it comes, under its robot (Links, Joints, Motors) or under "Scene objects".
+sent step by step (``WorldClient.execute``); while it is built each answer adds the step's
+entries to the tree as it comes; once built, the world's answer replaces them.
 
 The button follows the world's real state: the Start answer, then the stamps of
 ``world_update`` (simulated time advancing = running), so a world started or paused by another
@@ -20,8 +25,9 @@ from PyQt5.QtCore import Qt, pyqtSignal
 from PyQt5.QtWidgets import (QCheckBox, QFileDialog, QHBoxLayout, QLabel, QPushButton,
                              QTreeWidget, QTreeWidgetItem, QVBoxLayout, QWidget)
 
+from gui.core.build import SCENE_OBJECTS
+from odin_common.interface import motor_joint
 from odin_common.limits import MIN_STEP
-from odin_common.specs import CompositeSpec
 
 RUNNING_STYLE = "QPushButton { background: #2e7d32; color: white; font-weight: bold; }"
 PAUSED_STYLE = "QPushButton { font-weight: bold; }"
@@ -78,6 +84,9 @@ class SimulationTab(QWidget):
         self.rebuild_button.clicked.connect(self.rebuild)
         self.problem_built.connect(self._remember)
         self._groups: dict = {}
+        self._roles: dict = {}
+        self._owners: dict = {}     # world ID -> the Kautham instance it was built for here
+        self._shown = None          # the inventory the tree shows
 
     # -- a world that came back -------------------------------------------------------------
     def _remember(self, path: str) -> None:
@@ -144,8 +153,7 @@ class SimulationTab(QWidget):
             self.last_build_seconds = time.monotonic() - started
             for handle in self._plan.robots:
                 self.window.scene.add_robot(handle, self._plan.problem.format)
-            for motor in ids["motors"].values():
-                self.window.scene.add_motor(motor, 1)
+            self.window.refresh_world()
             self.status.setText(f"Built {path} in {self.last_build_seconds:.2f} s: "
                                 f"{len(ids['bodies'])} bodies, {len(ids['joints'])} joints, "
                                 f"{len(ids['motors'])} motors.")
@@ -157,6 +165,7 @@ class SimulationTab(QWidget):
         def failed(message):
             self.building = False
             self.open_button.setEnabled(True)
+            self.window.refresh_world()
             self.status.setText("Open file failed (see the message below).")
             self.window.show_error(message)
 
@@ -167,10 +176,7 @@ class SimulationTab(QWidget):
         self._plan = plan
         if replace:
             self._clear()
-        self._roles = {inst.name: inst.role for inst in plan.problem.instances}
-        for body in plan.bodies():
-            if isinstance(body, CompositeSpec):
-                self.window.scene.add_composite(body.id, [p.name for p in body.parts])
+        self._roles.update({inst.name: inst.role for inst in plan.problem.instances})
 
     def _group(self, *path: str) -> QTreeWidgetItem:
         key = tuple(path)
@@ -186,25 +192,68 @@ class SimulationTab(QWidget):
             self._groups[key] = item
         return item
 
+    def _owner_label(self, owner: str) -> str:
+        return f"{owner} ({self._roles.get(owner, 'robot')})"
+
     def _add_step(self, step, answer) -> None:
         """The tree items of one step the world answered (under its robot or obstacle, or
-        under "Scene objects")."""
-        owner = () if step.owner is None else \
-            (f"{step.owner} ({self._roles.get(step.owner, 'robot')})",)
+        under "Scene objects"), shown while a problem is being built."""
+        owner = () if step.owner is None else (self._owner_label(step.owner),)
         for entry in step.entries(answer):
             self._group(*owner, entry.section).addChild(
                 QTreeWidgetItem([entry.name, entry.world_id]))
+            if step.owner is not None:
+                self._owners[entry.world_id] = step.owner
 
-    def add_built(self, group: str, name: str, world_id: str) -> None:
-        """An element built from another tab ("Objects", "Joints", "Motors")."""
-        self._group("Built here", group).addChild(QTreeWidgetItem([name, world_id]))
-        self._group("Built here").setExpanded(True)
+    # -- what the world holds -----------------------------------------------------------------
+    def show_world(self, inventory) -> None:
+        """Shows Get World's answer in the tree (kept as it is while a problem is being built,
+        and when nothing changed, so expansion and selection stay)."""
+        if self.building:
+            return
+        if not self.window.scene.objects and not inventory.objects:
+            self._owners.clear()
+        shown = (inventory.objects, inventory.joints, inventory.motors, inventory.robots,
+                 inventory.body_forces, inventory.joint_forces)
+        if shown == self._shown:
+            return
+        self._shown = shown
+        expanded = {key for key, item in self._groups.items() if item.isExpanded()}
+        self.tree.clear()
+        self._groups.clear()
+        robot_joints = {}
+        in_robots = set()
+        for robot in inventory.robots:
+            label = self._owner_label(robot.name)
+            for link, object_id in zip(robot.links, robot.objects):
+                self._leaf((label, "Links"), link, object_id)
+                in_robots.add(object_id)
+            for name, joint_id in zip(robot.joint_names, robot.joints):
+                self._leaf((label, "Joints"), name, joint_id)
+                robot_joints[joint_id] = (label, name)
+        for object_id in inventory.objects:
+            if object_id not in in_robots:
+                owner = self._owners.get(object_id)
+                group = (self._owner_label(owner), "Links") if owner else (SCENE_OBJECTS,)
+                self._leaf(group, object_id, object_id)
+        for joint_id in inventory.joints:
+            if joint_id not in robot_joints:
+                self._leaf(("Joints",), joint_id, joint_id)
+        for motor_id in inventory.motors:
+            owner = robot_joints.get(motor_joint(motor_id))
+            if owner:
+                self._leaf((owner[0], "Motors"), owner[1], motor_id)
+            else:
+                self._leaf(("Motors",), motor_id, motor_id)
+        for force_id in inventory.body_forces + inventory.joint_forces:
+            self._leaf(("Forces",), force_id, force_id)
+        for key, item in self._groups.items():
+            item.setExpanded(key in expanded or len(key) == 1)
+        if not self.window.scene.robots:
+            self.status.setText(_summary(inventory))
 
-    def remove_built(self, world_id: str) -> None:
-        for item in self.tree.findItems(world_id, Qt.MatchExactly | Qt.MatchRecursive, 1):
-            parent = item.parent()
-            if parent is not None:
-                parent.removeChild(item)
+    def _leaf(self, group: tuple, name: str, world_id: str) -> None:
+        self._group(*group).addChild(QTreeWidgetItem([name, world_id]))
 
     def element_count(self) -> int:
         """Leaves of the tree (built elements)."""
@@ -220,7 +269,8 @@ class SimulationTab(QWidget):
     def _clear(self) -> None:
         self.tree.clear()
         self._groups.clear()
-        self.window.scene.clear()
+        self._owners.clear()
+        self._shown = None
 
     # -- new scene ----------------------------------------------------------------------------
     def new_scene(self) -> None:
@@ -269,3 +319,13 @@ class SimulationTab(QWidget):
             self._same_stamps += 1
             if self.simulating and self._same_stamps >= 2:
                 self.set_simulating(False)
+
+
+def _summary(inventory) -> str:
+    """One line on what the world holds (the status of a window that built none of it)."""
+    if not inventory.objects:
+        return "The world is empty: open a problem, or build from the other tabs."
+    robots = ", ".join(r.name for r in inventory.robots)
+    return (f"The world holds {len(inventory.objects)} objects, {len(inventory.joints)} "
+            f"joints and {len(inventory.motors)} motors" +
+            (f"; robots: {robots}." if robots else "."))

@@ -1,34 +1,280 @@
-"""Past the thesis: the Viewer's live image (``/viewer/image``) inside the window."""
+"""Past the thesis: the Viewer's live image (``/viewer/image``) inside the window, navigated
+with the mouse through the Viewer's Set Camera service.
+
+Left drag orbits about the camera's target (horizontal: about world z; vertical: up and down,
+never over the poles), right or middle drag (or shift + left drag) pans, the wheel zooms towards
+the target. "Frame the robot" aims the camera at the robots the world holds (every object when
+it holds none), "Fit scene" gives the camera back to the Viewer's own fitting. Every move is a
+Set Camera (``set_pose``) sent on a thread of the panel's own; while one is on its way only the
+latest move waits, so a fast drag never queues calls. The camera the panel moves from is the
+Viewer's answer (``camera``), in the world frame (REP 103), metres.
+"""
 from __future__ import annotations
 
+import math
+import threading
 import time
+from typing import Callable, NamedTuple, Optional, Sequence
 
-from PyQt5.QtCore import Qt
+import numpy as np
+from PyQt5.QtCore import QObject, Qt, pyqtSignal
 from PyQt5.QtGui import QPixmap
-from PyQt5.QtWidgets import QLabel, QSizePolicy, QVBoxLayout, QWidget
+from PyQt5.QtWidgets import (QHBoxLayout, QLabel, QPushButton, QSizePolicy, QVBoxLayout,
+                             QWidget)
+
+from odin_common.interface import VIEWER_NAMESPACE
+
+ORBIT_PER_PIXEL = 0.01      # rad of orbit per pixel dragged
+ZOOM_PER_STEP = 0.85        # distance factor per wheel notch (120 eighths of a degree)
+MAX_ELEVATION = 1.5         # rad: the orbit stops short of the poles (up stays world z)
+MIN_DISTANCE = 0.02         # m: the eye never reaches the target
+FRAME_MARGIN = 0.3          # m added to a framed set of origins' radius (links have extent)
+
+
+class CameraPose(NamedTuple):
+    """eye, target, up: world frame, metres; fov_y: rad; width, height: pixels."""
+    eye: tuple
+    target: tuple
+    up: tuple
+    fov_y: float
+    width: int
+    height: int
+
+
+# -- navigation (pure) --------------------------------------------------------------------------
+def orbit(camera: CameraPose, d_azimuth: float, d_elevation: float) -> CameraPose:
+    """The eye turned about the target: ``d_azimuth`` rad about world z, ``d_elevation`` rad
+    up (clamped below the poles); the distance is kept and up is world z."""
+    target = np.asarray(camera.target)
+    offset = np.asarray(camera.eye) - target
+    distance = np.linalg.norm(offset)
+    azimuth = math.atan2(offset[1], offset[0]) + d_azimuth
+    elevation = math.asin(max(-1.0, min(1.0, offset[2] / distance))) + d_elevation
+    elevation = max(-MAX_ELEVATION, min(MAX_ELEVATION, elevation))
+    eye = target + distance * np.array([math.cos(elevation) * math.cos(azimuth),
+                                        math.cos(elevation) * math.sin(azimuth),
+                                        math.sin(elevation)])
+    return camera._replace(eye=tuple(eye), up=(0.0, 0.0, 1.0))
+
+
+def pan(camera: CameraPose, dx: float, dy: float) -> CameraPose:
+    """Eye and target moved together in the image plane: ``dx``, ``dy`` fractions of the
+    image's height (right, down), so what was under the cursor stays under it at the target's
+    depth."""
+    eye, target = np.asarray(camera.eye), np.asarray(camera.target)
+    forward = target - eye
+    distance = np.linalg.norm(forward)
+    right = np.cross(forward, camera.up)
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward / distance)
+    span = 2 * distance * math.tan(camera.fov_y / 2)      # m the image's height covers
+    shift = span * (-dx * right + dy * up)
+    return camera._replace(eye=tuple(eye + shift), target=tuple(target + shift))
+
+
+def zoom(camera: CameraPose, factor: float) -> CameraPose:
+    """The eye moved along the line of sight to ``factor`` times its distance to the target."""
+    eye, target = np.asarray(camera.eye), np.asarray(camera.target)
+    offset = eye - target
+    distance = max(np.linalg.norm(offset) * factor, MIN_DISTANCE)
+    return camera._replace(eye=tuple(target + offset / np.linalg.norm(offset) * distance))
+
+
+def frame(camera: CameraPose, points: Sequence, margin: float = FRAME_MARGIN) -> CameraPose:
+    """The camera looking at the sphere around ``points`` (m, world frame; radius their
+    spread + ``margin``) from its present direction, the whole sphere in view."""
+    pts = np.atleast_2d(np.asarray(points, dtype=float))
+    centre = (pts.min(axis=0) + pts.max(axis=0)) / 2
+    radius = float(np.max(np.linalg.norm(pts - centre, axis=1))) + margin
+    aspect = camera.width / camera.height
+    half_fov = min(camera.fov_y, 2 * math.atan(math.tan(camera.fov_y / 2) * aspect)) / 2
+    direction = np.asarray(camera.eye) - np.asarray(camera.target)
+    direction /= np.linalg.norm(direction)
+    eye = centre + direction * radius / math.sin(half_fov) * 1.05
+    return camera._replace(eye=tuple(eye), target=tuple(centre), up=(0.0, 0.0, 1.0))
+
+
+# -- Set Camera off the GUI thread --------------------------------------------------------------
+class CameraLink(QObject):
+    """Sends Set Camera requests on a thread of its own, the latest one only; ``answered``
+    carries the request's number and the Viewer's camera (CameraPose), ``failed`` a message."""
+
+    answered = pyqtSignal(int, object)
+    failed = pyqtSignal(str)
+
+    def __init__(self, viewer: str = VIEWER_NAMESPACE, parent=None):
+        super().__init__(parent)
+        self.service = f"{viewer.rstrip('/')}/set_camera"
+        self._wake = threading.Condition()
+        self._request: Optional[tuple] = None     # (number, fields)
+        self._numbers = 0
+        self._closing = False
+        self._thread = threading.Thread(target=self._run, name="set-camera", daemon=True)
+        self._thread.start()
+
+    def send(self, **fields) -> int:
+        """Queues a Set Camera (its fields), replacing one not sent yet; returns its number."""
+        with self._wake:
+            self._numbers += 1
+            self._request = (self._numbers, fields)
+            self._wake.notify()
+            return self._numbers
+
+    def close(self) -> None:
+        with self._wake:
+            self._closing = True
+            self._wake.notify()
+        self._thread.join(2.0)
+
+    def _run(self) -> None:
+        import rospy
+        from Services.srv import SetCamera
+        proxy = None
+        while True:
+            with self._wake:
+                while self._request is None and not self._closing:
+                    self._wake.wait()
+                if self._closing:
+                    break
+                (number, fields), self._request = self._request, None
+            try:
+                if proxy is None:
+                    proxy = rospy.ServiceProxy(self.service, SetCamera)
+                answer = proxy(**fields)
+            except Exception as error:      # Viewer absent or gone: say so, try again later
+                proxy = None
+                self.failed.emit(f"Set Camera: the Viewer does not answer ({self.service}): "
+                                 f"{error}")
+                continue
+            if not answer.success:
+                self.failed.emit(f"Set Camera refused: {answer.message}")
+            self.answered.emit(number, CameraPose(tuple(answer.eye), tuple(answer.target),
+                                          tuple(answer.up), float(answer.fov_y),
+                                          int(answer.width), int(answer.height)))
+
+
+class _ImageLabel(QLabel):
+    """The image; mouse drags and the wheel go to ``on_drag(dx, dy, button, modifiers)`` and
+    ``on_wheel(notches)`` (pixels, notches of 120)."""
+
+    def __init__(self, text: str, on_drag: Callable, on_wheel: Callable):
+        super().__init__(text)
+        self._on_drag, self._on_wheel = on_drag, on_wheel
+        self._last = None
+
+    def mousePressEvent(self, event) -> None:
+        self._last = event.pos()
+
+    def mouseMoveEvent(self, event) -> None:
+        if self._last is None:
+            return
+        d = event.pos() - self._last
+        self._last = event.pos()
+        self._on_drag(d.x(), d.y(), event.buttons(), event.modifiers())
+
+    def mouseReleaseEvent(self, event) -> None:
+        self._last = None
+
+    def wheelEvent(self, event) -> None:
+        self._on_wheel(event.angleDelta().y() / 120.0)
 
 
 class ViewerPanel(QWidget):
-    def __init__(self, parent=None):
+    """The image with mouse navigation; ``frame_points`` (set by the window) answers the world
+    points (m) "Frame the robot" aims at; ``message`` reports a refusal or an absent Viewer."""
+
+    message = pyqtSignal(str)
+
+    def __init__(self, parent=None, viewer: Optional[str] = VIEWER_NAMESPACE,
+                 frame_points: Callable[[], list] = list):
         super().__init__(parent)
-        self.label = QLabel("No image from the Viewer yet\n(rosrun Viewer viewer)")
+        self.label = _ImageLabel("No image from the Viewer yet\n(rosrun Viewer viewer)",
+                                 self._drag, self._wheel)
         self.label.setAlignment(Qt.AlignCenter)
         self.label.setMinimumSize(320, 240)
         self.label.setSizePolicy(QSizePolicy.Ignored, QSizePolicy.Ignored)
         self.label.setStyleSheet("background: #202020; color: #bbbbbb;")
+        self.label.setToolTip("Drag: orbit. Right drag or shift + drag: pan. Wheel: zoom.")
+        self.frame_button = QPushButton("Frame the robot")
+        self.frame_button.setToolTip("Aim the camera at the robots (every object without one)")
+        self.fit_button = QPushButton("Fit scene")
+        self.fit_button.setToolTip("The Viewer's own camera, fitted to the whole scene")
+        self.frame_points = frame_points
         self.frames = 0
         self.last_frame_time = 0.0
         self.image = None
+        self.camera: Optional[CameraPose] = None
+        self._last_request = 0
+        self.camera_answers = 0
+        self.link = CameraLink(viewer, self) if viewer is not None else None
         layout = QVBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
-        layout.addWidget(self.label)
+        layout.addWidget(self.label, 1)
+        row = QHBoxLayout()
+        row.addWidget(self.frame_button)
+        row.addWidget(self.fit_button)
+        row.addStretch(1)
+        layout.addLayout(row)
+        self.frame_button.clicked.connect(self.frame_robot)
+        self.fit_button.clicked.connect(lambda: self._send(fit_scene=True))
+        if self.link is not None:
+            self.link.answered.connect(self._answered)
+            self.link.failed.connect(self.message.emit)
 
+    # -- image --------------------------------------------------------------------------------
     def on_image(self, image) -> None:
         if image.isNull():
             return
+        if self.image is None and self.camera is None:
+            self._send()        # the first image: learn the Viewer's camera
         self.image = image
         self.frames += 1
         self.last_frame_time = time.monotonic()
         if self.isVisible():
             self.label.setPixmap(QPixmap.fromImage(image).scaled(
                 self.label.size(), Qt.KeepAspectRatio, Qt.SmoothTransformation))
+
+    # -- camera -------------------------------------------------------------------------------
+    def _send(self, **fields) -> None:
+        if self.link is not None:
+            self._last_request = self.link.send(**fields)
+
+    def _answered(self, number: int, camera: CameraPose) -> None:
+        self.camera_answers += 1
+        if number == self._last_request:    # an older answer would undo the moves since
+            self.camera = camera
+
+    def move_to(self, camera: CameraPose) -> None:
+        """Fixes the Viewer's camera at ``camera`` (shown at once; the answer confirms it)."""
+        self.camera = camera
+        self._send(set_pose=True, eye=camera.eye, target=camera.target, up=camera.up)
+
+    def _drag(self, dx: int, dy: int, buttons, modifiers) -> None:
+        if self.camera is None:
+            return
+        panning = buttons & (Qt.RightButton | Qt.MiddleButton) or \
+            (buttons & Qt.LeftButton and modifiers & Qt.ShiftModifier)
+        if panning:
+            height = max(self.label.height(), 1)
+            self.move_to(pan(self.camera, dx / height, dy / height))
+        elif buttons & Qt.LeftButton:
+            self.move_to(orbit(self.camera, -dx * ORBIT_PER_PIXEL, dy * ORBIT_PER_PIXEL))
+
+    def _wheel(self, notches: float) -> None:
+        if self.camera is not None and notches:
+            self.move_to(zoom(self.camera, ZOOM_PER_STEP ** notches))
+
+    def frame_robot(self) -> None:
+        points = self.frame_points()
+        if self.camera is None:
+            self.message.emit("Frame the robot: no camera from the Viewer yet "
+                              "(rosrun Viewer viewer)")
+        elif not points:
+            self.message.emit("Frame the robot: the world holds nothing to frame")
+        else:
+            self.move_to(frame(self.camera, points))
+
+    def close_link(self) -> None:
+        if self.link is not None:
+            self.link.close()
+            self.link = None
