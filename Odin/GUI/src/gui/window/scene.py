@@ -40,6 +40,7 @@ class SceneModel(QObject):
         self.joint_forces: list = []    # joint force IDs
         self.robots: dict = {}          # robot name -> gui.core.build.RobotHandle
         self.problem_format: Optional[str] = None
+        self.plan = None                # the last opened problem's gui.core.build.BuildPlan
 
     # -- from the world's topics -------------------------------------------------------------
     def on_world_update(self, msg) -> None:
@@ -124,6 +125,7 @@ class SceneModel(QObject):
         self.joint_forces.clear()
         self.robots.clear()
         self.problem_format = None
+        self.plan = None
         for what in ("motors", "forces", "robots"):
             self.changed.emit(what)
 
