@@ -9,7 +9,12 @@ can jitter and cost far more), and it is put on the table within the arm's reach
 Position (the thesis positioned its cans the same way). The other two cans stay static
 geometry.
 
-Driving, as the thesis's GUI did (section 7.4.3), one command per Portal cycle:
+Driving, in two modes (``run(mode=...)``; docs/EXPERIMENTS.md). "tracked" (the default,
+issue 12): after the starting position, the arm follows ``grasp_approach.txt`` and then the
+configurations the velocity rows below would reach (thumb opposed, hand closed, lifted,
+carried) through the joint servos, one tracked path under full physics (``Drive.tracked``),
+then the hand opens as below. "velocity", as the thesis's GUI did (section 7.4.3), one command
+per Portal cycle:
 1. starting position: ``Odin/GUI/paths/grasp_initial.txt`` -> one Set Position of every link;
 2. position path: ``grasp_approach.txt`` refined once by "double path precision", one Set
    Position per cycle: the open hand comes beside the can, palm towards it;
