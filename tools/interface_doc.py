@@ -236,7 +236,17 @@ def render_kautham() -> str:
             "The GUI (`rosrun GUI gui`, `load_problem`, `problem_info`) builds a Kautham problem "
             "with the services above (`gui.core.build`); `problem_info PROBLEM` shows the plan "
             "as JSON, with what Odin does not use under `ignored`. How a problem maps to the "
-            f"world:\n\n{mapping}\n\n### Control paths\n\n{MAPPING.strip()}\n\n")
+            f"world:\n\n{mapping}\n\n### Control paths\n\n{MAPPING.strip()}\n\n"
+            + render_tracked())
+
+
+def render_tracked() -> str:
+    """How a tracked path is timed and followed: gui.core.trajectory.TIMING and the docstring
+    of gui.core.execution (their one home)."""
+    from gui.core import execution
+    from gui.core.trajectory import TIMING
+    return (f"### Tracked paths\n\nTiming: {TIMING.strip()}\n\nExecution: "
+            f"{execution.__doc__.split(chr(10), 3)[3].strip()}\n\n")
 
 
 def _value(value) -> str:

@@ -25,15 +25,18 @@ def test_the_2drr_kps_solution_runs_to_its_goal_with_a_summary_and_a_plot(world,
     from gui.ros.client import WorldClient
     from odin_common.interface import Solver
     client = WorldClient()
-    # the exact solver: QuickStep's 20 iterations let this 1 kg-per-link chain shake under
-    # gravity near the goal (the GUI's Settings tab offers the same choice)
-    client.set_world(solver=Solver.WORLDSTEP)
+    assert client.world_parameters().solver == Solver.QUICKSTEP     # the world's default
+    # the exact solver, set by run_path --solver: QuickStep's 20 iterations let this 1
+    # kg-per-link chain shake under gravity near the goal (goal error 0.073 rad)
     summary, plot = tmp_path / "summary.json", tmp_path / "plot.png"
     result = world.run(["rosrun", "GUI", "run_path", str(problem), "--at-start", "--tracked",
-                        str(solution), "--fast", "--summary", str(summary), "--plot",
-                        str(plot)], timeout=180)
-    assert "kps path of 4 waypoints" in result.stdout.splitlines()[-1]
+                        str(solution), "--fast", "--solver", "worldstep", "--summary",
+                        str(summary), "--plot", str(plot)], timeout=180)
+    last = result.stdout.splitlines()[-1]
+    assert "kps path of 4 waypoints" in last and last.endswith("solver worldstep")
+    assert client.world_parameters().solver == Solver.WORLDSTEP
     report = json.loads(summary.read_text())
+    assert report["solver"] == "worldstep"
     assert report["goal_error"] <= 0.01
     assert 0.0 < report["tracking_error_max"] < 0.05
     assert report["duration_s"] > report["trajectory_s"] > 1.0

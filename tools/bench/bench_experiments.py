@@ -35,7 +35,7 @@ def _grasp_timing(out_dir: pathlib.Path, world_changes: dict) -> dict:
     the carry propagated again from its snapshot."""
     import grasp
     grasp.WORLD.update(world_changes)
-    grasp.run(frames=False, out_root=out_dir)
+    grasp.run(frames=False, out_root=out_dir, mode="velocity")   # the thesis's driving
     summary = json.loads((out_dir / "grasp" / "summary.json").read_text())
     return dict(summary["timing"], propagate_rtf=summary["carry_propagated"]["rtf"])
 

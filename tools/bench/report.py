@@ -32,7 +32,7 @@ BEGIN = ("<!-- bench table begin: written by tools/bench/report.py from out/benc
          "and tools/bench/goals.json; do not edit -->")
 END = "<!-- bench table end -->"
 HOST_FIGURE = "host_native_ode_steps_per_s"
-RELATIVE_UNITS = ("ratio", "count", "kB", "mm")
+RELATIVE_UNITS = ("ratio", "count", "kB", "mm", "rad")
 SPEC_KEYS = {"min", "max", "unit", "what"}
 
 

@@ -76,6 +76,7 @@ class Record:
     collided: dict = field(default_factory=dict)     # t -> [(first, second, depth m)]
     contacts: dict = field(default_factory=dict)     # t -> (pairs, contact points)
     contact_pairs: dict = field(default_factory=dict)  # t -> [(first, second)]
+    contact_depths: dict = field(default_factory=dict)  # t -> [(first, second, depth m)]
     rtf: list = field(default_factory=list)          # the world's ~real_time_factor values
     lock: threading.Lock = field(default_factory=threading.Lock)
 
@@ -225,6 +226,8 @@ class Session:
                 return  # a paused world's repeat publication of the same cycle
             self.record.contacts[t] = (len(message.pairs), points)
             self.record.contact_pairs[t] = [(p.first, p.second) for p in message.pairs]
+            self.record.contact_depths[t] = [(p.first, p.second, float(p.depth))
+                                             for p in message.pairs]
 
     def _on_rtf(self, message) -> None:
         with self.record.lock:
@@ -296,6 +299,18 @@ class Session:
             time.sleep(0.5)
         raise ExperimentError(f"the Viewer's picture did not settle in {timeout} s")
 
+    def wait_for_contacts(self, timeout: float = 10.0) -> None:
+        """Until the Contacts message of the current simulated time has arrived here."""
+        wanted = round(self.sim_time, 6)
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            with self.record.lock:
+                if wanted in self.record.contacts:
+                    return
+            time.sleep(0.001)
+        self.check_nodes()
+        raise ExperimentError(f"no Contacts stamped {wanted} s after {timeout} s")
+
     def wait_for_collided(self, timeout: float = 10.0) -> None:
         """Until the Collided message of the current simulated time has arrived here."""
         wanted = round(self.sim_time, 6)
@@ -354,6 +369,44 @@ class Session:
         positions = np.array([p for _, (p, _) in rows]).reshape(-1, 3)
         quats = np.array([q for _, (_, q) in rows]).reshape(-1, 4)
         return times, positions, quats
+
+
+# -- tracked execution, cycle by cycle ---------------------------------------------------------
+def session_tracking_port(session: Session, frame_every: int = 0):
+    """A ``gui.core.execution.TrackingPort`` that advances ``session`` one Step Once per Portal
+    cycle (so the world publishes every cycle and the Viewer's frames keep their numbering:
+    one every ``frame_every`` cycles, none at 0): the servos are updated once per cycle, the
+    period being the cycle's simulated time. Collisions are the pairs of ``~contacts``
+    (contact policy: ``Session(contacts=True)``), first time and deepest depth per cycle."""
+    from gui.core.execution import ClientTrackingPort
+
+    class SessionPort(ClientTrackingPort):
+        def step(self) -> float:
+            if self._step is None:
+                self._step = session.client.step_values().cycle_time
+            return self._step
+
+        def advance(self, duration: float, forces) -> list:
+            if forces:
+                raise ExperimentError("a session's tracked run drives no free-flying base")
+            started = session.sim_time
+            cycles = max(1, int(round(duration / self.step())))
+            stamps = []
+            for _ in range(cycles):
+                if frame_every and (session.cycles + 1) % frame_every == 0:
+                    session.cycle_and_frame()
+                else:
+                    session.cycle(1)
+                stamps.append(round(session.sim_time, 6))
+            self._states.clear()
+            if not session.want_contacts:
+                return []
+            session.wait_for_contacts()
+            with session.record.lock:
+                return [(a, b, depth, t - started) for t in stamps
+                        for a, b, depth in session.record.contact_depths.get(t, [])]
+
+    return SessionPort(session.client)
 
 
 # -- the problem, as the GUI builds it --------------------------------------------------------

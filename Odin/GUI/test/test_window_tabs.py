@@ -397,3 +397,39 @@ def test_motion_tab_runs_a_control_path_on_the_sphere_demo(window, kautham_dir, 
     bad.write_text("0.4 0.5 0.4 0.3\n0.4 0.5 0.4 -1\n")
     tab.run_path("control", str(bad))
     assert "bad.txt:2" in window.last_error and "not positive" in window.last_error
+
+
+def test_motion_tab_runs_a_tracked_plan_and_plots_it(window, kautham_dir, tmp_path):
+    """Kautham's public 2DRR_obstacle problem opened, then its .kps solution as a tracked path
+    in real time: the robot ends at the solution's goal and the plot shows target against
+    actual per joint; a mismatched plan is refused with file and line, running nothing."""
+    from gui.ros.client import WorldClient
+    from gui.window.testing import screenshot, wait_for
+    from odin_common.interface import Solver
+    tro = kautham_dir / "legacy_2012" / "examples" / "TRO"
+    window.simulation.open_problem(str(tro / "2DRR_obstacle.xml"))
+    wait_for(lambda: "2D-Robot" in window.scene.robots and not window.simulation.building, 30,
+             "the 2DRR problem")
+    # the exact solver, as tests/nodes/test_tracked_path.py says why
+    WorldClient().set_world(solver=Solver.WORLDSTEP)
+    window.tabs.setCurrentWidget(window.motion)
+    tab = window.motion
+    tab.toolbox.setCurrentIndex(3)
+    bad = tmp_path / "bad.kps"
+    bad.write_text('<?xml version="1.0"?>\n<Planner>\n <Queries>\n  <Query Solved="True">\n'
+                   '   <Result name="Path">0 1</Result>\n  </Query>\n </Queries>\n'
+                   ' <SampleSet dim="2" size="2">\n  <Sample>0.5 0.5</Sample>\n'
+                   '  <Sample>0.5 0.5 0.5</Sample>\n </SampleSet>\n</Planner>\n')
+    tab.run_path("tracked", str(bad))
+    assert "bad.kps:10" in window.last_error and tab.tracking_plot.report is None
+    tab.run_path("tracked", str(tro / "2DRR_obstacle_sol.kps"))
+    wait_for(lambda: "tracked path 2DRR_obstacle_sol.kps: " in tab.path_status.text()
+             and " s" in tab.path_status.text(), 10, "the tracked path running")
+    wait_for(lambda: tab.tracking_plot.report is not None, 60, "the tracked path's end",
+             lambda: tab.path_status.text())
+    report = tab.tracking_plot.report
+    assert report.goal_error <= 0.01, tab.path_status.text()
+    assert "goal error" in window.last_info
+    assert report.names == ["2D-Robot/link1", "2D-Robot/link2", "2D-Robot/tcp"]
+    assert report.targets[-1, 0] == pytest.approx(-0.4335, abs=1e-3)
+    screenshot(window, SHOTS / "motion_tracked.png")

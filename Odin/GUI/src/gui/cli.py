@@ -180,6 +180,11 @@ def run_path_main(argv: Optional[Sequence[str]] = None) -> int:
                         "summary (goal and tracking errors, collisions, per-joint series)")
     parser.add_argument("--plot", metavar="OUT.png", help="tracked: plot target against "
                         "actual per joint")
+    parser.add_argument("--solver", choices=["quickstep", "worldstep"],
+                        help="tracked: set the world's solver first (Set World; it stays set). "
+                        "The summary and the last line name the solver that ran: QuickStep "
+                        "(the world's default) can let an articulated chain shake near its goal "
+                        "where WORLDSTEP, the exact solver, reaches it")
     units = parser.add_mutually_exclusive_group()
     units.add_argument("--degrees", action="store_true",
                        help="values in degrees (mm) [default for 2012 problems]")
@@ -242,8 +247,12 @@ def _run_tracked(args, plan) -> int:
     units = DEGREES if args.degrees else RADIANS if args.radians else None
     solution = read_solution(args.tracked, plan.problem, args.robot, units)
     from gui.ros.client import WorldClient
+    from odin_common.interface import Solver
     client = WorldClient(timeout=args.timeout)
     _record_world_ids(client, plan)
+    if args.solver:
+        client.set_world(solver=Solver[args.solver.upper()])
+    solver = Solver(client.world_parameters().solver).name.lower()
     shown = [0]
 
     def progress(t: float, total: float) -> None:
@@ -255,10 +264,11 @@ def _run_tracked(args, plan) -> int:
                                    real_time=not args.fast)
     print(f"{solution.format} path of {solution.waypoint_count} waypoints: goal error "
           f"{report.goal_error:.3g}, tracking error max {report.tracking_error_max:.3g}, "
-          f"{report.duration_s:.2f} s simulated, {len(report.collisions)} colliding pairs")
+          f"{report.duration_s:.2f} s simulated, {len(report.collisions)} colliding pairs, "
+          f"solver {solver}")
     if args.summary:
         with open(args.summary, "w") as out:
-            json.dump(report.to_json(), out, indent=1)
+            json.dump(dict(report.to_json(), solver=solver), out, indent=1)
     if args.plot:
         _save_plot(report, args.plot)
     return 0

@@ -7,8 +7,11 @@ Move joint: a force / torque per joint axis (as many magnitudes as the joint typ
 the list of joint forces. Move motor: goal speeds. Move robot: initial position, velocity
 path and position path files (``gui.core.paths``), optionally refined by double path precision,
 and control paths (rows of the robot's Kautham controls in [0, 1] with a duration, applied as
-Kautham's ODE environment does: ``gui.core.control_path``, docs/INTERFACE.md); a path runs on a
-worker of its own (Stop ends it) so the other tabs stay usable meanwhile.
+Kautham's ODE environment does: ``gui.core.control_path``, docs/INTERFACE.md), and tracked
+paths (a Kautham plan: .kps solution, task file, OMPL or raw rows, timed within the joints'
+limits and followed by the joint servos under full physics, ``gui.core.execution``; its
+target against actual per joint is plotted below); a path runs on a worker of its own (Stop
+ends it) so the other tabs stay usable meanwhile.
 """
 from __future__ import annotations
 
@@ -21,6 +24,7 @@ from PyQt5.QtWidgets import (QButtonGroup, QCheckBox, QComboBox, QFileDialog, QG
 from gui.errors import GuiError
 from gui.window.fields import VectorRow, int_spin, spin
 from gui.window.scene import JOINT_TYPE_NAMES
+from gui.window.tracking_plot import TrackingPlot
 from odin_common.interface import JOINT_FORCE_MAGNITUDES, ForceKind
 from odin_common.step_values import StepValues
 
@@ -115,6 +119,10 @@ class MotionTab(QWidget):
         self.controls_button = QPushButton("Control path...")
         self.controls_button.setToolTip("rows of the robot's controls in [0, 1] and a duration "
                                         "(s), applied as Kautham's ODE environment does")
+        self.tracked_button = QPushButton("Tracked path...")
+        self.tracked_button.setToolTip("a Kautham plan (.kps, task file, OMPL or raw rows) "
+                                       "followed by the joint servos with contacts on")
+        self.tracking_plot = TrackingPlot()
         self.double = int_spin(0, 0, 6, "times the path precision is doubled (2^n finer)")
         self.stop_button = QPushButton("Stop path")
         self.stop_button.setEnabled(False)
@@ -129,8 +137,10 @@ class MotionTab(QWidget):
         grid.addWidget(self.controls_button, 3, 2)
         grid.addWidget(QLabel("Double path precision (times)"), 4, 0)
         grid.addWidget(self.double, 4, 1)
+        grid.addWidget(self.tracked_button, 5, 0)
         grid.addWidget(self.stop_button, 5, 1)
         grid.addWidget(self.path_status, 6, 0, 1, 3)
+        grid.addWidget(self.tracking_plot, 7, 0, 1, 3)
         grid.setRowStretch(7, 1)
         self.toolbox.addItem(page, "Move robot")
 
@@ -150,6 +160,7 @@ class MotionTab(QWidget):
         self.velocity_button.clicked.connect(lambda: self.choose_path("velocity"))
         self.position_button.clicked.connect(lambda: self.choose_path("position"))
         self.controls_button.clicked.connect(lambda: self.choose_path("control"))
+        self.tracked_button.clicked.connect(lambda: self.choose_path("tracked"))
         self.stop_button.clicked.connect(self.stop_path)
         window.scene.changed.connect(self._scene_changed)
         self._action_changed()
@@ -303,8 +314,8 @@ class MotionTab(QWidget):
             self.run_path(kind, path)
 
     def run_path(self, kind: str, path: str) -> None:
-        """``kind``: "initial", "velocity", "position" or "control"; runs on the path
-        worker."""
+        """``kind``: "initial", "velocity", "position", "control" or "tracked"; runs on the
+        path worker."""
         from gui.core.paths import DEGREES, RADIANS, load_robot_path, refine
         handle = self.window.scene.robots.get(self.robot.currentData())
         if handle is None:
@@ -314,6 +325,9 @@ class MotionTab(QWidget):
             self.run_control_path(handle, path)
             return
         units = DEGREES if self.units.currentIndex() == 0 else RADIANS
+        if kind == "tracked":
+            self.run_tracked_path(handle, path, units)
+            return
         try:
             rows = load_robot_path(path, handle, units)
         except Exception as error:  # a bad file is the user's: say what and where
@@ -362,6 +376,56 @@ class MotionTab(QWidget):
 
         self._submit_path("control path", pathlib.Path(path).name, handle.name, len(rows),
                           work)
+
+    def run_tracked_path(self, handle, path: str, units: str) -> None:
+        """The plan in ``path`` (raw rows drive ``handle``'s robot, in ``units``), read and
+        checked whole here, then executed in real time on the path worker (the world paused
+        meanwhile, running again afterwards if it was); the report is plotted."""
+        from gui.core.kautham.solutions import read_solution
+        plan = self.window.scene.plan
+        if plan is None:
+            self.window.show_error("Move robot: a tracked path needs the problem opened here")
+            return
+        try:
+            solution = read_solution(path, plan.problem, handle.name, units)
+        except GuiError as error:  # a bad file is the user's: say what and where
+            self.window.show_error(f"Move robot: {error}")
+            return
+        name = pathlib.Path(path).name
+
+        def work(client, job):
+            from gui.core.execution import run_tracked_on_client
+            from gui.window.worker import Cancelled
+
+            def progress(t: float, total: float) -> None:
+                if job.cancelled:
+                    raise Cancelled()
+                job.progress((t, total))
+            return run_tracked_on_client(client, plan, solution, progress=progress,
+                                         real_time=True)
+
+        def progress(value):
+            t, total = value
+            self.path_status.setText(f"tracked path {name}: {t:.2f}/{total:.2f} s")
+
+        def finished(report):
+            self.stop_button.setEnabled(False)
+            self.tracking_plot.show_report(report)
+            text = (f"tracked path {name}: goal error {report.goal_error:.3g}, tracking error "
+                    f"max {report.tracking_error_max:.3g}, {report.duration_s:.2f} s, "
+                    f"{len(report.collisions)} colliding pairs")
+            self.path_status.setText(text)
+            self.window.show_info(f"{handle.name}: {text}")
+
+        def failed(message):
+            self.stop_button.setEnabled(False)
+            self.path_status.setText(f"tracked path {name}: {message}")
+            self.window.show_error(message)
+
+        self.stop_button.setEnabled(True)
+        self.path_status.setText(f"tracked path {name}: starting ({solution.format}, "
+                                 f"{solution.waypoint_count} waypoints)")
+        self.window.path_worker.submit("tracked path", work, finished, failed, progress)
 
     def _submit_path(self, label: str, name: str, robot: str, total: int, work,
                      pace: str = "") -> None:

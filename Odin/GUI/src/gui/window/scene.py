@@ -46,6 +46,7 @@ class SceneModel(QObject):
         self.world_robots: tuple = ()   # gui.ros.client.WorldRobot of every robot declared
         self.robots: dict = {}          # robot name -> RobotHandle, robots this window built
         self.problem_format: Optional[str] = None
+        self.plan = None                # the last opened problem's gui.core.build.BuildPlan
         self.inventory = None           # the last Get World answer
         self._joint_types: dict = {}    # joint ID -> JointType value, from joint_data
 
@@ -63,8 +64,8 @@ class SceneModel(QObject):
         if inventory.robots != self.world_robots or handles != self.robots:
             self.world_robots = inventory.robots
             self.robots = handles
-            if not handles:
-                self.problem_format = None
+            if not handles:       # the robots this window built are gone: so is their plan
+                self.problem_format, self.plan = None, None
             self.changed.emit("robots")
 
     def _set(self, what: str, value) -> None:
@@ -123,6 +124,7 @@ class SceneModel(QObject):
         for what, empty in [("objects", []), ("joints", {}), ("motors", {}),
                             ("forces", ([], []))]:
             self._set(what, empty)
+        self.plan = None
         if self.robots or self.world_robots:
             self.robots, self.world_robots, self.problem_format = {}, (), None
             self.changed.emit("robots")

@@ -151,6 +151,7 @@ class SimulationTab(QWidget):
             self.building = False
             self.open_button.setEnabled(True)
             self.last_build_seconds = time.monotonic() - started
+            self.window.scene.plan = self._plan
             for handle in self._plan.robots:
                 self.window.scene.add_robot(handle, self._plan.problem.format)
             self.window.refresh_world()

@@ -12,6 +12,8 @@ from gui.window.plot_panel import COLORS
 
 STRIP_HEIGHT = 90
 """px per joint in a saved PNG."""
+MIN_SPAN = 1e-3
+"""rad or m: the least range a strip shows."""
 
 
 def draw(painter: QPainter, width: int, height: int, report) -> None:
@@ -39,8 +41,9 @@ def draw(painter: QPainter, width: int, height: int, report) -> None:
         target, actual = report.targets[:, k], report.actuals[:, k]
         low = float(min(target.min(), actual.min()))
         high = float(max(target.max(), actual.max()))
-        if high - low < 1e-9:
-            low, high = low - 1.0, high + 1.0
+        if high - low < MIN_SPAN:          # a joint that stays put: no magnified noise
+            middle = 0.5 * (low + high)
+            low, high = middle - 0.5 * MIN_SPAN, middle + 0.5 * MIN_SPAN
         painter.drawText(QPointF(2, area.top() + 10), f"{high:.3g}")
         painter.drawText(QPointF(2, area.bottom()), f"{low:.3g}")
         for values, pen in ((target, QPen(QColor("#555555"), 1.5, Qt.DashLine)),
