@@ -180,11 +180,12 @@ def run_path_main(argv: Optional[Sequence[str]] = None) -> int:
                         "summary (goal and tracking errors, collisions, per-joint series)")
     parser.add_argument("--plot", metavar="OUT.png", help="tracked: plot target against "
                         "actual per joint")
-    parser.add_argument("--solver", choices=["quickstep", "worldstep"],
+    parser.add_argument("--solver", choices=["auto", "quickstep", "worldstep"],
                         help="tracked: set the world's solver first (Set World; it stays set). "
-                        "The summary and the last line name the solver that ran: QuickStep "
-                        "(the world's default) can let an articulated chain shake near its goal "
-                        "where WORLDSTEP, the exact solver, reaches it")
+                        "The summary and the last line name the solver in force: AUTO (the "
+                        "world's default) steps small articulated scenes exactly (dWorldStep) "
+                        "and large ones with QuickStep, which alone can let a chain shake near "
+                        "its goal where WORLDSTEP, the exact solver, reaches it")
     units = parser.add_mutually_exclusive_group()
     units.add_argument("--degrees", action="store_true",
                        help="values in degrees (mm) [default for 2012 problems]")
