@@ -31,6 +31,8 @@ RULES = {
     "gui.planning": ROS + MESSAGES + QT + ("gui.ros", "gui.window", "virtual_world.portal",
                                            "virtual_world.ode", "virtual_world.pool", "viewer",
                                            "odin_common.messages"),
+    "gui.planning_pool": QT + ("gui.window", "virtual_world.core", "virtual_world.ode",
+                               "virtual_world.portal", "viewer"),
     "virtual_world.portal": QT + ("viewer", "gui", "virtual_world.ode"),
     "viewer.portal": QT + ("virtual_world", "gui"),
     "virtual_world.pool": QT + ("virtual_world.core", "virtual_world.ode",

@@ -161,7 +161,7 @@ def test_the_plan_tool_writes_a_control_path_and_prints_statistics(kautham_dir, 
     (["--time", "-1"], "time"),
     (["--seed", "0"], "seed"),
     (["--goal-tolerance", "0"], "goal_tolerance"),
-    (["--backend", "pool"], "not available yet"),
+    (["--backend", "pool", "--worlds", " , "], "no namespace"),
 ])
 def test_the_plan_tool_refuses_bad_input_in_one_line(kautham_dir, tmp_path, args, message):
     out = tmp_path / "plan.txt"

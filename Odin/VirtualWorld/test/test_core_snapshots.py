@@ -301,6 +301,57 @@ def test_propagation_from_a_snapshot_under_controls_then_kept(core):
     assert state_bytes(core) == after
 
 
+def test_propagation_from_a_state_vector_matches_stepping_on_from_it(core):
+    pile(core, 18)
+    core.step(H, 200)
+    vector = core.body_state_vector()
+    core.step(H, 150)                                       # elsewhere now
+    before = state_bytes(core)
+    result = core.propagate(0.3, H, start_state=vector)
+    assert state_bytes(core) == before                      # not kept: as it was
+    chained = core.propagate(0.2, H, start_state=result.state)
+    core.set_body_state_vector(vector)
+    core.step(H, 500)                                       # the same by stepping
+    assert chained.state.tobytes() == core.body_state_vector().tobytes()
+    for state in chained.states:
+        position, _, linear, _ = core.body_state(state.id)
+        assert np.array(state.position).tobytes() == position.tobytes()
+        assert np.array(state.linear).tobytes() == linear.tobytes()
+
+
+def test_a_state_vector_record_is_what_body_state_reads():
+    from odin_common.interface import BODY_STATE_SIZE, body_record
+    core = Core()
+    try:
+        pile(core, 3)
+        core.step(H, 120)
+        vector = core.body_state_vector()
+        assert vector.size == 1 + 3 * BODY_STATE_SIZE
+        for index, name in enumerate(("s0", "s1", "s2")):
+            position, quaternion, linear, angular = core.body_state(name)
+            record = body_record(vector, index)
+            for field, value in (("position", position), ("quaternion", quaternion),
+                                 ("linear", linear), ("angular", angular)):
+                assert np.asarray(record[field]).tobytes() == np.asarray(value).tobytes()
+            assert record["enabled"][0] in (0.0, 1.0)
+        with pytest.raises(OdinError, match="no body 3"):
+            body_record(vector, 3)
+    finally:
+        core.close()
+
+
+def test_a_bad_start_state_is_refused_and_changes_nothing(core):
+    pile(core, 3)
+    core.save_state("start")
+    before = state_bytes(core)
+    good = core.body_state_vector()
+    for kwargs in (dict(start_state=good[:-1]), dict(start_state=np.full(good.size, np.nan)),
+                   dict(start_state=good, start="start")):
+        with pytest.raises(InvalidArgument):
+            core.propagate(0.1, H, **kwargs)
+        assert state_bytes(core) == before, kwargs
+
+
 def test_propagation_reports_each_collision_once_with_its_first_time(core):
     core.build_object(ObjectSpec("ground", [4, 4, 1], position=(0, 0, -0.5), geometry_only=True))
     core.build_object(ObjectSpec("ball", [0.1], position=(0, 0, 0.6)))

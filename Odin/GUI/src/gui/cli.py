@@ -341,8 +341,12 @@ def plan_main(argv: Optional[Sequence[str]] = None) -> int:
                         help="control path file to write (rows: controls, duration s)")
     parser.add_argument("--seed", type=int, default=None, help="OMPL's random seed")
     parser.add_argument("--backend", choices=("core", "pool"), default="core",
-                        help="core: the world in this process [default]; pool: world nodes "
-                        "over ROS (not yet: docs/PLANNING.md)")
+                        help="core: the world in this process [default]; pool: the world "
+                        "nodes of --worlds over ROS (cleared and built from the problem)")
+    parser.add_argument("--worlds", default="/virtual_world", metavar="NS[,NS...]",
+                        help="--backend pool: the world nodes' namespaces [/virtual_world]")
+    parser.add_argument("--world-timeout", type=float, default=30.0, metavar="S",
+                        help="--backend pool: how long to wait for each world [30]")
     parser.add_argument("--robot", help="robot name (default: the first robot)")
     parser.add_argument("--goal-tolerance", type=float, default=None, metavar="M",
                         help="goal region radius in the plane, m [0.25]")
@@ -382,7 +386,10 @@ def _planning_backend(args):
     plan = _plan(args)
     problem = planning_problem(plan, args.robot, settings)
     if args.backend == "pool":
-        raise GuiError("--backend pool: not available yet (Propagate cannot start from a "
-                       "planner's state vector; docs/PLANNING.md): use --backend core")
+        from gui.planning_pool import PoolBackend
+        namespaces = [n.strip() for n in args.worlds.split(",") if n.strip()]
+        if not namespaces:
+            raise GuiError(f"--worlds {args.worlds!r}: no namespace given")
+        return PoolBackend(plan, problem, namespaces, timeout=args.world_timeout)
     from gui.planning.backend import CoreBackend
     return CoreBackend(plan, problem)

@@ -358,6 +358,32 @@ PLANE_DRAWN_THICKNESS = 0.002
 """m: ...and this thin, its top face on the plane."""
 
 
+# ------------------------------------------------------------------ body state vectors
+
+BODY_STATE_FIELDS: Tuple[Tuple[str, int], ...] = (
+    ("position", 3), ("quaternion", 4), ("rotation", 12), ("linear", 3), ("angular", 3),
+    ("enabled", 1))
+"""One body's record in a body state vector (Propagate's ``start_state`` and ``state``, GetState's
+``state_vector``; the C world's odin_step.h): centre of mass position m, quaternion (w, x, y, z),
+ODE's 3x4 rotation matrix, linear velocity m/s, angular velocity rad/s (world frame), enabled
+(1.0 or 0.0). A vector is ODE's random generator state, then one record per object with a body,
+in the world's object order (Propagate's ``states`` order)."""
+BODY_STATE_SIZE = sum(size for _, size in BODY_STATE_FIELDS)
+
+
+def body_record(vector: Sequence[float], index: int) -> Dict[str, Sequence[float]]:
+    """The fields (BODY_STATE_FIELDS) of the ``index``-th body of a body state vector."""
+    offset = 1 + index * BODY_STATE_SIZE
+    if index < 0 or offset + BODY_STATE_SIZE > len(vector):
+        raise InvalidArgument(f"a body state vector of {len(vector)} values has no body "
+                              f"{index}")
+    record = {}
+    for name, size in BODY_STATE_FIELDS:
+        record[name] = vector[offset:offset + size]
+        offset += size
+    return record
+
+
 # ---------------------------------------------------------------------------------- services
 
 WORLD_NAMESPACE = "/virtual_world"

@@ -7,8 +7,8 @@ Odin's world (issue 17; docs/PLANNING.md).
   invalidate a motion (Kautham's rule), and the settings of a search.
 - ``gui.planning.backend``: the ``Backend`` interface (propagate a batch of (state, control)
   pairs: restore, apply the control for its duration, read the result) and ``CoreBackend``,
-  the VirtualWorld's Core in this process. A back end over a pool of world nodes is not
-  written yet (docs/PLANNING.md, "Not done").
+  the VirtualWorld's Core in this process; the back end over a pool of world nodes is
+  ``gui.planning_pool.PoolBackend`` (outside this package: it uses ROS).
 - ``gui.planning.bridge``: OMPL's state space, control space, propagator, validity checker,
   goal region and planners over a back end; ``plan()`` answers a ``PlanResult`` whose rows
   are a Kautham control path (``gui.core.control_path.write_control_path``).

@@ -10,7 +10,7 @@ the n rows of the control path it becomes (one kept Propagate per row), so that 
 plan replays bit for bit in a fresh world.
 
 ``CoreBackend``: the VirtualWorld's Core in this process, built from the problem's plan
-(fastest: no messages).
+(fastest: no messages). ``gui.planning_pool.PoolBackend``: world nodes over ROS.
 """
 from __future__ import annotations
 
@@ -91,11 +91,26 @@ class CoreWorld:
         self.core.set_joint_parameters(joint_id, parameters)
 
     def execute(self, plan: BuildPlan) -> dict:
-        ids = BuiltIds()
-        for step in plan.steps:
-            step.send(self, ids)
-        plan.record_world_ids(ids)
-        return ids.as_dict()
+        return send_plan(self, plan)
+
+
+def send_plan(world, plan: BuildPlan) -> dict:
+    """Sends every step of ``plan`` to ``world`` (a CoreWorld or a gui.ros WorldClient) and
+    records the world's IDs in it; no robot is declared (the planner's worlds publish
+    nothing anyone reads)."""
+    ids = BuiltIds()
+    for step in plan.steps:
+        step.send(world, ids)
+    plan.record_world_ids(ids)
+    return ids.as_dict()
+
+
+def row_forces(problem: PlanningProblem, control: Sequence[float], base) -> list:
+    """The body forces (``force_requests``) that apply ``control`` for one propagation step
+    to the robot whose base is in ``base`` (position m, quaternion (w, x, y, z), linear
+    velocity m/s; world frame) when the step starts."""
+    act = actuation(problem.handle, ControlRow(tuple(control), problem.step), base)
+    return force_requests(act.forces)
 
 
 class CorePort:
@@ -161,9 +176,8 @@ class CoreBackend:
         core, problem = self.world.core, self.problem
         core.set_body_state_vector(state)
         base = self.port.body_state(problem.base_body)
-        act = actuation(problem.handle, ControlRow(tuple(control), problem.step), base)
         result = core.propagate(problem.step, self.world.step_values.step,
-                                body_forces=force_requests(act.forces), keep=True)
+                                body_forces=row_forces(problem, control, base), keep=True)
         self.propagations += 1
         position, _, linear, _ = core.body_state(problem.base_body)
         return Outcome(core.body_state_vector(), np.asarray(position), np.asarray(linear),
@@ -173,4 +187,5 @@ class CoreBackend:
         self.world.close()
 
 
-__all__ = ["Outcome", "Backend", "CoreWorld", "CorePort", "CoreBackend", "force_requests"]
+__all__ = ["Outcome", "Backend", "CoreWorld", "CorePort", "CoreBackend", "force_requests",
+           "row_forces", "send_plan"]

@@ -149,7 +149,8 @@ class Propagation(NamedTuple):
     """What a propagation did: it ran ``steps`` steps of ``step_size`` s from ``start_time``
     (simulated s), ended in ``states`` (every object with a body), met ``collisions`` (each
     pair once, deepest, with the time first seen), in ``wall_time`` s of this machine; ``kept``
-    says whether the world stayed in the final state."""
+    says whether the world stayed in the final state; ``state``: the final state as
+    ``Core.body_state_vector`` gives it (float64 vector)."""
     start_time: float
     step_size: float
     steps: int
@@ -157,6 +158,7 @@ class Propagation(NamedTuple):
     collisions: Tuple[Collision, ...]
     wall_time: float
     kept: bool
+    state: np.ndarray
 
 
 # ---------------------------------------------------------------------------------- records

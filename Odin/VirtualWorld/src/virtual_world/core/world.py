@@ -416,20 +416,30 @@ class Core:
         states themselves (OMPL): ODE's random generator state (QuickStep's constraint order),
         then per body with a body (object order) its raw record (position, quaternion wxyz,
         rotation matrix, linear and angular velocity, enabled: ``BODY_STATE_SIZE`` values,
-        m, m/s, rad/s, world frame). ``set_body_state_vector`` puts it back bit for bit.
-        Motors, servos and persistent forces are not in it: they stay as they are."""
+        m, m/s, rad/s, world frame; odin_common.interface.BODY_STATE_FIELDS).
+        ``set_body_state_vector`` puts it back bit for bit. Motors, servos and persistent
+        forces are not in it: they stay as they are."""
+        return self._state_vector()
+
+    def _state_vector(self) -> np.ndarray:
         scene = self._scene
-        ptrs = [o.body.ptr for o in scene.objects.values() if o.body is not None]
-        return np.concatenate(([float(scene.c.rand_seed)], bodies.read_states(ptrs).ravel()))
+        return np.concatenate(([float(scene.c.rand_seed)],
+                               bodies.read_states(self._body_ptrs()).ravel()))
+
+    def _body_ptrs(self) -> list:
+        return [o.body.ptr for o in self._scene.objects.values() if o.body is not None]
 
     @_changes_state
     def set_body_state_vector(self, vector: Sequence[float]) -> None:
         """Puts back a vector read by ``body_state_vector`` (the same objects), bit for bit:
         stepping on from it gives the results stepping on from when it was read gave."""
-        scene = self._scene
-        ptrs = [o.body.ptr for o in scene.objects.values() if o.body is not None]
+        self._put_state_vector(self._checked_state_vector(vector))
+
+    def _checked_state_vector(self, vector: Sequence[float]) -> np.ndarray:
+        """``vector`` as float64 when it is a body state vector of this world."""
+        count = len(self._body_ptrs())
         vector = np.asarray(vector, dtype=np.float64)
-        size = 1 + len(ptrs) * bodies.BODY_STATE_SIZE
+        size = 1 + count * bodies.BODY_STATE_SIZE
         if vector.shape != (size,) or not np.all(np.isfinite(vector)):
             raise InvalidArgument(f"a body state vector of this world has {size} finite "
                                   f"values (1 + {bodies.BODY_STATE_SIZE} per body); got "
@@ -437,10 +447,14 @@ class Core:
         seed = vector[0]
         if seed != int(seed) or not 0 <= seed < 2 ** 32:
             raise InvalidArgument(f"random generator state {seed!r} is not a 32-bit integer")
+        return vector
+
+    def _put_state_vector(self, vector: np.ndarray) -> None:
+        scene, ptrs = self._scene, self._body_ptrs()
         bodies.write_states(ptrs, vector[1:].reshape(len(ptrs), bodies.BODY_STATE_SIZE))
         scene.c.clear_records()
         scene.carried = {}
-        scene.c.rand_seed = int(seed)
+        scene.c.rand_seed = int(vector[0])
 
     @_locked
     def reset(self) -> None:
@@ -456,9 +470,11 @@ class Core:
     def propagate(self, duration: float, step_size: float,
                   motor_goals: Optional[Mapping[str, Sequence[float]]] = None,
                   body_forces: Sequence[Mapping] = (), start: str = "",
-                  keep: bool = False) -> Propagation:
+                  keep: bool = False,
+                  start_state: Optional[Sequence[float]] = None) -> Propagation:
         """Runs the world for ``duration`` s in steps of ``step_size`` s, as fast as it goes:
-        from the snapshot ``start`` (or from now), under ``motor_goals`` ({motor id: goal
+        from the snapshot ``start``, or from the body state vector ``start_state``
+        (``body_state_vector``'s; the rest of the state as it is now), or from now; under ``motor_goals`` ({motor id: goal
         speeds}) and ``body_forces`` (each the keyword arguments of add_body_force), recording
         every pair that collides on the way. Then the world goes back to the state it had
         before the call, unless ``keep``; the forces act during the propagation only.
@@ -474,11 +490,19 @@ class Core:
         start_snapshot = self._snapshot(start) if start else None
         if start_snapshot is not None:
             snapshots.check_fits(scene, start_snapshot, f"snapshot {start!r}")
+        if start_state is not None and len(start_state):
+            if start_snapshot is not None:
+                raise InvalidArgument("give a start snapshot or a start state, not both")
+            start_state = self._checked_state_vector(start_state)
+        else:
+            start_state = None
         before = snapshots.take(scene)
         started = time.perf_counter()
         try:
             if start_snapshot is not None:
                 snapshots.put_back(scene, start_snapshot)
+            if start_state is not None:
+                self._put_state_vector(start_state)
             if motor_goals:
                 motors.set_velocities(scene, motor_goals)
             added = [forces.add_body_force(scene, **dict(f)) for f in body_forces]
@@ -513,7 +537,8 @@ class Core:
         scene.carried = carried
         states = tuple(BodyState(i, *(tuple(v.tolist()) for v in readout.body_state(scene, i)))
                        for i, o in scene.objects.items() if o.body is not None)
-        return Propagation(start_time, step_size, steps, states, collisions, 0.0, False)
+        return Propagation(start_time, step_size, steps, states, collisions, 0.0, False,
+                           self._state_vector())
 
     @_locked
     def check_collision(self, poses: Sequence[Tuple[str, Sequence[float], Sequence[float]]]

@@ -12,6 +12,7 @@ from typing import Sequence, Tuple
 
 import numpy as np
 
+from odin_common import interface
 from virtual_world.ode.bindings import ffi, lib
 
 IDENTITY = (1.0, 0.0, 0.0, 0.0)
@@ -85,7 +86,9 @@ def body_mass(body) -> Tuple[float, np.ndarray]:
 
 BODY_STATE_SIZE = lib.ODIN_BODY_STATE_SIZE
 """Doubles per body in read_states/write_states (odin_step.h: position, quaternion, rotation
-matrix, linear and angular velocity, enabled)."""
+matrix, linear and angular velocity, enabled; odin_common.interface.BODY_STATE_FIELDS names
+them for the clients of Propagate's state vectors)."""
+assert BODY_STATE_SIZE == interface.BODY_STATE_SIZE, "odin_step.h and BODY_STATE_FIELDS differ"
 
 
 def read_states(bodies: Sequence) -> np.ndarray:

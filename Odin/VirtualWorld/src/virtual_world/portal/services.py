@@ -232,6 +232,7 @@ class WorldServices:
                 "motor_axes": [len(m.goals) for m in motors],
                 "motor_goals": [v for m in motors for v in m.goals],
                 "motor_max_forces": [v for m in motors for v in m.max_forces],
+                "state_vector": self.core.body_state_vector().tolist(),
                 "message": f"{len(bodies)} bodies, {len(joints)} joints, {len(motors)} motors"}
 
     def save_state(self, request) -> dict:
@@ -258,7 +259,7 @@ class WorldServices:
         result = self.core.propagate(
             request.duration, step, motor_goals=goals,
             body_forces=[messages.body_force_arguments(f) for f in request.forces],
-            start=request.start, keep=request.keep)
+            start=request.start, keep=request.keep, start_state=request.start_state)
         if result.kept:
             self._sync_loop_time()
         return {"start_time": result.start_time, "step": result.step_size,
@@ -266,7 +267,7 @@ class WorldServices:
                 "states": [messages.body_state_message(s) for s in result.states],
                 "collisions": conversions.collision_pairs(result.collisions),
                 "first_times": [c.first_time for c in result.collisions],
-                "wall_time": result.wall_time,
+                "wall_time": result.wall_time, "state": result.state.tolist(),
                 "message": f"{result.steps} steps in {result.wall_time:.3g} s"
                            + (", kept" if result.kept else "")}
 

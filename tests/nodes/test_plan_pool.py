@@ -1,0 +1,80 @@
+"""The planning bridge's pool back end (gui.planning_pool, issue 17): two world nodes hold the
+Sphere problem; propagations from the planner's state vectors, fanned out over them, answer
+bit for bit what the Core back end answers, and a plan searched through the pool replays in the
+Core to the same place; `rosrun GUI plan --backend pool` refuses an absent world in one line."""
+from __future__ import annotations
+
+import logging
+import subprocess
+
+import numpy as np
+import pytest
+
+pytestmark = pytest.mark.forked
+
+NAMESPACES = ["/w0/virtual_world", "/w1/virtual_world"]
+SPHERE = ("current_2025", "demos", "OMPL_ode_demos", "Sphere", "Sphere.xml")
+
+
+def _sphere_plan(kautham_dir):
+    from gui.core.build import plan_problem
+    from gui.core.kautham.problem import load_problem
+    logging.disable(logging.WARNING)
+    try:
+        return plan_problem(load_problem(kautham_dir.joinpath(*SPHERE)))
+    finally:
+        logging.disable(logging.NOTSET)
+
+
+def _same(a, b) -> bool:
+    return (a.state.tobytes() == b.state.tobytes() and a.position.tobytes() == b.position.tobytes()
+            and a.velocity.tobytes() == b.velocity.tobytes() and a.collisions == b.collisions)
+
+
+def test_the_pool_answers_what_the_core_answers_and_plans_that_replay(ros_master, kautham_dir):
+    for namespace in ("/w0", "/w1"):
+        ros_master.rosrun("VirtualWorld", "virtualWorld", f"__ns:={namespace}")
+    for namespace in NAMESPACES:
+        ros_master.wait_for_service(f"{namespace}/propagate")
+    from gui.planning.backend import CoreBackend
+    from gui.planning.bridge import plan, replay
+    from gui.planning.problem import planning_problem
+    from gui.planning_pool import PoolBackend
+    sphere = _sphere_plan(kautham_dir)
+    problem = planning_problem(sphere)
+    core = CoreBackend(sphere, problem)
+    pool = PoolBackend(_sphere_plan(kautham_dir), planning_problem(_sphere_plan(kautham_dir)),
+                       NAMESPACES)
+    try:
+        assert pool.size == 2
+        assert pool.start_state().tobytes() == core.start_state().tobytes()
+        for got, want in zip(pool.base_state(pool.start_state()),
+                             core.base_state(core.start_state())):
+            assert got.tobytes() == want.tobytes()
+        rng = np.random.default_rng(3)
+        vectors = [core.start_state()]
+        for _ in range(3):                   # a chain of steps, then a fan from its states
+            vectors.append(core.propagate([(vectors[-1], (0.9, 0.2, 0.4))])[0].state)
+        requests = [(vectors[k % 4], tuple(rng.random(2)) + (0.4,)) for k in range(8)]
+        fanned, alone = pool.propagate(requests), core.propagate(requests)
+        assert all(_same(a, b) for a, b in zip(fanned, alone))
+        assert pool.propagations == 8
+        result = plan(pool, "KPIECE1", time_limit=3.0, seed=11)
+        assert result.propagations > 50 and result.rows
+        assert replay(core, result.rows).tobytes() == result.final_position.tobytes()
+    finally:
+        pool.close()
+        core.close()
+
+
+def test_plan_with_the_pool_refuses_an_absent_world_in_one_line(ros_master, kautham_dir,
+                                                                 tmp_path):
+    out = tmp_path / "p.path"
+    run = subprocess.run(["rosrun", "GUI", "plan", str(kautham_dir.joinpath(*SPHERE)),
+                          "--backend", "pool", "--worlds", "/nobody/virtual_world",
+                          "--world-timeout", "2", "--time", "1", "--out", str(out)],
+                         capture_output=True, text=True, timeout=120, env=ros_master.env)
+    assert run.returncode == 2, run.stderr
+    errors = [line for line in run.stderr.splitlines() if not line.startswith("plan: warning")]
+    assert errors == ["plan: error: /nobody/virtual_world: no world answering after 2 s"]
+    assert not out.exists()
