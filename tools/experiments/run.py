@@ -1,8 +1,8 @@
-"""Runs the thesis's three experiments (chapter 10) and Kautham's ODE sphere demo end to end,
-headless.
+"""Runs the thesis's three experiments (chapter 10), Kautham's ODE sphere demo and its plan by
+OMPL's KPIECE1 end to end, headless.
 
-    python tools/experiments/run.py                   # all four
-    python tools/experiments/run.py grasp             # one (contactless, pile, grasp, sphere)
+    python tools/experiments/run.py                   # all five
+    python tools/experiments/run.py grasp             # one (contactless ... plan_sphere)
     python tools/experiments/run.py --no-frames pile  # no Viewer frames (the same simulation)
 
 Each experiment starts its own roscore, ``rosrun VirtualWorld virtualWorld`` and ``rosrun
@@ -25,7 +25,7 @@ from gui.core.kautham.corpus import corpus_dir, missing_message
 HERE = pathlib.Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-NAMES = ("contactless", "pile", "grasp", "sphere")
+NAMES = ("contactless", "pile", "grasp", "sphere", "plan_sphere")
 
 
 def _raise_keyboard_interrupt(signum, frame):
@@ -35,7 +35,7 @@ def _raise_keyboard_interrupt(signum, frame):
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("names", nargs="*", metavar="name",
-                        help="contactless, pile, grasp or sphere (default: all four)")
+                        help=", ".join(NAMES) + " (default: all)")
     parser.add_argument("--no-frames", action="store_true", help="no Viewer frames")
     args = parser.parse_args(argv)
     unknown = [n for n in args.names if n not in NAMES]
