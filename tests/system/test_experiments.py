@@ -169,6 +169,25 @@ def test_sphere_demo_rests_on_the_ground_and_a_control_path_drives_it_to_its_goa
     assert o["rows"] == 57
 
 
+@pytest.mark.forked
+def test_plan_sphere_kpiece1_plan_replays_to_the_goal_region_in_a_fresh_world(kautham_dir):
+    """KPIECE1 plans the public Sphere in-process; its written control path, run row by row
+    through Propagate in a world node only built from the problem, leaves the sphere where the
+    planner's own replay did, in the goal region (tools/experiments/plan_sphere.py)."""
+    import plan_sphere
+    facts = plan_sphere.run(frames=False)
+    o = facts["outcome"]
+    failed = [name for name, held in plan_sphere.checks(o).items() if not held]
+    assert not failed, (failed, o)
+    # the worlds are deterministic: the same bits, not merely close
+    assert o["replay_bit_identical"], (o["planned_end_m"], o["executed_end_m"])
+    # seed 7 solves it in 340 propagations, 60 rows of 0.03 s, pushing one block (cubeDE1);
+    # the search stops when solved, so its length does not depend on the machine's speed
+    assert o["planner"]["propagations"] == 340 and o["rows_run"] == 60
+    assert o["start_m"] == pytest.approx([0.44, -0.67, 0.2], abs=1e-4)
+    assert ["SphereDE", "cubeDE1"] in o["sphere_touched"]
+
+
 def test_one_command_runs_several_experiments(kautham_dir):
     """`make experiments` runs them one after another from one command; each has a roscore of
     its own, which one rospy process cannot follow (it hung on the second before)."""
