@@ -107,8 +107,9 @@ def test_the_urdf_puts_every_link_where_the_model_and_the_world_bodies_are(probl
             # where the description says in that object
             expected = [T @ body.offset @ _link_in_object(description, k)
                         for k, (T, body) in enumerate(zip(links, handle.bodies))]
-            # the world's joint values are q - Home; the description's offsets give q back
-            world_values = q - handle.home
+            # the world's joint values are q - the configuration the robot was built in (the
+            # query's start in a current problem, else Home); the offsets give q back
+            world_values = q - handle.built_at
             values = {name: offset + v for name, offset, v in zip(
                 description.joint_names, description.joint_offsets, world_values)}
             poses = _urdf_poses(description.urdf, values, expected[0])

@@ -59,7 +59,8 @@ class RobotDescription:
     link_orientations: Tuple[float, ...]    # 4 per link, (w, x, y, z)
     joint_names: Tuple[str, ...]            # the robot's one-axis joints, its own names
     joints: Tuple[str, ...]                 # the world joint of each
-    joint_offsets: Tuple[float, ...]        # rad or m: robot value = offset + world value
+    joint_offsets: Tuple[float, ...]        # rad or m: robot value = offset + world value (the
+    #                                        configuration it was built in, RobotHandle.built_at)
     generated: bool                         # a URDF generated here, not the robot's own file
 
 
@@ -91,7 +92,7 @@ def describe_robot(handle, mesh_dir: Optional[os.PathLike] = None) -> RobotDescr
         link_positions=tuple(positions), link_orientations=tuple(orientations),
         joint_names=tuple(joint_of_link[i] for i in movable[:len(handle.joint_ids)]),
         joints=tuple(handle.joint_ids),
-        joint_offsets=tuple(float(v) for v in handle.home[:len(handle.joint_ids)]),
+        joint_offsets=tuple(float(v) for v in handle.built_at[:len(handle.joint_ids)]),
         generated=not given)
 
 
