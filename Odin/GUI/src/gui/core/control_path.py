@@ -270,19 +270,11 @@ class ClientPort:
 
     def body_state(self, body_id: str) -> BodyState:
         if body_id not in self._states:
-            # Set Servo and Get State have no typed method on WorldClient yet: call() takes the
-            # request's fields (plain lists) and answers the response
-            response = self.client.call("get_state", objects=[body_id])
-            b = response.bodies[0]
-            self._states[body_id] = (np.array(b.position), np.array(b.orientation),
-                                     np.array(b.linear))
+            self._states[body_id] = self.client.body_kinematics(body_id)[:3]
         return self._states[body_id]
 
     def set_servo(self, command: ServoCommand) -> None:
-        self.client.call("set_servo", motors=list(command.motors),
-                         targets=list(command.targets), rates=list(command.rates),
-                         gains=list(command.gains), max_speeds=list(command.max_speeds),
-                         max_forces=list(command.max_forces))
+        self.client.set_servo(command)
 
     def advance(self, duration: float, forces) -> None:
         started = time.monotonic()

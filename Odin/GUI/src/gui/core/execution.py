@@ -388,16 +388,11 @@ class ClientTrackingPort:
 
     def body_state(self, body_id: str) -> BodyState:
         if body_id not in self._states:
-            b = self.client.call("get_state", objects=[body_id]).bodies[0]
-            self._states[body_id] = (np.array(b.position), np.array(b.orientation),
-                                     np.array(b.linear), np.array(b.angular))
+            self._states[body_id] = self.client.body_kinematics(body_id)
         return self._states[body_id]
 
     def set_servo(self, command: ServoCommand) -> None:
-        self.client.call("set_servo", motors=list(command.motors),
-                         targets=list(command.targets), rates=list(command.rates),
-                         gains=list(command.gains), max_speeds=list(command.max_speeds),
-                         max_forces=list(command.max_forces))
+        self.client.set_servo(command)
 
     def set_body_velocity(self, body_id: str, linear, angular) -> None:
         self.client.set_body_velocity(body_id, linear=list(linear), angular=list(angular))

@@ -355,6 +355,21 @@ class WorldClient:
         """Reset to the state right after the last build; returns the simulated time (s)."""
         return float(self.call("reset").sim_time)
 
+    def body_kinematics(self, object_id: str) -> Tuple[np.ndarray, np.ndarray, np.ndarray,
+                                                       np.ndarray]:
+        """Get State of one body: position (m, world), orientation (w, x, y, z, world), linear
+        velocity (m/s, world) and angular velocity (rad/s, world)."""
+        b = self.call("get_state", objects=[object_id]).bodies[0]
+        return (np.array(b.position), np.array(b.orientation), np.array(b.linear),
+                np.array(b.angular))
+
+    def set_servo(self, command) -> None:
+        """Set Servo from a gui.core.control_path.ServoCommand (motors, targets rad or m,
+        rates, gains 1/s, speed limits, force limits)."""
+        self.call("set_servo", motors=list(command.motors), targets=list(command.targets),
+                  rates=list(command.rates), gains=list(command.gains),
+                  max_speeds=list(command.max_speeds), max_forces=list(command.max_forces))
+
     def propagate(self, duration: float, step: float = 0.0,
                   motor_goals: Optional[Dict[str, Sequence[float]]] = None,
                   forces: Sequence[dict] = (), start: str = "", keep: bool = False
