@@ -236,3 +236,16 @@ def test_an_unknown_encoding_is_one_clear_error(tmp_path):
     f.write_text('<?xml version="1.0" encoding="UTF0"?>\n<Problem/>\n')
     status, _, err = problem_info(f)
     assert status == 2 and "malformed XML" in one_error_line(err)
+
+
+def test_path_and_control_files_larger_than_the_limit_are_refused_unread(tmp_path):
+    from gui.core.control_path import read_control_path
+    from gui.core.paths import read_path
+    from gui.errors import PathFileError
+    huge = tmp_path / "huge.txt"
+    with open(huge, "wb") as f:
+        f.truncate((MAX_INPUT_FILE_MB + 1) * 2 ** 20)
+    with pytest.raises(PathFileError, match="larger than the"):
+        read_path(huge)
+    with pytest.raises(PathFileError, match="larger than the"):
+        read_control_path(huge, 2)

@@ -23,6 +23,7 @@ from typing import Optional
 
 import numpy as np
 
+from gui.core.sizes import check_file_size
 from gui.errors import PathFileError
 from gui.core.kautham.xmlfile import read_xml
 from gui.core.model import PRISMATIC
@@ -45,6 +46,7 @@ def read_rows(path: os.PathLike | str, n_values: Optional[int] = None,
     p = pathlib.Path(path)
     if not p.is_file():
         raise PathFileError("path file not found", p)
+    check_file_size(p, "path file", PathFileError)
     text = p.read_text(errors="replace")
     if text.lstrip().startswith("<"):
         root = read_xml(p, "task file")

@@ -44,6 +44,7 @@ import numpy as np
 from gui.core.kautham.xmlfile import Node, read_xml
 from gui.core.model import Instance, Problem
 from gui.core.paths import DEGREES, RADIANS, read_rows, to_si
+from gui.core.sizes import check_file_size
 from gui.errors import PathFileError, ProblemError
 from odin_common.rotations import quaternion_to_matrix
 
@@ -100,6 +101,7 @@ def read_solution(path: os.PathLike | str, problem: Problem, robot: Optional[str
         raise PathFileError("path file not found", p)
     if not problem.robots:
         raise PathFileError(f"problem {problem.source} has no robot to move", p)
+    check_file_size(p, "path file", PathFileError)
     text = p.read_text(errors="replace")
     if text.lstrip().startswith("<"):
         root = _read_xml(p)
