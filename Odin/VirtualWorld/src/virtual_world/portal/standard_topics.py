@@ -35,7 +35,31 @@ from virtual_world.portal.tf_writer import TfWriter
 _log = logging.getLogger("rosout")
 
 
-class _FullMarkersOnSubscribe(rospy.SubscribeListener):
+class _SendsToNewSubscribers(rospy.SubscribeListener):
+    """A listener that sends a message of its own to each new subscriber of ``publisher`` (set
+    once the publisher exists: it takes its listener when made).
+
+    rospy's ``peer_publish`` serialises into the one buffer the topic's ``publish`` uses, but
+    without the lock that ``publish`` and the latched-message send take; sent unlocked, it
+    met the latched message a new subscriber gets at the same moment and both came out
+    corrupt (RViz under load drew no geometry: "argument out of range"). So every send here
+    holds that lock (``Publisher.impl``'s, the one rospy's own ``publish`` takes)."""
+
+    def __init__(self):
+        super().__init__()
+        self.publisher: rospy.Publisher | None = None
+
+    def send_alone(self, peer_publish, message) -> None:
+        """``peer_publish(message)`` holding the publisher's lock."""
+        impl = self.publisher.impl
+        impl.acquire()
+        try:
+            peer_publish(message)
+        finally:
+            impl.release()
+
+
+class _FullMarkersOnSubscribe(_SendsToNewSubscribers):
     """Sends every marker to each new subscriber of ``~markers`` (the latched message alone is
     only the last change). The markers are computed on the world's loop thread, and rospy calls
     this on the thread that accepts every connection of the node (services too): so the work
@@ -54,13 +78,13 @@ class _FullMarkersOnSubscribe(rospy.SubscribeListener):
 
     def _send(self, topic_name, peer_publish) -> None:
         try:
-            self._on_loop(lambda: peer_publish(self._markers.full()))
+            self._on_loop(lambda: self.send_alone(peer_publish, self._markers.full()))
         except Exception as error:   # the world stopping, the subscriber gone
             _log.warning("virtual_world: no markers for a new subscriber of %s: %s",
                          topic_name, error)
 
 
-class _LastTfOnSubscribe(rospy.SubscribeListener):
+class _LastTfOnSubscribe(_SendsToNewSubscribers):
     """Sends the last /tf message to each new subscriber: while paused the world sends none."""
 
     def __init__(self):
@@ -70,7 +94,7 @@ class _LastTfOnSubscribe(rospy.SubscribeListener):
     def peer_subscribe(self, topic_name, topic_publish, peer_publish) -> None:
         last = self.last
         if last is not None:
-            peer_publish(last)
+            self.send_alone(peer_publish, last)
 
 
 class StandardTopics:
@@ -83,10 +107,12 @@ class StandardTopics:
         self._tf_listener = _LastTfOnSubscribe()
         self.pub_tf = rospy.Publisher("/tf", TFMessage, queue_size=100,
                                       subscriber_listener=self._tf_listener)
+        self._tf_listener.publisher = self.pub_tf
         self.pub_tf_static = rospy.Publisher("/tf_static", TFMessage, queue_size=10, latch=True)
-        self.pub_markers = rospy.Publisher(
-            "~markers", MarkerArray, queue_size=100, latch=True,
-            subscriber_listener=_FullMarkersOnSubscribe(mirror.markers, on_loop))
+        markers_listener = _FullMarkersOnSubscribe(mirror.markers, on_loop)
+        self.pub_markers = rospy.Publisher("~markers", MarkerArray, queue_size=100, latch=True,
+                                           subscriber_listener=markers_listener)
+        markers_listener.publisher = self.pub_markers
         self._tf = TfWriter()
         self._tf_static = TfWriter()
         self._static_published = None
