@@ -108,10 +108,36 @@ def test_cube_mesh_is_closed_and_keeps_hard_edges():
     np.testing.assert_allclose(np.sort(np.abs(normals), axis=1), [[0, 0, 1]] * 36, atol=1e-6)
 
 
-def test_inverted_or_open_meshes_are_not_closed():
+def _outward_share(geometry) -> float:
+    """Share of the triangles whose winding normal points away from the origin."""
+    corners = geometry.vertices_B[geometry.indices_B].reshape(-1, 3, 3).astype(float)
+    normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    return float(np.mean(np.einsum("ij,ij->i", normals, corners.mean(axis=1)) > 0))
+
+
+def test_a_closed_mesh_wound_inwards_is_turned_outwards_and_drawn_closed():
     inverted = np.array(CUBE_TRIANGLES).reshape(-1, 3)[:, ::-1].ravel()
-    assert not geometry_from_parameters(CUBE_VERTICES, inverted).closed
+    cube = geometry_from_parameters(CUBE_VERTICES, inverted)
+    assert cube.closed and _outward_share(cube) == 1.0
+    normals = cube.normals_B[cube.indices_B].astype(float)
+    centres = cube.vertices_B[cube.indices_B].astype(float)
+    assert np.all(np.einsum("ij,ij->i", normals, centres) > 0)    # lit from outside
+
+
+def test_open_or_inconsistently_wound_meshes_are_not_closed():
     assert not geometry_from_parameters(CUBE_VERTICES, CUBE_TRIANGLES[:-3]).closed
+    one_flipped = np.array(CUBE_TRIANGLES).reshape(-1, 3)
+    one_flipped[0] = one_flipped[0, ::-1]
+    assert not geometry_from_parameters(CUBE_VERTICES, one_flipped.ravel()).closed
+
+
+def test_repeated_triangles_and_unwelded_corners_keep_a_mesh_closed():
+    # CAD meshes repeat a few triangles; STL-like soups repeat each corner per triangle
+    repeated = CUBE_TRIANGLES + CUBE_TRIANGLES[:3]
+    assert geometry_from_parameters(CUBE_VERTICES, repeated).closed
+    corners = np.array(CUBE_VERTICES).reshape(-1, 3)[CUBE_TRIANGLES]
+    soup = geometry_from_parameters(corners.ravel(), range(len(corners)))
+    assert soup.closed
 
 
 def test_finely_tessellated_surface_is_smooth():

@@ -138,3 +138,21 @@ def test_translucent_objects_blend(renderer):
     frame = renderer.render(scene)
     rgb = patch(frame, scene.camera.project([(0, 0, 0.4)])[0])
     assert rgb[2] > rgb[0] + 40 and rgb[0] > 30        # blue over the light background
+
+
+def test_a_dense_mesh_far_away_is_drawn_at_a_coarser_level_in_its_colour(renderer,
+                                                                                tmp_path):
+    import trimesh
+    ball = trimesh.creation.icosphere(subdivisions=5, radius=0.3)     # 20k triangles
+    vertices, faces = np.asarray(ball.vertices).ravel(), np.asarray(ball.faces).ravel()
+    frames, levels = [], []
+    for name, eye in (("near", (0.7, 0.0, 0.3)), ("far", (15.0, 0.0, 0.3))):
+        scene = fixed_scene(eye_W=eye, target_W=(0.0, 0.0, 0.3))
+        scene.view_object("ball", vertices, faces, position_W=(0, 0, 0.3), color=RED)
+        frames.append(renderer.render(scene))
+        save(frames[-1], tmp_path, f"lod_{name}")
+        levels.append(renderer._meshes and max(level for _, level in renderer._meshes))
+        centre = scene.camera.project([(0, 0, 0.3)])[0]
+        assert is_hue(patch(frames[-1], centre, 1), 0), name
+    # near: a pixel is ~1.4 mm, the 1 mm level (0); at 15 m ~5 cm: the coarsest (32 mm)
+    assert levels == [0, 5]

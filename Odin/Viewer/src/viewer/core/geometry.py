@@ -20,7 +20,8 @@ import numpy as np
 from odin_common.errors import InvalidArgument
 from odin_common.interface import (PLANE_DRAWN_SIZE, PLANE_DRAWN_THICKNESS, SHAPE_PARAMETERS,
                                    Shape, shape_of)
-from odin_common.meshes import DISPLAY_TOLERANCE, capsule_mesh, display_mesh  # noqa: F401
+from odin_common.meshes import (DISPLAY_TOLERANCE, capsule_mesh, cluster_vertices,  # noqa: F401
+                                display_mesh)
 from odin_common.rotations import quaternion_to_matrix, unit_quaternion
 from viewer.errors import ViewerError
 
@@ -72,6 +73,8 @@ class Geometry:
     bounded: False for a plane (infinite in the world, drawn as a large floor): the camera
         fits the scene without it.
     key: unique per Geometry, so that a renderer can cache GPU buffers by it.
+    levels: a large mesh's levels of detail (:class:`MeshLevels`); None for primitives and
+        small meshes.
     """
     kind: str
     scale_B: tuple
@@ -82,10 +85,19 @@ class Geometry:
     closed: bool = True
     bounded: bool = True
     key: int = field(default_factory=lambda: next(_keys))
+    levels: "MeshLevels | None" = None
 
     @property
     def triangle_count(self) -> int:
         return len(self.indices_B) // 3
+
+    def detail(self, cell: float) -> tuple:
+        """(level, vertices_B, normals_B, indices_B) to draw this mesh with where detail finer
+        than ``cell`` m is lost on screen (its levels of detail, :class:`MeshLevels`); level 0
+        (these arrays) for a mesh without levels."""
+        if self.levels is None:
+            return 0, self.vertices_B, self.normals_B, self.indices_B
+        return self.levels.for_cell(cell)
 
 
 def _positive(values: Sequence[float], names: Sequence[str], shape: str) -> list:
@@ -144,6 +156,12 @@ def capsule_geometry(radius: float, length: float, slices: int = 32, stacks: int
 #: their own with the face's normal (hard edges stay hard, curved surfaces look smooth)
 CREASE_ANGLE = math.radians(40.0)
 
+#: Levels of detail: level k of a mesh clusters its vertices on a grid of
+#: DISPLAY_TOLERANCE * 2**k m, k = 0 .. LOD_LEVELS - 1 (1 to 32 mm). Meshes of fewer
+#: than LOD_MIN_TRIANGLES triangles are always drawn whole.
+LOD_LEVELS = 6
+LOD_MIN_TRIANGLES = 500
+
 
 # Meshes of more than DISPLAY_DETAIL_TRIANGLES triangles are drawn with their vertices clustered
 # at DISPLAY_TOLERANCE (odin_common.meshes.display_mesh, shared with the world's RViz markers).
@@ -152,7 +170,9 @@ CREASE_ANGLE = math.radians(40.0)
 def mesh_geometry(vertices_B: np.ndarray, indices: Sequence[int]) -> Geometry:
     """An indexed mesh from vertices (n, 3) m and triangle indices (3 per triangle), with
     area-weighted vertex normals split at creases sharper than ``CREASE_ANGLE``; large meshes
-    are simplified for display (clustered at ``DISPLAY_TOLERANCE``)."""
+    are simplified for display (clustered at ``DISPLAY_TOLERANCE``). A closed mesh wound
+    inwards (clockwise, as some Kautham VRML files are) is turned outwards, so that it is drawn
+    as a closed one: back faces culled, one side lit (half the cost of an open one)."""
     vertices = np.asarray(vertices_B, dtype=float)
     if not np.all(np.isfinite(vertices)):
         raise ViewerError("mesh vertices must be finite numbers (m)")
@@ -165,8 +185,25 @@ def mesh_geometry(vertices_B: np.ndarray, indices: Sequence[int]) -> Geometry:
     if np.any(bad):
         raise ViewerError(f"mesh index {int(idx[bad][0])} out of range: the mesh has "
                           f"{len(vertices)} vertices")
-    closed = _closed_and_outward(idx.reshape(-1, 3), vertices[idx].reshape(-1, 3, 3))
+    winding = _closed_winding(vertices, idx.reshape(-1, 3))
+    if winding < 0:
+        idx = idx.reshape(-1, 3)[:, ::-1].reshape(-1)
     vertices, idx = display_mesh(vertices, idx)
+    drawn_vertices, normals, drawn_indices = _shaded(vertices, idx)
+    radius = float(np.max(np.linalg.norm(vertices[np.unique(idx)], axis=1)))
+    levels = MeshLevels(vertices, idx) if len(idx) // 3 >= LOD_MIN_TRIANGLES else None
+    geometry = Geometry("mesh", (1.0, 1.0, 1.0), radius, vertices_B=drawn_vertices,
+                        normals_B=normals, indices_B=drawn_indices, closed=winding != 0,
+                        levels=levels)
+    if levels is not None:
+        levels.keep(0, drawn_vertices, normals, drawn_indices)
+    return geometry
+
+
+def _shaded(vertices: np.ndarray, idx: np.ndarray) -> tuple:
+    """(vertices (n', 3) float32, normals (n', 3) float32, indices (3 t,) uint32) of an
+    indexed mesh with area-weighted vertex normals, corners at creases sharper than
+    CREASE_ANGLE given a vertex of their own with the face's normal."""
     corners = vertices[idx].reshape(-1, 3, 3)
     area_normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
     lengths = np.linalg.norm(area_normals, axis=1, keepdims=True)
@@ -180,24 +217,70 @@ def mesh_geometry(vertices_B: np.ndarray, indices: Sequence[int]) -> Geometry:
     sharp = np.einsum("ij,ij->i", vertex_normals[idx], corner_face) < math.cos(CREASE_ANGLE)
     out_idx = idx.copy()
     out_idx[sharp] = len(vertices) + np.arange(int(sharp.sum()))
-    radius = float(np.max(np.linalg.norm(vertices[np.unique(idx)], axis=1)))
-    return Geometry("mesh", (1.0, 1.0, 1.0), radius,
-                    vertices_B=np.concatenate([vertices, vertices[idx[sharp]]]).astype(np.float32),
-                    normals_B=np.concatenate([vertex_normals, corner_face[sharp]]).astype(np.float32),
-                    indices_B=out_idx.astype(np.uint32),
-                    closed=closed)
+    return (np.concatenate([vertices, vertices[idx[sharp]]]).astype(np.float32),
+            np.concatenate([vertex_normals, corner_face[sharp]]).astype(np.float32),
+            out_idx.astype(np.uint32))
 
 
-def _closed_and_outward(triangles: np.ndarray, corners: np.ndarray) -> bool:
-    """Every directed edge appears once and its reverse once, and the signed volume is > 0."""
-    edges = np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]])
-    n = int(triangles.max()) + 1
+class MeshLevels:
+    """A mesh's levels of detail, each made the first time it is asked for: level k clusters
+    the drawn mesh's vertices on a grid of DISPLAY_TOLERANCE * 2**k m
+    (odin_common.meshes.cluster_vertices, which keeps the surface within a cell's diagonal of
+    the mesh), so a mesh that covers few pixels is drawn with few triangles. On llvmpipe a
+    frame's cost grows with its triangles: the SAH hand's 95k triangles, a few dozen pixels
+    tall in the Viewer's default view, cost most of a frame."""
+
+    def __init__(self, vertices: np.ndarray, idx: np.ndarray):
+        self._vertices = vertices
+        self._idx = idx
+        self._made: dict = {}
+
+    def keep(self, level: int, *arrays) -> None:
+        self._made[level] = arrays
+
+    def for_cell(self, cell: float) -> tuple:
+        """(level, vertices, normals, indices) of the coarsest level whose grid is at most
+        ``cell`` m; a level whose triangles all collapse is never used (the one before it
+        is)."""
+        wanted = 0
+        while wanted + 1 < LOD_LEVELS and DISPLAY_TOLERANCE * 2 ** (wanted + 1) <= cell:
+            wanted += 1
+        for level in range(wanted, 0, -1):
+            arrays = self._made.get(level)
+            if arrays is None:
+                arrays = self._made[level] = self._make(level)
+            if arrays:
+                return (level, *arrays)
+        return (0, *self._made[0])
+
+    def _make(self, level: int) -> tuple:
+        vertices, idx = cluster_vertices(self._vertices, self._idx,
+                                         DISPLAY_TOLERANCE * 2 ** level)
+        return _shaded(vertices, idx) if idx.size else ()
+
+
+def _closed_winding(vertices: np.ndarray, triangles: np.ndarray) -> int:
+    """+1 when the surface is closed and wound outwards (counter-clockwise seen from outside),
+    -1 when closed and wound inwards, 0 when open or wound inconsistently. Closed: with
+    vertices at the same place taken as one, collapsed triangles left out and a repeated one
+    counted once (CAD meshes have both), every edge is met as often in one direction as in
+    the other (no boundary, neighbours wound alike). Wound: the sign of the enclosed volume."""
+    _, welded = np.unique(vertices, axis=0, return_inverse=True)
+    t = welded.reshape(-1)[triangles]
+    t = t[(t[:, 0] != t[:, 1]) & (t[:, 1] != t[:, 2]) & (t[:, 2] != t[:, 0])]
+    if len(t) == 0:
+        return 0
+    first = np.argmin(t, axis=1)[:, None]          # a repeated triangle counts once
+    t = np.unique(np.take_along_axis(t, (first + np.arange(3)) % 3, axis=1), axis=0)
+    edges = np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]])
+    n = int(t.max()) + 1
     forward = np.sort(edges[:, 0] * n + edges[:, 1])
     backward = np.sort(edges[:, 1] * n + edges[:, 0])
-    if np.any(forward[1:] == forward[:-1]) or not np.array_equal(forward, backward):
-        return False
+    if not np.array_equal(forward, backward):
+        return 0
+    corners = vertices[triangles]
     volume = np.einsum("ij,ij->i", corners[:, 0], np.cross(corners[:, 1], corners[:, 2])).sum()
-    return bool(volume > 0)
+    return 1 if volume > 0 else -1 if volume < 0 else 0
 
 
 # -- unit primitives, tessellated once ------------------------------------------------------
