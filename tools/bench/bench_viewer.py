@@ -3,7 +3,7 @@ TX90_RHand_ICRA10_5PMD_TwoCan.xml), loaded with the GUI's Kautham loader (gui.co
 gui.core.build: the same requests the GUI sends, ~195k triangles).
 
 viewer_frame_ms_grasp: median wall time (ms) to render one 640x480 frame of the scene and read
-    it back as an array, Core + renderer in this process (no ROS). Goal <= 40.
+    it back as an array, Core + renderer in this process (no ROS), the default camera. Goal <= 15.
 viewer_fps_held: frames per second the Viewer node actually publishes on ~image over 10 s while
     a publisher sends SpaceDistribution for the scene at 25 Hz (robot moving). Goal >= 24.
 Writes out_dir/viewer_grasp.png (the frame measured) and out_dir/viewer_bench.json.

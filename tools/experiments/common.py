@@ -104,11 +104,15 @@ class Session:
 
     ``with Session("pile", world_parameters, camera, track={"can"}) as s:`` then
     ``s.client`` (gui.ros.client.WorldClient), ``s.cycle()``, ``s.frame()``, ``s.record``.
+    ``viewer=False`` runs no Viewer (no frames then): the benchmarks time the world with and
+    without one rendering beside it.
     """
 
     def __init__(self, name: str, world_parameters: dict, camera: Camera,
                  track: Iterable[str] = (), frames: bool = True, contacts: bool = False,
-                 out_root: pathlib.Path = OUT_ROOT):
+                 out_root: pathlib.Path = OUT_ROOT, viewer: bool = True):
+        if frames and not viewer:
+            raise ExperimentError(f"{name}: frames come from the Viewer: run it (viewer=True)")
         self.name = name
         self.out = pathlib.Path(out_root) / name
         self.frames_dir = self.out / "frames"
@@ -117,6 +121,8 @@ class Session:
         self.track = set(track)
         self.save_frames = frames
         self.want_contacts = contacts
+        self.with_viewer = viewer
+        self.viewer = None
         self.record = Record()
         self.frame_paths: list = []
         self.frame_times: list = []
@@ -160,13 +166,15 @@ class Session:
         self.world = master.rosrun("VirtualWorld", "virtualWorld",
                                    *world_args(self.world_parameters))
         cam = self.camera
-        self.viewer = master.rosrun(
-            "Viewer", "viewer", f"_snapshot_dir:={self.frames_dir}",
-            "_eye:=[%s]" % ",".join(repr(float(v)) for v in cam.eye),
-            "_target:=[%s]" % ",".join(repr(float(v)) for v in cam.target),
-            f"_width:={cam.width}", f"_height:={cam.height}")
+        if self.with_viewer:
+            self.viewer = master.rosrun(
+                "Viewer", "viewer", f"_snapshot_dir:={self.frames_dir}",
+                "_eye:=[%s]" % ",".join(repr(float(v)) for v in cam.eye),
+                "_target:=[%s]" % ",".join(repr(float(v)) for v in cam.target),
+                f"_width:={cam.width}", f"_height:={cam.height}")
         master.wait_for_service("/virtual_world/step_once")
-        master.wait_for_service("/viewer/save_snapshot")
+        if self.with_viewer:
+            master.wait_for_service("/viewer/save_snapshot")
         from gui.ros.client import WorldClient
         self.client = WorldClient(timeout=30.0)
         self._subscribers = [
@@ -191,7 +199,7 @@ class Session:
 
     def check_nodes(self) -> None:
         for process in (self.world, self.viewer):
-            if process.poll() is not None:
+            if process is not None and process.poll() is not None:
                 raise ExperimentError(f"{' '.join(process.args)} died:\n"
                                       + self._master.log_text(process)[-3000:])
 

@@ -104,7 +104,9 @@ def motor_of(handle, link_name: str) -> str:
 MODES = ("tracked", "velocity")
 
 
-def run(frames: bool = True, out_root=None, mode: str = "tracked") -> dict:
+def run(frames: bool = True, out_root=None, mode: str = "tracked", viewer: bool = True) -> dict:
+    """The grasp in ``mode``; with ``frames``, the Viewer's numbered frames and close-ups;
+    ``viewer=False`` (no frames) runs it without a Viewer node (bench_experiments)."""
     if mode not in MODES:
         raise common.ExperimentError(f"grasp mode {mode!r}: choose from {', '.join(MODES)}")
     from gui.core.paths import RADIANS, load_robot_path
@@ -115,7 +117,7 @@ def run(frames: bool = True, out_root=None, mode: str = "tracked") -> dict:
         p["can_length_m"]))
     kwargs = {} if out_root is None else {"out_root": out_root}
     with common.Session("grasp", WORLD, CAMERA, track={CAN, PALM}, frames=frames,
-                        contacts=True, **kwargs) as s:
+                        contacts=True, viewer=viewer, **kwargs) as s:
         s.client.execute(plan)
         handle = plan.robots[0]
         initial = load_robot_path(common.PATHS_DIR / "grasp_initial.txt", handle, RADIANS)
