@@ -310,8 +310,11 @@ def render_parameters() -> str:
     lines += ["", f"### `{VIEWER_NAMESPACE}`", ""]
     lines += _node_table(VIEWER_PARAMETERS)
     lines += ["", "Meshes of more than 2,000 triangles are drawn with their vertices clustered "
-              "at 1 mm (`odin_common.meshes.DISPLAY_TOLERANCE`); the world's collision meshes "
-              "are not affected.", "", "### `/gui`", ""]
+              "at 1 mm (`odin_common.meshes.DISPLAY_TOLERANCE`); meshes of 500 triangles or "
+              "more are drawn at the coarsest level of detail whose grid (2 to 32 mm) is at "
+              "most a pixel where they come nearest the camera "
+              "(`viewer.core.geometry.MeshLevels`); the world's collision meshes are not "
+              "affected.", "", "### `/gui`", ""]
     lines += _node_table(GUI_PARAMETERS)
     return "\n".join(lines) + "\n"
 
