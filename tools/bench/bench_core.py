@@ -132,6 +132,9 @@ def build_scene(core, mode: int, forces: int, motors: int) -> None:
     """The scene of native/core_scene.c through the Core API."""
     from virtual_world.core import FORCE, ObjectSpec
 
+    # native/core_scene.c steps with QuickStep; the Core's default solver (auto) would take
+    # dWorldStep for the pile's first steps (few contact rows) and do other work
+    core.set_world_parameters(solver=0)
     core.build_object(ObjectSpec("ground", [20, 20, 1], position=(0, 0, -0.5),
                                  geometry_only=True))
     if mode == 1:
