@@ -206,6 +206,24 @@ def test_marker_changes_hold_only_what_changed_and_grey_follows_collisions():
     assert [m.action for m in _markers(markers.take_changes())] == [Marker.DELETEALL, Marker.ADD]
 
 
+def test_grey_follows_collisions_across_rebuilds_and_names_not_yet_drawn():
+    pose = ((0, 0, 0), (1, 0, 0, 0))
+    markers = GeometryMarkers()
+    markers.set_colliding({"d"})                      # no marker yet: nothing to send
+    assert markers.take_changes() is None
+    markers.add("d", [0.1], [], 0, (1, 0, 0, 1), "d", pose)
+    markers.take_changes()
+    markers.set_colliding({"d"})                      # now drawn: it turns grey
+    (grey,) = _markers(markers.take_changes())
+    assert grey.color.g == pytest.approx(COLLIDING_COLOR[1])
+    markers.add("d", [0.2], [], 0, (1, 0, 0, 1), "d", pose)   # rebuilt: its own colour
+    assert _markers(markers.take_changes())[0].color.r == 1.0
+    markers.set_colliding({"d"})                      # still colliding: grey again
+    assert _markers(markers.take_changes())[0].color.g == pytest.approx(COLLIDING_COLOR[1])
+    markers.set_colliding({"d"})
+    assert markers.take_changes() is None             # nothing changed, nothing sent
+
+
 def test_a_large_mesh_marker_is_simplified_as_the_viewer_draws_it():
     n = 200    # a 200 x 200 grid of 0.5 mm: 79,202 triangles
     x, y = np.meshgrid(np.linspace(0, 0.1, n), np.linspace(0, 0.1, n))

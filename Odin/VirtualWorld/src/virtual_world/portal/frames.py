@@ -59,6 +59,7 @@ class ObjectFrames:
 
     def __init__(self) -> None:
         self._objects: Dict[str, _Frame] = {}
+        self._taken = {WORLD_FRAME}    # every frame in use (kept: a set per build is O(n^2))
         self._layout_key: Optional[tuple] = None
         self._layout: tuple = ()
 
@@ -71,17 +72,21 @@ class ObjectFrames:
         in_object = {name: compose_poses(*world_in_object, np.asarray(pose[0], float),
                                          np.asarray(pose[1], float))
                      for name, pose in geometries}
-        frame = unique_frame(frame_id(object_id), self._taken())
+        frame = unique_frame(frame_id(object_id), self._taken)
         self._objects[object_id] = _Frame(frame, frame, static, in_object, IDENTITY_POSE)
+        self._taken.add(frame)
         self._layout_key = None
         return frame
 
     def remove(self, object_id: str) -> None:
-        if self._objects.pop(object_id, None) is not None:
+        entry = self._objects.pop(object_id, None)
+        if entry is not None:
+            self._taken.discard(entry.name)
             self._layout_key = None
 
     def clear(self) -> None:
         self._objects.clear()
+        self._taken = {WORLD_FRAME}
         self._layout_key = None
 
     def __contains__(self, object_id: str) -> bool:
@@ -108,7 +113,9 @@ class ObjectFrames:
         """The object becomes a robot's link: its frame is ``frame``, at ``link_in_object``
         (the link frame's pose in the object's frame)."""
         entry = self._objects[object_id]
+        self._taken.discard(entry.name)
         entry.name = frame
+        self._taken.add(frame)
         entry.place(link_in_object)
         self._layout_key = None
 
@@ -117,7 +124,9 @@ class ObjectFrames:
         entry = self._objects.get(object_id)
         if entry is None:
             return
-        entry.name = unique_frame(entry.own_name, self._taken() - {entry.name})
+        self._taken.discard(entry.name)
+        entry.name = unique_frame(entry.own_name, self._taken)
+        self._taken.add(entry.name)
         entry.place(IDENTITY_POSE)
         self._layout_key = None
 
@@ -173,8 +182,5 @@ class ObjectFrames:
                       np.asarray(local_p, float).reshape(-1, 3),
                       np.asarray(local_q, float).reshape(-1, 4))
                      for frames, rows, local_p, local_q in (groups[False], groups[True]))
-
-    def _taken(self) -> set:
-        return {f.name for f in self._objects.values()} | {WORLD_FRAME}
 
 

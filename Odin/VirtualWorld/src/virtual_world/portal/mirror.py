@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import collections
 from dataclasses import dataclass
-from typing import Dict, Iterable, List, Sequence, Tuple
+from typing import Dict, Iterable, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -50,6 +50,7 @@ class WorldMirror:
         self.objects: "collections.OrderedDict[str, ObjectInfo]" = collections.OrderedDict()
         self.changed = False             # the world changed since the last publication
         self._robot_changes: List[Tuple[str, Robot]] = []
+        self._movable: Optional[List[str]] = None   # movable_objects until the next change
 
     # -- the scene's changes (the world's services call these after the Core succeeded) -------
     def built(self, object_id: str, spec, geometries: Sequence) -> None:
@@ -69,6 +70,7 @@ class WorldMirror:
             static=bool(spec.geometry_only),
             movable=not (spec.geometry_only or spec.fixed),
             geometries=tuple(g.name for g in geometries), size=_size(spec))
+        self._movable = None
         self.changed = True
 
     def removed(self, object_id: str = "", joint_ids: Iterable[str] = ()) -> None:
@@ -80,6 +82,7 @@ class WorldMirror:
         if info is not None:
             self.frames.remove(object_id)
             self.markers.remove(info.geometries)
+        self._movable = None
         self.changed = True
 
     def cleared(self) -> None:
@@ -89,6 +92,7 @@ class WorldMirror:
         self.frames.clear()
         self.markers.clear()
         self.objects.clear()
+        self._movable = None
         self.changed = True
 
     # -- robots --------------------------------------------------------------------------------
@@ -108,6 +112,7 @@ class WorldMirror:
         self.robots.set(robot)
         self._replace_markers(set(replaced) | set(frames))
         self._robot_changes.append(("set", robot))
+        self._movable = None
         self.changed = True
 
     def remove_robot(self, name: str) -> Robot:
@@ -127,6 +132,7 @@ class WorldMirror:
             self.frames.unset_link(object_id)
         self._replace_markers(objects)
         self._robot_changes.append(("remove", robot))
+        self._movable = None
 
     def _replace_markers(self, object_ids: Iterable[str]) -> None:
         for object_id in object_ids:
@@ -139,9 +145,12 @@ class WorldMirror:
     # -- reading -------------------------------------------------------------------------------
     def movable_objects(self) -> List[str]:
         """Objects a user may drag or push: bodies neither fixed nor static, and no robot's
-        link (a link is moved through its joints)."""
-        return [o for o, info in self.objects.items()
-                if info.movable and self.robots.robot_of_object(o) is None]
+        link (a link is moved through its joints). Asked every publication: computed again
+        only after the scene or its robots changed."""
+        if self._movable is None:
+            self._movable = [o for o, info in self.objects.items()
+                             if info.movable and self.robots.robot_of_object(o) is None]
+        return list(self._movable)
 
 
 def _size(spec) -> float:
