@@ -189,15 +189,11 @@ def mesh_geometry(vertices_B: np.ndarray, indices: Sequence[int]) -> Geometry:
     if winding < 0:
         idx = idx.reshape(-1, 3)[:, ::-1].reshape(-1)
     vertices, idx = display_mesh(vertices, idx)
-    drawn_vertices, normals, drawn_indices = _shaded(vertices, idx)
+    drawn = _shaded(vertices, idx)
     radius = float(np.max(np.linalg.norm(vertices[np.unique(idx)], axis=1)))
-    levels = MeshLevels(vertices, idx) if len(idx) // 3 >= LOD_MIN_TRIANGLES else None
-    geometry = Geometry("mesh", (1.0, 1.0, 1.0), radius, vertices_B=drawn_vertices,
-                        normals_B=normals, indices_B=drawn_indices, closed=winding != 0,
-                        levels=levels)
-    if levels is not None:
-        levels.keep(0, drawn_vertices, normals, drawn_indices)
-    return geometry
+    levels = MeshLevels(vertices, idx, drawn) if len(idx) // 3 >= LOD_MIN_TRIANGLES else None
+    return Geometry("mesh", (1.0, 1.0, 1.0), radius, vertices_B=drawn[0], normals_B=drawn[1],
+                    indices_B=drawn[2], closed=winding != 0, levels=levels)
 
 
 def _shaded(vertices: np.ndarray, idx: np.ndarray) -> tuple:
@@ -230,13 +226,12 @@ class MeshLevels:
     frame's cost grows with its triangles: the SAH hand's 95k triangles, a few dozen pixels
     tall in the Viewer's default view, cost most of a frame."""
 
-    def __init__(self, vertices: np.ndarray, idx: np.ndarray):
+    def __init__(self, vertices: np.ndarray, idx: np.ndarray, level0: tuple):
+        """``vertices``, ``idx``: the drawn mesh before shading; ``level0``: its shaded
+        (vertices, normals, indices) (:func:`_shaded`)."""
         self._vertices = vertices
         self._idx = idx
-        self._made: dict = {}
-
-    def keep(self, level: int, *arrays) -> None:
-        self._made[level] = arrays
+        self._made: dict = {0: level0}
 
     def for_cell(self, cell: float) -> tuple:
         """(level, vertices, normals, indices) of the coarsest level whose grid is at most
