@@ -26,13 +26,8 @@ def take(problem: pathlib.Path, out: pathlib.Path) -> list:
         master.rosrun("Viewer", "viewer", f"_snapshot_dir:={master.ros_home}")
         master.wait_for_service("/virtual_world/get_world")
         master.wait_for_service("/viewer/set_camera")
-        import rospy
-        from gui.window.main_window import MainWindow
-        from gui.window.testing import app, click, pump, screenshot, wait_for
-        app()
-        rospy.init_node("gui", anonymous=False, disable_signals=True)
-        window = MainWindow(poll_period=0.2)
-        window.show()
+        from gui.window.testing import open_window, click, pump, screenshot, wait_for
+        window = open_window()
         try:
             return _tour(window, problem, out, click, pump, screenshot, wait_for)
         finally:

@@ -16,13 +16,8 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 def test_window_waits_for_the_world_then_reconnects(ros_master):
     os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
-    import rospy
-    from gui.window.main_window import MainWindow
-    from gui.window.testing import app, click, pump, screenshot, type_into, wait_for
-    app()
-    rospy.init_node("gui", anonymous=False, disable_signals=True)
-    window = MainWindow(poll_period=0.2)
-    window.show()
+    from gui.window.testing import open_window, click, pump, screenshot, type_into, wait_for
+    window = open_window()
     try:
         pump(0.5)
         assert not window.connected
@@ -63,16 +58,11 @@ def test_window_waits_for_the_world_then_reconnects(ros_master):
 
 def test_a_slow_call_is_reported_and_never_blocks_the_event_loop(ros_master):
     os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
-    import rospy
     from PyQt5.QtCore import QTimer
-    from gui.window.main_window import MainWindow
-    from gui.window.testing import app, wait_for
+    from gui.window.testing import open_window, wait_for
     ros_master.rosrun("VirtualWorld", "virtualWorld")
     ros_master.wait_for_service("/virtual_world/set_joint_force")
-    app()
-    rospy.init_node("gui", anonymous=False, disable_signals=True)
-    window = MainWindow(poll_period=0.2)
-    window.show()
+    window = open_window()
     try:
         wait_for(lambda: window.connected, 15, "connection")
         done = []
@@ -102,16 +92,11 @@ def test_a_slow_call_is_reported_and_never_blocks_the_event_loop(ros_master):
 
 def test_the_viewer_image_shows_in_the_window(ros_master):
     os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
-    import rospy
-    from gui.window.main_window import MainWindow
-    from gui.window.testing import app, click, screenshot, type_into, wait_for
+    from gui.window.testing import open_window, click, screenshot, type_into, wait_for
     ros_master.rosrun("VirtualWorld", "virtualWorld")
     ros_master.rosrun("Viewer", "viewer")
     ros_master.wait_for_service("/virtual_world/set_joint_force")
-    app()
-    rospy.init_node("gui", anonymous=False, disable_signals=True)
-    window = MainWindow(poll_period=0.2)
-    window.show()
+    window = open_window()
     try:
         wait_for(lambda: window.connected, 15, "connection")
         window.tabs.setCurrentWidget(window.objects)
@@ -138,14 +123,9 @@ def test_a_restarted_world_is_offered_the_last_problem_again(ros_master, kautham
     """The world dies under a built problem and a new one starts empty: the window says so,
     offers the last problem (it never rebuilds unasked), and one click builds it again."""
     os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
-    import rospy
-    from gui.window.main_window import MainWindow
-    from gui.window.testing import app, click, screenshot, wait_for
-    app()
+    from gui.window.testing import open_window, click, screenshot, wait_for
     node = ros_master.rosrun("VirtualWorld", "virtualWorld")
-    rospy.init_node("gui", anonymous=False, disable_signals=True)
-    window = MainWindow(poll_period=0.2)
-    window.show()
+    window = open_window()
     problem = kautham_dir / "legacy_2012" / "examples" / "TRO" / "2DRR_obstacle.xml"
     try:
         wait_for(lambda: window.connected, 30, "the window to find the world")

@@ -30,8 +30,7 @@ def test_the_viewer_panel_frames_orbits_and_zooms(ros_master):
     from PyQt5.QtWidgets import QApplication
     from PyQt5.QtTest import QTest
     from Messages.msg import Joint, Robot
-    from gui.window.main_window import MainWindow
-    from gui.window.testing import app, click, pump, screenshot, wait_for
+    from gui.window.testing import open_window, click, pump, screenshot, wait_for
     from world_client import WorldClient, box, sphere
     ros_master.rosrun("VirtualWorld", "virtualWorld")
     ros_master.wait_for_service("/virtual_world/set_joint_force")
@@ -45,10 +44,7 @@ def test_the_viewer_panel_frames_orbits_and_zooms(ros_master):
                      anchor=[0.5, 0.2, 1.5], axis1=[0, 1, 0]).id
     other.ok("set_robot", robot=Robot(name="pendulum", links=["bob"], objects=["ball"],
                                       joint_names=["swing"], joints=[hinge]))
-    app()
-    rospy.init_node("gui", anonymous=False, disable_signals=True)
-    window = MainWindow(poll_period=0.2)
-    window.show()
+    window = open_window()
     panel = window.viewer_panel
     try:
         wait_for(lambda: panel.camera is not None and window.scene.world_robots and

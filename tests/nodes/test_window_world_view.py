@@ -37,17 +37,12 @@ def _combo(combo) -> list:
 
 def test_a_world_built_by_another_client_shows_in_the_window(ros_master):
     os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
-    import rospy
     from Messages.msg import Joint, Robot
-    from gui.window.main_window import MainWindow
-    from gui.window.testing import app, screenshot, wait_for
+    from gui.window.testing import open_window, screenshot, wait_for
     from world_client import WorldClient, box, sphere
     node = ros_master.rosrun("VirtualWorld", "virtualWorld")
     ros_master.wait_for_service("/virtual_world/set_joint_force")
-    app()
-    rospy.init_node("gui", anonymous=False, disable_signals=True)
-    window = MainWindow(poll_period=0.2)
-    window.show()
+    window = open_window()
     try:
         wait_for(lambda: window.connected and window.world_reads > 0, 15, "the first Get World")
         assert window.simulation.status.text().startswith("The world is empty")

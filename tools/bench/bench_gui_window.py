@@ -84,17 +84,13 @@ def _child(out_dir: pathlib.Path, cold_open_only: bool = False) -> None:
 
     from gui.core.build import plan_problem
     from gui.core.kautham.problem import load_problem
-    from gui.window.main_window import MainWindow
-    from gui.window.testing import app, click, pump, wait_for
+    from gui.window.testing import open_window, click, pump, wait_for
 
     problem = _kautham_dir() / PROBLEM
     plan = plan_problem(load_problem(problem))     # only to know what "all built" means
     n_joints = plan.counts()["JointStep"]
     n_elements = sum(len(s.entries("")) for s in plan.steps)
-    app()
-    rospy.init_node("gui", anonymous=False, disable_signals=True)
-    window = MainWindow(poll_period=0.2)
-    window.show()
+    window = open_window()
     wait_for(lambda: window.connected and window.updates > 0, 30, "connection")
     QFileDialog.getOpenFileName = staticmethod(lambda *a, **k: (str(problem), ""))
     tab = window.simulation

@@ -23,13 +23,8 @@ def window(ros_master):
     os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
     node = ros_master.rosrun("VirtualWorld", "virtualWorld")
     ros_master.wait_for_service("/virtual_world/set_joint_force")
-    import rospy
-    from gui.window.main_window import MainWindow
-    from gui.window.testing import app, wait_for
-    app()
-    rospy.init_node("gui", anonymous=False, disable_signals=True)
-    win = MainWindow(poll_period=0.2)
-    win.show()
+    from gui.window.testing import open_window, wait_for
+    win = open_window()
     wait_for(lambda: win.connected and win.updates > 0, 15, "the window to connect")
     yield win
     win.shutdown()

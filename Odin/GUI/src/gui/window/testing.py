@@ -20,6 +20,18 @@ def app() -> QApplication:
     return QApplication.instance()
 
 
+def open_window(poll_period: float = 0.2):
+    """The process's QApplication, this process as the ROS node "gui", and a shown MainWindow
+    polling the world every ``poll_period`` s (the caller shuts it down)."""
+    import rospy
+    from gui.window.main_window import MainWindow
+    app()
+    rospy.init_node("gui", anonymous=False, disable_signals=True)
+    window = MainWindow(poll_period=poll_period)
+    window.show()
+    return window
+
+
 def pump(seconds: float = 0.05) -> None:
     """Runs the Qt event loop for ``seconds``."""
     deadline = time.monotonic() + seconds
