@@ -50,6 +50,13 @@ def kautham_dir() -> pathlib.Path:
 _CORPUS_SKIP = "needs the Kautham corpus: "
 
 
+@pytest.fixture(scope="session")
+def ode_demos_dir() -> pathlib.Path:
+    """Kautham's car and chain physics demos, vendored in the repository (read-only;
+    tools/kautham/ode_demos/MANIFEST.md)."""
+    return ROOT / "tools" / "kautham" / "ode_demos"
+
+
 def pytest_terminal_summary(terminalreporter):
     skipped = [report for report in terminalreporter.stats.get("skipped", [])
                if _CORPUS_SKIP in str(report.longrepr)]
