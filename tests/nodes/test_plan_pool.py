@@ -1,7 +1,8 @@
 """The planning bridge's pool back end (gui.planning_pool, issue 17): two world nodes hold the
 Sphere problem; propagations from the planner's state vectors, fanned out over them, answer
 bit for bit what the Core back end answers, and a plan searched through the pool replays in the
-Core to the same place; `rosrun GUI plan --backend pool` refuses an absent world in one line."""
+Core to the same place; the chain's servo controls answer the same through the pool;
+`rosrun GUI plan --backend pool` refuses an absent world in one line."""
 from __future__ import annotations
 
 import logging
@@ -17,11 +18,15 @@ SPHERE = ("current_2025", "demos", "OMPL_ode_demos", "Sphere", "Sphere.xml")
 
 
 def _sphere_plan(kautham_dir):
+    return _plan(kautham_dir.joinpath(*SPHERE))
+
+
+def _plan(problem_file):
     from gui.core.build import plan_problem
     from gui.core.kautham.problem import load_problem
     logging.disable(logging.WARNING)
     try:
-        return plan_problem(load_problem(kautham_dir.joinpath(*SPHERE)))
+        return plan_problem(load_problem(problem_file))
     finally:
         logging.disable(logging.NOTSET)
 
@@ -48,8 +53,8 @@ def test_the_pool_answers_what_the_core_answers_and_plans_that_replay(ros_master
     try:
         assert pool.size == 2
         assert pool.start_state().tobytes() == core.start_state().tobytes()
-        for got, want in zip(pool.base_state(pool.start_state()),
-                             core.base_state(core.start_state())):
+        for got, want in zip(pool.tracked_state(pool.start_state()),
+                             core.tracked_state(core.start_state())):
             assert got.tobytes() == want.tobytes()
         rng = np.random.default_rng(3)
         vectors = [core.start_state()]
@@ -62,6 +67,33 @@ def test_the_pool_answers_what_the_core_answers_and_plans_that_replay(ros_master
         result = plan(pool, "KPIECE1", time_limit=3.0, seed=11)
         assert result.propagations > 50 and result.rows
         assert replay(core, result.rows).tobytes() == result.final_position.tobytes()
+    finally:
+        pool.close()
+        core.close()
+
+
+def test_servo_controls_through_the_pool_answer_what_the_core_answers(ros_master,
+                                                                      ode_demos_dir):
+    """The chain's controls are a Set Servo and a Propagate made by one world: whichever
+    world serves a request, and whatever it served before, the answer is the Core's."""
+    for namespace in ("/w0", "/w1"):
+        ros_master.rosrun("VirtualWorld", "virtualWorld", f"__ns:={namespace}")
+    for namespace in NAMESPACES:
+        ros_master.wait_for_service(f"{namespace}/propagate")
+    from gui.planning.backend import CoreBackend
+    from gui.planning.problem import planning_problem
+    from gui.planning_pool import PoolBackend
+    chain = _plan(ode_demos_dir / "demos" / "OMPL_ode_demos" / "Chain" / "k-PMPChain.xml")
+    core = CoreBackend(chain, planning_problem(chain))
+    pool = PoolBackend(chain, planning_problem(chain), NAMESPACES)
+    try:
+        vectors = [core.start_state()]
+        for _ in range(3):
+            vectors.append(core.propagate([(vectors[-1], (0.9, 0.1, 0.5))])[0].state)
+        rng = np.random.default_rng(5)
+        requests = [(vectors[k % 4], tuple(rng.random(3))) for k in range(10)]
+        fanned, alone = pool.propagate(requests), core.propagate(requests)
+        assert all(_same(a, b) for a, b in zip(fanned, alone))
     finally:
         pool.close()
         core.close()

@@ -4,7 +4,9 @@ this machine or on several hosts of the ROS graph, each holding the problem's wo
 Every propagation is one Propagate call that starts from the planner's state vector
 (``start_state``) and answers the state reached (``state``), so any world of the pool can serve
 any request, and a batch (``PoolBackend.propagate`` of several requests) is fanned out over
-the worlds at once. The worlds are deterministic: the answers are bit for bit those of the
+the worlds at once. A control that sets servos (a car, joints) is a Set Servo and the
+Propagate after it, made by the same world one after the other: every control sets the same
+servo values in full, so what an earlier request left set never matters. The worlds are deterministic: the answers are bit for bit those of the
 Core back end (``gui.planning.backend.CoreBackend``). The pool's worlds belong to the planner:
 each is cleared (New Scene), paused and built from the problem when the back end starts.
 """
@@ -16,7 +18,7 @@ import numpy as np
 
 from gui.core.build import BuildPlan
 from gui.errors import PlanningError
-from gui.planning.backend import Outcome, row_forces, send_plan
+from gui.planning.backend import Outcome, force_requests, send_plan, step_actuation
 from gui.planning.problem import PlanningProblem
 from odin_common.interface import body_record
 from odin_common.messages import body_force_message
@@ -48,7 +50,7 @@ class PoolBackend:
                     self.step = client.step_values().step
                 finally:
                     client.close()
-            self._start, self._base_index, self._base_com = self._read_start()
+            self._start, self._bodies = self._read_start()
         except PoolError as error:
             self.pool.close()
             raise PlanningError(str(error)) from None
@@ -63,11 +65,13 @@ class PoolBackend:
             raise PlanningError("the pool's worlds built the problem differently (their body "
                                 "states differ): are they all the same Odin?")
         ids = [body.id for body in answers[0].bodies]
-        if self.problem.base_body not in ids:
-            raise PlanningError(f"the pool's worlds have no body {self.problem.base_body!r}")
-        index = ids.index(self.problem.base_body)
-        com = answers[0].centers_of_mass[index]
-        return vectors[0], index, np.array([com.x, com.y, com.z])
+        bodies = {}
+        for name in (self.problem.base_body, self.problem.tracked_body):
+            if name not in ids:
+                raise PlanningError(f"the pool's worlds have no body {name!r}")
+            com = answers[0].centers_of_mass[ids.index(name)]
+            bodies[name] = (ids.index(name), np.array([com.x, com.y, com.z]))
+        return vectors[0], bodies
 
     @property
     def size(self) -> int:
@@ -76,39 +80,50 @@ class PoolBackend:
     def start_state(self) -> np.ndarray:
         return self._start.copy()
 
-    def base_state(self, state):
-        position, _, linear = self._base(state)
-        return position, linear
+    def tracked_state(self, state):
+        position, quaternion, linear = self._body(state, self.problem.tracked_body)
+        return self.problem.tracked_origin(position, quaternion), linear
 
-    def _base(self, state):
-        """The base's (origin m, quaternion (w, x, y, z), linear velocity m/s), world frame,
-        in a state vector: its record holds the centre of mass (the Core's body_state)."""
-        record = body_record(state, self._base_index)
+    def _body(self, state, name: str):
+        """A body's (frame origin m, quaternion (w, x, y, z), linear velocity m/s), world
+        frame, in a state vector: its record holds the centre of mass (the Core's
+        body_state)."""
+        index, com = self._bodies[name]
+        record = body_record(state, index)
         quaternion = np.array(record["quaternion"])
-        origin = np.array(record["position"]) - quaternion_to_matrix(quaternion) @ self._base_com
+        origin = np.array(record["position"]) - quaternion_to_matrix(quaternion) @ com
         return origin, quaternion, np.array(record["linear"])
 
     def propagate(self, requests) -> List[Outcome]:
-        fields = [self._request(np.asarray(state, dtype=np.float64), control)
-                  for state, control in requests]
+        calls = [self._calls(np.asarray(state, dtype=np.float64), control)
+                 for state, control in requests]
         try:
-            answers = self.pool.propagate(fields)
+            answers = self.pool.map_calls(calls)
         except self._pool_error as error:
             raise PlanningError(str(error)) from None
         self.propagations += len(answers)
         return [self._outcome(answer) for answer in answers]
 
-    def _request(self, state: np.ndarray, control) -> dict:
-        base = self._base(state)
+    def _calls(self, state: np.ndarray, control) -> list:
+        """The calls one world makes for one request: Set Servo when the control sets servos,
+        then the Propagate from ``state``."""
+        act = step_actuation(self.problem, control, self._body(state, self.problem.base_body))
         forces = [body_force_message(f["object_id"], int(f["kind"]), f["vector"])
-                  for f in row_forces(self.problem, control, base)]
-        return dict(start_state=state.tolist(), duration=self.problem.step, step=self.step,
-                    forces=forces, keep=False)
+                  for f in force_requests(act.forces)]
+        calls = []
+        if act.servo is not None:
+            calls.append(("set_servo", act.servo.request_fields()))
+        calls.append(("propagate", dict(start_state=state.tolist(), duration=self.problem.step,
+                                        step=self.step, forces=forces, keep=False)))
+        return calls
 
     def _outcome(self, answer) -> Outcome:
-        base = answer.states[self._base_index]
-        return Outcome(np.asarray(answer.state, dtype=np.float64), np.array(base.position),
-                       np.array(base.linear),
+        index, _ = self._bodies[self.problem.tracked_body]
+        body = answer.states[index]
+        position = self.problem.tracked_origin(np.array(body.position),
+                                               np.array(body.orientation))
+        return Outcome(np.asarray(answer.state, dtype=np.float64), position,
+                       np.array(body.linear),
                        tuple((c.first, c.second) for c in answer.collisions))
 
     def close(self) -> None:

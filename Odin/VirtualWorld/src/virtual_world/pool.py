@@ -57,9 +57,10 @@ class _World:
             task = self.tasks.get()
             if task is None:
                 break
-            index, service, fields, answers, done, from_free = task
+            index, calls, answers, done, from_free = task
             try:
-                answers[index] = self._call(service, fields)
+                for service, fields in calls:
+                    answers[index] = self._call(service, fields)
             except Exception as error:   # handed back to the caller's thread
                 answers[index] = error
             finally:
@@ -112,16 +113,22 @@ class WorldPool:
         answers: list = [None] * self.size
         done = threading.Semaphore(0)
         for k, world in enumerate(self._worlds):
-            world.tasks.put((k, service, fields, answers, done, False))
+            world.tasks.put((k, [(service, fields)], answers, done, False))
         return self._gather(answers, done)
 
     def map(self, service: str, requests: Sequence[dict]) -> list:
         """One call of ``service`` per request (its fields), each to the next world that is
         free; the answers in the order of ``requests``."""
+        return self.map_calls([[(service, dict(fields))] for fields in requests])
+
+    def map_calls(self, requests: Sequence[Sequence[tuple]]) -> list:
+        """Like ``map``, but each request is a list of calls, (service, fields) each, that one
+        world makes in order (a Set Servo and the Propagate it is for); the answer to each
+        request is its last call's."""
         answers: list = [None] * len(requests)
         done = threading.Semaphore(0)
-        for k, fields in enumerate(requests):
-            self._free.get().tasks.put((k, service, dict(fields), answers, done, True))
+        for k, calls in enumerate(requests):
+            self._free.get().tasks.put((k, list(calls), answers, done, True))
         return self._gather(answers, done)
 
     def propagate(self, requests: Sequence[dict]) -> list:

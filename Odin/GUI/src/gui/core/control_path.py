@@ -92,6 +92,12 @@ class ServoCommand:
     max_speeds: Tuple[float, ...] = ()
     max_forces: Tuple[float, ...] = ()
 
+    def request_fields(self) -> dict:
+        """The Set Servo request's fields (lists)."""
+        return dict(motors=list(self.motors), targets=list(self.targets),
+                    rates=list(self.rates), gains=list(self.gains),
+                    max_speeds=list(self.max_speeds), max_forces=list(self.max_forces))
+
 
 @dataclass(frozen=True)
 class Actuation:

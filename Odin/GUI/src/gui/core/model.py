@@ -269,13 +269,28 @@ class PlannerPhysics:
 
 
 @dataclass(frozen=True)
+class PlannerSearch:
+    """What a Kautham ODE planner's parameters ask of a search (None: not given; the planning
+    bridge, gui.planning, uses them): ``min_control_steps`` / ``max_control_steps`` ("Min/Max
+    Control Steps": how many propagation steps a control is held), ``goal_bias`` ("Goal
+    Bias"), ``max_speed`` ("Max Speed", m/s) and ``time_limit`` ("_Max Planning Time", s)."""
+    min_control_steps: Optional[int] = None
+    max_control_steps: Optional[int] = None
+    goal_bias: Optional[float] = None
+    max_speed: Optional[float] = None
+    time_limit: Optional[float] = None
+
+
+@dataclass(frozen=True)
 class Planner:
     """The problem's ``<Planner>``: its ``name``; ``physics``: one of Kautham's ODE planners,
     which simulate the problem (a ground plane, dynamic obstacles: ``Problem.physics``);
-    ``settings``: the physics its parameters ask for."""
+    ``settings``: the physics its parameters ask for; ``search``: what they ask of a
+    planner's search."""
     name: str
     physics: bool
     settings: PlannerPhysics = PlannerPhysics()
+    search: PlannerSearch = PlannerSearch()
     source: str = ""
     line: Optional[int] = None
 

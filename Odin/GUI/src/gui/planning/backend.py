@@ -3,8 +3,9 @@
 A ``Backend`` propagates a batch of requests, each (state, control): put the world in the
 state (``Core.body_state_vector``'s layout), apply the control for one propagation step as a
 control path row (``gui.core.control_path.actuation``: for a free body, the force that would
-carry the base to the control's position in the step), step, and answer the state reached,
-the robot base's position and velocity, and the pairs that collided on the way. A planner's
+carry the base to the control's position in the step; for a car or joints, the servo
+settings, sent before the step as ``run_path`` sends them), step, and answer the state
+reached, the tracked link's position and velocity, and the pairs that collided on the way. A planner's
 propagation of a control for n steps is n such calls in a row, exactly as ``run_path`` runs
 the n rows of the control path it becomes (one kept Propagate per row), so that the written
 plan replays bit for bit in a fresh world.
@@ -14,21 +15,21 @@ plan replays bit for bit in a fresh world.
 """
 from __future__ import annotations
 
-from typing import List, NamedTuple, Protocol, Sequence, Tuple
+from typing import List, NamedTuple, Optional, Protocol, Sequence, Tuple
 
 import numpy as np
 
 from gui.core.build import BuildPlan, BuiltIds
-from gui.core.control_path import ControlRow, ServoCommand, actuation
+from gui.core.control_path import Actuation, ControlRow, ServoCommand, actuation
 from gui.planning.problem import PlanningProblem
 from odin_common.interface import ForceKind
 from odin_common.step_values import StepValues
 
 
 class Outcome(NamedTuple):
-    """After one propagation step: ``state`` the world's body state vector; ``position`` (3,) m
-    and ``velocity`` (3,) m/s of the robot's base (world frame); ``collisions``: the pairs
-    (names) that collided during the step."""
+    """After one propagation step: ``state`` the world's body state vector; ``position`` (3,) m,
+    the tracked link's origin, and ``velocity`` (3,) m/s, its body's (world frame);
+    ``collisions``: the pairs (names) that collided during the step."""
     state: np.ndarray
     position: np.ndarray
     velocity: np.ndarray
@@ -43,8 +44,9 @@ class Backend(Protocol):
     def start_state(self) -> np.ndarray:
         """The body state vector of the world as the problem built it."""
 
-    def base_state(self, state: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
-        """The robot base's position (3,) m and velocity (3,) m/s in a body state vector."""
+    def tracked_state(self, state: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+        """The tracked link's origin (3,) m and its body's velocity (3,) m/s (world frame) in
+        a body state vector."""
 
     def propagate(self, requests: Sequence[Tuple[np.ndarray, Sequence[float]]]
                   ) -> List[Outcome]:
@@ -105,12 +107,11 @@ def send_plan(world, plan: BuildPlan) -> dict:
     return ids.as_dict()
 
 
-def row_forces(problem: PlanningProblem, control: Sequence[float], base) -> list:
-    """The body forces (``force_requests``) that apply ``control`` for one propagation step
-    to the robot whose base is in ``base`` (position m, quaternion (w, x, y, z), linear
+def step_actuation(problem: PlanningProblem, control: Sequence[float], base) -> Actuation:
+    """What applying ``control`` for one propagation step asks of the world (servo settings,
+    forces), the robot's base being in ``base`` (position m, quaternion (w, x, y, z), linear
     velocity m/s; world frame) when the step starts."""
-    act = actuation(problem.handle, ControlRow(tuple(control), problem.step), base)
-    return force_requests(act.forces)
+    return actuation(problem.handle, ControlRow(tuple(control), problem.step), base)
 
 
 class CorePort:
@@ -160,14 +161,18 @@ class CoreBackend:
             raise
         self.port = CorePort(self.world)
         self.propagations = 0
+        self._servo_sent: Optional[ServoCommand] = None
 
     def start_state(self) -> np.ndarray:
         return self._start.copy()
 
-    def base_state(self, state):
+    def tracked_state(self, state):
         self.world.core.set_body_state_vector(state)
-        position, _, linear, _ = self.world.core.body_state(self.problem.base_body)
-        return np.asarray(position), np.asarray(linear)
+        return self._tracked()
+
+    def _tracked(self):
+        position, quaternion, linear, _ = self.world.core.body_state(self.problem.tracked_body)
+        return self.problem.tracked_origin(position, quaternion), np.asarray(linear)
 
     def propagate(self, requests):
         return [self._one(state, control) for state, control in requests]
@@ -175,12 +180,16 @@ class CoreBackend:
     def _one(self, state, control) -> Outcome:
         core, problem = self.world.core, self.problem
         core.set_body_state_vector(state)
-        base = self.port.body_state(problem.base_body)
-        result = core.propagate(problem.step, self.world.step_values.step,
-                                body_forces=row_forces(problem, control, base), keep=True)
+        act = step_actuation(problem, control, self.port.body_state(problem.base_body))
+        if act.servo is not None and act.servo != self._servo_sent:
+            # the same settings again change nothing: a control held over several steps
+            # is sent once (this world's servos are set by this back end alone)
+            self.port.set_servo(act.servo)
+            self._servo_sent = act.servo
+        result = self.port.advance(problem.step, act.forces)
         self.propagations += 1
-        position, _, linear, _ = core.body_state(problem.base_body)
-        return Outcome(core.body_state_vector(), np.asarray(position), np.asarray(linear),
+        position, linear = self._tracked()
+        return Outcome(core.body_state_vector(), position, linear,
                        tuple((c.first, c.second) for c in result.collisions))
 
     def close(self) -> None:
@@ -188,4 +197,4 @@ class CoreBackend:
 
 
 __all__ = ["Outcome", "Backend", "CoreWorld", "CorePort", "CoreBackend", "force_requests",
-           "row_forces", "send_plan"]
+           "send_plan", "step_actuation"]

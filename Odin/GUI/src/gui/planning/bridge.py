@@ -1,17 +1,20 @@
 """OMPL's control planners over an Odin back end (ROS-free; OMPL 2 from PyPI).
 
 The OMPL problem (``gui.planning.problem`` says what each part means):
-- state space: a compound of the robot base's position and velocity (6 values: x, y, z m,
-  vx, vy, vz m/s, world frame; bounds from the problem's limits and ``max_speed``; weight 1:
+- state space: a compound of the tracked link's position and velocity (6 values: x, y, z m,
+  vx, vy, vz m/s, world frame; the robot's base, or a held chain's tool; bounds from the
+  problem's limits and ``max_speed``; weight 1:
   planners measure distances and cells here) and the whole world's body state vector
   (``Core.body_state_vector``, weight 0: carried, never measured) with one value appended,
   1 when the step into the state touched an obstacle the robot must not;
 - control space: [0, 1]^k, the robot's `.cntr` controls (those searched); a control lasts ``min_control_steps``
   to ``max_control_steps`` propagation steps of ``step`` s;
 - propagator: the back end's (restore, apply the row, step, read);
-- validity: the base in bounds and no forbidden contact on the way in;
-- goal region: the base within ``goal_tolerance`` of the query's goal, in the plane;
-- projection (KPIECE1's grid): the base's x and y, cells of a quarter of the goal region.
+- validity: the tracked link in bounds and no forbidden contact on the way in;
+- goal region: the tracked link within ``goal_tolerance`` of where the query's goal puts it,
+  in the plane;
+- projection (KPIECE1's grid): the tracked link's x and y, cells of a quarter of the goal
+  region.
 
 ``plan(backend, planner, time_limit, seed)`` solves and answers a ``PlanResult`` whose
 ``rows`` are the control path (one row per propagation step). The planner classes the wheel's
@@ -36,7 +39,8 @@ UNCONSTRUCTIBLE = ("SST", "PDST")
 """Control planners the wheel names but cannot construct ("no constructor defined")."""
 
 ROBOT_VALUES = 6
-"""The robot component: base position (3, m) then velocity (3, m/s), world frame."""
+"""The robot component: the tracked link's position (3, m) then velocity (3, m/s), world
+frame."""
 WORLD_BOUND = 1e10
 """The world component's bounds: its values are never sampled for use, only carried (ODE's
 random generator state, below 2^32, is its largest value)."""
@@ -44,9 +48,9 @@ random generator state, below 2^32, is its largest value)."""
 
 @dataclass(frozen=True)
 class PlanResult:
-    """What a search found. ``solved``: an exact solution (the base in the goal region);
+    """What a search found. ``solved``: an exact solution (the tracked link in the goal region);
     ``rows``: the control path (the best approximate one when not solved; empty when the
-    planner found nothing); ``final_position`` (3,) m, world: where the base ends when the
+    planner found nothing); ``final_position`` (3,) m, world: where the tracked link ends when the
     rows are run from the start in the back end's world; ``goal_distance``: m, in the plane;
     ``propagations``: propagation steps the search ran; ``time_s``: wall-clock seconds of the
     search; ``status``: OMPL's planner status."""
@@ -105,7 +109,7 @@ class _Callbacks:
     def write(self, state, vector: np.ndarray, backend_outcome) -> None:
         robot, world = state[0], state[1]
         if backend_outcome is None:
-            position, velocity = self.backend.base_state(vector)
+            position, velocity = self.backend.tracked_state(vector)
             flag = 0.0
         else:
             position, velocity = backend_outcome.position, backend_outcome.velocity
@@ -197,7 +201,7 @@ class _Setup:
 
 def _goal_region(ob, si, problem):
     class GoalXY(ob.GoalRegion):
-        """The query's goal: the base within the tolerance, in the plane."""
+        """The query's goal: the tracked link within the tolerance, in the plane."""
 
         def __init__(self, si, problem):
             super().__init__(si)
@@ -270,14 +274,15 @@ def _rows(path, problem) -> List[ControlRow]:
 
 
 def replay(backend, rows) -> np.ndarray:
-    """(3,) m: where the base ends when ``rows`` run from the start state in the back end."""
+    """(3,) m: where the tracked link ends when ``rows`` run from the start state in the back
+    end."""
     vector = backend.start_state()
     position = None
     for row in rows:
         outcome = backend.propagate([(vector, row.controls)])[0]
         vector, position = outcome.state, outcome.position
     if position is None:
-        position = backend.base_state(vector)[0]
+        position = backend.tracked_state(vector)[0]
     return np.asarray(position)
 
 

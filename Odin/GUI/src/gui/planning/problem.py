@@ -1,25 +1,35 @@
 """What a loaded Kautham problem asks of a planner (ROS-free, OMPL-free).
 
-A planning problem drives one robot whose base is a free body (Kautham's 2D environments: the
-Sphere demos), in a world built from the problem (``gui.core.build``):
+A planning problem drives one robot of a world built from the problem (``gui.core.build``),
+as Kautham's ODE environments drive the robots of its physics demos: a free body pushed by a
+force (its 2D environments: the Sphere demos), a car on hinge-2 wheels (CarEnvironment), a
+chain whose base is held to the world, driven at its joints (PlanarChainEnvironment):
 
 - its **state** is the world's: every body's dynamic state (``Core.body_state_vector``); the
-  planner measures distances and makes progress on the robot base's position and velocity
-  (m, m/s, world frame), bounded by the problem's ``<Limits>`` and ``SearchSettings.max_speed``;
-- a **control** is a row of the robot's control path, k values in [0, 1] (the `.cntr`'s,
-  mapped as ``gui.core.control_path`` maps them); in the plane (``SearchSettings.planar``,
-  Kautham's 2D planners: "Control Dimensions" 2) the planner searches the controls that move
-  the base in x or y only, and holds the others at the query's ``<Init>`` values (the
-  Sphere's z control, which presses it onto the ground); a control is held for a whole number of propagation
-  steps between ``min_control_steps`` and ``max_control_steps`` (Kautham's ODE planners'
-  "Min/Max Control Steps"), each step one row of ``step`` s;
-- the **goal region** is the query's ``<Goal>``: the base within ``goal_tolerance`` m of the
-  goal's position in x and y (Kautham's KauthamDEGoalRegion measures in the plane too, with a
-  0.05 m threshold, under planning times of minutes);
+  planner measures distances and makes progress on the **tracked link**'s origin and velocity
+  (m, m/s, world frame), bounded by the problem's ``<Limits>`` and ``SearchSettings.max_speed``.
+  The tracked link is the robot's base, except for a robot whose base is held: there it is its
+  tool, the last link of the chain from the base before it branches (a gripper's first link,
+  where its fingers fork) or the chain's last link (Kautham's chain planner measures its body
+  3, "the gripper's first link", which is this link of its demo chain);
+- a **control** is a row of the robot's control path, k values in [0, 1] mapped as
+  ``gui.core.control_path`` maps them (a free body: the force that reaches the row's position;
+  a car: steering and wheel speed; joints: servo targets); in the plane
+  (``SearchSettings.planar``, Kautham's 2D planners: "Control Dimensions" 2) the planner
+  searches a free body's controls that move it in x or y only, and holds the others at the
+  query's ``<Init>`` values (the Sphere's z control, which presses it onto the ground); a car's
+  two controls and a chain's controls are all searched; a control is held for a whole number
+  of propagation steps between ``min_control_steps`` and ``max_control_steps`` (Kautham's ODE
+  planners' "Min/Max Control Steps"), each step one row of ``step`` s;
+- the **goal region** is the query's ``<Goal>``: the tracked link within ``goal_tolerance`` m
+  of where it is at the goal configuration, in x and y (Kautham's KauthamDEGoalRegion measures
+  in the plane too, with a 0.05 m threshold, under planning times of minutes);
 - a **motion is invalid** when the robot touches an obstacle it must not: Kautham's
   KauthamOpenDEEnvironment lets its robots touch the floor and the obstacles it lists as
   manipulable (``MANIPULABLE``: the cubes, boxes and cylinders of its demos), every other
-  obstacle is "fixed" (the arena's walls); or when its base leaves the bounds.
+  obstacle is "fixed" (the arena's walls); a held chain may push manipulable obstacles with its
+  tool only (PlanarChainEnvironment: its "tcp" bodies; its other links touching any obstacle
+  make the motion invalid); or when the tracked link leaves the bounds.
 """
 from __future__ import annotations
 
@@ -30,8 +40,10 @@ from typing import Iterable, Optional, Tuple
 import numpy as np
 
 from gui.core.build import GROUND, BuildPlan, RobotHandle
-from gui.core.model import FREE_BODY, MOBILE
+from gui.core.control_path import control_size
+from gui.core.model import CAR, FREE_BODY, MOBILE
 from gui.errors import PlanningError
+from odin_common.rotations import quaternion_to_matrix
 
 MANIPULABLE = frozenset(
     [f"cubeDE{k}" for k in ("", 1, 2, 3, 4, 5, 6, 7, 8)] + ["cylinder1", "cylinder2",
@@ -58,6 +70,21 @@ class SearchSettings:
     goal_bias: float = 0.05
     planar: bool = True
 
+    @classmethod
+    def of_problem(cls, plan: BuildPlan, **overrides) -> "SearchSettings":
+        """The settings ``plan``'s problem asks for: its planner's Min/Max Control Steps, Goal
+        Bias and Max Speed where it gives them (``PlannerSearch``), the defaults otherwise;
+        then ``overrides`` (fields given as not None)."""
+        planner = plan.problem.planner
+        given = {}
+        if planner is not None:
+            search = planner.search
+            given = {name: getattr(search, name) for name in
+                     ("min_control_steps", "max_control_steps", "goal_bias", "max_speed")
+                     if getattr(search, name) is not None}
+        given.update({k: v for k, v in overrides.items() if v is not None})
+        return cls(**given)
+
     def check(self) -> None:
         if self.step is not None and not (math.isfinite(self.step) and self.step > 0):
             raise PlanningError(f"step {self.step!r} s must be positive")
@@ -75,14 +102,20 @@ class SearchSettings:
 @dataclass(frozen=True)
 class PlanningProblem:
     """One robot's planning problem (module docstring). ``base_body``: the world ID of the
-    robot's base body; ``base_bounds`` (3, 2): m, world frame, low and high per axis;
-    ``goal_xy`` (2,): m, world frame; ``forbidden``: object IDs the robot must not touch;
-    ``robot_bodies``: the robot's body IDs; ``step``: s, one propagation step;
-    ``searched``: indices of the controls the planner chooses, the others held at
-    ``held`` (the query start's controls)."""
+    robot's base body (a free base's force acts on it); ``tracked_body``: the tracked link's
+    body and ``tracked_offset`` (4, 4) that body's pose in the link's frame; ``base_bounds``
+    (3, 2): m, world frame, low and high per axis, for the tracked link's origin; ``goal_xy``
+    (2,): m, world frame, the tracked link's origin at the goal; ``forbidden``: object IDs the
+    robot must not touch; ``robot_bodies``: the robot's body IDs; ``tool_bodies``: those that
+    may push manipulable obstacles; ``step``: s, one propagation step; ``searched``: indices
+    of the controls the planner chooses, the others held at ``held`` (the query start's
+    controls)."""
     handle: RobotHandle
     base_body: str
+    tracked_body: str
+    tracked_offset: np.ndarray
     robot_bodies: Tuple[str, ...]
+    tool_bodies: frozenset
     base_bounds: np.ndarray
     goal_xy: np.ndarray
     forbidden: frozenset
@@ -99,27 +132,39 @@ class PlanningProblem:
             full[index] = float(value)
         return tuple(full)
 
-    def goal_distance(self, base_position) -> float:
-        """m: how far the base is from the goal in the plane."""
-        return float(math.hypot(base_position[0] - self.goal_xy[0],
-                                base_position[1] - self.goal_xy[1]))
+    def tracked_origin(self, body_position, body_quaternion) -> np.ndarray:
+        """(3,) m, world: the tracked link's origin when its body's frame is at
+        ``body_position`` with ``body_quaternion`` (w, x, y, z)."""
+        pose = np.eye(4)
+        pose[:3, :3] = quaternion_to_matrix(body_quaternion)
+        pose[:3, 3] = body_position
+        return (pose @ np.linalg.inv(self.tracked_offset))[:3, 3]
 
-    def in_goal(self, base_position) -> bool:
-        return self.goal_distance(base_position) < self.settings.goal_tolerance
+    def goal_distance(self, tracked_position) -> float:
+        """m: how far the tracked link is from the goal in the plane."""
+        return float(math.hypot(tracked_position[0] - self.goal_xy[0],
+                                tracked_position[1] - self.goal_xy[1]))
+
+    def in_goal(self, tracked_position) -> bool:
+        return self.goal_distance(tracked_position) < self.settings.goal_tolerance
 
     def forbidden_contacts(self, pairs: Iterable[Tuple[str, str]]) -> list:
-        """The pairs (object IDs or geometry names) that touch the robot and a forbidden
-        obstacle."""
-        robot = set(self.robot_bodies)
-        return [(a, b) for a, b in pairs
-                if (_object(a) in robot and _object(b) in self.forbidden)
-                or (_object(b) in robot and _object(a) in self.forbidden)]
+        """The pairs (object IDs or geometry names) where the robot touches an obstacle it
+        must not: a forbidden one, or any but the ground with a body outside its tool."""
+        return [(a, b) for a, b in pairs if self._forbidden_pair(_object(a), _object(b))
+                or self._forbidden_pair(_object(b), _object(a))]
 
-    def in_bounds(self, base_position, base_velocity) -> bool:
+    def _forbidden_pair(self, robot_body: str, other: str) -> bool:
+        if robot_body not in self.robot_bodies or other in self.robot_bodies:
+            return False
+        return other in self.forbidden or (other != GROUND
+                                           and robot_body not in self.tool_bodies)
+
+    def in_bounds(self, tracked_position, tracked_velocity) -> bool:
         low, high = self.base_bounds[:, 0], self.base_bounds[:, 1]
-        position = np.asarray(base_position)
+        position = np.asarray(tracked_position)
         return bool(np.all(position >= low) and np.all(position <= high)
-                    and np.all(np.abs(base_velocity) <= self.settings.max_speed))
+                    and np.all(np.abs(tracked_velocity) <= self.settings.max_speed))
 
 
 def _object(name: str) -> str:
@@ -128,39 +173,88 @@ def _object(name: str) -> str:
 
 
 def planning_problem(plan: BuildPlan, robot: Optional[str] = None,
-                     settings: SearchSettings = SearchSettings()) -> PlanningProblem:
-    """The planning problem of ``plan``'s robot (the first robot when None); PlanningError
-    when the robot is not one the planner drives or the problem has no query."""
+                     settings: Optional[SearchSettings] = None) -> PlanningProblem:
+    """The planning problem of ``plan``'s robot (the first robot when None) searched with
+    ``settings`` (None: ``SearchSettings.of_problem``); PlanningError when the robot is not
+    one the planner drives or the problem has no query."""
+    if settings is None:
+        settings = SearchSettings.of_problem(plan)
     settings.check()
     try:
         handle = plan.robot(robot)
     except KeyError as error:
         raise PlanningError(str(error.args[0] if error.args else error)) from None
-    if handle.kind not in (FREE_BODY, MOBILE) or handle.motor_ids:
-        raise PlanningError(f"robot {handle.name} is a {handle.kind or 'fixed'} robot"
-                            f"{' with joints' if handle.motor_ids else ''}: the planner "
-                            "drives a free body (Kautham's 2D environments) only")
-    if handle.goal is None or handle.start is None:
-        raise PlanningError(f"robot {handle.name}: the problem has no query (<Init> and "
-                            "<Goal>) to plan")
-    controls = handle.instance.controls
-    if controls is None or not controls.se3 or not controls.moved_base_axes():
-        raise PlanningError(f"robot {handle.name}: its controls move no axis of its base")
     if plan.world is None:
         raise PlanningError("the problem has no physics (not one of Kautham's ODE planners): "
                             "nothing to propagate")
+    if handle.goal is None or handle.start is None:
+        raise PlanningError(f"robot {handle.name}: the problem has no query (<Init> and "
+                            "<Goal>) to plan")
+    searched = _searched_controls(handle, settings)
     step = settings.step if settings.step is not None else plan.world.step
-    searched = tuple(range(controls.size))
-    if settings.planar:
-        searched = tuple(k for k in searched if np.any(controls.matrix[:2, k] != 0.0))
-    held = handle.start.controls or (0.5,) * controls.size
+    size = control_size(handle)
+    held = handle.start.controls if handle.kind != CAR and handle.start.controls else None
+    tracked = _tracked_link(handle)
+    tool = _tool_links(handle, tracked)
+    goal = handle.instance.model.link_poses(handle.goal.base_pose, handle.goal.joints)[tracked]
     return PlanningProblem(
         handle=handle, base_body=handle.bodies[0].body_id,
+        tracked_body=handle.bodies[tracked].body_id,
+        tracked_offset=np.array(handle.bodies[tracked].offset, dtype=float),
         robot_bodies=tuple(b.body_id for b in handle.bodies),
-        base_bounds=_base_bounds(handle), goal_xy=np.array(handle.goal.base_pose[:2, 3]),
-        forbidden=frozenset(_forbidden(plan, handle)), control_size=controls.size,
+        tool_bodies=frozenset(handle.bodies[i].body_id for i in tool),
+        base_bounds=_base_bounds(handle), goal_xy=np.array(goal[:2, 3]),
+        forbidden=frozenset(_forbidden(plan, handle)), control_size=size,
         step=float(step), settings=settings, searched=searched,
-        held=tuple(float(v) for v in held))
+        held=tuple(float(v) for v in (held or (0.5,) * size)))
+
+
+def _searched_controls(handle: RobotHandle, settings: SearchSettings) -> Tuple[int, ...]:
+    """The controls the planner chooses (module docstring); PlanningError when the robot's
+    controls drive nothing."""
+    if handle.kind == CAR:
+        return tuple(range(control_size(handle)))
+    controls = handle.instance.controls
+    if controls is None:
+        raise PlanningError(f"robot {handle.name}: it has no controls (no control file)")
+    base_axes = controls.moved_base_axes() if controls.se3 else []
+    driven_base = handle.kind in (FREE_BODY, MOBILE) and base_axes
+    if not driven_base and not handle.motor_ids:
+        raise PlanningError(f"robot {handle.name}: its controls move no axis of its base and "
+                            "it has no joints to drive")
+    searched = tuple(range(controls.size))
+    if settings.planar and driven_base and not handle.motor_ids:
+        searched = tuple(k for k in searched if np.any(controls.matrix[:2, k] != 0.0))
+    return searched
+
+
+def _tracked_link(handle: RobotHandle) -> int:
+    """The index of the link the planner follows (module docstring): the base, or a held
+    robot's tool."""
+    model = handle.instance.model
+    if handle.kind in (FREE_BODY, MOBILE, CAR) or not handle.motor_ids:
+        return 0
+    link = 0
+    while len(model.children(link)) == 1:
+        link = model.children(link)[0]
+    if link == 0:
+        raise PlanningError(f"robot {handle.name}: its held base branches at once, so it has "
+                            "no one tool for the planner to follow")
+    return link
+
+
+def _tool_links(handle: RobotHandle, tracked: int) -> list:
+    """The links that may push manipulable obstacles: all but a held chain's links before its
+    tool (the tool and what hangs from it)."""
+    model = handle.instance.model
+    if tracked == 0:
+        return list(range(len(model.links)))
+    tool, frontier = [], [tracked]
+    while frontier:
+        link = frontier.pop()
+        tool.append(link)
+        frontier += model.children(link)
+    return sorted(tool)
 
 
 def _base_bounds(handle: RobotHandle) -> np.ndarray:

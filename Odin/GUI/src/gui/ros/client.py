@@ -366,9 +366,7 @@ class WorldClient:
     def set_servo(self, command) -> None:
         """Set Servo from a gui.core.control_path.ServoCommand (motors, targets rad or m,
         rates, gains 1/s, speed limits, force limits)."""
-        self.call("set_servo", motors=list(command.motors), targets=list(command.targets),
-                  rates=list(command.rates), gains=list(command.gains),
-                  max_speeds=list(command.max_speeds), max_forces=list(command.max_forces))
+        self.call("set_servo", **command.request_fields())
 
     def propagate(self, duration: float, step: float = 0.0,
                   motor_goals: Optional[Dict[str, Sequence[float]]] = None,

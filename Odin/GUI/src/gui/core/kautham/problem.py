@@ -26,7 +26,9 @@ A file is of the current format when it has ``<Obstacle>`` or ``<Controls>`` ele
 
 The planner and the query: ``<Planner><Parameters><Name>`` says whether Kautham simulates the
 problem (its ODE planners) and which robot kind its environment drives; its ERP, CFM, Max
-Contacts and PropagationStepSize parameters are read (``Planner.settings``). The first
+Contacts and PropagationStepSize parameters are read (``Planner.settings``), and its Min/Max
+Control Steps, Goal Bias, Max Speed and _Max Planning Time for the planning bridge
+(``Planner.search``). The first
 ``<Query>`` (``<Init>``/``<Goal>`` control vectors, or ``<RobotControl name init goal>``) maps
 through the controls (``gui.core.kautham.controls``) to each robot's start and goal
 configuration. In a current problem a value Odin uses that is wrong is an error naming the
@@ -54,7 +56,7 @@ from gui.core.kautham.xmlfile import Node, parse_number, read_xml
 from gui.core.kinematics import pose_from_axis_angle
 from gui.core.model import (CAR, FIXED_BASE, FREE_BODY, MOBILE, REVOLUTE, Attachment,
                             Control, ControlSet, Ignored, Instance, Planner, PlannerPhysics,
-                            Problem, RobotModel, warn_once)
+                            PlannerSearch, Problem, RobotModel, warn_once)
 from gui.core.shapes import COIN_SUFFIXES, TRIMESH_SUFFIXES
 from gui.errors import ProblemError
 
@@ -76,6 +78,11 @@ with a fixed base)."""
 PLANNER_PHYSICS = {"Error Reduction Parameter": "erp", "Constraint Force Mixing": "cfm",
                    "Max Contacts": "max_contacts", "PropagationStepSize": "step"}
 """The ODE planners' parameters Odin applies (PlannerPhysics field names)."""
+PLANNER_SEARCH = {"Min Control Steps": "min_control_steps",
+                  "Max Control Steps": "max_control_steps", "Goal Bias": "goal_bias",
+                  "Max Speed": "max_speed", "_Max Planning Time": "time_limit"}
+"""The ODE planners' parameters Odin's planning bridge uses (PlannerSearch field names)."""
+_WHOLE_PARAMETERS = ("max_contacts", "min_control_steps", "max_control_steps")
 
 _ROBOT_CHILDREN = {
     "home": None, "limits": None, "kauthamname": None,
@@ -298,10 +305,10 @@ class _Loader:
         name_node = parameters.find("Name")
         name = name_node.text.strip() if name_node is not None else ""
         physics = name in PHYSICS_PLANNERS
-        values, unused = {}, []
+        values, search, unused = {}, {}, []
         for parameter in parameters.findall("Parameter"):
             pname = (parameter.get("name") or "").strip()
-            field = PLANNER_PHYSICS.get(pname) if physics else None
+            field = PLANNER_PHYSICS.get(pname, PLANNER_SEARCH.get(pname)) if physics else None
             if field is None:
                 unused.append(pname)
                 continue
@@ -312,16 +319,13 @@ class _Loader:
                     raise
                 unused.append(pname)
                 continue
-            if field == "max_contacts":
-                if value != int(value) or value < 1:
-                    raise parameter.error(f"Max Contacts {parameter.text.strip()!r} is not a "
-                                          "whole number >= 1")
-                value = int(value)
-            values[field] = value
+            value = _planner_parameter(parameter, pname, field, value)
+            (values if field in PlannerPhysics.__dataclass_fields__ else search)[field] = value
         if unused:
             self.ignore(parameters, f"planner {name or '(unnamed)'} parameters "
                         + ", ".join(f'"{u}"' for u in unused),
-                        "planning parameters: Odin simulates, it does not plan")
+                        "not used: Odin's planning bridge sets its search up itself "
+                        "(gui.planning)")
         for child in parameters.children:
             if child.tag.lower() not in ("name", "parameter"):
                 self.ignore(child, f"<Parameters> <{child.tag}>", "a planner's setting")
@@ -329,7 +333,8 @@ class _Loader:
             self.ignore(name_node, f"planner {name}", "not one of Kautham's ODE planners: "
                         "the problem is built without Kautham's physics (no ground, "
                         "obstacles with a mass only are bodies)")
-        return Planner(name, physics, PlannerPhysics(**values), node.path, parameters.line)
+        return Planner(name, physics, PlannerPhysics(**values), PlannerSearch(**search),
+                       node.path, parameters.line)
 
     def _query(self, planner: Node, robots: List[Instance]) -> None:
         queries = planner.find("Queries")
@@ -410,6 +415,20 @@ class _Loader:
 def _fill(values) -> list:
     """A control vector from <RobotControl> elements: a control not given is 0 (Kautham's)."""
     return [0.0 if v is None else float(v) for v in values]
+
+
+def _planner_parameter(node: Node, name: str, field: str, value: float):
+    """A planner parameter's value, checked: the counts whole numbers >= 1 (Max Contacts,
+    Min/Max Control Steps), Goal Bias in [0, 1], a speed or time positive."""
+    if field in _WHOLE_PARAMETERS:
+        if value != int(value) or value < 1:
+            raise node.error(f"{name} {node.text.strip()!r} is not a whole number >= 1")
+        return int(value)
+    if field == "goal_bias" and not 0.0 <= value <= 1.0:
+        raise node.error(f"Goal Bias {node.text.strip()!r} is not in [0, 1]")
+    if field in ("max_speed", "time_limit") and not value > 0.0:
+        raise node.error(f"{name} {node.text.strip()!r} is not positive")
+    return value
 
 
 def parse_text_number(node: Node) -> float:
