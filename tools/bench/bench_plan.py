@@ -11,6 +11,12 @@
   propagations_per_s_pool   the same batch through a pool of 2 world nodes (fanned out, one
                             ROS round trip per step), and ..._pool1 through a pool of 1:
                             their ratio is plan_pool_speedup_2 (this machine's 2 cores).
+  propagations_per_s_native the same batch through a plain ODE propagator written directly
+                            against libode (native/plan_scene.c: the same bodies, forces and
+                            step, no Odin), served to the planner the same way: the native
+                            limit. plan_core_over_native: the Core's rate over it, side by side.
+  plan_sphere_native_solved KPIECE1 (seed 1, TIME_S) over the native propagator solves the
+                            query too (1) or not (0): the native world is the same problem.
 Needs the Kautham data (ODIN_KAUTHAM_DIR). ``ODIN_BENCH_PLAN_SEEDS`` runs fewer seeds.
 """
 import logging
@@ -29,6 +35,7 @@ from odin_common.ros_master import RosMaster  # noqa: E402
 SEEDS = int(os.environ.get("ODIN_BENCH_PLAN_SEEDS", 10))
 TIME_S = 10.0
 BATCH = 200
+REPEATS = 3
 SPHERE = ("current_2025", "demos", "OMPL_ode_demos", "Sphere", "Sphere.xml")
 
 
@@ -81,6 +88,118 @@ def _core_rate() -> dict:
         backend.close()
 
 
+class NativeBackend:
+    """The planning bridge's Backend over native/plan_scene.c: the Sphere world's bodies (as
+    the Core built them: primitives, masses, poses) in a plain libode world; the control's
+    force computed as the Core back end computes it (gui.planning.backend.step_actuation).
+    A state vector holds 13 values per body (plan_scene.c)."""
+
+    def __init__(self, core_backend, library: pathlib.Path):
+        import numpy as np
+        from cffi import FFI
+        self.problem = core_backend.problem
+        core = core_backend.world.core
+        self.ffi = FFI()
+        self.ffi.cdef("""
+            int ps_create(double, double, double, double, double, int, double);
+            int ps_add(int, const double *, double, const double *, const double *, int);
+            int ps_propagate(const double *, int, const double *, double, double *);
+            void ps_read(double *);
+            int ps_body_count(void);""")
+        self.lib = self.ffi.dlopen(str(library))
+        w = core.world_parameters
+        self.lib.ps_create(*w.gravity, w.erp, w.cfm, w.max_contacts, w.friction)
+        self.index = {}
+        for name in core.object_ids():
+            self._add(core, name)
+        self.size = 13 * self.lib.ps_body_count()
+        self._out = self.ffi.new("double[]", self.size)
+        self.lib.ps_read(self._out)
+        self._start = np.frombuffer(self.ffi.buffer(self._out), dtype=np.float64).copy()
+        self.robot = self.index[self.problem.base_body]
+        self.propagations = 0
+
+    def _add(self, core, name: str) -> None:
+        spec = core.object_spec(name)
+        dims = list(spec.parameters) or [0.0]
+        shape = 6 if spec.shape == 6 else (1 if len(dims) == 1 else 3)
+        if spec.shape not in (0, 1, 3, 6) or len(dims) not in (1, 3):
+            raise RuntimeError(f"{name}: the native propagator takes spheres, boxes, planes")
+        dynamic = not (spec.geometry_only or spec.fixed)
+        if dynamic:
+            position, quaternion, _, _ = core.body_state(name)
+        else:
+            position, quaternion = spec.position, spec.orientation
+        role = 1 if name in self.problem.robot_bodies else (
+            2 if name in self.problem.forbidden else 0)
+        index = self.lib.ps_add(shape, dims, spec.mass if dynamic else 0.0, list(position),
+                                list(quaternion), role)
+        if index >= 0:
+            self.index[name] = index
+        elif index == -2:
+            raise RuntimeError("the native propagator holds 64 bodies at most")
+
+    def start_state(self):
+        return self._start.copy()
+
+    def _body(self, state, name):
+        k = 13 * self.index[name]
+        return state[k:k + 3], state[k + 3:k + 7], state[k + 7:k + 10]
+
+    def tracked_state(self, state):
+        position, quaternion, linear = self._body(state, self.problem.tracked_body)
+        return self.problem.tracked_origin(position, quaternion), linear.copy()
+
+    def propagate(self, requests):
+        import numpy as np
+        from gui.planning.backend import Outcome, step_actuation
+        outcomes = []
+        for state, control in requests:
+            act = step_actuation(self.problem, control, self._body(state, self.problem.base_body))
+            force = act.forces[0][1] if act.forces else (0.0, 0.0, 0.0)
+            state = np.ascontiguousarray(state, dtype=np.float64)
+            touched = self.lib.ps_propagate(self.ffi.from_buffer("double[]", state), self.robot,
+                                            list(force), self.problem.step, self._out)
+            new = np.frombuffer(self.ffi.buffer(self._out), dtype=np.float64).copy()
+            self.propagations += 1
+            position, linear = self.tracked_state(new)
+            pairs = ((self.problem.base_body, sorted(self.problem.forbidden)[0]),) \
+                if touched else ()
+            outcomes.append(Outcome(new, position, linear, pairs))
+        return outcomes
+
+    def close(self) -> None:
+        pass
+
+
+def _native_library(out_dir: pathlib.Path) -> pathlib.Path:
+    import subprocess
+    library = out_dir / "plan_scene.so"
+    subprocess.run(["gcc", "-O2", "-DdDOUBLE", "-shared", "-fPIC",
+                    str(HERE / "native" / "plan_scene.c"), "-lode", "-o", str(library)],
+                   check=True)
+    return library
+
+
+def _native(library: pathlib.Path) -> dict:
+    """The Core's and the native propagator's batch rates side by side (alternating, best of
+    REPEATS each), and one KPIECE1 search over the native propagator."""
+    from gui.planning.backend import CoreBackend
+    from gui.planning.bridge import plan
+    core = CoreBackend(*_sphere())
+    native = NativeBackend(core, library)
+    try:
+        core_rates, native_rates = [], []
+        for _ in range(REPEATS):
+            core_rates.append(_rate(core))
+            native_rates.append(_rate(native))
+        result = plan(native, "KPIECE1", TIME_S, 1)
+        return {"core": max(core_rates), "native": max(native_rates),
+                "solved": result.solved}
+    finally:
+        core.close()
+
+
 def _pool_rate(size: int) -> dict:
     with RosMaster() as master:
         namespaces = [f"/w{k}/virtual_world" for k in range(size)]
@@ -103,12 +222,16 @@ def run(out_dir: pathlib.Path) -> dict:
     core = in_child(_core_rate)["per_s"]
     pool2 = in_child(_pool_rate, 2)["per_s"]
     pool1 = in_child(_pool_rate, 1)["per_s"]
+    native = in_child(_native, _native_library(out_dir))
     return {"plan_sphere_success": round(len(solved) / len(searches), 3),
             "plan_sphere_median_s": round(statistics.median(solved), 2) if solved else TIME_S,
             "propagations_per_s_core": round(core, 1),
             "propagations_per_s_pool": round(pool2, 1),
             "propagations_per_s_pool1": round(pool1, 1),
-            "plan_pool_speedup_2": round(pool2 / pool1, 3)}
+            "plan_pool_speedup_2": round(pool2 / pool1, 3),
+            "propagations_per_s_native": round(native["native"], 1),
+            "plan_core_over_native": round(native["core"] / native["native"], 4),
+            "plan_sphere_native_solved": int(native["solved"])}
 
 
 if __name__ == "__main__":

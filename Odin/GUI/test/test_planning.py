@@ -62,14 +62,14 @@ def test_bad_search_settings_are_refused_with_their_name(sphere_plan, settings, 
         planning_problem(sphere_plan, settings=settings)
 
 
-def test_a_robot_with_joints_is_refused_with_its_name(kautham_dir):
+def test_a_problem_without_physics_is_refused_with_the_reason(kautham_dir):
     logging.disable(logging.WARNING)
     try:
         chain = plan_problem(load_problem(
             kautham_dir / "legacy_2012" / "examples" / "Kuka_two_columns.xml"))
     finally:
         logging.disable(logging.NOTSET)
-    with pytest.raises(PlanningError, match="free body"):
+    with pytest.raises(PlanningError, match="no physics"):
         planning_problem(chain)
 
 
@@ -186,3 +186,43 @@ def test_the_plan_tool_names_a_missing_problem_file(tmp_path):
     run = _plan_tool(str(tmp_path / "nope.xml"), "--out", str(tmp_path / "p"))
     assert run.returncode == 2 and run.stderr.startswith("plan: error:")
     assert "nope.xml" in run.stderr
+
+
+def test_parallel_searches_stop_at_the_first_solution_which_replays(sphere_plan):
+    from gui.planning.parallel import plan_in_parallel
+    problem = planning_problem(sphere_plan)
+    result, outcomes = plan_in_parallel(lambda k: CoreBackend(sphere_plan, problem), 2,
+                                        "KPIECE1", 60.0, 7)
+    assert result.solved and result.seed in (7, 8)
+    assert [o.seed for o in outcomes] == [7, 8]
+    assert any(o.result is result for o in outcomes)
+    backend = CoreBackend(sphere_plan, problem)
+    try:
+        assert replay(backend, result.rows).tobytes() == result.final_position.tobytes()
+    finally:
+        backend.close()
+
+
+def test_parallel_searches_that_all_fail_say_why(sphere_plan):
+    from gui.planning.parallel import plan_in_parallel
+
+    def broken(k):
+        raise PlanningError(f"world {k} is gone")
+    with pytest.raises(PlanningError, match="seed 3: PlanningError: world 0 is gone; seed 4"):
+        plan_in_parallel(broken, 2, "KPIECE1", 1.0, 3)
+    with pytest.raises(PlanningError, match="whole number"):
+        plan_in_parallel(broken, 0, "KPIECE1", 1.0, 3)
+
+
+@pytest.mark.parametrize("args,message", [
+    (["--parallel", "0"], "--parallel 0"),
+    (["--parallel", "3", "--backend", "pool", "--worlds", "/a,/b"], "need as many worlds"),
+])
+def test_the_plan_tool_refuses_bad_parallel_searches_in_one_line(kautham_dir, tmp_path, args,
+                                                                 message):
+    out = tmp_path / "plan.txt"
+    run = _plan_tool(str(kautham_dir.joinpath(*SPHERE)), "--out", str(out), *args)
+    errors = [line for line in run.stderr.splitlines() if "warning" not in line]
+    assert run.returncode == 2, run.stderr
+    assert len(errors) == 1 and errors[0].startswith("plan: error:") and message in errors[0]
+    assert not out.exists()

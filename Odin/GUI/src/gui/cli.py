@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import random
 import sys
 import time
 from typing import Optional, Sequence
@@ -335,8 +336,9 @@ def plan_main(argv: Optional[Sequence[str]] = None) -> int:
     parser.add_argument("problem", help="the problem XML file")
     parser.add_argument("--planner", default="KPIECE1",
                         help=f"OMPL control planner: {', '.join(PLANNERS)} [KPIECE1]")
-    parser.add_argument("--time", type=float, default=10.0, metavar="S",
-                        help="wall-clock seconds the planner may search [10]")
+    parser.add_argument("--time", type=float, default=None, metavar="S",
+                        help="wall-clock seconds the planner may search [the problem's "
+                        "\"_Max Planning Time\", else 10]")
     parser.add_argument("--out", required=True, metavar="PATH",
                         help="control path file to write (rows: controls, duration s)")
     parser.add_argument("--seed", type=int, default=None, help="OMPL's random seed")
@@ -350,46 +352,95 @@ def plan_main(argv: Optional[Sequence[str]] = None) -> int:
     parser.add_argument("--robot", help="robot name (default: the first robot)")
     parser.add_argument("--goal-tolerance", type=float, default=None, metavar="M",
                         help="goal region radius in the plane, m [0.25]")
+    parser.add_argument("--min-control-steps", type=int, default=None, metavar="N",
+                        help="a control is held at least N propagation steps [the problem's "
+                        "\"Min Control Steps\", else 2]")
+    parser.add_argument("--max-control-steps", type=int, default=None, metavar="N",
+                        help="and at most N [the problem's \"Max Control Steps\", else 30]")
+    parser.add_argument("--parallel", type=int, default=1, metavar="N",
+                        help="N independent searches at once, seeds SEED..SEED+N-1, each in a "
+                        "process with a back end of its own (pool: its share of --worlds); "
+                        "the first solution wins [1]")
     _build_options(parser)
     args = parser.parse_args(argv)
     _warnings_to_stderr("plan")
-    backend = None
     try:
-        backend = _planning_backend(args)
-        from gui.planning.bridge import plan
-        result = plan(backend, args.planner, args.time, args.seed)
-        print(json.dumps(result.statistics(), indent=1), flush=True)
+        result, time_limit, seed = _search(args)
         if not result.solved:
             return _fail("plan", GuiError(
-                f"{args.problem}: no solution within {args.time:g} s ({args.planner}, seed "
-                f"{args.seed}): the closest plan ends {result.goal_distance:.3f} m from the "
-                "goal")) - 1
+                f"{args.problem}: no solution within {time_limit:g} s ({args.planner}, seed "
+                f"{seed}{_searches(args)}): the closest plan ends {result.goal_distance:.3f} m "
+                "from the goal")) - 1
         from gui.core.control_path import write_control_path
         write_control_path(args.out, result.rows, comments=(
             f"control path planned by rosrun GUI plan {args.problem}",
-            f"planner {args.planner}, seed {args.seed}, {result.time_s:.2f} s, "
+            f"planner {args.planner}, seed {result.seed}, {result.time_s:.2f} s, "
             f"ends {result.goal_distance:.4f} m from the goal",
             "each row: the robot's controls in [0, 1], then the duration (s)"))
         print(f"plan: {len(result.rows)} rows ({result.duration:.3f} s) written to {args.out}")
     except (GuiError, OSError) as error:
         return _fail("plan", error)
-    finally:
-        if backend is not None:
-            backend.close()
     return 0
 
 
-def _planning_backend(args):
+def _searches(args) -> str:
+    return f" and the next {args.parallel - 1}" if args.parallel > 1 else ""
+
+
+def _search(args):
+    """(the plan's result, the time limit s, the (first) seed); prints the statistics."""
+    from gui.planning.bridge import plan
+    make_backend, time_limit = _planning_backends(args)
+    seed = args.seed
+    if args.parallel == 1:
+        backend = make_backend(0)
+        try:
+            result = plan(backend, args.planner, time_limit, seed)
+        finally:
+            backend.close()
+        print(json.dumps(result.statistics(), indent=1), flush=True)
+        return result, time_limit, seed
+    from gui.planning.parallel import plan_in_parallel
+    if seed is None:
+        seed = random.randrange(1, 2 ** 31)
+    result, outcomes = plan_in_parallel(make_backend, args.parallel, args.planner,
+                                        time_limit, seed)
+    print(json.dumps({**result.statistics(), "searches": [o.summary() for o in outcomes]},
+                     indent=1), flush=True)
+    return result, time_limit, seed
+
+
+def _planning_backends(args):
+    """(make_backend(k): the back end of search k of ``args.parallel``, the search's time
+    limit s). Every search's back end holds the problem's world: the Core builds one in the
+    process calling it; with the pool, search k gets every ``args.parallel``-th world of
+    ``--worlds`` from the k-th."""
     from gui.planning.problem import SearchSettings, planning_problem
-    settings = SearchSettings() if args.goal_tolerance is None else \
-        SearchSettings(goal_tolerance=args.goal_tolerance)
+    if args.parallel < 1:
+        raise GuiError(f"--parallel {args.parallel}: need 1 or more searches")
     plan = _plan(args)
+    settings = SearchSettings.of_problem(plan, goal_tolerance=args.goal_tolerance,
+                                         min_control_steps=args.min_control_steps,
+                                         max_control_steps=args.max_control_steps)
     problem = planning_problem(plan, args.robot, settings)
+    planner = plan.problem.planner
+    time_limit = args.time if args.time is not None else \
+        (planner.search.time_limit if planner and planner.search.time_limit else 10.0)
     if args.backend == "pool":
-        from gui.planning_pool import PoolBackend
         namespaces = [n.strip() for n in args.worlds.split(",") if n.strip()]
         if not namespaces:
             raise GuiError(f"--worlds {args.worlds!r}: no namespace given")
-        return PoolBackend(plan, problem, namespaces, timeout=args.world_timeout)
-    from gui.planning.backend import CoreBackend
-    return CoreBackend(plan, problem)
+        if len(namespaces) < args.parallel:
+            raise GuiError(f"--parallel {args.parallel} searches need as many worlds; "
+                           f"--worlds names {len(namespaces)}")
+
+        def pool_backend(k: int):
+            from gui.planning_pool import PoolBackend
+            return PoolBackend(plan, problem, namespaces[k::args.parallel],
+                               timeout=args.world_timeout)
+        return pool_backend, time_limit
+
+    def core_backend(k: int):
+        from gui.planning.backend import CoreBackend
+        return CoreBackend(plan, problem)
+    return core_backend, time_limit
