@@ -186,7 +186,9 @@ class CoreBackend:
             # is sent once (this world's servos are set by this back end alone)
             self.port.set_servo(act.servo)
             self._servo_sent = act.servo
-        result = self.port.advance(problem.step, act.forces)
+        result = core.propagate(problem.step, self.world.step_values.step,
+                                body_forces=force_requests(act.forces), keep=True,
+                                read_states=False)      # as CorePort.advance, states unread
         self.propagations += 1
         position, linear = self._tracked()
         return Outcome(core.body_state_vector(), position, linear,

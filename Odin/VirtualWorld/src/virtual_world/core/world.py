@@ -471,14 +471,16 @@ class Core:
                   motor_goals: Optional[Mapping[str, Sequence[float]]] = None,
                   body_forces: Sequence[Mapping] = (), start: str = "",
                   keep: bool = False,
-                  start_state: Optional[Sequence[float]] = None) -> Propagation:
+                  start_state: Optional[Sequence[float]] = None,
+                  read_states: bool = True) -> Propagation:
         """Runs the world for ``duration`` s in steps of ``step_size`` s, as fast as it goes:
         from the snapshot ``start``, or from the body state vector ``start_state``
         (``body_state_vector``'s; the rest of the state as it is now), or from now; under ``motor_goals`` ({motor id: goal
         speeds}) and ``body_forces`` (each the keyword arguments of add_body_force), recording
         every pair that collides on the way. Then the world goes back to the state it had
         before the call, unless ``keep``; the forces act during the propagation only.
-        Everything is checked before anything changes."""
+        ``read_states`` False leaves the answer's ``states`` empty (a planner reads the state
+        vector alone). Everything is checked before anything changes."""
         scene = self._scene
         duration = check.number("duration", duration)
         step_size = check.step_size(step_size)
@@ -506,7 +508,7 @@ class Core:
             if motor_goals:
                 motors.set_velocities(scene, motor_goals)
             added = [forces.add_body_force(scene, **dict(f)) for f in body_forces]
-            result = self._run(steps, step_size)
+            result = self._run(steps, step_size, read_states)
             for force_id in added:
                 forces.remove_body_force(scene, force_id)
         except Exception:
@@ -516,7 +518,7 @@ class Core:
             snapshots.put_back(scene, before)
         return result._replace(wall_time=time.perf_counter() - started, kept=keep)
 
-    def _run(self, steps: int, step_size: float) -> Propagation:
+    def _run(self, steps: int, step_size: float, read_states: bool = True) -> Propagation:
         """Steps with every step's collisions recorded; what a propagation answers."""
         scene = self._scene
         readout.carry_collisions(scene, set())
@@ -536,7 +538,8 @@ class Core:
         scene.c.clear_records()
         scene.carried = carried
         states = tuple(BodyState(i, *(tuple(v.tolist()) for v in readout.body_state(scene, i)))
-                       for i, o in scene.objects.items() if o.body is not None)
+                       for i, o in scene.objects.items() if o.body is not None) \
+            if read_states else ()
         return Propagation(start_time, step_size, steps, states, collisions, 0.0, False,
                            self._state_vector())
 
