@@ -126,7 +126,8 @@ def test_problem_info_lists_what_odin_does_not_use_and_warns_once_each():
     assert result.returncode == 0, result.stderr
     info = json.loads(result.stdout)
     whats = [i["what"] for i in info["ignored"]]
-    assert any('"Goal Bias"' in w for w in whats)           # a planning parameter
+    assert any('"Control Dimensions"' in w for w in whats)  # a planning parameter unused
+    assert not any('"Goal Bias"' in w for w in whats)       # the planning bridge uses it
     assert any("Constraint Force Mixing" in w for w in whats)
     assert any("<inertial>" in w for w in whats)             # the placeholder inertias
     warnings = [l for l in result.stderr.splitlines() if l.startswith("problem_info: warning:")]
