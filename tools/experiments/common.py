@@ -254,15 +254,19 @@ class Session:
 
     def wait_for_update(self, timeout: float = 10.0) -> None:
         """Until the world_update of the current simulated time has arrived here."""
+        self._wait_for_stamp("poses", "world_update", timeout)
+
+    def _wait_for_stamp(self, kept: str, message: str, timeout: float) -> None:
+        """Until ``record.<kept>`` holds the current simulated time's ``message``."""
         wanted = round(self.sim_time, 6)
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
             with self.record.lock:
-                if wanted in self.record.poses:
+                if wanted in getattr(self.record, kept):
                     return
-            time.sleep(0.002)
+            time.sleep(0.001)
         self.check_nodes()
-        raise ExperimentError(f"no world_update stamped {wanted} s after {timeout} s")
+        raise ExperimentError(f"no {message} stamped {wanted} s after {timeout} s")
 
     def cycle_and_frame(self) -> Optional[pathlib.Path]:
         """One cycle, then its Viewer frame. The Viewer lags a little behind a burst of
@@ -309,27 +313,11 @@ class Session:
 
     def wait_for_contacts(self, timeout: float = 10.0) -> None:
         """Until the Contacts message of the current simulated time has arrived here."""
-        wanted = round(self.sim_time, 6)
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            with self.record.lock:
-                if wanted in self.record.contacts:
-                    return
-            time.sleep(0.001)
-        self.check_nodes()
-        raise ExperimentError(f"no Contacts stamped {wanted} s after {timeout} s")
+        self._wait_for_stamp("contacts", "Contacts", timeout)
 
     def wait_for_collided(self, timeout: float = 10.0) -> None:
         """Until the Collided message of the current simulated time has arrived here."""
-        wanted = round(self.sim_time, 6)
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            with self.record.lock:
-                if wanted in self.record.collided:
-                    return
-            time.sleep(0.001)
-        self.check_nodes()
-        raise ExperimentError(f"no Collided stamped {wanted} s after {timeout} s")
+        self._wait_for_stamp("collided", "Collided", timeout)
 
     def finish(self) -> None:
         """Waits for the last messages; call before reading ``record``."""
