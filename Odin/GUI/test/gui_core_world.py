@@ -5,8 +5,11 @@ The plan's steps call only these methods, as they do WorldClient's; the node tes
 experiments send the same plans through the real client."""
 from __future__ import annotations
 
+import logging
+
 import numpy as np
 
+from gui.core.build import plan_problem
 from gui.planning import backend as planning_backend
 
 
@@ -28,3 +31,14 @@ class CoreWorld(planning_backend.CoreWorld):
 
 
 CorePort = planning_backend.CorePort
+
+
+def quiet_plan(problem_file):
+    """The build plan of a Kautham problem file, its warnings about what Odin does not use
+    silenced (the loader's own tests check them)."""
+    from gui.core.kautham.problem import load_problem
+    logging.disable(logging.WARNING)
+    try:
+        return plan_problem(load_problem(problem_file))
+    finally:
+        logging.disable(logging.NOTSET)

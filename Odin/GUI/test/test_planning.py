@@ -1,7 +1,6 @@
 """The planning bridge (gui.planning, issue 17) without ROS: the problem it reads from a Kautham
 file, the Core back end's exact restore, OMPL's search on the Sphere demo, the control path
 it writes and its replay in a fresh world, and the plan tool's answers to bad input."""
-import logging
 import subprocess
 import sys
 
@@ -11,23 +10,18 @@ import pytest
 from gui.core.build import plan_problem
 from gui.core.control_path import (ControlRow, read_control_path, run_control_path,
                                    write_control_path)
-from gui.core.kautham.problem import load_problem
 from gui.errors import PathFileError, PlanningError
 from gui.planning.backend import CoreBackend
 from gui.planning.bridge import PLANNERS, plan, replay
 from gui.planning.problem import SearchSettings, planning_problem
-from gui_core_world import CorePort, CoreWorld
+from gui_core_world import CorePort, CoreWorld, quiet_plan
 
 SPHERE = ("current_2025", "demos", "OMPL_ode_demos", "Sphere", "Sphere.xml")
 
 
 @pytest.fixture
 def sphere_plan(kautham_dir):
-    logging.disable(logging.WARNING)
-    try:
-        return plan_problem(load_problem(kautham_dir.joinpath(*SPHERE)))
-    finally:
-        logging.disable(logging.NOTSET)
+    return quiet_plan(kautham_dir.joinpath(*SPHERE))
 
 
 @pytest.fixture
@@ -63,12 +57,7 @@ def test_bad_search_settings_are_refused_with_their_name(sphere_plan, settings, 
 
 
 def test_a_problem_without_physics_is_refused_with_the_reason(kautham_dir):
-    logging.disable(logging.WARNING)
-    try:
-        chain = plan_problem(load_problem(
-            kautham_dir / "legacy_2012" / "examples" / "Kuka_two_columns.xml"))
-    finally:
-        logging.disable(logging.NOTSET)
+    chain = quiet_plan(kautham_dir / "legacy_2012" / "examples" / "Kuka_two_columns.xml")
     with pytest.raises(PlanningError, match="no physics"):
         planning_problem(chain)
 

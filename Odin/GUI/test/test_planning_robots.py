@@ -3,29 +3,23 @@
 follows, and the car; their servo-driven propagations restore exactly and replay bit for bit
 in a fresh world as run_path runs them; the planner's parameters the problem gives are the
 search's."""
-import logging
 
 import numpy as np
 import pytest
 
 from gui.core.build import plan_problem
 from gui.core.control_path import ControlRow, run_control_path
-from gui.core.kautham.problem import load_problem
 from gui.planning.backend import CoreBackend
 from gui.planning.bridge import plan, replay
 from gui.planning.problem import SearchSettings, planning_problem
-from gui_core_world import CorePort, CoreWorld
+from gui_core_world import CorePort, CoreWorld, quiet_plan
 
 CHAIN = ("demos", "OMPL_ode_demos", "Chain", "k-PMPChain.xml")
 CAR = ("demos", "OMPL_ode_demos", "Car", "k-PMPCar.xml")
 
 
 def _plan(ode_demos_dir, parts):
-    logging.disable(logging.WARNING)
-    try:
-        return plan_problem(load_problem(ode_demos_dir.joinpath(*parts)))
-    finally:
-        logging.disable(logging.NOTSET)
+    return quiet_plan(ode_demos_dir.joinpath(*parts))
 
 
 @pytest.fixture
