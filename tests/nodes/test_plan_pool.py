@@ -5,6 +5,7 @@ Core to the same place; the chain's servo controls answer the same through the p
 `rosrun GUI plan --backend pool` refuses an absent world in one line."""
 from __future__ import annotations
 
+import json
 import logging
 import subprocess
 
@@ -97,6 +98,25 @@ def test_servo_controls_through_the_pool_answer_what_the_core_answers(ros_master
     finally:
         pool.close()
         core.close()
+
+
+def test_parallel_searches_share_the_pool_one_world_each(ros_master, kautham_dir, tmp_path):
+    """`plan --parallel 2` over two worlds: each search builds the problem in its own world
+    (a process of its own, a node of its own) and the first solution is written."""
+    for namespace in ("/w0", "/w1"):
+        ros_master.rosrun("VirtualWorld", "virtualWorld", f"__ns:={namespace}")
+    for namespace in NAMESPACES:
+        ros_master.wait_for_service(f"{namespace}/propagate")
+    out = tmp_path / "p.path"
+    run = subprocess.run(["rosrun", "GUI", "plan", str(kautham_dir.joinpath(*SPHERE)),
+                          "--backend", "pool", "--worlds", ",".join(NAMESPACES),
+                          "--parallel", "2", "--seed", "7", "--time", "60", "--out", str(out)],
+                         capture_output=True, text=True, timeout=300, env=ros_master.env)
+    assert run.returncode == 0, run.stderr
+    statistics = json.loads(run.stdout[:run.stdout.rindex("}") + 1])
+    assert statistics["solved"] and statistics["seed"] in (7, 8)
+    assert sorted(s["seed"] for s in statistics["searches"]) == [7, 8]
+    assert out.exists()
 
 
 def test_plan_with_the_pool_refuses_an_absent_world_in_one_line(ros_master, kautham_dir,
