@@ -188,6 +188,23 @@ def test_plan_sphere_kpiece1_plan_replays_to_the_goal_region_in_a_fresh_world(ka
     assert ["SphereDE", "cubeDE1"] in o["sphere_touched"]
 
 
+@pytest.mark.forked
+def test_plan_sphere_walls_crosses_the_arena_past_the_inner_walls(kautham_dir):
+    """KPIECE1 plans Kautham's second sphere demo (k-PMPSphere.xml: three inner walls) and the
+    plan replays in a fresh world node to the goal region without touching a wall
+    (tools/experiments/plan_sphere_walls.py)."""
+    import plan_sphere_walls
+    facts = plan_sphere_walls.run(frames=False)
+    o = facts["outcome"]
+    failed = [name for name, held in plan_sphere_walls.checks(o).items() if not held]
+    assert not failed, (failed, o)
+    assert o["replay_bit_identical"], (o["planned_end_m"], o["executed_end_m"])
+    # seed 1 solves it in 2,381 propagations, 84 rows; the sphere starts on the far side of
+    # the inner wall from its goal
+    assert o["planner"]["propagations"] == 2381 and o["rows_run"] == 84
+    assert o["start_m"][1] > 0.5 > -0.5 > o["goal_xy_m"][1]
+
+
 def test_one_command_runs_several_experiments(kautham_dir):
     """`make experiments` runs them one after another from one command; each has a roscore of
     its own, which one rospy process cannot follow (it hung on the second before)."""

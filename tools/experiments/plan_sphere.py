@@ -85,20 +85,23 @@ def search(plan, p: dict):
     return problem, result
 
 
-def run(frames: bool = True) -> dict:
+def run(frames: bool = True, problem_file=PROBLEM, name: str = "plan_sphere",
+        parameters: dict = PARAMETERS, camera: "common.Camera" = CAMERA) -> dict:
+    """Plans ``problem_file``'s query (a Sphere demo) and runs the plan in a fresh world node
+    (the module docstring); the experiment ``name`` writes out/experiments/<name>/."""
     from gui.core.control_path import (ClientPort, control_size, read_control_path,
                                        run_control_path, write_control_path)
-    p = dict(PARAMETERS)
-    _, searched = common.load_plan(PROBLEM)
+    p = dict(parameters)
+    _, searched = common.load_plan(problem_file)
     problem, result = search(searched, p)
-    _, plan = common.load_plan(PROBLEM)            # a fresh plan for the fresh world
+    _, plan = common.load_plan(problem_file)       # a fresh plan for the fresh world
     bodies = {b.id: b for b in plan.bodies() if not b.geometry_only}
     handle = plan.robot()
-    with common.Session("plan_sphere", WORLD, CAMERA, track=set(bodies), frames=frames,
+    with common.Session(name, WORLD, camera, track=set(bodies), frames=frames,
                         contacts=True) as s:
         path = s.out / "plan.path"
         write_control_path(path, result.rows, comments=(
-            f"planned by {p['planner']}, seed {p['seed']} (tools/experiments/plan_sphere.py)",
+            f"planned by {p['planner']}, seed {p['seed']} (tools/experiments/{name}.py)",
             "each row: the sphere's controls in [0, 1], then the duration (s)"))
         rows = read_control_path(path, control_size(handle))
         if s.client.world().simulating:

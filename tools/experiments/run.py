@@ -1,8 +1,8 @@
-"""Runs the thesis's three experiments (chapter 10), Kautham's ODE sphere demo and its plan by
-OMPL's KPIECE1 end to end, headless.
+"""Runs the thesis's three experiments (chapter 10), Kautham's ODE sphere demo and the plans
+OMPL's KPIECE1 makes for both public sphere demos end to end, headless.
 
-    python tools/experiments/run.py                   # all five
-    python tools/experiments/run.py grasp             # one (contactless ... plan_sphere)
+    python tools/experiments/run.py                   # all six
+    python tools/experiments/run.py grasp             # one (contactless ... plan_sphere_walls)
     python tools/experiments/run.py --no-frames pile  # no Viewer frames (the same simulation)
 
 Each experiment starts its own roscore, ``rosrun VirtualWorld virtualWorld`` and ``rosrun
@@ -25,7 +25,7 @@ from gui.core.kautham.corpus import corpus_dir, missing_message
 HERE = pathlib.Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-NAMES = ("contactless", "pile", "grasp", "sphere", "plan_sphere")
+NAMES = ("contactless", "pile", "grasp", "sphere", "plan_sphere", "plan_sphere_walls")
 
 
 def _raise_keyboard_interrupt(signum, frame):
