@@ -169,18 +169,24 @@ def test_sphere_demo_rests_on_the_ground_and_a_control_path_drives_it_to_its_goa
     assert o["rows"] == 57
 
 
+def _planned_and_replayed(experiment) -> dict:
+    """A planning experiment's outcome, after its checks held and the fresh world ended the
+    plan at the planner's bits (the worlds are deterministic: the same bits, not merely
+    close)."""
+    o = experiment.run(frames=False)["outcome"]
+    failed = [name for name, held in experiment.checks(o).items() if not held]
+    assert not failed, (failed, o)
+    assert o["replay_bit_identical"], (o["planned_end_m"], o["executed_end_m"])
+    return o
+
+
 @pytest.mark.forked
 def test_plan_sphere_kpiece1_plan_replays_to_the_goal_region_in_a_fresh_world(kautham_dir):
     """KPIECE1 plans the public Sphere in-process; its written control path, run row by row
     through Propagate in a world node only built from the problem, leaves the sphere where the
     planner's own replay did, in the goal region (tools/experiments/plan_sphere.py)."""
     import plan_sphere
-    facts = plan_sphere.run(frames=False)
-    o = facts["outcome"]
-    failed = [name for name, held in plan_sphere.checks(o).items() if not held]
-    assert not failed, (failed, o)
-    # the worlds are deterministic: the same bits, not merely close
-    assert o["replay_bit_identical"], (o["planned_end_m"], o["executed_end_m"])
+    o = _planned_and_replayed(plan_sphere)
     # seed 7 solves it in 340 propagations, 60 rows of 0.03 s, pushing one block (cubeDE1);
     # the search stops when solved, so its length does not depend on the machine's speed
     assert o["planner"]["propagations"] == 340 and o["rows_run"] == 60
@@ -194,11 +200,7 @@ def test_plan_sphere_walls_crosses_the_arena_past_the_inner_walls(kautham_dir):
     plan replays in a fresh world node to the goal region without touching a wall
     (tools/experiments/plan_sphere_walls.py)."""
     import plan_sphere_walls
-    facts = plan_sphere_walls.run(frames=False)
-    o = facts["outcome"]
-    failed = [name for name, held in plan_sphere_walls.checks(o).items() if not held]
-    assert not failed, (failed, o)
-    assert o["replay_bit_identical"], (o["planned_end_m"], o["executed_end_m"])
+    o = _planned_and_replayed(plan_sphere_walls)
     # seed 1 solves it in 2,381 propagations, 84 rows; the sphere starts on the far side of
     # the inner wall from its goal
     assert o["planner"]["propagations"] == 2381 and o["rows_run"] == 84

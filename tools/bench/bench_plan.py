@@ -92,7 +92,12 @@ class NativeBackend:
     """The planning bridge's Backend over native/plan_scene.c: the Sphere world's bodies (as
     the Core built them: primitives, masses, poses) in a plain libode world; the control's
     force computed as the Core back end computes it (gui.planning.backend.step_actuation).
-    A state vector holds 13 values per body (plan_scene.c)."""
+    A state vector holds STATE_SIZE values per body (plan_scene.c)."""
+
+    STATE_SIZE = 13
+    """plan_scene.c's per body: position, quaternion (w, x, y, z), linear, angular velocity."""
+    ROLE_OTHER, ROLE_ROBOT, ROLE_FORBIDDEN = 0, 1, 2
+    """plan_scene.c's geometry roles: it reports the robot touching a forbidden one."""
 
     def __init__(self, core_backend, library: pathlib.Path):
         import numpy as np
@@ -112,7 +117,7 @@ class NativeBackend:
         self.index = {}
         for name in core.object_ids():
             self._add(core, name)
-        self.size = 13 * self.lib.ps_body_count()
+        self.size = self.STATE_SIZE * self.lib.ps_body_count()
         self._out = self.ffi.new("double[]", self.size)
         self.lib.ps_read(self._out)
         self._start = np.frombuffer(self.ffi.buffer(self._out), dtype=np.float64).copy()
@@ -120,19 +125,22 @@ class NativeBackend:
         self.propagations = 0
 
     def _add(self, core, name: str) -> None:
+        from odin_common.interface import Shape
         spec = core.object_spec(name)
         dims = list(spec.parameters) or [0.0]
-        shape = 6 if spec.shape == 6 else (1 if len(dims) == 1 else 3)
-        if spec.shape not in (0, 1, 3, 6) or len(dims) not in (1, 3):
+        shape = Shape.PLANE if spec.shape == Shape.PLANE else (
+            Shape.SPHERE if len(dims) == 1 else Shape.BOX)
+        if spec.shape not in (Shape.BY_COUNT, Shape.SPHERE, Shape.BOX, Shape.PLANE) \
+                or len(dims) not in (1, 3):
             raise RuntimeError(f"{name}: the native propagator takes spheres, boxes, planes")
         dynamic = not (spec.geometry_only or spec.fixed)
         if dynamic:
             position, quaternion, _, _ = core.body_state(name)
         else:
             position, quaternion = spec.position, spec.orientation
-        role = 1 if name in self.problem.robot_bodies else (
-            2 if name in self.problem.forbidden else 0)
-        index = self.lib.ps_add(shape, dims, spec.mass if dynamic else 0.0, list(position),
+        role = self.ROLE_ROBOT if name in self.problem.robot_bodies else (
+            self.ROLE_FORBIDDEN if name in self.problem.forbidden else self.ROLE_OTHER)
+        index = self.lib.ps_add(int(shape), dims, spec.mass if dynamic else 0.0, list(position),
                                 list(quaternion), role)
         if index >= 0:
             self.index[name] = index
@@ -143,7 +151,7 @@ class NativeBackend:
         return self._start.copy()
 
     def _body(self, state, name):
-        k = 13 * self.index[name]
+        k = self.STATE_SIZE * self.index[name]
         return state[k:k + 3], state[k + 3:k + 7], state[k + 7:k + 10]
 
     def tracked_state(self, state):
@@ -163,6 +171,8 @@ class NativeBackend:
             new = np.frombuffer(self.ffi.buffer(self._out), dtype=np.float64).copy()
             self.propagations += 1
             position, linear = self.tracked_state(new)
+            # plan_scene.c says only that a forbidden geometry was touched: the pair names
+            # one of them, which is all forbidden_contacts needs
             pairs = ((self.problem.base_body, sorted(self.problem.forbidden)[0]),) \
                 if touched else ()
             outcomes.append(Outcome(new, position, linear, pairs))

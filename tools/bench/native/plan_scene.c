@@ -12,7 +12,6 @@
  * (w, x, y, z), linear velocity (m/s), angular velocity (rad/s), world frame. */
 #include <ode/ode.h>
 #include <stdint.h>
-#include <stdlib.h>
 #include <string.h>
 
 #define MAX_BODIES 64

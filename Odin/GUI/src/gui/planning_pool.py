@@ -6,8 +6,9 @@ Every propagation is one Propagate call that starts from the planner's state vec
 any request, and a batch (``PoolBackend.propagate`` of several requests) is fanned out over
 the worlds at once. A control that sets servos (a car, joints) is a Set Servo and the
 Propagate after it, made by the same world one after the other: every control sets the same
-servo values in full, so what an earlier request left set never matters. The worlds are deterministic: the answers are bit for bit those of the
-Core back end (``gui.planning.backend.CoreBackend``). The pool's worlds belong to the planner:
+servo values in full, so what an earlier request left set never matters. The worlds are
+deterministic: the answers are bit for bit those of the Core back end
+(``gui.planning.backend.CoreBackend``). The pool's worlds belong to the planner:
 each is cleared (New Scene), paused and built from the problem when the back end starts.
 """
 from __future__ import annotations

@@ -5,10 +5,10 @@ state (``Core.body_state_vector``'s layout), apply the control for one propagati
 control path row (``gui.core.control_path.actuation``: for a free body, the force that would
 carry the base to the control's position in the step; for a car or joints, the servo
 settings, sent before the step as ``run_path`` sends them), step, and answer the state
-reached, the tracked link's position and velocity, and the pairs that collided on the way. A planner's
-propagation of a control for n steps is n such calls in a row, exactly as ``run_path`` runs
-the n rows of the control path it becomes (one kept Propagate per row), so that the written
-plan replays bit for bit in a fresh world.
+reached, the tracked link's position and velocity, and the pairs that collided on the way. A
+planner's propagation of a control for n steps is n such calls in a row, exactly as
+``run_path`` runs the n rows of the control path it becomes (one kept Propagate per row), so
+that the written plan replays bit for bit in a fresh world.
 
 ``CoreBackend``: the VirtualWorld's Core in this process, built from the problem's plan
 (fastest: no messages). ``gui.planning_pool.PoolBackend``: world nodes over ROS.
@@ -137,8 +137,10 @@ class CorePort:
         core.set_servos(servos)
 
     def advance(self, duration: float, forces):
+        # a control path reads the world through body_state: the answer's states go unread
         return self.world.core.propagate(duration, self.world.step_values.step,
-                                         body_forces=force_requests(forces), keep=True)
+                                         body_forces=force_requests(forces), keep=True,
+                                         read_states=False)
 
 
 def force_requests(forces) -> list:
@@ -186,9 +188,7 @@ class CoreBackend:
             # is sent once (this world's servos are set by this back end alone)
             self.port.set_servo(act.servo)
             self._servo_sent = act.servo
-        result = core.propagate(problem.step, self.world.step_values.step,
-                                body_forces=force_requests(act.forces), keep=True,
-                                read_states=False)      # as CorePort.advance, states unread
+        result = self.port.advance(problem.step, act.forces)
         self.propagations += 1
         position, linear = self._tracked()
         return Outcome(core.body_state_vector(), position, linear,

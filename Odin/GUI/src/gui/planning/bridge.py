@@ -48,12 +48,12 @@ random generator state, below 2^32, is its largest value)."""
 
 @dataclass(frozen=True)
 class PlanResult:
-    """What a search found. ``solved``: an exact solution (the tracked link in the goal region);
-    ``rows``: the control path (the best approximate one when not solved; empty when the
-    planner found nothing); ``final_position`` (3,) m, world: where the tracked link ends when the
-    rows are run from the start in the back end's world; ``goal_distance``: m, in the plane;
-    ``propagations``: propagation steps the search ran; ``time_s``: wall-clock seconds of the
-    search; ``status``: OMPL's planner status."""
+    """What a search found. ``solved``: an exact solution (the tracked link in the goal
+    region); ``rows``: the control path (the best approximate one when not solved; empty when
+    the planner found nothing); ``final_position`` (3,) m, world: where the tracked link ends
+    when the rows are run from the start in the back end's world; ``goal_distance``: m, in the
+    plane; ``propagations``: propagation steps the search ran; ``time_s``: wall-clock seconds
+    of the search; ``status``: OMPL's planner status."""
     planner: str
     seed: Optional[int]
     solved: bool

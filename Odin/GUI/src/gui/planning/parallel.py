@@ -38,8 +38,8 @@ class SearchOutcome:
 
     def summary(self) -> dict:
         if self.result is None:
-            return {"seed": self.seed, "stopped" if not self.error else "error":
-                    self.error or True}
+            return {"seed": self.seed, "error": self.error} if self.error else \
+                {"seed": self.seed, "stopped": True}
         r = self.result
         return {"seed": self.seed, "solved": r.solved, "time_s": round(r.time_s, 3),
                 "goal_distance_m": round(r.goal_distance, 4), "propagations": r.propagations}

@@ -103,7 +103,8 @@ class SearchSettings:
 class PlanningProblem:
     """One robot's planning problem (module docstring). ``base_body``: the world ID of the
     robot's base body (a free base's force acts on it); ``tracked_body``: the tracked link's
-    body and ``tracked_offset`` (4, 4) that body's pose in the link's frame; ``base_bounds``
+    body and ``tracked_link_origin`` (3,) m, the link's origin in that body's frame (the
+    inverse of the body's offset in the link, taken once); ``base_bounds``
     (3, 2): m, world frame, low and high per axis, for the tracked link's origin; ``goal_xy``
     (2,): m, world frame, the tracked link's origin at the goal; ``forbidden``: object IDs the
     robot must not touch; ``robot_bodies``: the robot's body IDs; ``tool_bodies``: those that
@@ -113,7 +114,7 @@ class PlanningProblem:
     handle: RobotHandle
     base_body: str
     tracked_body: str
-    tracked_offset: np.ndarray
+    tracked_link_origin: np.ndarray
     robot_bodies: Tuple[str, ...]
     tool_bodies: frozenset
     base_bounds: np.ndarray
@@ -135,10 +136,8 @@ class PlanningProblem:
     def tracked_origin(self, body_position, body_quaternion) -> np.ndarray:
         """(3,) m, world: the tracked link's origin when its body's frame is at
         ``body_position`` with ``body_quaternion`` (w, x, y, z)."""
-        pose = np.eye(4)
-        pose[:3, :3] = quaternion_to_matrix(body_quaternion)
-        pose[:3, 3] = body_position
-        return (pose @ np.linalg.inv(self.tracked_offset))[:3, 3]
+        return np.asarray(body_position) + \
+            quaternion_to_matrix(body_quaternion) @ self.tracked_link_origin
 
     def goal_distance(self, tracked_position) -> float:
         """m: how far the tracked link is from the goal in the plane."""
@@ -193,20 +192,21 @@ def planning_problem(plan: BuildPlan, robot: Optional[str] = None,
     searched = _searched_controls(handle, settings)
     step = settings.step if settings.step is not None else plan.world.step
     size = control_size(handle)
-    held = handle.start.controls if handle.kind != CAR and handle.start.controls else None
+    held = handle.start.controls if handle.kind != CAR and handle.start.controls else \
+        (0.5,) * size
     tracked = _tracked_link(handle)
     tool = _tool_links(handle, tracked)
     goal = handle.instance.model.link_poses(handle.goal.base_pose, handle.goal.joints)[tracked]
     return PlanningProblem(
         handle=handle, base_body=handle.bodies[0].body_id,
         tracked_body=handle.bodies[tracked].body_id,
-        tracked_offset=np.array(handle.bodies[tracked].offset, dtype=float),
+        tracked_link_origin=np.linalg.inv(handle.bodies[tracked].offset)[:3, 3],
         robot_bodies=tuple(b.body_id for b in handle.bodies),
         tool_bodies=frozenset(handle.bodies[i].body_id for i in tool),
         base_bounds=_base_bounds(handle), goal_xy=np.array(goal[:2, 3]),
         forbidden=frozenset(_forbidden(plan, handle)), control_size=size,
         step=float(step), settings=settings, searched=searched,
-        held=tuple(float(v) for v in (held or (0.5,) * size)))
+        held=tuple(float(v) for v in held))
 
 
 def _searched_controls(handle: RobotHandle, settings: SearchSettings) -> Tuple[int, ...]:
@@ -234,9 +234,10 @@ def _tracked_link(handle: RobotHandle) -> int:
     model = handle.instance.model
     if handle.kind in (FREE_BODY, MOBILE, CAR) or not handle.motor_ids:
         return 0
-    link = 0
-    while len(model.children(link)) == 1:
-        link = model.children(link)[0]
+    link, children = 0, model.children(0)
+    while len(children) == 1:
+        link = children[0]
+        children = model.children(link)
     if link == 0:
         raise PlanningError(f"robot {handle.name}: its held base branches at once, so it has "
                             "no one tool for the planner to follow")

@@ -320,12 +320,11 @@ class _Loader:
                 unused.append(pname)
                 continue
             value = _planner_parameter(parameter, pname, field, value)
-            (values if field in PlannerPhysics.__dataclass_fields__ else search)[field] = value
+            (values if pname in PLANNER_PHYSICS else search)[field] = value
         if unused:
             self.ignore(parameters, f"planner {name or '(unnamed)'} parameters "
                         + ", ".join(f'"{u}"' for u in unused),
-                        "not used: Odin's planning bridge sets its search up itself "
-                        "(gui.planning)")
+                        "Odin's planning bridge sets these up itself (gui.planning)")
         for child in parameters.children:
             if child.tag.lower() not in ("name", "parameter"):
                 self.ignore(child, f"<Parameters> <{child.tag}>", "a planner's setting")
