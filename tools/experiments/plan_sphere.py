@@ -68,11 +68,13 @@ class FramedClient:
 
 
 def search(plan, p: dict):
-    """(problem, PlanResult): KPIECE1 over the Core back end, as ``rosrun GUI plan`` runs it."""
+    """(problem, PlanResult): KPIECE1 over the Core back end, as ``rosrun GUI plan`` runs it
+    (``--goal-tolerance`` from ``p["goal_tolerance_m"]`` where given)."""
     from gui.planning.backend import CoreBackend
     from gui.planning.bridge import plan as plan_query
-    from gui.planning.problem import planning_problem
-    problem = planning_problem(plan)
+    from gui.planning.problem import SearchSettings, planning_problem
+    problem = planning_problem(plan, settings=SearchSettings.of_problem(
+        plan, goal_tolerance=p.get("goal_tolerance_m")))
     backend = CoreBackend(plan, problem)
     try:
         result = plan_query(backend, p["planner"], p["time_limit_s"], p["seed"])
@@ -127,16 +129,29 @@ def analyse(s, p, problem, result, rows, results, collisions, before, after,
     end = executed[-1]
     touched = sorted({tuple(sorted((a, b))) for row in collisions for a, b, _, _ in row
                       if SPHERE in (a, b)})
-    forbidden = problem.forbidden_contacts(touched)
     # in the plane: the blocks are built 0.27 m above where they rest and fall meanwhile
-    moved = {name: round(float(np.linalg.norm(after[name][0][:2] - before[name][0][:2])), 4)
-             for name in before if name != SPHERE}
+    moved = moved_in_the_plane(before, after, [name for name in before if name != SPHERE])
     inner = p["walls_inner_face_m"]
     return {"outcome": {
+        **plan_facts(problem, result, rows, results, end),
+        "start_m": [round(float(v), 4) for v in before[SPHERE][0]],
+        "sphere_touched": [list(pair) for pair in touched],
+        "forbidden_contacts": [list(pair) for pair in problem.forbidden_contacts(touched)],
+        "max_abs_xy_m": round(float(np.abs(executed[:, :2]).max()), 4),
+        "stayed_inside_the_walls": bool(np.abs(executed[:, :2]).max()
+                                        < inner - radius),
+        "obstacles_moved_in_the_plane_m": moved,
+    }, "contacts": s.contact_rates()}
+
+
+def plan_facts(problem, result, rows, results, end) -> dict:
+    """What every planning experiment reports of its plan: the planner's statistics, the
+    goal, the rows written, read back and run, and where the fresh world ended the tracked
+    link (``end``, (3,) m) against the planner's own replay and the goal."""
+    return {
         "planner": result.statistics(),
         "goal_xy_m": [round(float(v), 4) for v in problem.goal_xy],
         "goal_tolerance_m": problem.settings.goal_tolerance,
-        "start_m": [round(float(v), 4) for v in before[SPHERE][0]],
         "rows_written": len(result.rows),
         "rows_read_back_identical": list(rows) == list(result.rows),
         "rows_run": len(results),
@@ -147,13 +162,13 @@ def analyse(s, p, problem, result, rows, results, collisions, before, after,
         "replay_bit_identical": end.tobytes() == np.asarray(result.final_position).tobytes(),
         "distance_to_goal_at_end_m": round(problem.goal_distance(end), 4),
         "in_goal_region": bool(problem.in_goal(end)),
-        "sphere_touched": [list(pair) for pair in touched],
-        "forbidden_contacts": [list(pair) for pair in forbidden],
-        "max_abs_xy_m": round(float(np.abs(executed[:, :2]).max()), 4),
-        "stayed_inside_the_walls": bool(np.abs(executed[:, :2]).max()
-                                        < inner - radius),
-        "obstacles_moved_in_the_plane_m": moved,
-    }, "contacts": s.contact_rates()}
+    }
+
+
+def moved_in_the_plane(before: dict, after: dict, names) -> dict:
+    """{name: m} how far each body moved in x and y between two ``_states`` readings."""
+    return {name: round(float(np.linalg.norm(after[name][0][:2] - before[name][0][:2])), 4)
+            for name in names}
 
 
 #: the executed plan ends where the planner's replay ended, within this (m): determinism
@@ -178,13 +193,19 @@ def checks(o: dict) -> dict:
 def verdict(facts: dict) -> tuple:
     """(outcome held, one line per fact) for run.py."""
     o = facts["outcome"]
-    held = checks(o)
+    return plan_verdict(checks(o), o, o["sphere_touched"], "blocks pushed")
+
+
+def plan_verdict(held: dict, o: dict, touched: list, moved: str) -> tuple:
+    """(every check ``held``, one line per check and one of the plan's figures): a planning
+    experiment's verdict, ``touched`` the pairs its robot touched, ``moved`` what its
+    ``obstacles_moved_in_the_plane_m`` are called."""
     lines = [f"{name}: {'yes' if ok else 'NO'}" for name, ok in held.items()]
     stats = o["planner"]
     lines.append(f"{stats['planner']} seed {stats['seed']}: {stats['time_s']} s, "
                  f"{stats['propagations']} propagations, {o['rows_run']} rows "
                  f"({o['plan_duration_s']} s); ends {o['distance_to_goal_at_end_m']} m from the "
                  f"goal, {o['replay_difference_m']:.3g} m from the planned end "
-                 f"(bit-identical: {o['replay_bit_identical']}); touched {o['sphere_touched']}; "
-                 f"blocks pushed {o['obstacles_moved_in_the_plane_m']} m")
+                 f"(bit-identical: {o['replay_bit_identical']}); touched {touched}; "
+                 f"{moved} {o['obstacles_moved_in_the_plane_m']} m")
     return all(held.values()), lines

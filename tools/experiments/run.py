@@ -1,8 +1,9 @@
 """Runs the thesis's three experiments (chapter 10), Kautham's ODE sphere demo and the plans
-OMPL's KPIECE1 makes for both public sphere demos end to end, headless.
+OMPL's KPIECE1 makes for both public sphere demos and Kautham's chain demo end to end,
+headless.
 
-    python tools/experiments/run.py                   # all six
-    python tools/experiments/run.py grasp             # one (contactless ... plan_sphere_walls)
+    python tools/experiments/run.py                   # all seven
+    python tools/experiments/run.py grasp             # one (contactless ... plan_chain)
     python tools/experiments/run.py --no-frames pile  # no Viewer frames (the same simulation)
 
 Each experiment starts its own roscore, ``rosrun VirtualWorld virtualWorld`` and ``rosrun
@@ -25,7 +26,8 @@ from gui.core.kautham.corpus import corpus_dir, missing_message
 HERE = pathlib.Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-NAMES = ("contactless", "pile", "grasp", "sphere", "plan_sphere", "plan_sphere_walls")
+NAMES = ("contactless", "pile", "grasp", "sphere", "plan_sphere", "plan_sphere_walls",
+         "plan_chain")
 
 
 def _raise_keyboard_interrupt(signum, frame):

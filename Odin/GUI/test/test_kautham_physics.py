@@ -246,20 +246,27 @@ ARM_PROBLEM = """<?xml version="1.0"?><Problem>
  OBSTACLE
  <Controls robot="arm.cntr"/>
  ATTACH
- <Planner><Parameters><Name>KPIECEChainPlanner</Name>
+ <Planner><Parameters><Name>PLANNER</Name>
   <Parameter name="PropagationStepSize">0.01</Parameter></Parameters>
   <Queries><Query>QUERY</Query></Queries></Planner>
 </Problem>"""
 
 
+KINEMATIC = "omplRRTConnect"
+"""A planner of Kautham's without physics: the problem's URDF is simulated as it says."""
+
+
 def _arm(folder: pathlib.Path, damping=2.0, friction=0.5, query="<Init>0.75 0.25</Init>"
-         "<Goal>0.25 0.75</Goal>", obstacle="", attach="", cntr=ARM_CNTR) -> pathlib.Path:
+         "<Goal>0.25 0.75</Goal>", obstacle="", attach="", cntr=ARM_CNTR,
+         planner="KPIECEChainPlanner") -> pathlib.Path:
+    """The two-link arm's problem in ``folder`` (Kautham's chain planner: its physics; a
+    planner without physics, such as omplRRTConnect, builds the URDF's own joints)."""
     (folder / "arm.urdf").write_text(ARM.replace("DAMPING", str(damping))
                                      .replace("FRICTION", str(friction)))
     (folder / "arm.cntr").write_text(cntr)
     problem = folder / "arm.xml"
     problem.write_text(ARM_PROBLEM.replace("QUERY", query).replace("OBSTACLE", obstacle)
-                       .replace("ATTACH", attach))
+                       .replace("ATTACH", attach).replace("PLANNER", planner))
     return problem
 
 
@@ -282,7 +289,7 @@ def test_a_chain_starts_at_its_init_through_the_cntr_and_its_limits(tmp_path):
 
 
 def test_urdf_physics_become_mass_properties_motor_limits_and_surfaces(tmp_path):
-    plan = plan_problem(load_problem(_arm(tmp_path)))
+    plan = plan_problem(load_problem(_arm(tmp_path, planner=KINEMATIC)))
     bodies = {b.id: b for b in plan.bodies()}
     upper = bodies["arm/upper"]
     # one box at (0.25, 0, 0) in the link: the body sits there; the file's centre of mass
@@ -303,6 +310,25 @@ def test_urdf_physics_become_mass_properties_motor_limits_and_surfaces(tmp_path)
     assert any(i.what == "<transmission>" for i in plan.ignored)
 
 
+def test_kautham_s_chain_planner_drives_the_chain_as_its_environment_does(tmp_path, world):
+    """Kautham's chain planner (PlanarChainEnvironment) drives every joint at up to 1 rad/s
+    under 7 N m and its ODE environment reads no joint damping or friction, whatever the
+    URDF says (here 30 and 10 N m, 1.5 and 2 rad/s, damping 2 N m s, friction 0.5 N m):
+    each unused value is warned about."""
+    plan = plan_problem(load_problem(_arm(tmp_path)))
+    motors = {(s.joint_key, s.purpose): s.spec for s in _steps(plan, MotorStep)}
+    assert set(motors) == {("arm/upper", ""), ("arm/fore", "")}
+    assert all(spec.max_forces == (7.0,) for spec in motors.values())
+    handle = plan.robot()
+    assert handle.max_speeds == [1.0, 1.0] and handle.max_forces == [7.0, 7.0]
+    assert any(i.what == '<dynamics> of joint "upper"' for i in plan.ignored)
+    # both joints 2 rad and more from their targets: each turns at the environment's speed
+    world.execute(plan)
+    run_control_path(CorePort(world), handle, [ControlRow(handle.goal.controls, 0.01)] * 30)
+    rates = {j.id: j.rates[0] for j in world.core.joint_states() if j.rates}
+    assert [abs(rates[j]) for j in handle.joint_ids] == pytest.approx([1.0, 1.0], rel=0.02)
+
+
 @pytest.mark.parametrize("damping,friction", [(2.0, 0.5), (2.0, 0.0), (0.0, 0.5)])
 def test_joint_damping_and_friction_resist_as_urdf_says(tmp_path, world, damping, friction):
     """With the driving motor off, a constant joint torque tau gives the shoulder a terminal
@@ -310,7 +336,7 @@ def test_joint_damping_and_friction_resist_as_urdf_says(tmp_path, world, damping
     friction does not move it. ODE's exact solver: QuickStep's default 20 iterations leave
     a chain's constraints loose (README, known limits)."""
     plan = plan_problem(load_problem(_arm(tmp_path, damping=damping, friction=friction,
-                                          query="<Init>0.5 0.5</Init>")))
+                                          query="<Init>0.5 0.5</Init>", planner=KINEMATIC)))
     world.execute(plan)
     handle = plan.robot()
     core = world.core

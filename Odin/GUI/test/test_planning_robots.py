@@ -52,6 +52,11 @@ def test_a_held_chain_pushes_with_its_tool_only(chain_plan):
     assert problem.forbidden_contacts([("box2", "Chain/link2")]) == [("box2", "Chain/link2")]
     assert problem.forbidden_contacts([("Chain/finger1", "redCube2")]) == \
         [("Chain/finger1", "redCube2")]
+    # nothing but the ground may touch a fixed obstacle, not even a box the tool pushes
+    # (PlanarChainEnvironment's isValidCollision)
+    assert problem.forbidden_contacts([("box2", "box1"), ("box1", "ground"),
+                                       ("box2", "box3"), ("redCube2", "box1")]) == \
+        [("box2", "box1"), ("redCube2", "box1")]
 
 
 def test_the_problem_s_planner_parameters_are_the_search_s(chain_plan):

@@ -23,11 +23,13 @@ How a problem maps to the world:
   reversed like a hinge's, so that a positive steering turns left and a positive wheel speed
   rolls the car forward; suspension ERP 0.4 / CFM 0.8). Then one Set Motor per movable joint
   (angular for hinges and hinge-2s, linear for sliders; zero speed, so the robot holds its
-  pose; the joint's effort limit as its force limit, infinite without one), id "motor:" +
-  joint id; a joint with friction gets a second
+  pose; the joint's effort limit as its force limit, infinite without one; the chain of
+  Kautham's chain planner gets PlanarChainEnvironment's 7 N m and 1 rad/s for every joint
+  instead, whatever its URDF says), id "motor:" + joint id; a joint with friction gets a second
   motor at zero speed whose force limit is the friction ("friction:" + joint id), a joint
   with damping a third at zero speed, unlimited force and CFM 1 / damping, which makes ODE
-  apply exactly -damping x the joint's rate ("damping:" + joint id).
+  apply exactly -damping x the joint's rate ("damping:" + joint id); under Kautham's own
+  physics (one of its ODE planners) no joint has either, as in its ODE environment.
 - The base by the robot's kind (``gui.core.model``): FIXED_BASE -> in a 2012 problem a fixed
   (kinematic) body that never moves; in a current one a dynamic body held by a FIXED joint to
   the world (Kautham's chain); FREE_BODY, MOBILE, CAR -> a dynamic body, free.
@@ -63,9 +65,10 @@ import numpy as np
 
 from gui.core import inertia as inertia_rule
 from gui.core.kautham import environment
+from gui.core.kautham.problem import PHYSICS_PLANNERS
 from gui.core.kinematics import pose_to_position_quaternion
-from gui.core.model import (CAR, FIXED_BASE, REVOLUTE, Configuration, Instance, Problem,
-                            warn_once)
+from gui.core.model import (CAR, FIXED_BASE, REVOLUTE, Configuration, Ignored, Instance,
+                            Problem, warn_once)
 from gui.core.shapes import Shape
 from gui.core.world_settings import WorldSettings, kautham_world
 from odin_common.interface import (JointParameter, JointType, MotorKind, Shape as ShapeKind,
@@ -538,6 +541,16 @@ def _with_surface(spec: BodySpec, surface) -> BodySpec:
                                                  for p in spec.parts))
 
 
+class _Drive(NamedTuple):
+    """How a movable joint is driven and resisted: ``effort`` (N m or N) and ``speed`` (rad/s
+    or m/s) limits, None where none; ``friction`` (N m or N) and ``damping`` (N m s/rad or
+    N s/m), 0 for none."""
+    effort: Optional[float]
+    speed: Optional[float]
+    friction: float
+    damping: float
+
+
 class _Planner:
     """One plan: the problem's instances in order, then attachments."""
 
@@ -552,6 +565,9 @@ class _Planner:
         self.dynamic = {i.name for i in problem.obstacles
                         if i.movable or i.name in attached
                         or (self.physics and problem.format == "current")}
+        # Kautham's chain planner drives its chain's joints as PlanarChainEnvironment does
+        self.chain_drive = problem.physics and \
+            PHYSICS_PLANNERS.get(problem.planner.name) == FIXED_BASE
         self.steps: list = []
         self.handles: list = []
         self.ignored: list = list(problem.ignored)
@@ -677,9 +693,10 @@ class _Planner:
             self.steps.append(JointStep(key, inst.name, joint, limits=link.limits))
             handle.joint_keys.append(key)
             handle.joint_ids.append(joint.default_id)
-            handle.max_forces.append(link.effort)
-            handle.max_speeds.append(link.velocity)
-            motors.extend(self._motors(key, inst.name, joint, link, motor_kind))
+            drive = self._drive(inst, link)
+            handle.max_forces.append(drive.effort)
+            handle.max_speeds.append(drive.speed)
+            motors.extend(self._motors(key, inst.name, joint, drive, motor_kind))
         self.steps.extend(motors)
         handle.motor_ids = [default_motor_id(j) for j in handle.joint_ids]
 
@@ -719,25 +736,42 @@ class _Planner:
                                      (JointParameter.SUSPENSION_CFM, 1,
                                       environment.SUSPENSION_CFM)))
 
+    def _drive(self, inst: Instance, link) -> "_Drive":
+        """How a movable joint is driven and resisted: its URDF's limits and ``<dynamics>``;
+        under Kautham's own physics no ``<dynamics>`` (its ODE environment never reads it;
+        warned), and for the chain of Kautham's chain planner the limits PlanarChainEnvironment
+        drives it with, whatever its URDF's."""
+        effort, speed, friction, damping = link.effort, link.velocity, link.friction, \
+            link.damping
+        if self.problem.physics and (friction > 0 or damping > 0):
+            self.ignored.append(Ignored(
+                link.source, link.line, f'<dynamics> of joint "{link.name}"',
+                "Kautham's ODE environment applies no joint friction or damping"))
+            friction = damping = 0.0
+        if self.chain_drive and inst.kind == FIXED_BASE:
+            effort, speed = environment.CHAIN_JOINT_TORQUE, environment.CHAIN_JOINT_SPEED
+        return _Drive(effort, speed, friction, damping)
+
     @staticmethod
-    def _motors(key: str, owner: str, joint: JointSpec, link, kind: MotorKind) -> list:
-        """The joint's driving motor (its effort as force limit), and the motors that give it
-        its friction and damping."""
+    def _motors(key: str, owner: str, joint: JointSpec, drive: "_Drive",
+                kind: MotorKind) -> list:
+        """The joint's driving motor (``drive.effort`` as its force limit), and the motors
+        that give it its friction and damping."""
         axes = 2 if joint.type == JointType.HINGE2 else 1
-        effort = (link.effort,) * axes if link.effort else ()
+        forces = (drive.effort,) * axes if drive.effort else ()
         out = [MotorStep(key, owner, MotorSpec(joint=joint.default_id, kind=kind,
-                                               max_forces=effort))]
-        if link.friction > 0:
+                                               max_forces=forces))]
+        if drive.friction > 0:
             out.append(MotorStep(key, owner, MotorSpec(
-                joint=joint.default_id, kind=kind, max_forces=(link.friction,) * axes,
+                joint=joint.default_id, kind=kind, max_forces=(drive.friction,) * axes,
                 id=f"friction:{joint.default_id}"), purpose="friction"))
-        if link.damping > 0:
+        if drive.damping > 0:
             # a motor at zero speed whose constraint has CFM c gives a force -(rate) / c
             # (ODE solves J v = goal - CFM lambda): viscous damping of 1 / c
             out.append(MotorStep(key, owner, MotorSpec(
                 joint=joint.default_id, kind=kind, id=f"damping:{joint.default_id}"),
                 purpose="damping", parameters=tuple(
-                    (JointParameter.CFM, axis, 1.0 / link.damping)
+                    (JointParameter.CFM, axis, 1.0 / drive.damping)
                     for axis in range(1, axes + 1))))
         return out
 

@@ -49,7 +49,9 @@ kind of robot:
 - joints (a fixed-base chain, or a mobile robot's arm): Set Servo on each joint's motor toward
   q (the joint's URDF velocity limit as the servo's speed limit, its effort limit as the
   motor's force limit; Odin's servo defaults without them): Kautham's PlanarChainEnvironment
-  sets motor speeds under a torque limit, which a servo does each step;
+  sets motor speeds under a torque limit, which a servo does each step; the chain of a
+  problem for Kautham's chain planner (KPIECEChainPlanner) moves as that environment moves
+  it, at up to 1 rad/s under 7 N m per joint, whatever its URDF's limits;
 - a free body (Kautham's 2D environments push the robot with a force): along each base axis
   the controls move, the constant force F = m (2 (x* - x0 - v0 d) / d^2), which would carry
   the base (mass m, at x0 with velocity v0 when the row starts) to the row's position x* in

@@ -28,8 +28,10 @@ chain whose base is held to the world, driven at its joints (PlanarChainEnvironm
   KauthamOpenDEEnvironment lets its robots touch the floor and the obstacles it lists as
   manipulable (``MANIPULABLE``: the cubes, boxes and cylinders of its demos), every other
   obstacle is "fixed" (the arena's walls); a held chain may push manipulable obstacles with its
-  tool only (PlanarChainEnvironment: its "tcp" bodies; its other links touching any obstacle
-  make the motion invalid); or when the tracked link leaves the bounds.
+  tool only, and nothing may touch a fixed obstacle but the ground (PlanarChainEnvironment: its
+  "tcp" bodies may touch "freeManipulatable" ones; its other links touching any obstacle, and
+  a pushed obstacle or a fixed one touching a fixed one, make the motion invalid); or when the
+  tracked link leaves the bounds.
 """
 from __future__ import annotations
 
@@ -108,7 +110,9 @@ class PlanningProblem:
     (3, 2): m, world frame, low and high per axis, for the tracked link's origin; ``goal_xy``
     (2,): m, world frame, the tracked link's origin at the goal; ``forbidden``: object IDs the
     robot must not touch; ``robot_bodies``: the robot's body IDs; ``tool_bodies``: those that
-    may push manipulable obstacles; ``step``: s, one propagation step; ``searched``: indices
+    may push manipulable obstacles; ``guard_fixed``: nothing but the ground may touch a
+    forbidden obstacle, not only the robot (a held chain's environment); ``step``: s, one
+    propagation step; ``searched``: indices
     of the controls the planner chooses, the others held at ``held`` (the query start's
     controls)."""
     handle: RobotHandle
@@ -120,6 +124,7 @@ class PlanningProblem:
     base_bounds: np.ndarray
     goal_xy: np.ndarray
     forbidden: frozenset
+    guard_fixed: bool
     control_size: int
     step: float
     settings: SearchSettings
@@ -148,10 +153,16 @@ class PlanningProblem:
         return self.goal_distance(tracked_position) < self.settings.goal_tolerance
 
     def forbidden_contacts(self, pairs: Iterable[Tuple[str, str]]) -> list:
-        """The pairs (object IDs or geometry names) where the robot touches an obstacle it
-        must not: a forbidden one, or any but the ground with a body outside its tool."""
-        return [(a, b) for a, b in pairs if self._forbidden_pair(_object(a), _object(b))
-                or self._forbidden_pair(_object(b), _object(a))]
+        """The pairs (object IDs or geometry names) that make a motion invalid: the robot
+        touching a forbidden obstacle, or any but the ground with a body outside its tool;
+        with ``guard_fixed``, anything but the ground touching a forbidden obstacle."""
+        return [(a, b) for a, b in pairs if self._invalid(_object(a), _object(b))]
+
+    def _invalid(self, first: str, second: str) -> bool:
+        if self._forbidden_pair(first, second) or self._forbidden_pair(second, first):
+            return True
+        return self.guard_fixed and GROUND not in (first, second) and \
+            (first in self.forbidden or second in self.forbidden)
 
     def _forbidden_pair(self, robot_body: str, other: str) -> bool:
         if robot_body not in self.robot_bodies or other in self.robot_bodies:
@@ -204,7 +215,8 @@ def planning_problem(plan: BuildPlan, robot: Optional[str] = None,
         robot_bodies=tuple(b.body_id for b in handle.bodies),
         tool_bodies=frozenset(handle.bodies[i].body_id for i in tool),
         base_bounds=_base_bounds(handle), goal_xy=np.array(goal[:2, 3]),
-        forbidden=frozenset(_forbidden(plan, handle)), control_size=size,
+        forbidden=frozenset(_forbidden(plan, handle)), guard_fixed=tracked != 0,
+        control_size=size,
         step=float(step), settings=settings, searched=searched,
         held=tuple(float(v) for v in held))
 

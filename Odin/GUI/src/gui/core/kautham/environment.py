@@ -7,10 +7,11 @@ body with its URDF mass (0 becomes 1 kg); a planar chain's base held to the worl
 joint. CarEnvironment.cpp: four wheels on hinge-2 joints (steering axis vertical, the first
 two wheels' up, the others' down; suspension ERP 0.4, CFM 0.8); its controls are a steering
 angle in [-0.5, 0.5] rad, reached at a rate of 1/s under 2 N m, and a wheel speed in
-[-5, 10] rad/s under 50 N m. PlanarChainEnvironment.cpp: motor speeds on the joints under a
-torque limit of 7 N m, written for its own two-link demo chain (Odin servos a chain's joints
-under each joint's URDF effort limit instead: gui.core.control_path). twoDRobotEnvironment.cpp and ConstraintAware2DRobotEnvironment.cpp: a
-force on the free body.
+[-5, 10] rad/s under 50 N m. PlanarChainEnvironment.cpp: motor speeds in [-1, 1] rad/s on
+the joints under a torque limit of 7 N m, whatever the URDF's limits say (its demo chain's
+URDF gives 0.1 rad/s and 300 N m); Odin's servo then moves a held chain's joints toward their
+targets under those limits (gui.core.control_path). twoDRobotEnvironment.cpp and
+ConstraintAware2DRobotEnvironment.cpp: a force on the free body.
 """
 from __future__ import annotations
 
@@ -35,3 +36,8 @@ STEERING_MAX_TORQUE = 2.0
 """N m: the steering motor's force limit."""
 WHEEL_MAX_TORQUE = 50.0
 """N m: the wheel motor's force limit."""
+
+CHAIN_JOINT_SPEED = 1.0
+"""rad/s: the fastest a held chain's joint moves (PlanarChainEnvironment's control bounds)."""
+CHAIN_JOINT_TORQUE = 7.0
+"""N m: a held chain's joint motor's force limit (PlanarChainEnvironment's dParamFMax)."""
