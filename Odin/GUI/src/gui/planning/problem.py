@@ -112,9 +112,8 @@ class PlanningProblem:
     robot must not touch; ``robot_bodies``: the robot's body IDs; ``tool_bodies``: those that
     may push manipulable obstacles; ``guard_fixed``: nothing but the ground may touch a
     forbidden obstacle, not only the robot (a held chain's environment); ``step``: s, one
-    propagation step; ``searched``: indices
-    of the controls the planner chooses, the others held at ``held`` (the query start's
-    controls)."""
+    propagation step; ``searched``: indices of the controls the planner chooses, the others
+    held at ``held`` (the query start's controls)."""
     handle: RobotHandle
     base_body: str
     tracked_body: str
