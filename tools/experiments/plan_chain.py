@@ -90,9 +90,7 @@ def run(frames: bool = True) -> dict:
 
 
 def analyse(s, problem, result, rows, results, collisions, end, before, after) -> dict:
-    robot = set(problem.robot_bodies)
-    touched = sorted({tuple(sorted((a, b))) for row in collisions for a, b, _, _ in row
-                      if (a.split("#")[0] in robot) != (b.split("#")[0] in robot)})
+    touched = problem.robot_contacts((a, b) for row in collisions for a, b, _, _ in row)
     return {"outcome": {
         **plan_sphere.plan_facts(problem, result, rows, results, end),
         "tracked_link": problem.tracked_body,

@@ -127,8 +127,7 @@ def analyse(s, p, problem, result, rows, results, collisions, before, after,
             radius: float) -> dict:
     executed = np.array([r.base_position for r in results])
     end = executed[-1]
-    touched = sorted({tuple(sorted((a, b))) for row in collisions for a, b, _, _ in row
-                      if SPHERE in (a, b)})
+    touched = problem.robot_contacts((a, b) for row in collisions for a, b, _, _ in row)
     # in the plane: the blocks are built 0.27 m above where they rest and fall meanwhile
     moved = moved_in_the_plane(before, after, [name for name in before if name != SPHERE])
     inner = p["walls_inner_face_m"]

@@ -57,6 +57,10 @@ def test_a_held_chain_pushes_with_its_tool_only(chain_plan):
     assert problem.forbidden_contacts([("box2", "box1"), ("box1", "ground"),
                                        ("box2", "box3"), ("redCube2", "box1")]) == \
         [("box2", "box1"), ("redCube2", "box1")]
+    # what the robot touched, once per pair of objects: not itself, not others' contacts
+    assert problem.robot_contacts([("box2", "Chain/finger1"), ("box1", "ground"),
+                                   ("Chain/link1", "Chain/link2"),
+                                   ("Chain/finger1", "box2")]) == [("Chain/finger1", "box2")]
 
 
 def test_the_problem_s_planner_parameters_are_the_search_s(chain_plan):

@@ -110,10 +110,9 @@ class PlanningProblem:
     (3, 2): m, world frame, low and high per axis, for the tracked link's origin; ``goal_xy``
     (2,): m, world frame, the tracked link's origin at the goal; ``forbidden``: object IDs the
     robot must not touch; ``robot_bodies``: the robot's body IDs; ``tool_bodies``: those that
-    may push manipulable obstacles; ``guard_fixed``: nothing but the ground may touch a
-    forbidden obstacle, not only the robot (a held chain's environment); ``step``: s, one
-    propagation step; ``searched``: indices of the controls the planner chooses, the others
-    held at ``held`` (the query start's controls)."""
+    may push manipulable obstacles; ``step``: s, one propagation step; ``searched``: indices
+    of the controls the planner chooses, the others held at ``held`` (the query start's
+    controls)."""
     handle: RobotHandle
     base_body: str
     tracked_body: str
@@ -123,7 +122,6 @@ class PlanningProblem:
     base_bounds: np.ndarray
     goal_xy: np.ndarray
     forbidden: frozenset
-    guard_fixed: bool
     control_size: int
     step: float
     settings: SearchSettings
@@ -150,6 +148,19 @@ class PlanningProblem:
 
     def in_goal(self, tracked_position) -> bool:
         return self.goal_distance(tracked_position) < self.settings.goal_tolerance
+
+    @property
+    def guard_fixed(self) -> bool:
+        """Nothing but the ground may touch a forbidden obstacle, not only the robot: a held
+        chain's environment (PlanarChainEnvironment), whose tracked link is its tool."""
+        return self.tracked_body != self.base_body
+
+    def robot_contacts(self, pairs: Iterable[Tuple[str, str]]) -> list:
+        """The distinct pairs of objects (sorted) among ``pairs`` (object IDs or geometry
+        names) where the robot touches something else."""
+        robot = set(self.robot_bodies)
+        objects = {tuple(sorted((_object(a), _object(b)))) for a, b in pairs}
+        return sorted(pair for pair in objects if (pair[0] in robot) != (pair[1] in robot))
 
     def forbidden_contacts(self, pairs: Iterable[Tuple[str, str]]) -> list:
         """The pairs (object IDs or geometry names) that make a motion invalid: the robot
@@ -214,8 +225,7 @@ def planning_problem(plan: BuildPlan, robot: Optional[str] = None,
         robot_bodies=tuple(b.body_id for b in handle.bodies),
         tool_bodies=frozenset(handle.bodies[i].body_id for i in tool),
         base_bounds=_base_bounds(handle), goal_xy=np.array(goal[:2, 3]),
-        forbidden=frozenset(_forbidden(plan, handle)), guard_fixed=tracked != 0,
-        control_size=size,
+        forbidden=frozenset(_forbidden(plan, handle)), control_size=size,
         step=float(step), settings=settings, searched=searched,
         held=tuple(float(v) for v in held))
 
