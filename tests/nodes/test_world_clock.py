@@ -37,7 +37,7 @@ def _scene(client) -> None:
     client.set_robot(RobotDescription(
         name="pendulum", urdf=PENDULUM_URDF, links=("pivot", "bob"), objects=("pivot", "ball"),
         link_positions=(), link_orientations=(), joint_names=("swing",), joints=(joint,),
-        joint_offsets=(), generated=False))
+        joint_axes=(), joint_offsets=(), generated=False))
 
 
 class _Stamps:

@@ -160,7 +160,8 @@ WHEEL = ('<link name="{n}_wheel_link"><inertial><mass value="0.2"/><inertia ixx=
          'xyz="0 1 0"/></joint>')
 
 
-def _car(folder: pathlib.Path) -> pathlib.Path:
+def _car(folder: pathlib.Path, planner: str = "KPIECECarPlanner") -> pathlib.Path:
+    """A car whose base's x is ahead and z up, its wheels turning about its y, on the ground."""
     wheels = "".join(WHEEL.format(n=n, x=x, y=y) for n, x, y in (
         ("front_left", 0.25, 0.2), ("front_right", 0.25, -0.2), ("back_right", -0.25, -0.2),
         ("back_left", -0.25, 0.2)))
@@ -169,49 +170,94 @@ def _car(folder: pathlib.Path) -> pathlib.Path:
         'value="2"/><inertia ixx="0.02" iyy="0.06" izz="0.08" ixy="0" ixz="0" iyz="0"/>'
         '</inertial><collision><geometry><box size="0.6 0.3 0.1"/></geometry></collision>'
         f'</link>{wheels}</robot>')
+    for name in ("cubeDE1", "wall1"):      # one Kautham lets a robot push, one it doesn't
+        (folder / f"{name}.urdf").write_text(
+            f'<?xml version="1.0"?><robot name="{name}"><link name="base"><inertial><mass '
+            'value="0.5"/><inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" '
+            'iyz="0"/></inertial><collision><geometry><box size="0.2 0.2 0.2"/></geometry>'
+            '</collision></link></robot>')
     problem = folder / "car.xml"
     problem.write_text(
         '<?xml version="1.0"?><Problem><Robot robot="car.urdf"><Home X="0" Y="0" Z="0.11" '
-        'WX="0" WY="0" WZ="1" TH="0"/></Robot><Planner><Parameters><Name>KPIECECarPlanner'
-        '</Name><Parameter name="PropagationStepSize">0.01</Parameter></Parameters>'
-        '</Planner></Problem>')
+        'WX="0" WY="0" WZ="1" TH="0"/></Robot><Obstacle obstacle="cubeDE1.urdf"><Home X="0" '
+        'Y="3" Z="0.1" WX="0" WY="0" WZ="1" TH="0"/></Obstacle><Obstacle obstacle="wall1.urdf">'
+        '<Home X="0" Y="-3" Z="0.1" WX="0" WY="0" WZ="1" TH="0"/></Obstacle><Planner>'
+        f'<Parameters><Name>{planner}</Name><Parameter name="PropagationStepSize">0.01'
+        '</Parameter></Parameters></Planner></Problem>')
     return problem
 
 
-def test_a_car_gets_hinge2_wheels_with_kautham_suspension(tmp_path):
+def _yaw(world) -> float:
+    """rad: the car's heading about +z."""
+    w, _, _, z = world.core.body_state("SimpleCar/base_link")[1]
+    return 2 * math.atan2(z, w)
+
+
+def test_a_kautham_car_gets_carenvironment_wheels_and_friction(tmp_path):
     plan = plan_problem(load_problem(_car(tmp_path)))
     handle = plan.robot()
     assert handle.kind == CAR
     entity = _steps(plan, EntityStep)[0].spec
     assert not any(o.fixed for o in entity.objects)            # a free, dynamic base
-    wheels = [s.spec for s in _steps(plan, JointStep)]
+    wheels = [s.spec for s in _steps(plan, JointStep) if s.owner == "SimpleCar"]
     assert [w.type for w in wheels] == [JointType.HINGE2] * 4
+    # CarEnvironment's world axes, whatever the car's frame: steering about +z for the first
+    # two wheels in link order and -z for the others, spin about +y
+    assert [w.axis1 for w in wheels] == [(0, 0, 1.0)] * 2 + [(0, 0, -1.0)] * 2
+    assert [w.axis2 for w in wheels] == [(0, 1.0, 0)] * 4
     for joint in wheels:
-        front = joint.anchor[0] > 0
-        # steering axis vertical, front and rear opposite (Kautham's +1 / -1), both reversed
-        assert joint.axis1 == pytest.approx((0, 0, -1.0 if front else 1.0))
-        assert joint.axis2 == pytest.approx((0, -1.0, 0))
         assert dict(((p, a), v) for p, a, v in joint.parameters) == {
             (JointParameter.SUSPENSION_ERP, 1): 0.4, (JointParameter.SUSPENSION_CFM, 1): 0.8}
     assert len(handle.motor_ids) == 4
+    # CarEnvironment's setupContact: robot on ground 5, a manipulable cube 0.1, the other
+    # obstacles ("fixed") 0.1; Odin mixes two by the smaller
+    friction = {o.name: o.surface.friction for s in _steps(plan, (EntityStep, ObjectStep))
+                for o in (s.spec.objects if isinstance(s, EntityStep) else [s.spec])}
+    assert friction == {"ground": 5.0, "cubeDE1": 0.1, "wall1": 0.1, **{
+        f"SimpleCar/{n}": 5.0 for n in ("base_link", "front_left_wheel_link",
+                                        "front_right_wheel_link", "back_right_wheel_link",
+                                        "back_left_wheel_link")}}
 
 
-def test_a_car_drives_forward_and_turns_left_with_positive_controls(tmp_path, world):
+def test_a_kautham_car_rolls_toward_world_minus_x_with_positive_wheel_speed(tmp_path, world):
     plan = plan_problem(load_problem(_car(tmp_path)))
     world.execute(plan)
     world.run(0.5)
     handle = plan.robot()
     port = CorePort(world)
-    # steering 0 (c = 0.5), wheel speed -5 + 15 x 0.6 = 4 rad/s: 0.32 m/s on 0.08 m wheels
+    # steering 0 (c = 0.5), wheel speed -5 + 15 x 0.6 = 4 rad/s: the chassis turns at 4 rad/s
+    # about +y relative to its wheels, so they roll toward -x: 0.32 m/s on 0.08 m wheels
+    straight = run_control_path(port, handle, [ControlRow((0.5, 0.6), 1.0)])
+    assert straight[0].base_position[0] == pytest.approx(-0.32, abs=0.03)
+    assert abs(straight[0].base_position[1]) < 0.005
+    # steering +0.5 rad: the first wheels (ahead, at +x) turn by -0.5 about +z, the others
+    # by +0.5 (reached at 1/s), so the car yaws about +z and, going toward -x, heads for -y
+    turn = run_control_path(port, handle, [ControlRow((1.0, 0.6), 0.5)] * 6)
+    assert _yaw(world) > 0.3
+    assert turn[-1].base_position[1] < -0.02
+    back = run_control_path(port, handle, [ControlRow((0.5, 0.0), 1.0)])   # -5 rad/s
+    assert back[0].base_position[0] > turn[-1].base_position[0] + 0.2
+
+
+def test_a_car_outside_kauthams_car_planner_drives_forward_and_turns_left(tmp_path, world):
+    """Where CarEnvironment does not drive it, a car's axes come from its own frame: its
+    wheels' joint axis, steering along its z; a positive wheel speed rolls it ahead."""
+    plan = plan_problem(load_problem(_car(tmp_path, KINEMATIC)), BuildDefaults(ground=True))
+    wheels = [s.spec for s in _steps(plan, JointStep) if s.owner == "SimpleCar"]
+    for joint in wheels:     # reversed, as a robot's hinges: body1's turn relative to body2
+        front = joint.anchor[0] > 0
+        assert joint.axis1 == pytest.approx((0, 0, -1.0 if front else 1.0))
+        assert joint.axis2 == pytest.approx((0, -1.0, 0))
+    assert _steps(plan, ObjectStep)[0].spec.surface.friction is None    # the world's
+    world.execute(plan)
+    world.run(0.5)
+    handle = plan.robot()
+    port = CorePort(world)
     straight = run_control_path(port, handle, [ControlRow((0.5, 0.6), 1.0)])
     assert straight[0].base_position[0] == pytest.approx(0.32, abs=0.03)
-    assert abs(straight[0].base_position[1]) < 0.005
     turn = run_control_path(port, handle, [ControlRow((1.0, 0.6), 0.5)] * 3)
-    heading = world.core.body_state("SimpleCar/base_link")[1]
-    assert 2 * math.atan2(heading[3], heading[0]) > 0.1          # yawed left (+z)
+    assert _yaw(world) > 0.1                                        # yawed left (+z)
     assert turn[-1].base_position[1] > 0.03                         # and went left
-    back = run_control_path(port, handle, [ControlRow((0.5, 0.0), 1.0)])   # -5 rad/s
-    assert back[0].base_position[0] < turn[-1].base_position[0] - 0.2
 
 
 ARM = """<?xml version="1.0"?><robot name="arm">

@@ -20,7 +20,7 @@ from virtual_world.portal.clock import WorldClock
 from virtual_world.portal.frames import ObjectFrames
 from virtual_world.portal.markers import GeometryMarkers, marker_shape
 from virtual_world.portal.mirror import WorldMirror
-from virtual_world.portal.robots import robot_of
+from virtual_world.portal.robots import robot_message, robot_of
 from virtual_world.portal.tf_writer import TfWriter
 
 
@@ -270,6 +270,27 @@ def test_a_declared_robot_renames_frames_publishes_its_joints_and_goes_with_its_
     assert mirror.frames.frames(["base"]) == ["base"]
 
 
+def test_a_robots_wheel_is_its_hinge2s_spin_named_by_joint_axes():
+    """A car's wheel (a hinge-2: steering, then spin) is a URDF continuous joint: joint_axes
+    1 makes its joint state the hinge-2's second value, the spin, not the steering."""
+    core, mirror = Core(), WorldMirror()
+    for spec in (ObjectSpec("chassis", (0.4, 0.2, 0.05), position=(0, 0, 1)),
+                 ObjectSpec("wheel", (0.05, 0.02), position=(0, 0.15, 1))):
+        built = core.build_object(spec)
+        mirror.built(built.id, core.object_spec(built.id), built.geometries)
+    hinge2 = core.add_joint(JointSpec(JointType.HINGE2, "chassis", "wheel", anchor=(0, 0.15, 1),
+                                      axis1=(0, 0, 1), axis2=(0, 1, 0)))
+    core.set_velocity("wheel", angular=(0, 3.0, 0))
+    robot = robot_of(RobotMessage(name="car", links=["base", "wheel_link"],
+                                  objects=["chassis", "wheel"], joint_names=["wheel_joint"],
+                                  joints=[hinge2], joint_axes=b"\x01"))
+    mirror.set_robot(robot, {s.id: s.type for s in core.joint_states()})
+    assert robot_message(robot).joint_axes == [1]
+    (state,) = [s for s in core.joint_states() if s.id == hinge2]
+    (_, names, positions, rates), = mirror.robots.joint_states(core.joint_states())
+    assert names == ["wheel_joint"]
+    assert rates == [state.rates[1]] and abs(rates[0]) > 1.0 and positions == [state.positions[1]]
+
 def test_set_robot_refuses_what_does_not_fit_the_world():
     core, mirror = Core(), WorldMirror()
     joint = _pendulum(core, mirror)
@@ -283,7 +304,11 @@ def test_set_robot_refuses_what_does_not_fit_the_world():
             (dict(links=["a"], objects=["bob"], link_orientations=[2, 0, 0, 0]),
              InvalidArgument),
             (dict(links=["a"], objects=["bob"], joint_names=["j"], joints=[joint],
-                  joint_offsets=[math.nan]), InvalidArgument)]:
+                  joint_offsets=[math.nan]), InvalidArgument),
+            (dict(links=["a"], objects=["bob"], joint_names=["j"], joints=[joint],
+                  joint_axes=[0, 0]), InvalidArgument),
+            (dict(links=["a"], objects=["bob"], joint_names=["j"], joints=[joint],
+                  joint_axes=[1]), InvalidArgument)]:
         with pytest.raises(error):
             mirror.set_robot(robot_of(RobotMessage(name="r", **fields)), types)
     assert len(mirror.robots) == 0 and mirror.frames.frames(["bob"]) == ["bob"]

@@ -18,10 +18,14 @@ How a problem maps to the world:
   collisions off), then per link one Set Joint: revolute -> HINGE, prismatic -> SLIDER (anchor
   and axis from the joint frame where the robot is built, world frame; LO_STOP/HI_STOP from the
   limits, relative to the value the joint is built at), a non-movable link -> FIXED joint to
-  its parent; a car's wheels -> HINGE2 (steering axis vertical, opposite for the wheels
-  ahead of the base's centre and the others, as Kautham's CarEnvironment; both axes sent
-  reversed like a hinge's, so that a positive steering turns left and a positive wheel speed
-  rolls the car forward; suspension ERP 0.4 / CFM 0.8). Then one Set Motor per movable joint
+  its parent; a car's wheels -> HINGE2 with CarEnvironment's suspension (ERP 0.4 / CFM 0.8):
+  for a car of Kautham's car planner CarEnvironment's world axes (steering about +z for the
+  first two wheels, -z for the others, spin about +y, whatever the car's pose: a positive
+  wheel speed rolls it toward world -x) and its contact friction by body kind
+  (``environment.CAR_FRICTION``, the ground's too); for any other car axes from its own frame
+  (steering about the base's up, opposite for the wheels ahead of its centre and the others;
+  both reversed like a hinge's, so that a positive steering turns left and a positive wheel
+  speed rolls the car along its +x). Then one Set Motor per movable joint
   (angular for hinges and hinge-2s, linear for sliders; zero speed, so the robot holds its
   pose; the joint's effort limit as its force limit, infinite without one; the chain of
   Kautham's chain planner gets PlanarChainEnvironment's 7 N m and 1 rad/s for every joint
@@ -74,7 +78,7 @@ from gui.core.world_settings import WorldSettings, kautham_world
 from odin_common.interface import (JointParameter, JointType, MotorKind, Shape as ShapeKind,
                                    default_motor_id)
 from odin_common.specs import (CompositeSpec, EntitySpec, JointSpec, MotorSpec, ObjectSpec,
-                               PartSpec)
+                               PartSpec, Surface)
 from odin_common.step_values import StepValues
 
 BodySpec = Union[ObjectSpec, CompositeSpec]
@@ -398,7 +402,8 @@ class RobotHandle:
     robot was built in (the world's joint readings are relative to ``built_at``); ``home``:
     Home's joint values. ``kind``: gui.core.model's robot kind. ``max_forces`` /
     ``max_speeds``: per movable joint, its effort and speed limits (None: none given).
-    ``base_mass``: kg, the base body's mass."""
+    ``joint_axes``: per movable joint, which of its world joint's values is the joint's (0; a
+    car's wheel is its hinge-2's spin, 1). ``base_mass``: kg, the base body's mass."""
     instance: Instance
     bodies: list                     # LinkBody per link, model order
     joint_keys: list                 # per movable joint (model.movable_links() order)
@@ -410,6 +415,7 @@ class RobotHandle:
     kind: str = ""
     max_forces: list = field(default_factory=list)
     max_speeds: list = field(default_factory=list)
+    joint_axes: list = field(default_factory=list)
     base_mass: float = 0.0
 
     def __post_init__(self):
@@ -565,9 +571,11 @@ class _Planner:
         self.dynamic = {i.name for i in problem.obstacles
                         if i.movable or i.name in attached
                         or (self.physics and problem.format == "current")}
-        # Kautham's chain planner drives its chain's joints as PlanarChainEnvironment does
-        self.chain_drive = problem.physics and \
-            PHYSICS_PLANNERS.get(problem.planner.name) == FIXED_BASE
+        # Kautham's chain planner drives its chain's joints as PlanarChainEnvironment does,
+        # its car planner sets its car's wheel axes as CarEnvironment does
+        planned = PHYSICS_PLANNERS.get(problem.planner.name) if problem.physics else None
+        self.chain_drive = planned == FIXED_BASE
+        self.car_environment = planned == CAR
         self.steps: list = []
         self.handles: list = []
         self.ignored: list = list(problem.ignored)
@@ -599,8 +607,10 @@ class _Planner:
         while name in taken:
             n += 1
             name = f"{GROUND}_{n}"
+        surface = Surface(friction=environment.CAR_FRICTION["ground"]) \
+            if self.car_environment else Surface()
         return ObjectSpec(name=name, parameters=(), shape=ShapeKind.PLANE, geometry_only=True,
-                          color=environment.GROUND_COLOR)
+                          color=environment.GROUND_COLOR, surface=surface)
 
     # -- instances ----------------------------------------------------------------------------
     def _configuration(self, inst: Instance) -> Tuple[np.ndarray, np.ndarray]:
@@ -624,7 +634,7 @@ class _Planner:
             if not static:
                 spec = self._mass_properties(spec, link, name, mass, offset)
                 self.masses.append((name, mass))
-            specs.append(_with_surface(spec, link.surface))
+            specs.append(_with_surface(spec, self._surface(inst, link, name)))
             bodies.append(LinkBody(spec.id, offset))
             self.link_bodies[(inst.name, link.name)] = bodies[-1]
         self.base_bodies[inst.name] = bodies[0]
@@ -655,6 +665,21 @@ class _Planner:
         if robot or not single:
             self.handles.append(handle)
 
+    def _surface(self, inst: Instance, link, name: str) -> Surface:
+        """The contact surface of ``inst``'s ``link`` (body ``name``): its URDF's, with the
+        friction Kautham's car environment gives the body's kind in its problems
+        (``environment.CAR_FRICTION``; a URDF friction it overrides is listed as ignored)."""
+        if not self.car_environment:
+            return link.surface
+        kind = "robot" if inst.role == "robot" else \
+            "manipulable" if inst.name in environment.MANIPULABLE else "fixed"
+        if link.surface.friction is not None:
+            self.ignored.append(Ignored(
+                link.source, link.line, f'contact friction {link.surface.friction:g} of '
+                f'{name}', "Kautham's car environment sets every contact's friction "
+                f"({kind}: {environment.CAR_FRICTION[kind]:g})"))
+        return dataclasses.replace(link.surface, friction=environment.CAR_FRICTION[kind])
+
     def _mass_properties(self, spec: BodySpec, link, name: str, mass: float,
                          offset: np.ndarray) -> BodySpec:
         given, ignored = inertia_rule.choose(link, name, mass, offset, self.defaults.inertia,
@@ -673,7 +698,7 @@ class _Planner:
         frames = model.joint_frames(base_pose, built_at)
         value = dict(zip(model.movable_links(), built_at))
         bodies = handle.bodies
-        motors = []
+        motors, wheels = [], 0
         for i, link in enumerate(model.links):
             if link.parent is None:
                 continue
@@ -685,11 +710,14 @@ class _Planner:
                 continue
             frame = frames[i]
             if inst.kind == CAR and link.parent == 0 and link.joint == REVOLUTE:
-                joint = self._wheel(link, frame, base_pose, parent_id, bodies[i].body_id)
-                motor_kind = MotorKind.ANGULAR
+                steering, spin = self._wheel_axes(link, frame, base_pose, wheels)
+                joint = _wheel(frame, steering, spin, parent_id, bodies[i].body_id)
+                motor_kind, wheels = MotorKind.ANGULAR, wheels + 1
+                handle.joint_axes.append(1)         # the URDF's wheel joint is the spin
             else:
                 joint = self._joint(link, frame, value[i], parent_id, bodies[i].body_id)
                 motor_kind = MotorKind.ANGULAR if link.joint == REVOLUTE else MotorKind.LINEAR
+                handle.joint_axes.append(0)
             self.steps.append(JointStep(key, inst.name, joint, limits=link.limits))
             handle.joint_keys.append(key)
             handle.joint_ids.append(joint.default_id)
@@ -715,26 +743,26 @@ class _Planner:
                          body1=parent_id, body2=child_id, anchor=_flat(frame[:3, 3]),
                          axis1=_flat(axis), parameters=params)
 
-    @staticmethod
-    def _wheel(link, frame: np.ndarray, base_pose: np.ndarray, parent_id: str,
-               child_id: str) -> JointSpec:
-        """A car's wheel on a hinge-2 (Kautham's CarEnvironment): the chassis is body1, the
-        steering axis vertical, opposite for the wheels ahead of the base's origin along its x
-        and for the others (so that the rear wheels steer against the front ones, as Kautham's
-        four do), the spin axis the wheel joint's, soft suspension. Both axes are sent
-        reversed, as a robot's hinges are: a hinge-2's angles and rates are body1's turn
-        relative to body2, so a positive steering angle then turns the front wheels left
-        (counter-clockwise seen from above) and a positive wheel speed turns a wheel about
-        its joint's axis (a car whose wheels turn about its y rolls along its +x)."""
+    def _wheel_axes(self, link, frame: np.ndarray, base_pose: np.ndarray, index: int
+                    ) -> Tuple[np.ndarray, np.ndarray]:
+        """(steering axis, spin axis), world frame, of the ``index``-th wheel of a car (in its
+        link order), as its hinge-2 is sent (module docstring).
+
+        For Kautham's car planner, CarEnvironment's: it sets world axes whatever the car's
+        pose or URDF (steering about +z for the first two wheels, -z for the others, spin
+        about +y), so a positive wheel speed turns the chassis about +y relative to its wheels
+        and rolls the car toward world -x. Otherwise axes the car's own frame gives: steering
+        along the base's z, opposite for the wheels ahead of the base's origin along its x and
+        for the others (the rear wheels steer against the front ones, as Kautham's four do);
+        spin about the wheel joint's axis; both reversed, as a robot's hinges are (a
+        hinge-2's angles and rates are body1's turn relative to body2), so a positive
+        steering turns the front wheels left (counter-clockwise seen from above) and a
+        positive wheel speed turns a wheel about its joint's axis (a car whose wheels turn
+        about its y rolls along its +x)."""
+        if self.car_environment:
+            return np.array((0.0, 0.0, 1.0 if index < 2 else -1.0)), np.array((0.0, 1.0, 0.0))
         ahead = (np.linalg.inv(base_pose) @ np.append(frame[:3, 3], 1.0))[0] > 0.0
-        up = base_pose[:3, 2] * (-1.0 if ahead else 1.0)
-        return JointSpec(type=JointType.HINGE2, body1=parent_id, body2=child_id,
-                         anchor=_flat(frame[:3, 3]), axis1=_flat(up),
-                         axis2=_flat(-(frame[:3, :3] @ link.axis)),
-                         parameters=((JointParameter.SUSPENSION_ERP, 1,
-                                      environment.SUSPENSION_ERP),
-                                     (JointParameter.SUSPENSION_CFM, 1,
-                                      environment.SUSPENSION_CFM)))
+        return base_pose[:3, 2] * (-1.0 if ahead else 1.0), -(frame[:3, :3] @ link.axis)
 
     def _drive(self, inst: Instance, link) -> "_Drive":
         """How a movable joint is driven and resisted: its URDF's limits and ``<dynamics>``;
@@ -782,6 +810,16 @@ class _Planner:
             obstacle = self.base_bodies[a.obstacle]
             self.steps.append(JointStep(f"{a.robot}/{a.link}+{a.obstacle}", a.robot, JointSpec(
                 type=JointType.FIXED, body1=link.body_id, body2=obstacle.body_id)))
+
+
+def _wheel(frame: np.ndarray, steering: np.ndarray, spin: np.ndarray, parent_id: str,
+           child_id: str) -> JointSpec:
+    """A car's wheel on a hinge-2 at the wheel joint's origin: the chassis body1, the axes
+    (world frame) as given, CarEnvironment's soft suspension along the steering axis."""
+    return JointSpec(type=JointType.HINGE2, body1=parent_id, body2=child_id,
+                     anchor=_flat(frame[:3, 3]), axis1=_flat(steering), axis2=_flat(spin),
+                     parameters=((JointParameter.SUSPENSION_ERP, 1, environment.SUSPENSION_ERP),
+                                 (JointParameter.SUSPENSION_CFM, 1, environment.SUSPENSION_CFM)))
 
 
 def plan_problem(problem: Problem, defaults: BuildDefaults = BuildDefaults()) -> BuildPlan:

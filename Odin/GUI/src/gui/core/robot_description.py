@@ -57,8 +57,10 @@ class RobotDescription:
     objects: Tuple[str, ...]                # the world object of each link
     link_positions: Tuple[float, ...]       # m, 3 per link: the link frame in the object's frame
     link_orientations: Tuple[float, ...]    # 4 per link, (w, x, y, z)
-    joint_names: Tuple[str, ...]            # the robot's one-axis joints, its own names
+    joint_names: Tuple[str, ...]            # the robot's movable joints, its own names
     joints: Tuple[str, ...]                 # the world joint of each
+    joint_axes: Tuple[int, ...]             # which of the world joint's values each is (a
+    #                                        car's wheel: 1, its hinge-2's spin; else 0)
     joint_offsets: Tuple[float, ...]        # rad or m: robot value = offset + world value (the
     #                                        configuration it was built in, RobotHandle.built_at)
     generated: bool                         # a URDF generated here, not the robot's own file
@@ -91,7 +93,7 @@ def describe_robot(handle, mesh_dir: Optional[os.PathLike] = None) -> RobotDescr
         objects=tuple(b.body_id for b in handle.bodies),
         link_positions=tuple(positions), link_orientations=tuple(orientations),
         joint_names=tuple(joint_of_link[i] for i in movable[:len(handle.joint_ids)]),
-        joints=tuple(handle.joint_ids),
+        joints=tuple(handle.joint_ids), joint_axes=tuple(handle.joint_axes),
         joint_offsets=tuple(float(v) for v in handle.built_at[:len(handle.joint_ids)]),
         generated=not given)
 

@@ -43,17 +43,10 @@ import numpy as np
 
 from gui.core.build import GROUND, BuildPlan, RobotHandle
 from gui.core.control_path import control_size
+from gui.core.kautham.environment import MANIPULABLE
 from gui.core.model import CAR, FREE_BODY, MOBILE
 from gui.errors import PlanningError
 from odin_common.rotations import quaternion_to_matrix
-
-MANIPULABLE = frozenset(
-    [f"cubeDE{k}" for k in ("", 1, 2, 3, 4, 5, 6, 7, 8)] + ["cylinder1", "cylinder2",
-                                                            "cylinder3", "SimpleCar"]
-    + [f"box{k}" for k in (2, 3, 4, 5)])
-"""Obstacles a robot may push: those Kautham's KauthamOpenDEEnvironment types
-"freeManipulatable" (by body name); the others are "fixed", which its robots must not touch."""
-
 
 @dataclass(frozen=True)
 class SearchSettings:
@@ -295,4 +288,4 @@ def _forbidden(plan: BuildPlan, handle: RobotHandle) -> list:
             and _object(body.id) not in MANIPULABLE]
 
 
-__all__ = ["MANIPULABLE", "SearchSettings", "PlanningProblem", "planning_problem"]
+__all__ = ["SearchSettings", "PlanningProblem", "planning_problem"]

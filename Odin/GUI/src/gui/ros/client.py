@@ -409,7 +409,7 @@ class WorldClient:
                         objects=list(d.objects), link_positions=_floats(d.link_positions),
                         link_orientations=_floats(d.link_orientations),
                         joint_names=list(d.joint_names), joints=list(d.joints),
-                        joint_offsets=_floats(d.joint_offsets))
+                        joint_axes=list(d.joint_axes), joint_offsets=_floats(d.joint_offsets))
         return self.call("set_robot", robot=message).ros_namespace
 
     def remove_robot(self, name: str) -> None:

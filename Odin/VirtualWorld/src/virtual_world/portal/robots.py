@@ -4,8 +4,9 @@ own ROS namespace and names (no rospy here, only the generated message classes).
 A robot is metadata over the Core's objects and joints, for the ROS side only: its namespace
 (``odin_common.interface.robot_namespace`` of its name), its URDF (the parameter
 ``<namespace>/robot_description``), its link names with the link frames' poses in their objects'
-frames (its links' tf frames are "<namespace>/<link>") and its one-axis joints' own names with
-offsets (its ``<namespace>/joint_states`` give ``offset + the world joint's value``). The world
+frames (its links' tf frames are "<namespace>/<link>") and its joints' own names, each one value
+of a world joint with an offset (its ``<namespace>/joint_states`` give ``offset + that value``:
+a hinge's angle, a slider's position, or a hinge-2 wheel's spin, its second value). The world
 forgets a robot when one of its objects or joints goes (removal, New Scene): the rest of it
 would no longer be the robot its description says.
 """
@@ -18,14 +19,10 @@ from typing import Dict, Iterable, List, Mapping, Sequence, Tuple
 import numpy as np
 
 from Messages.msg import Robot as RobotMessage
-from odin_common.interface import JointType, robot_link_frame, robot_namespace
+from odin_common.interface import JOINT_STATE_AXES, JointType, robot_link_frame, robot_namespace
 from odin_common.rotations import IDENTITY_WXYZ, unit_quaternion
 from virtual_world.core.validation import shared
 from virtual_world.errors import InvalidArgument, UnknownName
-
-#: joint types a robot's joint may be: one axis, one value (what JointState and URDF hold)
-ONE_AXIS_JOINTS = (JointType.HINGE, JointType.SLIDER)
-
 
 @dataclass(frozen=True)
 class RobotLink:
@@ -40,6 +37,7 @@ class RobotJoint:
     joint_id: str
     name: str
     offset: float                                   # rad or m
+    axis: int = 0                                   # which of the world joint's values
 
 
 @dataclass(frozen=True)
@@ -109,13 +107,25 @@ def robot_of(message: RobotMessage) -> Robot:
     if offsets.size != len(joints) or not np.all(np.isfinite(offsets)):
         raise InvalidArgument(f"Set Robot {name!r}: joint_offsets must be {len(joints)} finite "
                               f"numbers (rad or m) or none, got {list(offsets)}")
+    axes = _joint_axes(message.joint_axes, len(joints), name)
     namespace = shared(robot_namespace, name)
     return Robot(name, namespace, message.description,
                  tuple(RobotLink(o, link, tuple(p), tuple(q))
                        for o, link, p, q in zip(objects, links, positions.tolist(),
                                                 orientations)),
-                 tuple(RobotJoint(j, n, float(v))
-                       for j, n, v in zip(joints, joint_names, offsets)))
+                 tuple(RobotJoint(j, n, float(v), a)
+                       for j, n, v, a in zip(joints, joint_names, offsets, axes)))
+
+
+def _joint_axes(values, count: int, name: str) -> List[int]:
+    # uint8[] arrives as bytes from a ROS message and as a list from Python callers
+    axes = list(bytearray(values)) if isinstance(values, (bytes, bytearray)) else list(values)
+    if not axes:
+        return [0] * count
+    if len(axes) != count:
+        raise InvalidArgument(f"Set Robot {name!r}: joint_axes must be {count} axis indices "
+                              f"or none, got {axes}")
+    return [int(a) for a in axes]
 
 
 def robot_message(robot: Robot) -> RobotMessage:
@@ -126,7 +136,8 @@ def robot_message(robot: Robot) -> RobotMessage:
         link_positions=[v for link in robot.links for v in link.position],
         link_orientations=[v for link in robot.links for v in link.quaternion],
         joint_names=[j.name for j in robot.joints], joints=[j.joint_id for j in robot.joints],
-        joint_offsets=[j.offset for j in robot.joints])
+        joint_offsets=[j.offset for j in robot.joints],
+        joint_axes=[j.axis for j in robot.joints])
 
 
 class RobotRegistry:
@@ -150,7 +161,8 @@ class RobotRegistry:
     def check(self, robot: Robot, objects: Iterable[str], joint_types: Mapping[str, int]
               ) -> None:
         """Refuses ``robot`` unless its objects and joints are in the world (``objects``;
-        ``joint_types``: {joint ID: JointType}), its joints are one-axis joints, and neither
+        ``joint_types``: {joint ID: JointType}), its joints' world joints report the values
+        named (JOINT_STATE_AXES), and neither
         its namespace nor any of its objects belongs to another robot."""
         present = set(objects)
         for link in robot.links:
@@ -160,11 +172,13 @@ class RobotRegistry:
             kind = joint_types.get(joint.joint_id)
             if kind is None:
                 raise UnknownName(f"Set Robot {robot.name!r}: no joint {joint.joint_id!r}")
-            if kind not in ONE_AXIS_JOINTS:
+            values = JOINT_STATE_AXES.get(JointType(kind), ())
+            if joint.axis >= len(values):
+                reported = f"reports {', '.join(values)}" if values else "reports no value"
                 raise InvalidArgument(
-                    f"Set Robot {robot.name!r}: joint {joint.joint_id!r} is a "
-                    f"{JointType(kind).label}; a robot's joints are "
-                    f"{' or '.join(t.label for t in ONE_AXIS_JOINTS)} joints (one value each)")
+                    f"Set Robot {robot.name!r}: joint {joint.name!r} is value {joint.axis} of "
+                    f"world joint {joint.joint_id!r}, a {JointType(kind).label}, which "
+                    f"{reported} (joint_axes counts from 0)")
         for other in self._robots.values():
             if other.name == robot.name:
                 continue
@@ -213,11 +227,11 @@ class RobotRegistry:
             names, positions, rates = [], [], []
             for joint in robot.joints:
                 state = by_id.get(joint.joint_id)
-                if state is None or not state.positions:
+                if state is None or len(state.positions) <= joint.axis:
                     continue
                 names.append(joint.name)
-                positions.append(joint.offset + state.positions[0])
-                rates.append(state.rates[0])
+                positions.append(joint.offset + state.positions[joint.axis])
+                rates.append(state.rates[joint.axis])
             if names:
                 out.append((robot, names, positions, rates))
         return out

@@ -12,6 +12,12 @@ the joints under a torque limit of 7 N m, whatever the URDF's limits say (its de
 URDF gives 0.1 rad/s and 300 N m); Odin's servo then moves a held chain's joints toward their
 targets under those limits (gui.core.control_path). twoDRobotEnvironment.cpp and
 ConstraintAware2DRobotEnvironment.cpp: a force on the free body.
+
+Each environment types every body (KauthamOpenDEEnvironment's ``InstknowledgeInference``, by
+name): the robot's links "robBody", the obstacles it names ``MANIPULABLE`` (the cubes, boxes
+and cylinders of its demos) "freeManipulatable", which a robot may push, every other obstacle
+"fixed", which a robot must not touch; and its ``setupContact`` gives each pair of types a
+friction coefficient. ``CAR_FRICTION`` is CarEnvironment's.
 """
 from __future__ import annotations
 
@@ -41,3 +47,17 @@ CHAIN_JOINT_SPEED = 1.0
 """rad/s: the fastest a held chain's joint moves (PlanarChainEnvironment's control bounds)."""
 CHAIN_JOINT_TORQUE = 7.0
 """N m: a held chain's joint motor's force limit (PlanarChainEnvironment's dParamFMax)."""
+
+MANIPULABLE = frozenset(
+    [f"cubeDE{k}" for k in ("", 1, 2, 3, 4, 5, 6, 7, 8)] + ["cylinder1", "cylinder2",
+                                                            "cylinder3", "SimpleCar"]
+    + [f"box{k}" for k in (2, 3, 4, 5)])
+"""Obstacles (by name) KauthamOpenDEEnvironment types "freeManipulatable"."""
+
+CAR_FRICTION = {"robot": 5.0, "ground": 5.0, "manipulable": 0.1, "fixed": 0.1}
+"""Contact friction (Coulomb mu) of each kind of body in a problem of Kautham's car planner,
+so that two bodies in contact, whose frictions Odin mixes by taking the smaller, get
+CarEnvironment's ``setupContact``: the robot on the ground 5 (its wheels grip), a pushed cube
+on the ground, on a wall or a wall on the ground 0.1. One pair differs: Kautham gives the
+robot against a manipulable body 0.0001, which one coefficient per body cannot give without
+also making the cube slide on the ground; here it is 0.1."""
