@@ -26,11 +26,8 @@ pairs the chain touched; how far each obstacle moved.
 """
 from __future__ import annotations
 
-import numpy as np
-
 import common
 import plan_sphere
-from sphere import WORLD, _states
 
 PROBLEM = common.ROOT / "tools" / "kautham" / "ode_demos" / "demos" / "OMPL_ode_demos" / \
     "Chain" / "k-PMPChain.xml"
@@ -53,64 +50,22 @@ PUSHED = "box2"
 def run(frames: bool = True) -> dict:
     """Plans the chain demo's query and runs the plan in a fresh world node (module
     docstring)."""
-    from gui.core.control_path import (ClientPort, control_size, read_control_path,
-                                       run_control_path, write_control_path)
-    p = dict(PARAMETERS)
-    _, searched = common.load_plan(PROBLEM)
-    problem, result = plan_sphere.search(searched, p)
-    _, plan = common.load_plan(PROBLEM)        # a fresh plan for the fresh world
-    bodies = {b.id: b for b in plan.bodies() if not b.geometry_only}
-    handle = plan.robot()
-    with common.Session("plan_chain", WORLD, CAMERA, track=set(bodies), frames=frames,
-                        contacts=True) as s:
-        path = s.out / "plan.path"
-        write_control_path(path, result.rows, comments=(
-            f"planned by {p['planner']}, seed {p['seed']} (tools/experiments/plan_chain.py)",
-            "each row: the chain's controls (link1, link2, gripper) in [0, 1], then the "
-            "duration (s)"))
-        rows = read_control_path(path, control_size(handle))
-        if s.client.world().simulating:
-            s.client.pause()
-        s.client.execute(plan)
-        obstacles = [name for name in bodies if name not in problem.robot_bodies]
-        before = _states(s.client, obstacles)
-        s.frame()
-        client = plan_sphere.FramedClient(s, p["frame_every_rows"])
-        port = ClientPort(client, real_time=False)
-        results = run_control_path(port, handle, rows)
-        if len(rows) % p["frame_every_rows"]:
-            s.frame()
-        end = problem.tracked_origin(*port.body_state(problem.tracked_body)[:2])
-        after = _states(s.client, obstacles)
-        s.finish()
-        facts = analyse(s, problem, result, rows, results, client.collisions, end, before,
-                        after)
-        common.write_summary(s, facts, p)
-    return facts
+    return plan_sphere.plan_and_run("plan_chain", PROBLEM, PARAMETERS, CAMERA, frames,
+                                    "the chain's controls (link1, link2, gripper)", analyse)
 
 
-def analyse(s, problem, result, rows, results, collisions, end, before, after) -> dict:
-    touched = problem.robot_contacts((a, b) for row in collisions for a, b, _, _ in row)
-    return {"outcome": {
-        **plan_sphere.plan_facts(problem, result, rows, results, end),
-        "tracked_link": problem.tracked_body,
-        "chain_touched": [list(pair) for pair in touched],
-        "forbidden_contacts": [list(pair) for pair in problem.forbidden_contacts(touched)],
-        "obstacles_moved_in_the_plane_m": plan_sphere.moved_in_the_plane(before, after,
-                                                                         before),
-        "fixed_obstacles": sorted(problem.forbidden),
-    }, "contacts": s.contact_rates()}
+def analyse(s, e: "plan_sphere.Executed") -> dict:
+    end = e.problem.tracked_origin(*e.tracked_pose)
+    return {"outcome": {**plan_sphere.obstacle_facts(e, end, "chain_touched"),
+                        "tracked_link": e.problem.tracked_body},
+            "contacts": s.contact_rates()}
 
 
 def checks(o: dict) -> dict:
     """Each outcome the run must hold, by name (run.py's verdict and the test)."""
     moved = o["obstacles_moved_in_the_plane_m"]
     return {
-        "KPIECE1 solved it": o["planner"]["solved"],
-        "the path file holds the plan": o["rows_read_back_identical"]
-        and o["rows_run"] == o["rows_written"] > 0,
-        "the fresh world replays the plan": o["replay_difference_m"]
-        < plan_sphere.REPLAY_TOLERANCE_M,
+        **plan_sphere.replay_checks(o),
         "the gripper ends in the goal region": o["in_goal_region"],
         "only the gripper and fingers push, and only box2": not o["forbidden_contacts"],
         "box2 pushed out of link2's way": moved[PUSHED] > PUSHED_M,

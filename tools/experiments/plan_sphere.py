@@ -22,6 +22,7 @@ block moved; whether it stayed inside the walls.
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -91,6 +92,35 @@ def run(frames: bool = True, problem_file=PROBLEM, name: str = "plan_sphere",
         parameters: dict = PARAMETERS, camera: "common.Camera" = CAMERA) -> dict:
     """Plans ``problem_file``'s query (a Sphere demo) and runs the plan in a fresh world node
     (the module docstring); the experiment ``name`` writes out/experiments/<name>/."""
+    def outcome(s, e: Executed) -> dict:
+        return analyse(s, e.parameters, e.problem, e.result, e.rows, e.results, e.collisions,
+                       e.before, e.after, resting_height(e.bodies[SPHERE]))
+    return plan_and_run(name, problem_file, parameters, camera, frames,
+                        "the sphere's controls", outcome)
+
+
+@dataclass
+class Executed:
+    """A plan and its run in the fresh world node: what a planning experiment analyses."""
+    parameters: dict
+    problem: object                  # gui.planning.problem.PlanningProblem
+    result: object                   # gui.planning.bridge.PlanResult
+    bodies: dict                     # {object ID: ObjectSpec} the world built (no static ones)
+    rows: list                       # the control rows read back from plan.path
+    results: list                    # per row, what running it answered (control_path)
+    collisions: list                 # per row: ((first, second, depth m, t s), ...)
+    before: dict                     # {object ID: state} before the first row and after
+    after: dict                      # the last (sphere._states)
+    tracked_pose: tuple              # the tracked link's (position m, quaternion (w, x, y, z))
+
+
+def plan_and_run(name: str, problem_file, parameters: dict, camera: "common.Camera",
+                 frames: bool, controls: str, outcome) -> dict:
+    """Plans ``problem_file``'s query with ``parameters`` (``search``), writes the plan as
+    out/experiments/<name>/plan.path (its rows: ``controls`` in [0, 1], then the duration),
+    reads it back and runs it in a world node only built from the problem, with a Viewer frame
+    every ``frame_every_rows`` rows; ``outcome(session, Executed)`` makes the facts written
+    to summary.json, which are returned."""
     from gui.core.control_path import (ClientPort, control_size, read_control_path,
                                        run_control_path, write_control_path)
     p = dict(parameters)
@@ -104,7 +134,7 @@ def run(frames: bool = True, problem_file=PROBLEM, name: str = "plan_sphere",
         path = s.out / "plan.path"
         write_control_path(path, result.rows, comments=(
             f"planned by {p['planner']}, seed {p['seed']} (tools/experiments/{name}.py)",
-            "each row: the sphere's controls in [0, 1], then the duration (s)"))
+            f"each row: {controls} in [0, 1], then the duration (s)"))
         rows = read_control_path(path, control_size(handle))
         if s.client.world().simulating:
             s.client.pause()
@@ -112,13 +142,15 @@ def run(frames: bool = True, problem_file=PROBLEM, name: str = "plan_sphere",
         before = _states(s.client, bodies)
         s.frame()
         client = FramedClient(s, p["frame_every_rows"])
-        results = run_control_path(ClientPort(client, real_time=False), handle, rows)
+        port = ClientPort(client, real_time=False)
+        results = run_control_path(port, handle, rows)
         if len(rows) % p["frame_every_rows"]:
             s.frame()
+        tracked_pose = tuple(port.body_state(problem.tracked_body)[:2])
         after = _states(s.client, bodies)
         s.finish()
-        facts = analyse(s, p, problem, result, rows, results, client.collisions, before,
-                        after, resting_height(bodies[SPHERE]))
+        facts = outcome(s, Executed(p, problem, result, bodies, rows, results,
+                                    client.collisions, before, after, tracked_pose))
         common.write_summary(s, facts, p)
     return facts
 
@@ -174,13 +206,37 @@ def moved_in_the_plane(before: dict, after: dict, names) -> dict:
 REPLAY_TOLERANCE_M = 1e-9
 
 
-def checks(o: dict) -> dict:
-    """Each outcome the run must hold, by name (run.py's verdict and the test)."""
+def replay_checks(o: dict) -> dict:
+    """The checks every planning experiment makes of its plan and the plan's run."""
     return {
         "KPIECE1 solved it": o["planner"]["solved"],
         "the path file holds the plan": o["rows_read_back_identical"]
         and o["rows_run"] == o["rows_written"] > 0,
         "the fresh world replays the plan": o["replay_difference_m"] < REPLAY_TOLERANCE_M,
+    }
+
+
+def obstacle_facts(e: Executed, end, touched_key: str) -> dict:
+    """The facts of a robot's plan among obstacles it may push and obstacles it must not touch
+    (``end``: where the tracked link's origin ended, m): ``plan_facts``, the pairs it touched
+    (under ``touched_key``), the forbidden ones among them, how far each obstacle moved in the
+    plane, and which obstacles are fixed."""
+    problem = e.problem
+    touched = problem.robot_contacts((a, b) for row in e.collisions for a, b, _, _ in row)
+    obstacles = [name for name in e.bodies if name not in problem.robot_bodies]
+    return {
+        **plan_facts(problem, e.result, e.rows, e.results, end),
+        touched_key: [list(pair) for pair in touched],
+        "forbidden_contacts": [list(pair) for pair in problem.forbidden_contacts(touched)],
+        "obstacles_moved_in_the_plane_m": moved_in_the_plane(e.before, e.after, obstacles),
+        "fixed_obstacles": sorted(problem.forbidden),
+    }
+
+
+def checks(o: dict) -> dict:
+    """Each outcome the run must hold, by name (run.py's verdict and the test)."""
+    return {
+        **replay_checks(o),
         "it ends in the goal region": o["in_goal_region"],
         "it never touches a wall": not o["forbidden_contacts"] and all(
             d < STILL_M for name, d in o["obstacles_moved_in_the_plane_m"].items()

@@ -1,9 +1,9 @@
 """Runs the thesis's three experiments (chapter 10), Kautham's ODE sphere demo and the plans
-OMPL's KPIECE1 makes for both public sphere demos and Kautham's chain demo end to end,
-headless.
+OMPL's KPIECE1 makes for both public sphere demos and Kautham's chain and car demos end to
+end, headless.
 
-    python tools/experiments/run.py                   # all seven
-    python tools/experiments/run.py grasp             # one (contactless ... plan_chain)
+    python tools/experiments/run.py                   # all eight
+    python tools/experiments/run.py grasp             # one (contactless ... plan_car)
     python tools/experiments/run.py --no-frames pile  # no Viewer frames (the same simulation)
 
 Each experiment starts its own roscore, ``rosrun VirtualWorld virtualWorld`` and ``rosrun
@@ -27,7 +27,7 @@ HERE = pathlib.Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
 NAMES = ("contactless", "pile", "grasp", "sphere", "plan_sphere", "plan_sphere_walls",
-         "plan_chain")
+         "plan_chain", "plan_car")
 
 
 def _raise_keyboard_interrupt(signum, frame):

@@ -1,0 +1,89 @@
+"""Past the thesis (issue 17): OMPL's KPIECE1 plans Kautham's ODE car demo through Odin's
+physics, and the plan it writes drives the car across the arena in a fresh world node.
+
+Scene: Kautham's ``OMPL_ode_demos/Car/k-PMPCar.xml`` exactly as the GUI loads it (vendored
+from Kautham's repository: tools/kautham/ode_demos): SimpleCar scaled 20 times (a 0.2 kg
+chassis 0.5 m long on four 0.01 kg wheels of 0.04 m radius), built at the query's start in
+the arena's north-east corner, facing world -x; three 0.25 m cubes across its way, which it
+may push ("freeManipulatable"), and six walls it must not touch ("fixed"), all resting on an
+infinite ground plane. Kautham's car planner builds the car as its CarEnvironment does
+(gui.core.build): hinge-2 wheels with world axes (steering about +z for the front pair, -z
+for the rear, spinning about +y: a positive wheel speed rolls the car toward -x), a soft
+suspension, and its contact friction (the wheels grip the ground with 5, a cube slides on it
+with 0.1). Controls: a steering angle in [-0.5, 0.5] rad and a wheel speed in [-5, 10] rad/s.
+
+Planning (``gui.planning``, the in-process Core back end, as ``rosrun GUI plan`` runs it):
+KPIECE1 with a fixed OMPL seed searches both controls, each held 5 to 50 steps of 0.05 s (the
+problem's own parameters), until the chassis is within the goal region (0.25 m of the query's
+``<Goal>`` in the plane, at the arena's south-west corner). The solution is written as a
+Kautham control path, read back and run as ``rosrun GUI run_path --controls`` runs it in a
+world node only built from the problem, with a Viewer frame every ``frame_every_rows`` rows.
+
+Outcome (summary.json): the planner's statistics; where the executed plan leaves the chassis
+against where the planner's own replay left it (the same bits); its distance to the goal; the
+pairs the car touched; how far each obstacle moved; whether the car ends on its wheels.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+import common
+import plan_sphere
+
+PROBLEM = common.ROOT / "tools" / "kautham" / "ode_demos" / "demos" / "OMPL_ode_demos" / \
+    "Car" / "k-PMPCar.xml"
+PARAMETERS = {
+    "planner": "KPIECE1",
+    "seed": 6,
+    "time_limit_s": 120.0,
+    "frame_every_rows": 40,
+}
+#: the whole 9.6 m arena from above, a little from the south
+CAMERA = common.Camera(eye=(0.0, -4.5, 12.5), target=(0.0, -0.2, 0.0))
+#: the walls do not move more than this in the plane (m): they are never touched
+STILL_M = 0.005
+#: the chassis's up (its URDF's -y: its wheels hang along its +y) within this of world +z
+UPRIGHT_DEG = 30.0
+
+
+def run(frames: bool = True) -> dict:
+    """Plans the car demo's query and runs the plan in a fresh world node (module
+    docstring)."""
+    return plan_sphere.plan_and_run("plan_car", PROBLEM, PARAMETERS, CAMERA, frames,
+                                    "the car's controls (steering, wheel speed)", analyse)
+
+
+def tilt_deg(quaternion) -> float:
+    """Degrees between the chassis's up (its -y) and world +z; ``quaternion`` (w, x, y, z)."""
+    from odin_common.rotations import quaternion_to_matrix
+    up = -quaternion_to_matrix(quaternion)[:, 1]
+    return float(np.degrees(np.arccos(np.clip(up[2], -1.0, 1.0))))
+
+
+def analyse(s, e: "plan_sphere.Executed") -> dict:
+    position, quaternion = e.tracked_pose
+    heights = [float(r.base_position[2]) for r in e.results]
+    return {"outcome": {
+        **plan_sphere.obstacle_facts(e, e.problem.tracked_origin(position, quaternion),
+                                     "car_touched"),
+        "chassis_height_m": [round(min(heights), 4), round(max(heights), 4)],
+        "chassis_tilt_at_end_deg": round(tilt_deg(quaternion), 2),
+    }, "contacts": s.contact_rates()}
+
+
+def checks(o: dict) -> dict:
+    """Each outcome the run must hold, by name (run.py's verdict and the test)."""
+    moved = o["obstacles_moved_in_the_plane_m"]
+    return {
+        **plan_sphere.replay_checks(o),
+        "the car ends in the goal region": o["in_goal_region"],
+        "it never touches a wall": not o["forbidden_contacts"],
+        "the walls never move": all(moved[name] < STILL_M for name in o["fixed_obstacles"]),
+        "it ends on its wheels": o["chassis_tilt_at_end_deg"] < UPRIGHT_DEG,
+    }
+
+
+def verdict(facts: dict) -> tuple:
+    """(outcome held, one line per fact) for run.py."""
+    o = facts["outcome"]
+    return plan_sphere.plan_verdict(checks(o), o, o["car_touched"], "obstacles moved")
