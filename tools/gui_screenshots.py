@@ -59,11 +59,14 @@ def _tour(window, problem, out, click, pump, screenshot, wait_for) -> list:
 
 
 def _turn_two_joints() -> None:
-    """The first two motors of the robot turn slowly (the Motion tab's Set Velocity)."""
+    """The first two motors of the robot turn slowly (the Motion tab's Set Velocity), every
+    axis of a motor alike (a car's wheel has two: steering and spin)."""
     from gui.ros.client import WorldClient
     client = WorldClient()
     motors = sorted(m for m in client.world().motors if m.startswith("motor:"))[:2]
-    client.set_velocities(motors, [0.4, -0.25])
+    axes = client.call("get_state", motors=motors).motor_axes
+    client.set_velocities(motors, [speed for speed, count in zip((0.4, -0.25), axes)
+                                   for _ in range(count)])
     client.close()
 
 
