@@ -308,6 +308,8 @@ def test_set_robot_refuses_what_does_not_fit_the_world():
             (dict(links=["a"], objects=["bob"], joint_names=["j"], joints=[joint],
                   joint_axes=[0, 0]), InvalidArgument),
             (dict(links=["a"], objects=["bob"], joint_names=["j"], joints=[joint],
+                  joint_axes=[-1]), InvalidArgument),
+            (dict(links=["a"], objects=["bob"], joint_names=["j"], joints=[joint],
                   joint_axes=[1]), InvalidArgument)]:
         with pytest.raises(error):
             mirror.set_robot(robot_of(RobotMessage(name="r", **fields)), types)

@@ -122,9 +122,9 @@ def _joint_axes(values, count: int, name: str) -> List[int]:
     axes = list(bytearray(values)) if isinstance(values, (bytes, bytearray)) else list(values)
     if not axes:
         return [0] * count
-    if len(axes) != count:
+    if len(axes) != count or any(not 0 <= int(a) < 256 for a in axes):
         raise InvalidArgument(f"Set Robot {name!r}: joint_axes must be {count} axis indices "
-                              f"or none, got {axes}")
+                              f"(0 to 255) or none, got {axes}")
     return [int(a) for a in axes]
 
 
