@@ -1,16 +1,17 @@
 """Past the thesis (issue 17): OMPL's KPIECE1 plans Kautham's ODE car demo through Odin's
 physics, and the plan it writes drives the car across the arena in a fresh world node.
 
-Scene: Kautham's ``OMPL_ode_demos/Car/k-PMPCar.xml`` exactly as the GUI loads it (vendored
-from Kautham's repository: tools/kautham/ode_demos): SimpleCar scaled 20 times (a 0.2 kg
-chassis 0.5 m long on four 0.01 kg wheels of 0.04 m radius), built at the query's start in
-the arena's north-east corner, facing world -x; three 0.25 m cubes across its way, which it
-may push ("freeManipulatable"), and six walls it must not touch ("fixed"), all resting on an
-infinite ground plane. Kautham's car planner builds the car as its CarEnvironment does
-(gui.core.build): hinge-2 wheels with world axes (steering about +z for the front pair, -z
-for the rear, spinning about +y: a positive wheel speed rolls the car toward -x), a soft
-suspension, and its contact friction (the wheels grip the ground with 5, a cube slides on it
-with 0.1). Controls: a steering angle in [-0.5, 0.5] rad and a wheel speed in [-5, 10] rad/s.
+Scene: Kautham's ``OMPL_ode_demos/Car/k-PMPCar.xml`` exactly as the GUI loads it (vendored from
+Kautham's repository: tools/kautham/ode_demos): SimpleCar scaled 20 times (a 0.2 kg chassis 0.5
+m long on four 0.01 kg wheels of 0.04 m radius), built at the query's start in the arena's
+north-east corner, 0.5 m above the ground (it lands first), facing world -x; three 0.25 m cubes
+across its way, which it may push ("freeManipulatable"), and six walls it must not touch
+("fixed"), all resting on an infinite ground plane. Kautham's car planner builds the car as its
+CarEnvironment does (gui.core.build): hinge-2 wheels with world axes (steering about +z for the
+first two wheels in link order, -z for the others, spinning about +y: a positive wheel speed
+rolls the car toward -x), a soft suspension, and its contact friction (the wheels grip the
+ground with 5, a cube slides on it with 0.1). Controls: a steering angle in [-0.5, 0.5] rad and
+a wheel speed in [-5, 10] rad/s.
 
 Planning (``gui.planning``, the in-process Core back end, as ``rosrun GUI plan`` runs it):
 KPIECE1 with a fixed OMPL seed searches both controls, each held 5 to 50 steps of 0.05 s (the
