@@ -238,6 +238,7 @@ def test_plan_car_drives_kautham_s_car_to_its_goal_pushing_a_cube_aside():
     # it ends resting on its suspension at its ride height (its chassis 0.16 m up unloaded)
     assert 0.09 < o["executed_end_m"][2] < 0.14
 
+
 def test_one_command_runs_several_experiments(kautham_dir):
     """`make experiments` runs them one after another from one command; each has a roscore of
     its own, which one rospy process cannot follow (it hung on the second before)."""

@@ -62,11 +62,10 @@ def tilt_deg(quaternion) -> float:
 
 
 def analyse(s, e: "plan_sphere.Executed") -> dict:
-    position, quaternion = e.tracked_pose
+    quaternion = e.tracked_pose[1]
     heights = [float(r.base_position[2]) for r in e.results]
     return {"outcome": {
-        **plan_sphere.obstacle_facts(e, e.problem.tracked_origin(position, quaternion),
-                                     "car_touched"),
+        **plan_sphere.obstacle_facts(e, "car_touched"),
         "chassis_height_m": [round(min(heights), 4), round(max(heights), 4)],
         "chassis_tilt_at_end_deg": round(tilt_deg(quaternion), 2),
     }, "contacts": s.contact_rates()}

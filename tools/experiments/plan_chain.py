@@ -55,8 +55,7 @@ def run(frames: bool = True) -> dict:
 
 
 def analyse(s, e: "plan_sphere.Executed") -> dict:
-    end = e.problem.tracked_origin(*e.tracked_pose)
-    return {"outcome": {**plan_sphere.obstacle_facts(e, end, "chain_touched"),
+    return {"outcome": {**plan_sphere.obstacle_facts(e, "chain_touched"),
                         "tracked_link": e.problem.tracked_body},
             "contacts": s.contact_rates()}
 

@@ -216,12 +216,13 @@ def replay_checks(o: dict) -> dict:
     }
 
 
-def obstacle_facts(e: Executed, end, touched_key: str) -> dict:
-    """The facts of a robot's plan among obstacles it may push and obstacles it must not touch
-    (``end``: where the tracked link's origin ended, m): ``plan_facts``, the pairs it touched
+def obstacle_facts(e: Executed, touched_key: str) -> dict:
+    """The facts of a robot's plan among obstacles it may push and obstacles it must not touch:
+    ``plan_facts`` (the end: where the tracked link's origin ended), the pairs it touched
     (under ``touched_key``), the forbidden ones among them, how far each obstacle moved in the
     plane, and which obstacles are fixed."""
     problem = e.problem
+    end = problem.tracked_origin(*e.tracked_pose)
     touched = problem.robot_contacts((a, b) for row in e.collisions for a, b, _, _ in row)
     obstacles = [name for name in e.bodies if name not in problem.robot_bodies]
     return {

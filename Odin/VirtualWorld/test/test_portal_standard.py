@@ -291,6 +291,7 @@ def test_a_robots_wheel_is_its_hinge2s_spin_named_by_joint_axes():
     assert names == ["wheel_joint"]
     assert rates == [state.rates[1]] and abs(rates[0]) > 1.0 and positions == [state.positions[1]]
 
+
 def test_set_robot_refuses_what_does_not_fit_the_world():
     core, mirror = Core(), WorldMirror()
     joint = _pendulum(core, mirror)

@@ -78,7 +78,7 @@ from gui.core.world_settings import WorldSettings, kautham_world
 from odin_common.interface import (JointParameter, JointType, MotorKind, Shape as ShapeKind,
                                    default_motor_id)
 from odin_common.specs import (CompositeSpec, EntitySpec, JointSpec, MotorSpec, ObjectSpec,
-                               PartSpec, Surface)
+                               PartSpec, Surface, WORLD_SURFACE)
 from odin_common.step_values import StepValues
 
 BodySpec = Union[ObjectSpec, CompositeSpec]
@@ -608,7 +608,7 @@ class _Planner:
             n += 1
             name = f"{GROUND}_{n}"
         surface = Surface(friction=environment.CAR_FRICTION["ground"]) \
-            if self.car_environment else Surface()
+            if self.car_environment else WORLD_SURFACE
         return ObjectSpec(name=name, parameters=(), shape=ShapeKind.PLANE, geometry_only=True,
                           color=environment.GROUND_COLOR, surface=surface)
 

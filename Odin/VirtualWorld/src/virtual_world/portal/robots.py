@@ -162,8 +162,8 @@ class RobotRegistry:
               ) -> None:
         """Refuses ``robot`` unless its objects and joints are in the world (``objects``;
         ``joint_types``: {joint ID: JointType}), its joints' world joints report the values
-        named (JOINT_STATE_AXES), and neither
-        its namespace nor any of its objects belongs to another robot."""
+        named (JOINT_STATE_AXES), and neither its namespace nor any of its objects belongs to
+        another robot."""
         present = set(objects)
         for link in robot.links:
             if link.object_id not in present:
