@@ -5,7 +5,9 @@
 - a client killed in the middle of a long call: the world finishes the call, loses no state and
   answers the next client;
 - the master killed and restarted (it then knows no node): the world and the Viewer register
-  again by themselves, and new clients find their services and topics.
+  again by themselves, and new clients find their services and topics;
+- the nodes started before the master, with private parameters on their command lines (a
+  script, a launch or hosts starting together): they wait for it and then start with them.
 
 (The world killed and restarted under the GUI is test_window_connection.py; a diverging body is
 test_world_guard.py.)
@@ -18,6 +20,8 @@ import sys
 import time
 
 import pytest
+
+from odin_common.ros_master import RosMaster
 
 pytestmark = pytest.mark.forked
 
@@ -146,3 +150,38 @@ def test_the_master_restarted_the_nodes_register_again(ros_master):
     for process in (node, viewer):
         assert process.poll() is None, ros_master.log_text(process)[-2000:]
     assert "registered again" in ros_master.log_text(node)
+
+
+def test_nodes_started_before_the_master_wait_for_it_and_keep_their_parameters(tmp_path):
+    """rospy sets a node's ``_name:=value`` parameters on the master before anything else, and
+    without a master that killed the node (the CI run of the four-host test lost its Viewer
+    that way when it came up before roscore)."""
+    import rospy
+    from world_client import WorldClient
+
+    master = RosMaster(ros_home=tmp_path / "ros_home")
+    try:
+        env = dict(master.env, QT_QPA_PLATFORM="offscreen")
+        nodes = [master.rosrun("VirtualWorld", "virtualWorld", "_rate:=10"),
+                 master.rosrun("Viewer", "viewer", "_width:=320", "_height:=240"),
+                 master.popen(["rosrun", "GUI", "gui", "_viewer:=/viewer"], log_name="gui",
+                              env=env)]
+        time.sleep(3.0)                              # all three are waiting by now
+        for node in nodes:
+            assert node.poll() is None, master.log_text(node)[-2000:]
+            assert "waiting for the ROS master" in master.log_text(node)
+        master.start()
+        master.apply_to_this_process()
+        master.wait_for_service("/virtual_world/get_world", timeout=60)
+        master.wait_for_service("/viewer/set_camera", timeout=60)
+        assert master.run(["rosparam", "get", "/gui/viewer"]).stdout.strip() == "/viewer"
+        rospy.init_node("odin_test_client", anonymous=True, disable_signals=True)
+        world = WorldClient()
+        assert world.ok("get_world").rate == pytest.approx(10.0)
+        image = rospy.wait_for_message("/viewer/image", rospy.AnyMsg, timeout=30)
+        assert image is not None
+        world.close()
+        for node in nodes:
+            assert node.poll() is None, master.log_text(node)[-2000:]
+    finally:
+        master.stop()

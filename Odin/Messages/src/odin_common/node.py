@@ -12,6 +12,7 @@ registers everything again the way rospy does at start when it does not.
 """
 from __future__ import annotations
 
+import sys
 import threading
 import time
 import xmlrpc.client
@@ -21,17 +22,41 @@ import rospy
 from rospy.impl.registration import get_service_manager, get_topic_manager
 
 
-def init_ros_node(name: str) -> None:
-    """``rospy.init_node(name)`` with rospy's own signal handling, except that Ctrl-C while
-    the node still waits for its master ends it like any tool (``odin_common.tool.run``: 130,
-    no traceback): rospy turns that Ctrl-C into a ROSInitException ("Failed to initialize
-    time")."""
+def init_ros_node(name: str, disable_signals: bool = False, poll: float = 0.5) -> None:
+    """``rospy.init_node(name)`` once the master answers, with rospy's own signal handling
+    unless ``disable_signals`` (a Qt window handles Ctrl-C itself).
+
+    rospy waits for a master that is not up yet only for the node's registration: a private
+    parameter on the command line (``_eye:=[...]``) is set on the master first, and with no
+    master that raises ConnectionRefusedError and the node dies. roscpp waits; so does every
+    Odin node, so that nodes started together with roscore (a launch, a script, a test) come
+    up in any order. Ctrl-C while waiting ends the node like any tool (``odin_common.tool.run``:
+    130, no traceback); rospy turns a Ctrl-C during its own start into a ROSInitException
+    ("Failed to initialize time")."""
+    wait_for_master(name, poll)
     try:
-        rospy.init_node(name)
+        rospy.init_node(name, disable_signals=disable_signals)
     except rospy.ROSInitException:
         if rospy.core.is_shutdown_requested():
             raise KeyboardInterrupt from None
         raise
+
+
+def wait_for_master(caller_id: str, poll: float = 0.5) -> None:
+    """Returns once the master at ROS_MASTER_URI answers, asking every ``poll`` seconds and
+    saying once on stderr that the node waits (roscpp's "waiting for master")."""
+    master = rosgraph.Master(caller_id)
+    said = False
+    while True:
+        try:
+            master.getPid()
+            return
+        except (OSError, xmlrpc.client.Error, rosgraph.MasterError):
+            if not said:
+                print(f"{caller_id}: waiting for the ROS master at {master.master_uri}",
+                      file=sys.stderr, flush=True)
+                said = True
+            time.sleep(poll)
 
 
 class MasterWatch:

@@ -21,7 +21,7 @@ from typing import Optional, Sequence
 def main(argv: Optional[Sequence[str]] = None) -> int:
     import rospy
 
-    from odin_common.node import MasterWatch
+    from odin_common.node import MasterWatch, init_ros_node
     from PyQt5.QtCore import QTimer
     from PyQt5.QtWidgets import QApplication
 
@@ -29,7 +29,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     from gui.window.main_window import MainWindow
     args = rospy.myargv(list(argv) if argv is not None else sys.argv)
     app = QApplication(args)
-    rospy.init_node("gui", anonymous=False, disable_signals=True)
+    init_ros_node("gui", disable_signals=True)
     MasterWatch()
     window = MainWindow(world=rospy.get_param("~world", DEFAULTS["world"]),
                         viewer=rospy.get_param("~viewer", DEFAULTS["viewer"]))
