@@ -297,14 +297,15 @@ def test_start_up_parameters_are_read(ros_master):
 
     ros_master.rosrun("VirtualWorld", "virtualWorld", "_rate:=10", "_step:=0.002",
                       "_steps_per_cycle:=5", "_contact_less:=true", "_gravity:=[0, 0, -1.5]",
-                      "_max_contacts:=4", "_collision_mesh_tolerance:=0.003")
+                      "_max_contacts:=4", "_collision_mesh_tolerance:=0.003",
+                      "_auto_disable:=true")
     ros_master.wait_for_service("/virtual_world/set_joint_force")
     rospy.init_node("odin_test_client", anonymous=True, disable_signals=True)
     client = WorldClient()
     assert client.ok("step_once").sim_time == pytest.approx(0.01)
     values = client.ok("set_world", set_erp=True, erp=0.2)
     assert values.contact_less and values.max_contacts == 4
-    assert values.collision_mesh_tolerance == 0.003
+    assert values.collision_mesh_tolerance == 0.003 and values.auto_disable is True
     assert list(values.gravity) == [0, 0, -1.5]
     step = client.ok("set_step", rate=10.0)
     assert (step.step, step.steps_per_cycle) == pytest.approx((0.002, 5))

@@ -103,7 +103,8 @@ def test_settings_tab_step_values_and_world_parameters(window):
     assert tab.in_force_labels["step"].text() == "0.002"
     assert not check.isChecked()
 
-    # world parameters: gravity, ERP = 0 (zero is valid), friction, collision policy, solver
+    # world parameters: gravity, ERP = 0 (zero is valid), friction, collision policy, solver,
+    # auto-disable
     tab.toolbox.setCurrentIndex(1)
     type_into(tab.gravity.boxes[2], "-1.62")
     type_into(tab.world_boxes["erp"], "0")
@@ -111,14 +112,20 @@ def test_settings_tab_step_values_and_world_parameters(window):
     type_into(tab.world_boxes["friction"], "0.5")
     tab.highlight_radio.setChecked(True)
     tab.solver.setCurrentIndex(1)
+    assert tab.in_force_labels["auto_disable"].text() == "off"
+    tab.sleep.setChecked(True)
+    assert tab.sleep_check.isChecked()
     click(tab.set_world_button)
     wait_for(lambda: tab.in_force.get("gravity") is not None
              and tab.in_force["gravity"][2] == pytest.approx(-1.62), 5, "gravity in force")
     assert tab.in_force["erp"] == 0.0
     assert tab.in_force["friction"] == pytest.approx(0.5)
     assert tab.in_force["contact_less"] is True and tab.in_force["solver"] == 1
+    assert tab.in_force["auto_disable"] is True
+    assert tab.in_force_labels["auto_disable"].text() == "on"
     response = _world().ok("set_world", set_erp=True, erp=0.0)   # answers all values in force
     assert response.gravity[2] == pytest.approx(-1.62) and response.erp == 0.0
+    assert response.auto_disable is True
     # hard limits: ERP cannot go past 1, whatever is typed
     type_into(tab.world_boxes["erp"], "7")
     assert tab.world_boxes["erp"].value() <= 1.0

@@ -98,6 +98,10 @@ PARAMETERS: Tuple[ParameterInfo, ...] = (
                   "what follows a divergence: 0 the body is parked (kinematic, still, "
                   "colliding with nothing, within the extent) and the world goes on; 1 parked "
                   "and the simulation paused", "set_divergence", 0, 1),
+    ParameterInfo("auto_disable", "bool", "-",
+                  "ODE's auto-disabling: a body slower than 0.01 m/s and 0.01 rad/s for 10 "
+                  "steps sleeps (is not stepped) until a moving body touches it or a request "
+                  "changes the world; off keeps every body awake", "set_auto_disable"),
 )
 """Every world parameter, in the order of Set World's request."""
 
@@ -132,6 +136,7 @@ class WorldParameters:
     divergence_angular_speed: float = 10000.0
     world_extent: float = 10000.0
     divergence_policy: int = 0
+    auto_disable: bool = False
 
     def replace(self, **changes) -> "WorldParameters":
         """A validated copy with ``changes``; unknown names raise InvalidArgument."""

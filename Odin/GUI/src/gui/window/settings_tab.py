@@ -172,7 +172,14 @@ class SettingsTab(QWidget):
         grid.addWidget(QLabel("QuickStep iterations"), 1, 0)
         grid.addWidget(self.iterations, 1, 1)
         self._in_force_label(grid, "solver", 0)
-        grid.setRowStretch(2, 1)
+        self.sleep_check = QCheckBox("Set auto-disable")
+        self.sleep = QCheckBox("Resting bodies sleep until touched or changed")
+        self.sleep.setChecked(default("auto_disable"))
+        self.sleep.setToolTip(PARAMETER_INFO["auto_disable"].what)
+        grid.addWidget(self.sleep_check, 2, 0)
+        grid.addWidget(self.sleep, 2, 1)
+        self._in_force_label(grid, "auto_disable", 2)
+        grid.setRowStretch(3, 1)
         self.toolbox.addItem(page, "Solver")
 
         self.set_world_button = QPushButton("Set checked world parameters")
@@ -184,6 +191,7 @@ class SettingsTab(QWidget):
         self.iterations.valueChanged.connect(lambda _i: self.solver_check.setChecked(True))
         self.max_contacts.valueChanged.connect(lambda _i: self.max_contacts_check.setChecked(True))
         self.contacts_radio.toggled.connect(lambda _b: self.policy_check.setChecked(True))
+        self.sleep.toggled.connect(lambda _b: self.sleep_check.setChecked(True))
 
         layout = QVBoxLayout(self)
         layout.addWidget(self.toolbox, 1)
@@ -240,6 +248,8 @@ class SettingsTab(QWidget):
         if self.solver_check.isChecked():
             changes["solver"] = Solver(self.solver.currentIndex())
             changes["quickstep_iterations"] = int(self.iterations.value())
+        if self.sleep_check.isChecked():
+            changes["auto_disable"] = self.sleep.isChecked()
         return changes
 
     def send_world(self) -> None:
@@ -261,6 +271,8 @@ class SettingsTab(QWidget):
                 text = "(" + ", ".join(f"{v:g}" for v in value) + ")"
             elif key == "contact_less":
                 text = "detect only" if value else "contacts"
+            elif key == "auto_disable":
+                text = "on" if value else "off"
             elif key == "solver":
                 text = SOLVER_NAMES.get(value, str(value)) + \
                     f", {parameters.quickstep_iterations} it."
@@ -268,7 +280,7 @@ class SettingsTab(QWidget):
                 text = f"{value:g}"
             label.setText(text)
         for check in [self.gravity_check, self.policy_check, self.max_contacts_check,
-                      self.solver_check, *self.world_checks.values()]:
+                      self.solver_check, self.sleep_check, *self.world_checks.values()]:
             check.setChecked(False)
 
     def refresh(self) -> None:

@@ -46,6 +46,14 @@ def _locked(method):
     return wrapper
 
 
+def _wake_sleepers(scene) -> None:
+    """Under auto_disable, a request that changed the world wakes every body: a body asleep on
+    a support just removed must fall, one given a velocity or a force must move. ODE itself
+    wakes a sleeper only when an awake body touches it."""
+    if scene.parameters.auto_disable:
+        scene.c.wake()
+
+
 def _changes_contents(method):
     """A call that may add or remove objects, joints or motors: the next change of state takes
     a new reset point."""
@@ -53,6 +61,7 @@ def _changes_contents(method):
     def wrapper(self, *args, **kwargs):
         result = method(self, *args, **kwargs)
         self._scene.contents_changed = True
+        _wake_sleepers(self._scene)
         return result
     return _locked(wrapper)
 
@@ -68,6 +77,18 @@ def _changes_state(method):
             scene.contents_changed = False
         return method(self, *args, **kwargs)
     return _locked(wrapper)
+
+
+def _disturbs(method):
+    """A request that changes the dynamic state from outside (poses, velocities, forces, motor
+    goals, surfaces): ``_changes_state``, and then the sleepers wake. Putting back a recorded
+    state, stepping and propagating do not wake: the state says which bodies sleep."""
+    @functools.wraps(method)
+    def wrapper(self, *args, **kwargs):
+        result = method(self, *args, **kwargs)
+        _wake_sleepers(self._scene)
+        return result
+    return _changes_state(wrapper)
 
 
 class Core:
@@ -188,7 +209,7 @@ class Core:
         """Names of the object's geometries (one, or a composite's parts)."""
         return [g.name for g in self._scene.object(object_id).geometries]
 
-    @_changes_state
+    @_disturbs
     def set_surface(self, name: str, surface) -> None:
         """The contact properties (odin_common.specs.Surface) of an object's geometries (an
         object ID) or of one part of a composite (its geometry name), from now on; how two
@@ -204,20 +225,20 @@ class Core:
             return 0
         return bodies.triangle_count(geometry.owner.ptr)
 
-    @_changes_state
+    @_disturbs
     def set_poses(self, poses: Sequence[Tuple[str, Sequence[float], Sequence[float]]],
                   reset_velocity: bool = False) -> None:
         """Moves objects: (object id, position m world, orientation wxyz) each, all or
         nothing. reset_velocity zeroes the bodies' linear and angular velocities."""
         objects.set_poses(self._scene, poses, reset_velocity)
 
-    @_changes_state
+    @_disturbs
     def set_velocity(self, object_id: str, linear=None, angular=None) -> None:
         """Sets the linear velocity of the centre of mass (m/s, world) and/or the angular
         velocity (rad/s, world) of a body; None keeps the current one."""
         objects.set_velocity(self._scene, object_id, linear, angular)
 
-    @_changes_state
+    @_disturbs
     def set_velocities(self, object_id: str = "", linear=None, angular=None,
                        motor_ids: Sequence[str] = (), velocities: Sequence[float] = ()) -> None:
         """Set Velocity: an object's velocities and/or motor goal speeds (one flat list, each
@@ -257,7 +278,7 @@ class Core:
     def joint_ids(self) -> List[str]:
         return list(self._scene.joints)
 
-    @_changes_state
+    @_disturbs
     def set_joint_parameters(self, joint_id: str,
                              parameters: Sequence[Tuple[int, int, float]]) -> None:
         """(parameter, axis 1..3, value) triples on a joint or a motor, all or nothing (see
@@ -306,13 +327,13 @@ class Core:
             return {}
         return motors.split_per_axis(self._scene, motor_ids, values, what)
 
-    @_changes_state
+    @_disturbs
     def set_servos(self, servos: Mapping[str, Mapping]) -> None:
         """Servo mode for motors, all checked first (core.motors.set_servos): each tracks a
         position target on its joint's axes."""
         motors.set_servos(self._scene, servos)
 
-    @_changes_state
+    @_disturbs
     def release_servos(self, motor_ids: Sequence[str]) -> None:
         """Motors back from servo mode to speed goals, at zero."""
         motors.release_servos(self._scene, motor_ids)
@@ -331,14 +352,14 @@ class Core:
     def remove_motor(self, motor_id: str) -> None:
         motors.remove_motor(self._scene, motor_id)
 
-    @_changes_state
+    @_disturbs
     def set_motor_velocities(self, velocities: Mapping[str, Sequence[float]]) -> None:
         """Goal speeds (rad/s or m/s) per motor axis; all checked before any is set."""
         motors.set_velocities(self._scene, velocities)
 
     # ------------------------------------------------------------------ forces
 
-    @_changes_state
+    @_disturbs
     def add_body_force(self, object_id: str, kind: int, vector,
                        vector_in_body_frame: bool = False, at_point: bool = False,
                        point=(0.0, 0.0, 0.0), point_in_body_frame: bool = False) -> str:
@@ -349,7 +370,7 @@ class Core:
         return forces.add_body_force(self._scene, object_id, kind, vector,
                                      vector_in_body_frame, at_point, point, point_in_body_frame)
 
-    @_changes_state
+    @_disturbs
     def remove_body_force(self, force_id: str) -> None:
         forces.remove_body_force(self._scene, force_id)
 
@@ -357,14 +378,14 @@ class Core:
     def body_force_ids(self) -> List[str]:
         return list(self._scene.body_forces)
 
-    @_changes_state
+    @_disturbs
     def add_joint_force(self, joint_id: str, magnitudes: Sequence[float]) -> str:
         """A persistent force/torque along a joint's axes, applied before every step until
         removed (odin_common.interface.JOINT_FORCE_MAGNITUDES). Returns
         "jointforce:<joint>:<n>"."""
         return forces.add_joint_force(self._scene, joint_id, magnitudes)
 
-    @_changes_state
+    @_disturbs
     def remove_joint_force(self, force_id: str) -> None:
         forces.remove_joint_force(self._scene, force_id)
 
@@ -378,12 +399,16 @@ class Core:
     def save_state(self, name: str) -> None:
         """Keeps the whole dynamic state under ``name`` (replacing a snapshot of that name):
         poses, velocities, joint and motor parameters, motor goals, persistent forces,
-        simulated time (core.snapshots). New Scene forgets every snapshot."""
+        simulated time (core.snapshots), which bodies sleep. New Scene forgets every snapshot.
+        Under auto_disable it also starts every body's rest count again, as putting the state
+        back does (ODE's count is out of reach), so that both step on alike."""
         name = check.name("snapshot name", name, allow_marker=True)
         held, limit = self._scene.snapshots, self.resources.max_snapshots
         if name not in held and len(held) >= limit:
             raise InvalidArgument(f"snapshot {name!r}: the world holds {len(held)} snapshots, "
                                   f"the limit (max_snapshots); remove one first")
+        if self._scene.parameters.auto_disable:
+            self._scene.c.restart_rest_counts()
         held[name] = snapshots.take(self._scene)
 
     @_changes_state
@@ -432,7 +457,9 @@ class Core:
     @_changes_state
     def set_body_state_vector(self, vector: Sequence[float]) -> None:
         """Puts back a vector read by ``body_state_vector`` (the same objects), bit for bit:
-        stepping on from it gives the results stepping on from when it was read gave."""
+        stepping on from it gives the results stepping on from when it was read gave. Under
+        auto_disable the bodies' rest counts start again here (ODE's count is in no vector),
+        so a body about to fall asleep may sleep some steps later than it did."""
         self._put_state_vector(self._checked_state_vector(vector))
 
     def _checked_state_vector(self, vector: Sequence[float]) -> np.ndarray:
@@ -595,6 +622,14 @@ class Core:
     def parked_objects(self) -> List[str]:
         """The objects the divergence guard parked (kinematic, still, colliding with nothing)."""
         return list(self._scene.parked)
+
+    @_locked
+    def sleeping_objects(self) -> List[str]:
+        """The objects ODE's auto-disabling has put to sleep (world parameter auto_disable):
+        not stepped until an awake body touches them or a request changes the world."""
+        return [object_id for object_id, obj in self._scene.objects.items()
+                if obj.body is not None and not obj.fixed
+                and object_id not in self._scene.parked and not bodies.is_awake(obj.body.ptr)]
 
     @_locked
     def detect_collisions(self) -> None:

@@ -54,6 +54,11 @@ def body_state(body) -> Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
             np.array([v[0], v[1], v[2]]), np.array([w[0], w[1], w[2]]))
 
 
+def is_awake(body) -> bool:
+    """False while ODE's auto-disabling keeps the body asleep."""
+    return bool(lib.dBodyIsEnabled(body))
+
+
 def unpark(body, collide: bool) -> None:
     """Undoes the divergence guard's parking (odin_step.c): the body dynamic again, its geoms
     colliding again unless ``collide`` is False (an object without collisions)."""

@@ -30,7 +30,7 @@ void odin_write_body_states(dBodyID *bodies, int n, const double *in) {
         dBodySetPosition(b, s[0], s[1], s[2]);
         dBodySetLinearVel(b, s[19], s[20], s[21]);
         dBodySetAngularVel(b, s[22], s[23], s[24]);
-        if (s[25] != 0.0) dBodyEnable(b);
-        else dBodyDisable(b);
+        dBodyEnable(b);                /* the rest count starts again (odin_step.h) */
+        if (s[25] == 0.0) dBodyDisable(b);
     }
 }

@@ -500,6 +500,45 @@ static int guard(OdinWorld *w) {
 
 void odin_world_clear_divergences(OdinWorld *w) { w->n_diverged = 0; }
 
+/* ---------------------------------------------------------------- sleeping bodies */
+
+void odin_world_sync_auto_disable(OdinWorld *w) {
+    dWorldSetAutoDisableFlag(w->world, w->auto_disable);
+    for (int i = 0; i < w->n_guarded; ++i) dBodySetAutoDisableFlag(w->guarded[i], w->auto_disable);
+}
+
+void odin_world_wake(OdinWorld *w) {
+    for (int i = 0; i < w->n_guarded; ++i) dBodyEnable(w->guarded[i]);
+}
+
+/* dBodyEnable is ODE's only way to set a body's rest count (to its idle steps). */
+static void restart_rest_count(dBodyID b) {
+    int asleep = !dBodyIsEnabled(b);
+    dBodyEnable(b);
+    if (asleep) dBodyDisable(b);
+}
+
+void odin_world_restart_rest_counts(OdinWorld *w) {
+    for (int i = 0; i < w->n_guarded; ++i) restart_rest_count(w->guarded[i]);
+}
+
+int odin_world_sleeping(const OdinWorld *w) {
+    int n = 0;
+    for (int i = 0; i < w->n_guarded; ++i) n += !dBodyIsEnabled(w->guarded[i]);
+    return n;
+}
+
+/* ODE steps only awake bodies and clears only their accumulators: the persistent forces added
+ * to a sleeping body every step would pile up and all act on it the step it wakes. */
+static void clear_sleepers_forces(const OdinWorld *w) {
+    for (int i = 0; i < w->n_guarded; ++i) {
+        dBodyID b = w->guarded[i];
+        if (dBodyIsEnabled(b)) continue;
+        dBodySetForce(b, 0, 0, 0);
+        dBodySetTorque(b, 0, 0, 0);
+    }
+}
+
 /* ---------------------------------------------------------------- step (thesis 5.5) */
 
 /* The rows a joint adds to ODE's constraint system at most (its getInfo1's m with a limit or
@@ -517,11 +556,13 @@ static int joint_rows(dJointID j) {
 }
 
 /* The constraint rows of the step about to be taken, counting stops above `bound`. Each joint
- * is counted at its first dynamic body (a parked body is kinematic, hence fixed). */
+ * is counted at its first dynamic body (a parked body is kinematic, hence fixed); a sleeping
+ * body's joints are not stepped. */
 static int constraint_rows(const OdinWorld *w, int bound) {
     int rows = 0;
     for (int i = 0; i < w->n_guarded; ++i) {
         dBodyID b = w->guarded[i];
+        if (!dBodyIsEnabled(b)) continue;
         int n = dBodyGetNumJoints(b);
         for (int k = 0; k < n; ++k) {
             dJointID j = dBodyGetJoint(b, k);
@@ -568,6 +609,7 @@ int odin_world_step(OdinWorld *w, double h, int count) {
             dWorldStep(w->world, h);
         }
         /* 5. fixed bodies are kinematic (dBodySetKinematic): nothing to reset */
+        if (w->auto_disable) clear_sleepers_forces(w);
         if (w->recording && !w->contact_less) read_contact_forces(w);
         dJointGroupEmpty(w->contact_group);           /* 6. contacts last one step */
         w->step_count++;

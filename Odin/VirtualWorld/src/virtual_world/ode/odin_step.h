@@ -141,6 +141,8 @@ typedef struct OdinWorld {
     dBodyID *guarded; int n_guarded;   /* the dynamic bodies (Python's array) */
     double max_speed, max_spin, extent;
     int stop_on_divergence;  /* 1: the step loop stops after a step that parked a body */
+    int auto_disable;        /* ODE's auto-disabling is on: after each step the force and
+                                torque accumulators of sleeping bodies are cleared */
     OdinDivergence *diverged; int n_diverged; int cap_diverged;
     long step_count;         /* steps taken since the scene began */
     int recording;           /* internal: record pairs during this collide pass */
@@ -160,6 +162,18 @@ typedef struct OdinWorld {
 /* Runs `count` steps of `h` seconds; returns the steps taken (fewer when the guard parked a
  * body and stop_on_divergence is set). */
 int odin_world_step(OdinWorld *w, double h, int count);
+/* ODE's auto-disabling flag is each body's own, copied from the world's when the body is made:
+ * sets every guarded body's to auto_disable (after the flag or the guarded bodies changed). */
+void odin_world_sync_auto_disable(OdinWorld *w);
+/* Wakes every guarded body (dBodyEnable: its rest count starts again): a request changed the
+ * world, and a sleeping body must meet the change as an awake one would. */
+void odin_world_wake(OdinWorld *w);
+/* Starts every guarded body's rest count again, sleepers staying asleep. ODE keeps the count
+ * where no API reads it, so a snapshot cannot hold it: Save State restarts it here and putting
+ * a state back restarts it (odin_write_body_states), and stepping on from either is the same. */
+void odin_world_restart_rest_counts(OdinWorld *w);
+/* How many guarded bodies sleep now (ODE's auto-disabling). */
+int odin_world_sleeping(const OdinWorld *w);
 /* Forgets the divergences Python has read. */
 void odin_world_clear_divergences(OdinWorld *w);
 /* Records the pairs touching now, without stepping and without contacts: under the contact-less

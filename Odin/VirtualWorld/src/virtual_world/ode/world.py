@@ -65,6 +65,11 @@ class CWorld:
         s.max_spin = p.divergence_angular_speed
         s.extent = p.world_extent
         s.stop_on_divergence = int(p.divergence_policy == 1)
+        s.auto_disable = int(p.auto_disable)
+        lib.odin_world_sync_auto_disable(s)
+        # every body meets new parameters awake (gravity turned, a surface changed), and with
+        # auto-disabling off nothing else would ever wake a sleeper
+        lib.odin_world_wake(s)
 
     @property
     def max_contacts(self) -> int:
@@ -83,6 +88,20 @@ class CWorld:
     def last_solver(self) -> int:
         """The solver the last step used: 0 QuickStep, 1 dWorldStep."""
         return int(self.struct.last_solver)
+
+    def wake(self) -> None:
+        """Wakes every dynamic body (a request changed the world: see odin_world_wake)."""
+        lib.odin_world_wake(self.struct)
+
+    def restart_rest_counts(self) -> None:
+        """Every dynamic body's rest count starts again, sleepers stay asleep (a Save State
+        under auto_disable: see odin_world_restart_rest_counts)."""
+        lib.odin_world_restart_rest_counts(self.struct)
+
+    @property
+    def sleeping(self) -> int:
+        """Dynamic bodies that ODE's auto-disabling has put to sleep."""
+        return int(lib.odin_world_sleeping(self.struct))
 
     @property
     def step_count(self) -> int:
@@ -137,6 +156,7 @@ class CWorld:
         array = ffi.new("dBodyID[]", max(2 * len(bodies), 16))
         array[0:len(bodies)] = list(bodies)
         self._install("guarded", array, len(bodies))
+        lib.odin_world_sync_auto_disable(self.struct)   # an unparked body kept its old flag
 
     def add_guarded(self, body) -> None:
         """One more body for the guard, at the end of the list: amortised O(1) (the array
