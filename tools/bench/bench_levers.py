@@ -10,6 +10,8 @@ against the same program without it, alternately in one run:
   lever_auto_disable_enabled_rest<N> the share of bodies still enabled after the timed steps
   lever_threads2_speedup_rest<N>     steps/s with ODE's island threading on a pool of 2 threads
                                      (this machine's cores) ÷ on the caller's thread alone
+  auto_disable_speedup_rest<N>_odin  the lever Odin keeps, in Odin: the Core's steps/s on the
+                                     same scene with the world parameter auto_disable ÷ without
 
 N is 1,000 and 10,000. Each figure is the median over the rounds of the ratio within a round;
 ODIN_BENCH_ROUNDS sets the rounds (default 5). Every run also prints the largest drift of a
@@ -22,6 +24,8 @@ import os
 import pathlib
 import statistics
 import subprocess
+import sys
+import time
 
 HERE = pathlib.Path(__file__).resolve().parent
 ROOT = HERE.parent.parent
@@ -52,13 +56,42 @@ def measure(exe: pathlib.Path, bodies: int, lever: str) -> dict:
             "drift_m": float(out[4])}
 
 
+def measure_odin(bodies: int, auto_disable: bool) -> dict:
+    """The same scene in Odin's Core (its own process: a fresh heap for every run)."""
+    steps, warm = STEPS[bodies]
+    out = subprocess.run([sys.executable, __file__, "odin", str(bodies), str(int(auto_disable))],
+                         check=True, capture_output=True, text=True, timeout=1200).stdout
+    return {"steps_per_s": steps / float(out.split()[-1])}
+
+
+def _odin_seconds(bodies: int, auto_disable: bool) -> float:
+    from odin_common.interface import Shape
+    from virtual_world.core import Core, ObjectSpec, WorldParameters
+    steps, warm = STEPS[bodies]
+    core = Core(WorldParameters(auto_disable=auto_disable))
+    core.build_object(ObjectSpec("ground", [], shape=Shape.PLANE, geometry_only=True))
+    side = int(bodies ** 0.5 + 0.999999)
+    for i in range(bodies):
+        core.build_object(ObjectSpec(f"s{i}", [0.1], mass=1.0, position=(
+            (i % side) * 0.3 - side * 0.15, (i // side) * 0.3 - side * 0.15, 0.1)))
+    core.step(0.001, warm)
+    started = time.perf_counter()
+    core.step(0.001, steps)
+    return time.perf_counter() - started
+
+
+#: the Core's runs, beside the native levers
+ODIN = {"odin_base": False, "odin_auto_disable": True}
+
+
 def rounds_of(exe: pathlib.Path, bodies: int) -> list:
     """[{lever: measure()}], the levers' order rotated from round to round."""
-    names = list(LEVERS)
+    names = list(LEVERS) + list(ODIN)
     rounds = []
     for k in range(ROUNDS):
         order = names[k % len(names):] + names[:k % len(names)]
-        runs = {lever: measure(exe, bodies, lever) for lever in order}
+        runs = {lever: measure_odin(bodies, ODIN[lever]) if lever in ODIN
+                else measure(exe, bodies, lever) for lever in order}
         rounds.append(runs)
         print(f"  rest{bodies} round {k}: " + ", ".join(
             f"{lever} {runs[lever]['steps_per_s']:.1f}/s" for lever in names), flush=True)
@@ -66,15 +99,17 @@ def rounds_of(exe: pathlib.Path, bodies: int) -> list:
 
 
 def figures_of(bodies: int, rounds: list) -> dict:
-    def speedup(lever: str) -> float:
-        return round(statistics.median(r[lever]["steps_per_s"] / r["base"]["steps_per_s"]
+    def speedup(lever: str, base: str = "base") -> float:
+        return round(statistics.median(r[lever]["steps_per_s"] / r[base]["steps_per_s"]
                                        for r in rounds), 3)
     return {f"lever_hash_over_sap_rest{bodies}": speedup("hash"),
             f"lever_quadtree_over_sap_rest{bodies}": speedup("quadtree"),
             f"lever_auto_disable_speedup_rest{bodies}": speedup("auto_disable"),
             f"lever_auto_disable_enabled_rest{bodies}": round(statistics.median(
                 r["auto_disable"]["enabled"] for r in rounds), 4),
-            f"lever_threads2_speedup_rest{bodies}": speedup("threads2")}
+            f"lever_threads2_speedup_rest{bodies}": speedup("threads2"),
+            f"auto_disable_speedup_rest{bodies}_odin": speedup("odin_auto_disable",
+                                                               "odin_base")}
 
 
 def run(out_dir: pathlib.Path) -> dict:
@@ -87,4 +122,7 @@ def run(out_dir: pathlib.Path) -> dict:
 
 
 if __name__ == "__main__":
-    print(run(ROOT / "out" / "bench"))
+    if sys.argv[1:2] == ["odin"]:          # one Core run (measure_odin): prints its seconds
+        print(_odin_seconds(int(sys.argv[2]), bool(int(sys.argv[3]))))
+    else:
+        print(run(ROOT / "out" / "bench"))
