@@ -36,18 +36,35 @@ def cluster_vertices(vertices: np.ndarray, indices: np.ndarray,
     if not cell > 0:
         raise ValueError(f"cluster cell {cell!r} must be a positive length (m)")
     cells = np.floor(vertices / cell).astype(np.int64)
-    _, cluster = np.unique(cells, axis=0, return_inverse=True)
+    _, cluster = _unique_rows(cells, return_inverse=True)
     cluster = cluster.reshape(-1)
     count = int(cluster.max()) + 1
-    merged = np.zeros((count, 3))
-    np.add.at(merged, cluster, vertices)
+    # per axis, the sums in vertex order as np.add.at would make them, many times faster
+    merged = np.stack([np.bincount(cluster, weights=vertices[:, k], minlength=count)
+                       for k in range(3)], axis=1)
     merged /= np.bincount(cluster, minlength=count)[:, None]
     triangles = cluster[indices].reshape(-1, 3)
     keep = ((triangles[:, 0] != triangles[:, 1]) & (triangles[:, 1] != triangles[:, 2])
             & (triangles[:, 0] != triangles[:, 2]))
     triangles = triangles[keep]
-    _, first = np.unique(np.sort(triangles, axis=1), axis=0, return_index=True)
+    _, first = _unique_rows(np.sort(triangles, axis=1), return_index=True)
     return merged, triangles[np.sort(first)].reshape(-1)
+
+
+def _unique_rows(rows: np.ndarray, **options):
+    """``np.unique(rows, axis=0, **options)`` for an (n, 3) int64 array, the same answer in the
+    same order: each row packed into one int64 that sorts as the row does (ten times faster
+    than numpy's sort of rows as records, which set the time of loading a CAD hand), unless
+    the rows' span does not fit in 63 bits."""
+    if len(rows) == 0:
+        return np.unique(rows, axis=0, **options)
+    low = rows.min(axis=0)
+    span = rows.max(axis=0) - low + 1
+    if math.prod(int(n) for n in span) >= 2 ** 63:
+        return np.unique(rows, axis=0, **options)
+    shifted = rows - low
+    keys = (shifted[:, 0] * span[1] + shifted[:, 1]) * span[2] + shifted[:, 2]
+    return np.unique(keys, **options)
 
 
 def display_mesh(vertices: np.ndarray, indices: Sequence[int]) -> Tuple[np.ndarray, np.ndarray]:

@@ -99,6 +99,8 @@ class WorldPool:
             raise PoolError("a pool needs at least one world")
         if not rospy.core.is_initialized():
             rospy.init_node(node_name, anonymous=True, disable_signals=True)
+            from odin_common.node import prompt_shutdown
+            prompt_shutdown()
         self._free: queue.Queue = queue.Queue()
         self._worlds = [_World(n, self._free, timeout) for n in namespaces]
         for world in self._worlds:

@@ -126,6 +126,8 @@ class WorldClient:
         self._srv = srv
         if not rospy.core.is_initialized():
             rospy.init_node(node_name, anonymous=True, disable_signals=True)
+            from odin_common.node import prompt_shutdown
+            prompt_shutdown()
         self.namespace = namespace.rstrip("/")
         self._proxies: dict = {}
         try:

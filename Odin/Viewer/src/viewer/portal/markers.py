@@ -70,11 +70,14 @@ class MarkerIntake:
                     removals.append(marker.text)
                     views = [v for v in views if v[0] != marker.text]
             elif marker.action == Marker.ADD:
-                fields = view_fields(marker)
-                if fields is None or fields[0] in self.added:
+                name = marker.text
+                if name in self.added:
                     continue    # a geometry drawn already (a re-framed or recoloured marker)
-                if held(fields[0]) and fields[0] not in removals:
-                    continue    # the world sent it through View Object
+                if held(name) and name not in removals:
+                    continue    # the world sent it through View Object: no points to convert
+                fields = view_fields(marker)
+                if fields is None:
+                    continue
                 views.append(fields)
                 self.added.add(fields[0])
         return views, removals

@@ -255,7 +255,7 @@ def _build_geometry(scene: Scene, p: _Prepared, part: _Part, body, tag: int) -> 
 def _built_geometries(records: Sequence[GeometryRecord]) -> Tuple[BuiltGeometry, ...]:
     positions, quaternions = PoseReader([r.owner for r in records]).read()
     return tuple(BuiltGeometry(r.name, tuple(np.asarray(r.parameters, float).tolist()),
-                               tuple(int(i) for i in np.asarray(r.indices).reshape(-1)),
+                               tuple(np.asarray(r.indices, np.int64).reshape(-1).tolist()),
                                r.color, tuple(positions[k].tolist()),
                                tuple(quaternions[k].tolist()), r.shape_asked)
                  for k, r in enumerate(records))
