@@ -75,3 +75,44 @@ def test_every_new_subscriber_gets_all_markers_and_the_last_transforms(ros_maste
     assert counts[0] >= objects and set(counts) == {counts[0]}, (objects, counts)
     log = ros_master.log_text(world)
     assert "no markers for a new subscriber" not in log, log[-2000:]
+
+
+def test_interactive_markers_follow_only_the_objects_that_moved(ros_master):
+    """The world's interactive marker server (``~interactive``: RViz's drag and push handles)
+    inserts a marker per movable object, moves it when its object moves, and sends nothing
+    for objects that stay where their markers show them."""
+    import rospy
+    from visualization_msgs.msg import InteractiveMarkerUpdate
+    from Messages.msg import Situation
+    from world_client import WorldClient, box, sphere
+
+    ros_master.rosrun("VirtualWorld", "virtualWorld")
+    ros_master.wait_for_service("/virtual_world/set_position")
+    rospy.init_node("odin_test_client", anonymous=True, disable_signals=True)
+    updates = []
+    rospy.Subscriber("/virtual_world/interactive/update", InteractiveMarkerUpdate,
+                     lambda message: updates.append(message), queue_size=100)
+    world = WorldClient()
+    world.ok("build_object", object=box("floor", (4, 4, 0.1), (0, 0, -0.05), geometry_only=True))
+    world.ok("build_object", object=sphere("still", 0.1, (-1, 0, 0.1)))
+    world.ok("build_object", object=sphere("moved", 0.1, (1, 0, 0.1)))
+
+    def inserted():
+        return {m.name for u in updates for m in u.markers}
+    deadline = time.monotonic() + 20
+    while inserted() != {"still", "moved"} and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert inserted() == {"still", "moved"}
+    time.sleep(1.0)                                 # the world paused: nothing moves
+    before = len(updates)
+    world.ok("set_position", situations=[Situation("moved", [1.0, 1.5, 0.1], [1, 0, 0, 0])])
+    deadline = time.monotonic() + 10
+    poses = []
+    while not poses and time.monotonic() < deadline:
+        time.sleep(0.1)
+        poses = [p for u in updates[before:] for p in u.poses]
+    assert [p.name for p in poses] == ["moved"]
+    assert poses[0].pose.position.y == pytest.approx(1.5)
+    time.sleep(1.0)
+    assert [p.name for u in updates[before:] for p in u.poses] == ["moved"]   # once
+    world.close()

@@ -131,24 +131,34 @@ class InteractiveObjects:
             del self._shown[object_id]
             self._dragging.discard(object_id)
             changed = True
+        moved = self._moved([o for o in movable
+                             if o in self._shown and o not in self._dragging], object_poses)
         for object_id in movable:
             position, quaternion = object_poses[object_id]
-            shown = self._shown.get(object_id)
-            if shown is None:
+            if object_id not in self._shown:
                 self.server.insert(object_marker(object_id, position, quaternion,
                                                  self.mirror.objects[object_id].size),
                                    self._on_feedback)
                 self.menu.apply(self.server, object_id)
-            elif object_id in self._dragging or (
-                    np.abs(shown[0] - position).max() < MOVED_BY
-                    and np.abs(shown[1] - quaternion).max() < MOVED_BY):
-                continue
-            else:
+            elif object_id in moved:
                 self.server.setPose(object_id, _pose(position, quaternion))
+            else:
+                continue
             self._shown[object_id] = (np.array(position), np.array(quaternion))
             changed = True
         if changed:
             self.server.applyChanges()
+
+    def _moved(self, object_ids: list, object_poses: dict) -> set:
+        """Those of ``object_ids`` (shown) that moved more than MOVED_BY from where their
+        marker shows them: one comparison of stacked arrays, not two numpy calls an object
+        (which had cost the world a tenth of its time with 100 objects free running)."""
+        if not object_ids:
+            return set()
+        now = np.array([np.concatenate(object_poses[o]) for o in object_ids])
+        shown = np.array([np.concatenate(self._shown[o]) for o in object_ids])
+        far = np.abs(now - shown).max(axis=1) >= MOVED_BY
+        return {o for o, f in zip(object_ids, far) if f}
 
     # -- rospy's threads: what the user did -------------------------------------------------------
     def _on_feedback(self, feedback: InteractiveMarkerFeedback) -> None:
