@@ -1,5 +1,5 @@
 """ODE's own levers on the cost of many bodies (issue 14: "measure each and keep what pays"),
-each measured natively (native/levers.c: the peers' rest<N> scene stepped as Odin steps it)
+each measured natively (native/rest_scene.c: the peers' rest<N> scene stepped as Odin steps it)
 against the same program without it, alternately in one run:
 
   lever_hash_over_sap_rest<N>        steps/s with ODE's hash space ÷ with sweep and prune
@@ -33,20 +33,21 @@ ROUNDS = int(os.environ.get("ODIN_BENCH_ROUNDS", "5"))
 
 #: bodies -> (timed steps, untimed steps first); auto-disabling needs 10 resting steps
 STEPS = {1000: (400, 50), 10000: (40, 30)}
-#: lever -> levers.c's SPACE AUTO_DISABLE THREADS; "base" is Odin's own setting
+#: lever -> rest_scene.c's SPACE AUTO_DISABLE THREADS; "base" is Odin's own setting
 LEVERS = {"base": ("sap", 0, 1), "hash": ("hash", 0, 1), "quadtree": ("quadtree", 0, 1),
           "auto_disable": ("sap", 1, 1), "threads2": ("sap", 0, 2)}
 
 
 def _compile(out_dir: pathlib.Path) -> pathlib.Path:
-    exe = out_dir / "levers"
-    subprocess.run(["gcc", "-O2", "-DdDOUBLE", str(HERE / "native" / "levers.c"), "-lode",
+    exe = out_dir / "rest_scene_levers"
+    subprocess.run(["gcc", "-O2", "-DdDOUBLE", str(HERE / "native" / "rest_scene.c"), "-lode",
                     "-lm", "-o", str(exe)], check=True)
     return exe
 
 
 def measure(exe: pathlib.Path, bodies: int, lever: str) -> dict:
-    """One run of levers.c: steps/s, bodies enabled at the end, largest drift (m)."""
+    """One run of rest_scene.c with ``lever``: steps/s, bodies enabled at the end, largest
+    drift (m)."""
     steps, warm = STEPS[bodies]
     space, auto_disable, threads = LEVERS[lever]
     out = subprocess.run([str(exe), str(bodies), str(steps), str(warm), space,
@@ -65,18 +66,16 @@ def measure_odin(bodies: int, auto_disable: bool) -> dict:
 
 
 def _odin_seconds(bodies: int, auto_disable: bool) -> float:
-    from odin_common.interface import Shape
-    from virtual_world.core import Core, ObjectSpec, WorldParameters
+    """The peers' rest scene in Odin's Core (peers/odin_engine.py), the world parameter
+    auto_disable as given: seconds of the timed steps."""
+    sys.path.insert(0, str(HERE / "peers"))
+    import odin_engine
+    from virtual_world.core import WorldParameters
     steps, warm = STEPS[bodies]
-    core = Core(WorldParameters(auto_disable=auto_disable))
-    core.build_object(ObjectSpec("ground", [], shape=Shape.PLANE, geometry_only=True))
-    side = int(bodies ** 0.5 + 0.999999)
-    for i in range(bodies):
-        core.build_object(ObjectSpec(f"s{i}", [0.1], mass=1.0, position=(
-            (i % side) * 0.3 - side * 0.15, (i // side) * 0.3 - side * 0.15, 0.1)))
-    core.step(0.001, warm)
+    sim = odin_engine.Sim(f"rest{bodies}", WorldParameters(auto_disable=auto_disable))
+    sim.step(warm)
     started = time.perf_counter()
-    core.step(0.001, steps)
+    sim.step(steps)
     return time.perf_counter() - started
 
 

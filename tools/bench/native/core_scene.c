@@ -36,16 +36,9 @@ int main(int argc, char **argv) {
     if (argc < 5) { fprintf(stderr, "usage: core_scene MODE STEPS NFORCES NMOTORS [CHECKPOINT...]\n"); return 2; }
     int mode = atoi(argv[1]), steps = atoi(argv[2]), nforces = atoi(argv[3]), nmotors = atoi(argv[4]);
     dInitODE2(0);
-    world = dWorldCreate();
+    world = odin_world();
     dSpaceID space = odin_space();
     group = dJointGroupCreate(0);
-    dWorldSetGravity(world, 0, 0, -9.81);
-    dWorldSetERP(world, 0.2);
-    dWorldSetCFM(world, 1e-5);
-    dWorldSetContactSurfaceLayer(world, 0.001);
-    dWorldSetQuickStepNumIterations(world, 20);
-    dWorldSetLinearDampingThreshold(world, 0.01);
-    dWorldSetAngularDampingThreshold(world, 0.01);
     wall(space, 0, 0, -0.5, 20, 20, 1);
     if (mode == 1) {
         wall(space, 0.65, 0, 1, 0.2, 1.5, 2);

@@ -1,4 +1,5 @@
-/* What Odin's step loop does with colliding pairs, in plain C for the native baselines: every
+/* What Odin's step loop does, in plain C for the native baselines: its world settings
+ * (odin_world) and broad phase (odin_space), and what it does with colliding pairs: every
  * geom carries its serial (creation order, from 1) as its data; the near-callback collides each
  * pair with the lower serial first and keeps its contacts; after the pass the pairs are sorted
  * by (serial 1, serial 2) and their contact joints made in that order (odin_step.c's
@@ -63,6 +64,20 @@ __attribute__((noinline)) int collide_in_order(dWorldID world, dSpaceID space, d
         made += pairs[k].n;
     }
     return made;
+}
+
+/* A world with Odin's default settings (odin_common.world_parameters; QuickStep's 20
+ * iterations: the scenes step with dWorldQuickStep). */
+static dWorldID odin_world(void) {
+    dWorldID world = dWorldCreate();
+    dWorldSetGravity(world, 0, 0, -9.81);
+    dWorldSetERP(world, 0.2);
+    dWorldSetCFM(world, 1e-5);
+    dWorldSetContactSurfaceLayer(world, 0.001);
+    dWorldSetQuickStepNumIterations(world, 20);
+    dWorldSetLinearDampingThreshold(world, 0.01);
+    dWorldSetAngularDampingThreshold(world, 0.01);
+    return world;
 }
 
 /* The broad phase Odin collides with (virtual_world.ode.handles.new_space). */

@@ -10,15 +10,16 @@ import math
 import scenes
 from measure import rotate
 from odin_common.interface import JointType, MotorKind, Shape, Solver
-from virtual_world.core import Core, ObjectSpec
+from virtual_world.core import Core, ObjectSpec, WorldParameters
 
 #: the capsule's z turned onto x: (w, x, y, z), a quarter turn about y
 Z_ONTO_X = (math.cos(math.pi / 4), 0.0, math.sin(math.pi / 4), 0.0)
 
 
 class Sim:
-    def __init__(self, scene: str):
-        self.core = Core()
+    def __init__(self, scene: str, parameters: WorldParameters = None):
+        """``scene`` (scenes.SCENES) in a Core of ``parameters`` (Odin's defaults if None)."""
+        self.core = Core(parameters)
         self.bodies = 0
         self.settings = {"solver": Solver(self.core.world_parameters.solver).name,
                          "iterations": self.core.world_parameters.quickstep_iterations}

@@ -21,11 +21,17 @@ REASONS = {1: "a value is not finite", 2: "faster than divergence_speed",
            4: "beyond world_extent from the origin"}
 
 
+def guarded(scene: Scene) -> List[str]:
+    """The objects C checks (and, under auto_disable, lets sleep): every object with a dynamic
+    body, not parked."""
+    return [i for i, o in scene.objects.items()
+            if o.body is not None and not o.fixed and i not in scene.parked]
+
+
 def refresh(scene: Scene) -> None:
-    """Hands C the bodies to check: every object with a dynamic body, not parked. Called
-    whenever that set changes, and before a body goes (C must never see a freed body)."""
-    scene.c.set_guarded([o.body.ptr for i, o in scene.objects.items()
-                         if o.body is not None and not o.fixed and i not in scene.parked])
+    """Hands C the guarded bodies. Called whenever that set changes, and before a body goes
+    (C must never see a freed body)."""
+    scene.c.set_guarded([scene.objects[i].body.ptr for i in guarded(scene)])
 
 
 def collect(scene: Scene, step_size: float) -> List[Divergence]:

@@ -627,9 +627,9 @@ class Core:
     def sleeping_objects(self) -> List[str]:
         """The objects ODE's auto-disabling has put to sleep (world parameter auto_disable):
         not stepped until an awake body touches them or a request changes the world."""
-        return [object_id for object_id, obj in self._scene.objects.items()
-                if obj.body is not None and not obj.fixed
-                and object_id not in self._scene.parked and not bodies.is_awake(obj.body.ptr)]
+        scene = self._scene
+        return [object_id for object_id in guard.guarded(scene)
+                if not bodies.is_awake(scene.objects[object_id].body.ptr)]
 
     @_locked
     def detect_collisions(self) -> None:
