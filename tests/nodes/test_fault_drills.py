@@ -71,9 +71,8 @@ def test_the_viewer_killed_the_world_runs_on_and_a_new_viewer_gets_the_scene(ros
 
     viewer.send_signal(signal.SIGKILL)           # rosrun execs python: the node itself
     viewer.wait(10)
-    before = sim_time(world)
-    time.sleep(2.0)
-    assert sim_time(world) > before + 1.0        # still simulating, in real time
+    before = sim_time(world)                     # still simulating
+    wait_until(lambda: sim_time(world) > before + 1.0, timeout=30, period=0.2)
     assert "red" in world.poses()                # still publishing
     world.ok("build_object", object=box("late", (0.2, 0.2, 0.2), (1, 1, 0.1)))
 
@@ -157,7 +156,7 @@ def test_nodes_started_before_the_master_wait_for_it_and_keep_their_parameters(t
     without a master that killed the node (the CI run of the four-host test lost its Viewer
     that way when it came up before roscore)."""
     import rospy
-    from world_client import WorldClient
+    from world_client import WorldClient, wait_until
 
     master = RosMaster(ros_home=tmp_path / "ros_home")
     try:
@@ -166,10 +165,10 @@ def test_nodes_started_before_the_master_wait_for_it_and_keep_their_parameters(t
                  master.rosrun("Viewer", "viewer", "_width:=320", "_height:=240"),
                  master.popen(["rosrun", "GUI", "gui", "_viewer:=/viewer"], log_name="gui",
                               env=env)]
-        time.sleep(3.0)                              # all three are waiting by now
-        for node in nodes:
+        for node in nodes:                           # each imported and waiting
+            wait_until(lambda: node.poll() is not None
+                       or "waiting for the ROS master" in master.log_text(node), timeout=60)
             assert node.poll() is None, master.log_text(node)[-2000:]
-            assert "waiting for the ROS master" in master.log_text(node)
         master.start()
         master.apply_to_this_process()
         master.wait_for_service("/virtual_world/get_world", timeout=60)
