@@ -4,7 +4,8 @@ experiments and benchmarks run on (and what a user's own test suite may use).
 Every test that needs ROS gets its own roscore on a free loopback port and its own ROS_HOME,
 so tests never see each other's nodes, and every process started here is stopped (process
 group and all) when the test ends, pass or fail. Needs the ROS command-line tools (roscore,
-rosrun, rosservice), not rospy.
+rosrun), not rospy: the master is asked over its XML-RPC API from this process (a test waits
+for many services, and a ``rosservice`` process a poll cost 0.4 s of a core each).
 
     with RosMaster() as master:
         master.rosrun("VirtualWorld", "virtualWorld")
@@ -25,7 +26,9 @@ import socket
 import subprocess
 import tempfile
 import time
-from typing import Sequence
+import urllib.parse
+import xmlrpc.client
+from typing import Any, Sequence
 
 
 # Masters listen below the kernel's ephemeral range (net.ipv4.ip_local_port_range starts at
@@ -116,12 +119,19 @@ class RosMaster:
         return f"no answer after {self._startup_timeout} s"
 
     def _master_answers(self) -> bool:
-        # whatever holds a taken port may accept the connection and never answer
+        # roslaunch sets /rosdistro once the master is up: the same sign rosparam waited for
+        return self.master_call("getParam", "/rosdistro") is not None
+
+    def master_call(self, method: str, *args: Any, timeout: float = 5.0) -> Any:
+        """The value of one ROS Master API call (``lookupService``, ``getParam``, ...) made as
+        caller /odin_test, or None when the master does not answer in ``timeout`` s or answers
+        with an error code (whatever holds a taken port may accept and never answer)."""
+        proxy = xmlrpc.client.ServerProxy(self.uri, transport=_TimeoutTransport(timeout))
         try:
-            return self.run(["rosparam", "get", "/rosdistro"], check=False,
-                            timeout=5).returncode == 0
-        except subprocess.TimeoutExpired:
-            return False
+            code, _, value = getattr(proxy, method)("/odin_test", *args)
+        except (OSError, xmlrpc.client.Error):
+            return None
+        return value if code == 1 else None
 
     def _use_port(self, port: int) -> None:
         self.port = port
@@ -167,13 +177,26 @@ class RosMaster:
                               stdin=None if input is not None else subprocess.DEVNULL)
 
     def wait_for_service(self, name: str, timeout: float = 30.0) -> None:
+        """Until the service ``name`` is registered with the master and takes connections, as
+        rospy.wait_for_service waits; raises when a node started here died meanwhile."""
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
             self._raise_if_a_node_died()
-            if self.run(["rosservice", "type", name], check=False, timeout=10).returncode == 0:
+            if self._service_answers(name):
                 return
-            time.sleep(0.2)
+            time.sleep(0.1)
         raise TimeoutError(f"service {name} not up after {timeout} s; logs in {self.ros_home}")
+
+    def _service_answers(self, name: str) -> bool:
+        uri = self.master_call("lookupService", name)
+        if uri is None:
+            return False
+        address = urllib.parse.urlsplit(uri)        # rosrpc://host:port
+        try:
+            with socket.create_connection((address.hostname, address.port), timeout=5):
+                return True
+        except OSError:
+            return False
 
     def log_text(self, process: subprocess.Popen) -> str:
         return pathlib.Path(process.log_path).read_text(errors="replace")
@@ -183,6 +206,19 @@ class RosMaster:
             if process.poll() is not None:
                 raise RuntimeError(f"{process.args} exited with {process.returncode}:\n"
                                    + self.log_text(process)[-3000:])
+
+
+class _TimeoutTransport(xmlrpc.client.Transport):
+    """XML-RPC over HTTP that gives up after ``timeout`` s (the standard one waits forever)."""
+
+    def __init__(self, timeout: float):
+        super().__init__()
+        self._timeout = timeout
+
+    def make_connection(self, host):
+        connection = super().make_connection(host)
+        connection.timeout = self._timeout
+        return connection
 
 
 def _stop_group(process: subprocess.Popen, signal_first: int = signal.SIGINT) -> None:
