@@ -3,7 +3,7 @@ SHELL := /bin/bash
 ROOT  := $(CURDIR)
 ENV   := set -eo pipefail; source $(ROOT)/setup.bash;
 
-.PHONY: setup bench-setup build demo test bench experiments lint mutants soak clean
+.PHONY: setup bench-setup build demo test test-stress bench experiments lint mutants soak clean
 
 setup:
 	@tools/install.sh
@@ -16,8 +16,17 @@ build:
 demo: setup
 	@$(ENV) python tools/demo.py
 
+# the whole suite on every core (pytest-xdist: each node test owns its roscore and ROS_HOME;
+# tests sharing one build stay on one worker by xdist_group), the 15 slowest listed at the end
+PYTEST := python -m pytest -p no:cacheprovider -n auto --dist loadgroup --durations=15
+
 test: setup
-	@$(ENV) python -m pytest -p no:cacheprovider
+	@$(ENV) $(PYTEST)
+
+# the same suite with a busy loop on each core: finds the tests that wait for a time instead
+# of for the event they need
+test-stress: setup
+	@$(ENV) tools/with_busy_cores.sh $(PYTEST)
 
 # the peer engines (MuJoCo, PyBullet) in their own venv, .venv-bench: benchmarks only
 bench-setup:

@@ -1,6 +1,8 @@
 """The ROS harness itself: a private master comes up, answers, and leaves nothing behind."""
 import subprocess
 
+import pytest
+
 from odin_common.ros_master import RosMaster
 
 
@@ -21,6 +23,7 @@ def test_two_masters_do_not_share_a_port():
         assert second.run(["rosparam", "get", "/odin_probe"], check=False).returncode != 0
 
 
+@pytest.mark.slow
 def test_master_moves_to_another_port_when_its_port_is_taken():
     import socket
     master = RosMaster()

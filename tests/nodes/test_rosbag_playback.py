@@ -11,7 +11,7 @@ import time
 import numpy as np
 import pytest
 
-pytestmark = pytest.mark.forked
+pytestmark = [pytest.mark.forked, pytest.mark.slow]
 
 TOPICS = ["/virtual_world/world_update", "/virtual_world/markers", "/tf", "/tf_static",
           "/clock"]

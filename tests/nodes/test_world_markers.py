@@ -40,6 +40,7 @@ class _FirstMessage:
         return self.message
 
 
+@pytest.mark.slow
 def test_every_new_subscriber_gets_all_markers_and_the_last_transforms(ros_master,
                                                                         kautham_dir):
     from tf2_msgs.msg import TFMessage

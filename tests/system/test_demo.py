@@ -7,6 +7,7 @@ import subprocess
 import sys
 
 import numpy as np
+import pytest
 from PIL import Image
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -27,6 +28,7 @@ def _processes_pointing_at(uri: str) -> list:
     return found
 
 
+@pytest.mark.slow
 def test_demo_writes_moving_snapshots_and_stops_every_process():
     bare = dict(os.environ, ODIN_KAUTHAM_DIR=str(ROOT / "out" / "no-kautham-here"))
     result = subprocess.run([sys.executable, str(ROOT / "tools" / "demo.py")],

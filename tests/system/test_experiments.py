@@ -14,6 +14,8 @@ import pytest
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tools" / "experiments"))
 
+pytestmark = pytest.mark.slow       # 8-50 s each: a whole experiment
+
 
 @pytest.mark.forked
 def test_contactless_pair_greys_exactly_while_touching(kautham_dir):

@@ -10,6 +10,9 @@ import pytest
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 VENV_BIN = ROOT / ".venv" / "bin"
 
+# the install space is built once for the module (a catkin build): its tests share one worker
+pytestmark = pytest.mark.xdist_group("install_space")
+
 
 def _environment_of(setup: pathlib.Path) -> dict:
     """The environment a shell has after sourcing ``setup`` from a bare one (venv first on
@@ -20,7 +23,7 @@ def _environment_of(setup: pathlib.Path) -> dict:
     return dict(item.split("=", 1) for item in dump.split("\0") if "=" in item)
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")     # built once, whatever runs between its tests
 def install_env(tmp_path_factory) -> dict:
     workspace = tmp_path_factory.mktemp("install_ws")
     (workspace / "src").mkdir()

@@ -16,6 +16,7 @@ def test_interface_and_parameter_docs_are_what_the_code_generates():
     assert interface_doc.stale() == [], "run python tools/interface_doc.py"
 
 
+@pytest.mark.slow
 def test_every_documented_example_succeeds_against_live_nodes(ros_master):
     ros_master.rosrun("VirtualWorld", "virtualWorld")
     ros_master.rosrun("Viewer", "viewer", f"_snapshot_dir:={ros_master.ros_home}")
