@@ -37,11 +37,13 @@ def _stop(process) -> None:
 def _record(ros_master, bag) -> None:
     from gui.ros.client import WorldClient
     from odin_common.specs import ObjectSpec
+    from world_client import wait_until
     world = ros_master.rosrun("VirtualWorld", "virtualWorld")
     ros_master.wait_for_service("/virtual_world/build_object")
     recorder = ros_master.popen(["rosbag", "record", "-O", str(bag), *TOPICS],
                                 log_name="rosbag_record")
-    time.sleep(2.0)                     # rosbag subscribes to every topic first
+    wait_until(lambda: all(any(node.startswith("/record") for node in ros_master.subscribers(t))
+                           for t in TOPICS), timeout=60)    # rosbag subscribed to each topic
     client = WorldClient()
     client.build_object(ObjectSpec("ground", (4.0, 4.0, 0.1), position=(0, 0, -0.05),
                                    color=(0.55, 0.6, 0.55, 1), geometry_only=True))

@@ -187,6 +187,13 @@ class RosMaster:
             time.sleep(0.1)
         raise TimeoutError(f"service {name} not up after {timeout} s; logs in {self.ros_home}")
 
+    def subscribers(self, topic: str) -> list[str]:
+        """The nodes that the master knows to subscribe to ``topic`` (none while it does not
+        answer)."""
+        state = self.master_call("getSystemState")
+        subscriptions = state[1] if state is not None else []
+        return next((nodes for name, nodes in subscriptions if name == topic), [])
+
     def _service_answers(self, name: str) -> bool:
         uri = self.master_call("lookupService", name)
         if uri is None:
