@@ -12,7 +12,7 @@ from typing import List, Sequence, Tuple
 
 import numpy as np
 
-from odin_common.interface import AUTO_SOLVER_MAX_ROWS
+from odin_common.interface import AUTO_SOLVER_MAX_ROWS, DivergencePolicy
 from odin_common.world_parameters import WorldParameters
 from virtual_world.ode import handles
 from virtual_world.ode.bindings import ffi, lib
@@ -64,7 +64,7 @@ class CWorld:
         s.max_speed = p.divergence_speed
         s.max_spin = p.divergence_angular_speed
         s.extent = p.world_extent
-        s.stop_on_divergence = int(p.divergence_policy == 1)
+        s.stop_on_divergence = int(p.divergence_policy == DivergencePolicy.PARK_AND_PAUSE)
         s.auto_disable = int(p.auto_disable)
         lib.odin_world_sync_auto_disable(s)
         # every body meets new parameters awake (gravity turned, a surface changed), and with

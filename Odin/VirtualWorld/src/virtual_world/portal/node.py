@@ -63,7 +63,7 @@ from std_msgs.msg import Float64
 from Messages.msg import Collided, JointsData, ServoStates, SpaceDistribution
 from Services import srv
 from odin_common import OdinError
-from odin_common.interface import WORLD_SERVICES
+from odin_common.interface import WORLD_SERVICES, DivergencePolicy
 from odin_common.limits import ResourceLimits
 from odin_common.node import MasterWatch, init_ros_node
 from odin_common.world_parameters import PARAMETERS
@@ -225,7 +225,7 @@ class Portal:
                        event.id, event.time, event.reason, event.value)
         self.pub_diagnostics.publish(conversions.divergence_diagnostics(
             found, rospy.Time.from_sec(self.mirror.clock.now(self.core.sim_time))))
-        if self.core.world_parameters.divergence_policy == 1:
+        if self.core.world_parameters.divergence_policy == DivergencePolicy.PARK_AND_PAUSE:
             self.loop.simulate = False
 
     def _publish(self, report: CycleReport) -> None:
