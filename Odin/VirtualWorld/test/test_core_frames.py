@@ -12,6 +12,7 @@ import math
 import numpy as np
 import pytest
 
+from odin_common import interface
 from virtual_world.core import (Core, CompositeSpec, FORCE, ObjectSpec, PartSpec, TORQUE,
                                 WorldParameters)
 
@@ -105,7 +106,7 @@ def composite(prefix, position, rotation=COMPOSITE_ROTATION, **flags):
 
 
 def composite_id(prefix):
-    return ">" + ">".join(prefix + p[0] for p in PARTS)
+    return interface.composite_id([prefix + p[0] for p in PARTS])
 
 
 @pytest.fixture

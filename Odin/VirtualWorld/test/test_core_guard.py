@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from odin_common import limits
+from odin_common.interface import DivergencePolicy
 from virtual_world.core import FORCE, TORQUE, Core, ObjectSpec, WorldParameters
 from virtual_world.errors import InvalidArgument
 
@@ -82,7 +83,7 @@ def test_beyond_the_world_extent_a_body_is_parked_at_the_bound():
 
 
 def test_under_the_pausing_policy_the_step_stops_after_the_divergence():
-    core = Core(WorldParameters(divergence_policy=1))
+    core = Core(WorldParameters(divergence_policy=DivergencePolicy.PARK_AND_PAUSE))
     pile(core)
     core.build_object(ObjectSpec("dust", [0.01], mass=1e-6, position=(1.5, 1.5, 0.5)))
     core.add_body_force("dust", FORCE, (limits.MAX_FORCE, 0, 0))

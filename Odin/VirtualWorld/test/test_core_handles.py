@@ -169,6 +169,17 @@ def test_ode_messages_are_drained_into_logging(caplog):
     assert drain_messages() == []
 
 
+def test_what_ode_says_during_a_request_is_logged_before_the_request_returns(caplog):
+    core = Core()
+    core.build_object(ObjectSpec("ball", [0.1], position=(0, 0, 1)))
+    lib.odin_test_message(7, b"said during the step")   # as if dWorldStep had spoken
+    with caplog.at_level("WARNING", logger="virtual_world.core"):
+        core.step(0.01)
+    assert "said during the step" in caplog.text
+    assert drain_messages() == []                      # the ode layer drained it
+    core.close()
+
+
 def test_a_core_dropped_in_a_reference_cycle_is_freed_children_first(spy):
     """The collector finalizes a whole unreachable scene at once, in no set order: the world
     still goes last (it used to go first, and its bodies' dBodyDestroy then crashed)."""

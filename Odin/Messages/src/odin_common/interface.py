@@ -87,6 +87,13 @@ class Solver(IntEnum):
     #                      QuickStep above (piles, many contacts); the default
 
 
+class DivergencePolicy(IntEnum):
+    """Services/SetWorld ``divergence_policy``: what follows a divergence (world parameter
+    ``divergence_policy``; the .srv names the values in its comments only)."""
+    PARK = 0             # the body is parked (kinematic, still, no collisions); the world goes on
+    PARK_AND_PAUSE = 1   # parked, and the simulation paused (the world keeps answering)
+
+
 AUTO_SOLVER_MAX_ROWS = 120
 """Solver.AUTO's bound: the most constraint rows (counted per joint at most: 6 for a hinge,
 slider or fixed joint, 3 for a contact, ball or motor) a step may have to be solved by
@@ -420,7 +427,7 @@ class NodeParameter(NamedTuple):
 
 
 __all__ = ["NodeParameter", "SERVO_GAIN", "SERVO_MAX_SPEED", "JointType", "JointParameter", "SetJointAction", "MotorKind", "AxisFrame",
-           "ForceKind", "Solver", "AUTO_SOLVER_MAX_ROWS", "JOINT_AXES_USED", "JOINT_USES_ANCHOR",
+           "ForceKind", "Solver", "DivergencePolicy", "AUTO_SOLVER_MAX_ROWS", "JOINT_AXES_USED", "JOINT_USES_ANCHOR",
            "JOINT_NEEDS_TWO_BODIES", "JOINT_AXIS2_ON_BODY2", "JOINT_FORCE_MAGNITUDES", "JOINT_STATE_AXES", "JOINT_PARAMETERS",
            "JOINT_PARAMETER_AXES", "MOTOR_PARAMETERS", "UNIT_PARAMETERS",
            "NON_NEGATIVE_PARAMETERS", "joint_type", "default_joint_id", "MOTOR_PREFIX", "default_motor_id", "motor_joint",

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from typing import Any, Dict, Optional, Tuple
 
 from odin_common.errors import InvalidArgument
-from odin_common.interface import Solver
+from odin_common.interface import DivergencePolicy, Solver
 from odin_common.limits import MAX_GRAVITY
 
 # a tolerance above 1 m is mm taken for m
@@ -97,7 +97,8 @@ PARAMETERS: Tuple[ParameterInfo, ...] = (
     ParameterInfo("divergence_policy", "int", "-",
                   "what follows a divergence: 0 the body is parked (kinematic, still, "
                   "colliding with nothing, within the extent) and the world goes on; 1 parked "
-                  "and the simulation paused", "set_divergence", 0, 1),
+                  "and the simulation paused", "set_divergence",
+                  int(min(DivergencePolicy)), int(max(DivergencePolicy))),
     ParameterInfo("auto_disable", "bool", "-",
                   "ODE's auto-disabling: a body slower than 0.01 m/s and 0.01 rad/s for 10 "
                   "steps sleeps (is not stepped) until a moving body touches it or a request "
@@ -135,7 +136,7 @@ class WorldParameters:
     divergence_speed: float = 1000.0
     divergence_angular_speed: float = 10000.0
     world_extent: float = 10000.0
-    divergence_policy: int = 0
+    divergence_policy: int = DivergencePolicy.PARK
     auto_disable: bool = False
 
     def replace(self, **changes) -> "WorldParameters":

@@ -19,7 +19,8 @@ Published topics
     ``~image`` (sensor_msgs/Image): every rendered frame, rgb8, ``~width`` x ``~height``,
         at ``~rate``; header.stamp = wall time of rendering, frame_id ``odin_camera``.
 
-Services
+Services (odin_common.interface.VIEWER_SERVICES, each answered by the Portal's method of the
+same name)
     ``~view_object`` (Services/ViewObject): add an object, or replace the one with that ID (the
         world may re-send its scene to a Viewer that started late). Refused: empty ID, a
         parameter count that is no shape, sizes <= 0, empty mesh, index out of range, NaN
@@ -42,7 +43,7 @@ from __future__ import annotations
 import math
 import os
 import pathlib
-from typing import Optional
+from typing import Optional, Tuple
 
 import rospy
 import rospkg
@@ -50,10 +51,9 @@ from sensor_msgs.msg import Image
 from visualization_msgs.msg import MarkerArray
 
 from Messages.msg import Collided, SpaceDistribution
-from Services.srv import (SaveSnapshot, SaveSnapshotResponse, SetCamera, SetCameraResponse,
-                          ViewerNewScene, ViewerNewSceneResponse, ViewerRemoveObject,
-                          ViewerRemoveObjectResponse, ViewObject, ViewObjectResponse)
-from odin_common import OdinError
+from Services import srv
+from odin_common import OdinError, replies
+from odin_common.interface import VIEWER_SERVICES
 from odin_common.node import MasterWatch, init_ros_node
 from viewer.core.camera import Camera
 from viewer.errors import ViewerError
@@ -112,11 +112,7 @@ class Portal:
                                on_frame=self._on_frame)
         self.loop.start()
 
-        rospy.Service("~view_object", ViewObject, self._view_object)
-        rospy.Service("~remove_object", ViewerRemoveObject, self._remove_object)
-        rospy.Service("~new_scene", ViewerNewScene, self._new_scene)
-        rospy.Service("~save_snapshot", SaveSnapshot, self._save_snapshot)
-        rospy.Service("~set_camera", SetCamera, self._set_camera)
+        self._serve()
         rospy.Subscriber(f"{world}/world_update", SpaceDistribution, self._world_update,
                          queue_size=10)
         rospy.Subscriber(f"{world}/collided", Collided, self._collided, queue_size=10)
@@ -166,49 +162,45 @@ class Portal:
         self.loop.post(lambda scene, _: scene.collided(names))
 
     # -- services --------------------------------------------------------------------------
-    def _answer(self, response_type, fn, **extra):
-        """Runs fn() and turns an OdinError (or anything unexpected) into success: false."""
-        try:
-            message = fn() or ""
-            return response_type(success=True, message=message, **extra)
-        except OdinError as error:
-            return response_type(success=False, message=str(error), **extra)
-        except Exception as error:  # a bug must not take the node down; say what happened
-            rospy.logerr("viewer: %s failed: %r", response_type.__name__, error)
-            return response_type(success=False, message=f"internal error: {error!r}", **extra)
+    def _serve(self) -> None:
+        """One server per Viewer service (VIEWER_SERVICES), each answered by the method of the
+        same name (odin_common.replies.guarded: a refusal answers ``success: false``); Set
+        Camera also answers the camera in use when it refuses."""
+        in_force = {"set_camera": self._camera_in_use}
+        self.servers = []
+        for name, type_name in VIEWER_SERVICES.items():
+            service_class = getattr(srv, type_name)
+            self.servers.append(rospy.Service(
+                f"~{name}", service_class,
+                replies.guarded(service_class, getattr(self, name), in_force.get(name, dict))))
 
-    def _view_object(self, req) -> ViewObjectResponse:
-        def work():
-            request = prepare_view(req.id, req.parameters, req.indices, req.position,
-                                   req.orientation, req.color, req.shape)   # on this thread
-            replaced = self.loop.call(lambda scene, _: scene.view(request))
-            return f"replaced {req.id!r}" if replaced else f"added {req.id!r}"
-        return self._answer(ViewObjectResponse, work)
+    def view_object(self, req) -> dict:
+        """Adds the object, or replaces the one with its ID (checked on the server's thread)."""
+        request = prepare_view(req.id, req.parameters, req.indices, req.position,
+                               req.orientation, req.color, req.shape)   # on this thread
+        replaced = self.loop.call(lambda scene, _: scene.view(request))
+        return {"message": f"replaced {req.id!r}" if replaced else f"added {req.id!r}"}
 
-    def _remove_object(self, req) -> ViewerRemoveObjectResponse:
-        def work():
-            self.loop.call(lambda scene, _: scene.remove_object(req.id))
-            return f"removed {req.id!r}"
-        return self._answer(ViewerRemoveObjectResponse, work)
+    def remove_object(self, req) -> dict:
+        """Removes the object; an unknown ID is refused."""
+        self.loop.call(lambda scene, _: scene.remove_object(req.id))
+        return {"message": f"removed {req.id!r}"}
 
-    def _new_scene(self, req) -> ViewerNewSceneResponse:
-        return self._answer(ViewerNewSceneResponse,
-                            lambda: self.loop.call(lambda scene, _: scene.new_scene()))
+    def new_scene(self, req) -> dict:
+        """Empties the scene (the camera stays)."""
+        self.loop.call(lambda scene, _: scene.new_scene())
+        return {}
 
-    def _save_snapshot(self, req) -> SaveSnapshotResponse:
-        written = []
+    def save_snapshot(self, req) -> dict:
+        """Renders now and writes ``<~snapshot_dir>/<name>.png``; answers the path written."""
+        path = snapshot_path(self.snapshot_dir, req.name)
+        frame = self.loop.call(lambda scene, renderer: renderer.render(scene))
+        written = str(write_png(path, frame))
+        return {"message": f"wrote {written}", "path": written}
 
-        def work():
-            path = snapshot_path(self.snapshot_dir, req.name)
-            frame = self.loop.call(lambda scene, renderer: renderer.render(scene))
-            written.append(str(write_png(path, frame)))
-            return f"wrote {written[0]}"
-        response = self._answer(SaveSnapshotResponse, work)
-        response.path = written[0] if written else ""
-        return response
-
-    def _set_camera(self, req) -> SetCameraResponse:
-        def apply(scene: Scene, _) -> Camera:
+    def set_camera(self, req) -> dict:
+        """Sets the camera's size, field of view, pose or fitting; answers the camera in use."""
+        def apply(scene: Scene, _) -> Tuple[Camera, bool]:
             camera = scene.camera
             if req.set_size:
                 camera = camera.with_(width=req.width, height=req.height)
@@ -222,18 +214,18 @@ class Portal:
             fixed = True if req.set_pose else (False if req.fit_scene else None)
             scene.set_camera(camera, fixed)
             return scene.camera, scene.fitting
+        return _camera_fields(*self.loop.call(apply))
 
-        state = []
+    def _camera_in_use(self) -> dict:
+        """Set Camera's fields as the camera is now (what a refusal answers)."""
+        return _camera_fields(*self.loop.call(lambda scene, _: (scene.camera, scene.fitting)))
 
-        def work():
-            state.extend(self.loop.call(apply))
-        response = self._answer(SetCameraResponse, work)
-        camera, fitting = state if state else self.loop.call(
-            lambda scene, _: (scene.camera, scene.fitting))
-        response.eye, response.target, response.up = camera.eye_W, camera.target_W, camera.up_W
-        response.width, response.height, response.fov_y = camera.width, camera.height, camera.fov_y
-        response.fitting = fitting
-        return response
+
+def _camera_fields(camera: Camera, fitting: bool) -> dict:
+    """Set Camera's answer: the camera in use (m, world frame; pixels; rad)."""
+    return {"eye": camera.eye_W, "target": camera.target_W, "up": camera.up_W,
+            "width": camera.width, "height": camera.height, "fov_y": camera.fov_y,
+            "fitting": fitting}
 
 
 def main() -> None:

@@ -21,7 +21,6 @@ from virtual_world.core.scene import Scene
 from virtual_world.errors import DuplicateName, InvalidArgument, Unsupported
 from virtual_world.ode import handles
 from virtual_world.ode import joints as ode_joints
-from virtual_world.ode.runtime import drain_messages
 
 #: the joint types whose first two axes must not be parallel
 _TWO_AXES = frozenset({JointType.UNIVERSAL, JointType.HINGE2, JointType.PU, JointType.PR})
@@ -72,7 +71,6 @@ def create_joint(scene: Scene, spec: JointSpec) -> str:
     for o in objects:
         if o is not None:
             o.joints.add(joint_id)
-    drain_messages()
     return joint_id
 
 
@@ -94,7 +92,6 @@ def set_joint_parameters(scene: Scene, joint_id: str,
     checked = _checked_parameters(joint.type, joint_id, parameters)
     for parameter, axis, value in checked:
         ode_joints.set_joint_parameter(joint.owner.ptr, joint.type, parameter, axis, value)
-    drain_messages()
 
 
 def _checked_parameters(kind: JointType, joint_id: str, parameters) -> list:

@@ -23,7 +23,7 @@ import trimesh
 from virtual_world.core.shapes import Shape
 from virtual_world.errors import InvalidArgument
 from virtual_world.ode import bodies
-from virtual_world.ode.runtime import drain_messages, log
+from virtual_world.ode.runtime import log
 
 
 class MeshMass(NamedTuple):
@@ -101,5 +101,4 @@ def check_mass(what: str, dmass) -> None:
         raise InvalidArgument(f"{what}: principal moments {principal.tolist()} break the "
                               "triangle inequality (no rigid body has them)")
     if not bodies.mass_is_valid(dmass):
-        drain_messages()
         raise InvalidArgument(f"{what}: ODE rejects the mass parameters (dMassCheck)")

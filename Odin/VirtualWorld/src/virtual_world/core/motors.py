@@ -21,7 +21,6 @@ from virtual_world.core.scene import Scene
 from virtual_world.errors import DuplicateName, InvalidArgument, Unsupported
 from virtual_world.ode import handles
 from virtual_world.ode import joints as ode_joints
-from virtual_world.ode.runtime import drain_messages
 
 
 def create_motor(scene: Scene, spec: MotorSpec) -> str:
@@ -94,7 +93,6 @@ def create_motor(scene: Scene, spec: MotorSpec) -> str:
         if o is not None:
             o.motors.add(motor_id)
     rebuild_goals(scene)
-    drain_messages()
     return motor_id
 
 
@@ -169,7 +167,6 @@ def set_parameters(scene: Scene, motor: MotorRecord, checked: list) -> None:
         if parameter == JointParameter.VELOCITY:
             motor.velocity[axis - 1] = value
     scene.c.update_motor_goal(scene.motor_slots[motor.id], motor.velocity)
-    drain_messages()
 
 
 def rebuild_goals(scene: Scene) -> None:

@@ -25,7 +25,6 @@ from virtual_world.core.scene import Scene
 from virtual_world.core.shapes import Shape, collision_mesh, prepare_shape
 from virtual_world.errors import DuplicateName, InvalidArgument
 from virtual_world.ode import bodies, handles
-from virtual_world.ode.runtime import drain_messages
 from virtual_world.ode.world import PoseReader
 
 IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
@@ -220,7 +219,6 @@ def build(scene: Scene, prepared: _Prepared, tag: int = 0) -> Built:
     scene.objects[p.object_id] = obj
     if body is not None and not p.fixed:
         scene.c.add_guarded(body.ptr)
-    drain_messages()
     return Built(p.object_id, _built_geometries(obj.geometries))
 
 
@@ -361,7 +359,6 @@ def remove_object(scene: Scene, object_id: str) -> Removed:
         members.remove(object_id)
         if not members:
             del scene.entities[obj.entity]
-    drain_messages()
     return removed + Removed(geometries=names)
 
 

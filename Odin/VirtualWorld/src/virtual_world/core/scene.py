@@ -13,7 +13,6 @@ from odin_common.world_parameters import WorldParameters
 from virtual_world.core.records import (BodyForceRecord, Collision, GeometryRecord,
                                         JointForceRecord, JointRecord, MotorRecord, ObjectRecord)
 from virtual_world.errors import Unsupported, UnknownName
-from virtual_world.ode.runtime import drain_messages
 from virtual_world.ode.world import CWorld, PoseReader
 
 
@@ -51,7 +50,6 @@ class Scene:
         """Frees every ODE handle of the scene; idempotent."""
         self.c.close()
         self._pose_reader = None
-        drain_messages()
 
     # -- look-ups that refuse unknown names --------------------------------------------------
     def object(self, object_id: str) -> ObjectRecord:

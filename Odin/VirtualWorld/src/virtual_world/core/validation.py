@@ -10,6 +10,7 @@ import numpy as np
 
 from odin_common import errors as common
 from odin_common import limits, rotations
+from odin_common.interface import COMPOSITE_MARK
 from virtual_world.errors import InvalidArgument
 
 R = TypeVar("R")
@@ -72,11 +73,12 @@ def quaternion(what: str, value) -> np.ndarray:
 
 
 def name(what: str, value, allow_marker: bool = False) -> str:
-    """A non-empty string; without allow_marker it may not hold '>' (the composite mark)."""
+    """A non-empty string; without allow_marker it may not hold the composite mark
+    (odin_common.interface.COMPOSITE_MARK)."""
     if not isinstance(value, str) or not value:
         raise InvalidArgument(f"{what}={value!r} must be a non-empty string")
-    if not allow_marker and ">" in value:
-        raise InvalidArgument(f"{what}={value!r} must not contain '>'")
+    if not allow_marker and COMPOSITE_MARK in value:
+        raise InvalidArgument(f"{what}={value!r} must not contain {COMPOSITE_MARK!r}")
     return value
 
 

@@ -33,7 +33,7 @@ from virtual_world.core.records import (BodyState, Built, BuiltEntity, Collision
 from virtual_world.core.scene import Scene
 from virtual_world.errors import Closed, InvalidArgument, UnknownName
 from virtual_world.ode import bodies
-from virtual_world.ode.runtime import drain_messages, init_ode
+from virtual_world.ode.runtime import init_ode
 
 
 def _locked(method):
@@ -558,7 +558,6 @@ class Core:
             scene.c.record_every_step = False
         scene.sim_time += step_size * steps
         guard.collect(scene, step_size)
-        drain_messages()
         collisions = tuple(sorted(
             c._replace(first_time=start_time + (step - start_step) * step_size)
             for c, step in readout.named_records(scene)))
@@ -610,7 +609,6 @@ class Core:
         taken = scene.c.step(step_size, int(count))
         scene.sim_time += step_size * taken
         guard.collect(scene, step_size)
-        drain_messages()
 
     @_locked
     def take_divergences(self) -> List[Divergence]:
@@ -637,7 +635,6 @@ class Core:
         that read_collisions() reports what touches now in a paused world whose objects were
         moved (Set Position). Does nothing under the contact policy."""
         self._scene.c.detect()
-        drain_messages()
 
     @property
     def sim_time(self) -> float:

@@ -14,12 +14,14 @@ import numpy as np
 
 from odin_common import interface
 from virtual_world.ode.bindings import ffi, lib
+from virtual_world.ode.runtime import drains_ode_messages
 
 IDENTITY = (1.0, 0.0, 0.0, 0.0)
 
 
 # ---------------------------------------------------------------------------------- bodies
 
+@drains_ode_messages
 def configure_body(body, dmass, com_position: Sequence[float], quaternion: Sequence[float],
                    kinematic: bool) -> None:
     """Sets a new body's mass (centred: its centre of mass at the body origin), pose, and makes
@@ -30,11 +32,13 @@ def configure_body(body, dmass, com_position: Sequence[float], quaternion: Seque
         lib.dBodySetKinematic(body)
 
 
+@drains_ode_messages
 def set_body_pose(body, com_position: Sequence[float], quaternion: Sequence[float]) -> None:
     lib.dBodySetPosition(body, *com_position)
     lib.dBodySetQuaternion(body, list(quaternion))
 
 
+@drains_ode_messages
 def set_body_velocity(body, linear: Sequence[float] = None,
                       angular: Sequence[float] = None) -> None:
     """Linear velocity of the centre of mass (m/s) and/or angular velocity (rad/s), world;
@@ -59,6 +63,7 @@ def is_awake(body) -> bool:
     return bool(lib.dBodyIsEnabled(body))
 
 
+@drains_ode_messages
 def unpark(body, collide: bool) -> None:
     """Undoes the divergence guard's parking (odin_step.c): the body dynamic again, its geoms
     colliding again unless ``collide`` is False (an object without collisions)."""
@@ -71,6 +76,7 @@ def unpark(body, collide: bool) -> None:
         geom = lib.dBodyGetNextGeom(geom)
 
 
+@drains_ode_messages
 def park(body) -> None:
     """Parks a body as the divergence guard does: kinematic, still, colliding with nothing."""
     lib.dBodySetKinematic(body)
@@ -105,6 +111,7 @@ def read_states(bodies: Sequence) -> np.ndarray:
     return out
 
 
+@drains_ode_messages
 def write_states(bodies: Sequence, states: np.ndarray) -> None:
     """Puts back states read by read_states, bit for bit (odin_state.c says how)."""
     if len(bodies):
@@ -116,6 +123,7 @@ def write_states(bodies: Sequence, states: np.ndarray) -> None:
 
 # ---------------------------------------------------------------------------------- geoms
 
+@drains_ode_messages
 def set_geom_offset(geom, position: Sequence[float], quaternion: Sequence[float]) -> None:
     """Places a geom attached to a body relative to the body (centre of mass, body axes)."""
     if any(v != 0 for v in position):
@@ -124,6 +132,7 @@ def set_geom_offset(geom, position: Sequence[float], quaternion: Sequence[float]
         lib.dGeomSetOffsetQuaternion(geom, list(quaternion))
 
 
+@drains_ode_messages
 def set_geom_pose(geom, position: Sequence[float], quaternion: Sequence[float]) -> None:
     """Places a static (body-less) geom, world frame."""
     lib.dGeomSetPosition(geom, *position)
@@ -146,6 +155,7 @@ def static_geom_pose(geom) -> np.ndarray:
     return np.array([p[0], p[1], p[2]] + [R[k] for k in range(12)])
 
 
+@drains_ode_messages
 def set_static_geom_pose(geom, pose: np.ndarray) -> None:
     """Puts back a pose read by static_geom_pose (ODE copies both as given)."""
     if is_plane(geom):
@@ -155,6 +165,7 @@ def set_static_geom_pose(geom, pose: np.ndarray) -> None:
     lib.dGeomSetRotation(geom, pose[3:].tolist())
 
 
+@drains_ode_messages
 def place_plane(geom, normal: Sequence[float], offset: float) -> None:
     """Moves a plane: normal . x = offset (m), world frame."""
     lib.dGeomPlaneSetParams(geom, *normal, offset)
@@ -184,6 +195,7 @@ def set_geom_tag(geom_owner, tag: int) -> None:
     geom_owner.data.tag = tag
 
 
+@drains_ode_messages
 def exclude_from_collisions(geom) -> None:
     """The space never pairs a geom whose category and collide bits are all clear."""
     lib.dGeomSetCategoryBits(geom, 0)
@@ -196,6 +208,7 @@ def triangle_count(geom) -> int:
 
 # ---------------------------------------------------------------------------------- mass
 
+@drains_ode_messages
 def primitive_mass(kind: str, dims: Sequence[float], mass: float):
     """dMass of a sphere, cylinder (along z) or box of total ``mass`` kg about its centre."""
     m = ffi.new("dMass *")
@@ -212,6 +225,7 @@ def primitive_mass(kind: str, dims: Sequence[float], mass: float):
     return m
 
 
+@drains_ode_messages
 def mass_from_parameters(mass: float, center: Sequence[float], inertia: np.ndarray):
     """dMass of ``mass`` kg with ``inertia`` (3, 3) kg m^2 about ``center`` (m), which is
     then where the dMass's centre lies."""
@@ -223,12 +237,14 @@ def mass_from_parameters(mass: float, center: Sequence[float], inertia: np.ndarr
     return m
 
 
+@drains_ode_messages
 def zero_mass():
     m = ffi.new("dMass *")
     lib.dMassSetZero(m)
     return m
 
 
+@drains_ode_messages
 def add_mass(total, part, position: Sequence[float], quaternion: Sequence[float]) -> None:
     """Adds ``part`` (a dMass in the part's frame), rotated by ``quaternion`` and moved to
     ``position``, to ``total``."""
@@ -243,6 +259,7 @@ def mass_center(m) -> np.ndarray:
     return np.array([m.c[0], m.c[1], m.c[2]])
 
 
+@drains_ode_messages
 def center_mass(m) -> None:
     """Moves a dMass so that its centre of mass is its origin (ODE's bodies need that)."""
     lib.dMassTranslate(m, *(-mass_center(m)).tolist())
@@ -252,6 +269,7 @@ def inertia_matrix(m) -> np.ndarray:
     return np.array([[m.I[4 * r + c] for c in range(3)] for r in range(3)])
 
 
+@drains_ode_messages
 def mass_is_valid(m) -> bool:
     """ODE's own check (dMassCheck); it reports through ODE's message handler when false."""
     return bool(lib.dMassCheck(m))

@@ -25,6 +25,7 @@ import numpy as np
 
 from odin_common.interface import JointType, MotorKind
 from virtual_world.ode.bindings import ffi, lib
+from virtual_world.ode.runtime import drains_ode_messages
 
 DESTROYERS: Dict[str, Callable[[Any], None]] = {
     "world": lambda p: lib.dWorldDestroy(p),
@@ -109,6 +110,7 @@ class Owner:
         """The handle's C address (how C code names it back to Python)."""
         return int(ffi.cast("uintptr_t", self.ptr))
 
+    @drains_ode_messages
     def close(self) -> None:
         """Frees children first, then the handle; a second call does nothing."""
         self._finalizer.detach()
@@ -117,6 +119,7 @@ class Owner:
 
 # ---------------------------------------------------------------------------------- world
 
+@drains_ode_messages
 def new_world() -> Owner:
     return Owner("world", lib.dWorldCreate())
 
@@ -128,6 +131,7 @@ def new_world() -> Owner:
 BROAD_PHASES = ("sap", "hash")
 
 
+@drains_ode_messages
 def new_space(broad_phase: str = "sap") -> Owner:
     """A space of ``broad_phase`` (BROAD_PHASES) that never destroys its geoms (their owners
     do)."""
@@ -142,12 +146,14 @@ def new_space(broad_phase: str = "sap") -> Owner:
     return Owner("space", space)
 
 
+@drains_ode_messages
 def new_joint_group(world: Owner) -> Owner:
     return Owner("jointgroup", lib.dJointGroupCreate(0), parents=(world,))
 
 
 # ---------------------------------------------------------------------------------- bodies
 
+@drains_ode_messages
 def new_body(world: Owner) -> Owner:
     return Owner("body", lib.dBodyCreate(world.ptr), parents=(world,))
 
@@ -168,6 +174,7 @@ def new_geom(ptr: Any, space: Owner, serial: int, body: Optional[Owner] = None,
     return owner
 
 
+@drains_ode_messages
 def new_primitive(space: Owner, kind: str, dims: Sequence[float], serial: int,
                   body: Optional[Owner] = None) -> Owner:
     """A sphere (radius), cylinder or capsule (radius, length along z) or box (sides x, y,
@@ -188,6 +195,7 @@ def new_primitive(space: Owner, kind: str, dims: Sequence[float], serial: int,
     return new_geom(ptr, space, serial, body)
 
 
+@drains_ode_messages
 def new_trimesh(space: Owner, vertices: np.ndarray, triangles: np.ndarray, serial: int,
                 body: Optional[Owner] = None) -> Owner:
     """A trimesh geom over ``vertices`` (n, 3) m and ``triangles`` (m, 3) indices.
@@ -232,11 +240,13 @@ def _attached(ptr: Any, world: Owner, bodies: Sequence[Owner]) -> Owner:
     return owner
 
 
+@drains_ode_messages
 def new_joint(world: Owner, kind: JointType, bodies: Sequence[Owner]) -> Owner:
     """A joint of ``kind`` attached to one or two bodies (see _attached)."""
     return _attached(_CREATE_JOINT[kind](world.ptr, ffi.NULL), world, bodies)
 
 
+@drains_ode_messages
 def new_motor(world: Owner, kind: MotorKind, bodies: Sequence[Owner]) -> Owner:
     """An angular (dAMotor) or linear (dLMotor) motor attached like a joint."""
     return _attached(_CREATE_MOTOR[kind](world.ptr, ffi.NULL), world, bodies)

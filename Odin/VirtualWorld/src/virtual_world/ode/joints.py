@@ -13,6 +13,7 @@ import numpy as np
 
 from odin_common.interface import JointParameter, JointType, MotorKind
 from virtual_world.ode.bindings import ffi, lib
+from virtual_world.ode.runtime import drains_ode_messages
 
 T = JointType
 
@@ -95,6 +96,7 @@ decreases while its rate (and a motor on that axis) is positive. A servo there t
 negated value, so that a target in reported units still pulls the right way."""
 
 
+@drains_ode_messages
 def configure_joint(joint, kind: JointType, anchor: Sequence[float], axis1: Sequence[float],
                     axis2: Sequence[float], axis3: Sequence[float]) -> None:
     """Sets the anchor (m, world) and the axes (unit, world) ``kind`` uses; a fixed joint
@@ -135,11 +137,13 @@ def ode_parameter(parameter: JointParameter, axis: int) -> int:
     return _ODE_PARAMETER[parameter] + (axis - 1) * lib.dParamGroup
 
 
+@drains_ode_messages
 def set_joint_parameter(joint, kind: JointType, parameter: JointParameter, axis: int,
                         value: float) -> None:
     _SET_PARAMETER[kind](joint, ode_parameter(parameter, axis), value)
 
 
+@drains_ode_messages
 def set_motor_parameter(motor, kind: MotorKind, parameter: JointParameter, axis: int,
                         value: float) -> None:
     _SET_MOTOR_PARAMETER[kind](motor, ode_parameter(parameter, axis), value)
@@ -180,6 +184,7 @@ def joint_axes(joint, kind: JointType, motor_kind: MotorKind) -> List[np.ndarray
     return axes
 
 
+@drains_ode_messages
 def configure_motor(motor, kind: MotorKind, axes: Sequence[np.ndarray], frames: Sequence[int],
                     max_forces: Sequence[float]) -> None:
     """Sets a motor's axes (unit, world) anchored in ODE's frames (0 world, 1 ODE's body 1,

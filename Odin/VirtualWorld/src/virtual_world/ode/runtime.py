@@ -4,12 +4,18 @@ into Python's logging.
 ODE's error and debug handlers end the process after they return, so the Core validates every
 argument before calling ODE; odin_step.c's handlers print those messages to stderr first, and
 buffer the non-fatal ones (dMessage), which ``drain_messages`` moves into logging.
+
+Every function of the ode layer that makes ODE act (creates, configures, moves, frees, steps,
+collides, computes a mass) is decorated with ``drains_ode_messages``: what ODE said reaches
+logging before that function returns, so no caller above the ode layer drains by hand. Reading
+a value back makes ODE say nothing, so readers are left undecorated (hot read-outs stay lean).
 """
 from __future__ import annotations
 
+import functools
 import logging
 import threading
-from typing import List
+from typing import Callable, List, TypeVar
 
 from virtual_world.errors import OdeConfigurationError
 from virtual_world.ode.bindings import ffi, lib
@@ -18,9 +24,12 @@ log = logging.getLogger("virtual_world.core")
 
 _READY = False
 _LOCK = threading.Lock()
+_DRAIN_LOCK = threading.Lock()
 _MESSAGE_BUFFER = ffi.new("char[]", 512)
 _MESSAGE_NUMBER = ffi.new("int *")
 _LEVELS = ("message", "debug", "error")
+
+F = TypeVar("F", bound=Callable)
 
 
 def init_ode() -> None:
@@ -42,10 +51,23 @@ def init_ode() -> None:
 def drain_messages() -> List[str]:
     """Moves ODE's buffered messages into logging (warning level) and returns them."""
     messages = []
-    while True:
-        level = lib.odin_drain_message(_MESSAGE_BUFFER, 512, _MESSAGE_NUMBER)
-        if level < 0:
-            return messages
-        text = ffi.string(_MESSAGE_BUFFER).decode("utf-8", "replace")
-        messages.append(text)
-        log.warning("ODE %s %d: %s", _LEVELS[level], _MESSAGE_NUMBER[0], text)
+    with _DRAIN_LOCK:   # one buffer for the process; cffi lets go of the GIL in C calls
+        while True:
+            level = lib.odin_drain_message(_MESSAGE_BUFFER, 512, _MESSAGE_NUMBER)
+            if level < 0:
+                return messages
+            text = ffi.string(_MESSAGE_BUFFER).decode("utf-8", "replace")
+            messages.append(text)
+            log.warning("ODE %s %d: %s", _LEVELS[level], _MESSAGE_NUMBER[0], text)
+
+
+def drains_ode_messages(function: F) -> F:
+    """Decorates an ode-layer function that makes ODE act: ODE's buffered messages go to
+    logging (drain_messages) as it returns or raises."""
+    @functools.wraps(function)
+    def drained(*args, **kwargs):
+        try:
+            return function(*args, **kwargs)
+        finally:
+            drain_messages()
+    return drained

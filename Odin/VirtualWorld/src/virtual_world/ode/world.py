@@ -12,10 +12,11 @@ from typing import List, Sequence, Tuple
 
 import numpy as np
 
-from odin_common.interface import AUTO_SOLVER_MAX_ROWS
+from odin_common.interface import AUTO_SOLVER_MAX_ROWS, DivergencePolicy
 from odin_common.world_parameters import WorldParameters
 from virtual_world.ode import handles
 from virtual_world.ode.bindings import ffi, lib
+from virtual_world.ode.runtime import drains_ode_messages
 
 BodyForce = Tuple  # (body ptr, torque, vector_in_body, at_point, point_in_body, vector, point)
 JointForce = Tuple  # (joint ptr, ODE joint type, magnitudes)
@@ -39,6 +40,7 @@ class CWorld:
         self._arrays = {}          # keeps the action arrays alive while C points at them
         self.apply(parameters)
 
+    @drains_ode_messages
     def apply(self, p: WorldParameters) -> None:
         """The world parameters in ODE's world and the contact settings."""
         world, inf = self.world.ptr, lib.dInfinity
@@ -64,7 +66,7 @@ class CWorld:
         s.max_speed = p.divergence_speed
         s.max_spin = p.divergence_angular_speed
         s.extent = p.world_extent
-        s.stop_on_divergence = int(p.divergence_policy == 1)
+        s.stop_on_divergence = int(p.divergence_policy == DivergencePolicy.PARK_AND_PAUSE)
         s.auto_disable = int(p.auto_disable)
         lib.odin_world_sync_auto_disable(s)
         # every body meets new parameters awake (gravity turned, a surface changed), and with
@@ -89,10 +91,12 @@ class CWorld:
         """The solver the last step used: 0 QuickStep, 1 dWorldStep."""
         return int(self.struct.last_solver)
 
+    @drains_ode_messages
     def wake(self) -> None:
         """Wakes every dynamic body (a request changed the world: see odin_world_wake)."""
         lib.odin_world_wake(self.struct)
 
+    @drains_ode_messages
     def restart_rest_counts(self) -> None:
         """Every dynamic body's rest count starts again, sleepers stay asleep (a Save State
         under auto_disable: see odin_world_restart_rest_counts)."""
@@ -151,6 +155,7 @@ class CWorld:
                 g.velocity[k] = value
         self._install("motors", array, len(goals))
 
+    @drains_ode_messages
     def set_guarded(self, bodies: Sequence) -> None:
         """The bodies the divergence guard checks after every step (the dynamic ones)."""
         array = ffi.new("dBodyID[]", max(2 * len(bodies), 16))
@@ -214,12 +219,14 @@ class CWorld:
         self._arrays[field] = array
 
     # -- stepping and read-out ---------------------------------------------------------------
+    @drains_ode_messages
     def step(self, step_size: float, count: int) -> int:
         """``count`` steps in one C call (odin_step.c: collide, actions, step, empty, guard);
         returns the steps taken (fewer when the guard parked a body under the pausing
         policy)."""
         return int(lib.odin_world_step(self.struct, step_size, count))
 
+    @drains_ode_messages
     def detect(self, any_policy: bool = False) -> None:
         """Records what touches now, without stepping or contacts: under the contact-less
         policy, or under either when ``any_policy`` (a collision query)."""
@@ -245,6 +252,7 @@ class CWorld:
     def clear_records(self) -> None:
         lib.odin_world_clear_records(self.struct)
 
+    @drains_ode_messages
     def close(self) -> None:
         """Frees every handle of the scene and the record buffers; idempotent."""
         if self.world.closed:

@@ -51,7 +51,6 @@ from __future__ import annotations
 import logging
 import sys
 import threading
-import traceback
 from typing import Callable
 
 import rospy
@@ -62,8 +61,8 @@ from std_msgs.msg import Float64
 
 from Messages.msg import Collided, JointsData, ServoStates, SpaceDistribution
 from Services import srv
-from odin_common import OdinError
-from odin_common.interface import WORLD_SERVICES
+from odin_common import OdinError, replies
+from odin_common.interface import WORLD_SERVICES, DivergencePolicy
 from odin_common.limits import ResourceLimits
 from odin_common.node import MasterWatch, init_ros_node
 from odin_common.world_parameters import PARAMETERS
@@ -172,25 +171,14 @@ class Portal:
 
     def _guarded(self, service_class, handler: Callable) -> Callable:
         """Runs ``handler(request) -> dict`` on the loop thread and turns the outcome into the
-        service's response: an OdinError becomes ``success: false`` with its message, anything
-        unexpected too (logged with its traceback); the node stays up either way. Set World and
-        Set Step also report the values in force when they refuse."""
-        response_class = service_class._response_class
+        service's response (odin_common.replies.guarded); the node stays up either way. Set
+        World and Set Step also report the values in force when they refuse."""
+        # values in force are immutable snapshots: safe to read from the server's thread
         in_force = {srv.SetWorld: lambda: self.core.world_parameters.as_dict(),
                     srv.SetStep: self.services.step_fields}.get(service_class, dict)
-
-        def serve(request):
-            try:
-                fields = self.loop.call(lambda: handler(request))
-                return response_class(success=True, **fields)
-            except OdinError as error:
-                message = str(error)
-            except Exception as error:
-                _log.error("%s failed:\n%s", service_class._type, traceback.format_exc())
-                message = f"internal error: {type(error).__name__}: {error}"
-            # values in force are immutable snapshots: safe to read from this thread
-            return response_class(success=False, message=message, **in_force())
-        return serve
+        return replies.guarded(service_class,
+                               lambda request: self.loop.call(lambda: handler(request)),
+                               in_force)
 
     # -- running ------------------------------------------------------------------------------
     def run(self) -> None:
@@ -225,7 +213,7 @@ class Portal:
                        event.id, event.time, event.reason, event.value)
         self.pub_diagnostics.publish(conversions.divergence_diagnostics(
             found, rospy.Time.from_sec(self.mirror.clock.now(self.core.sim_time))))
-        if self.core.world_parameters.divergence_policy == 1:
+        if self.core.world_parameters.divergence_policy == DivergencePolicy.PARK_AND_PAUSE:
             self.loop.simulate = False
 
     def _publish(self, report: CycleReport) -> None:
