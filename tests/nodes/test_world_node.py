@@ -234,7 +234,7 @@ def test_composites_and_entities(world):
 def test_contact_less_collisions_are_reported_with_depth(world):
     import rospy
     from Messages.msg import Collided
-    from world_client import box, sphere
+    from world_client import box, sphere, wait_until
 
     world.ok("set_world", set_contact_less=True, contact_less=True, set_gravity=True,
              gravity=[0, 0, 0])
@@ -243,11 +243,17 @@ def test_contact_less_collisions_are_reported_with_depth(world):
     world.ok("set_velocity", object="ball", set_linear=True, linear=[-1.0, 0, 0])
     reports = []
     sub = rospy.Subscriber("/virtual_world/collided", Collided, reports.append)
-    time.sleep(0.5)
+    wait_until(lambda: sub.get_num_connections() > 0, timeout=30)
     world.ok("step_once", cycles=5)          # 0.2 s: the ball enters the wall, no contacts
-    time.sleep(0.5)
+
+    def pairs():
+        return [pair for report in list(reports) for pair in report.pairs]
+    try:                                     # the paused world reports what touches now
+        wait_until(lambda: any(pair.depth > 0.05 for pair in pairs()), timeout=30)
+    except TimeoutError:
+        pass                                 # the asserts below say what came
     sub.unregister()
-    pairs = [pair for report in reports for pair in report.pairs]
+    pairs = pairs()
     assert pairs, "no collision reported"
     assert {pairs[-1].first, pairs[-1].second} == {"wall", "ball"}
     assert max(pair.depth for pair in pairs) > 0.05
