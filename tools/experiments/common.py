@@ -418,7 +418,7 @@ def replace_step(plan, name: str, spec) -> None:
     """Replaces the plan's Build Object step named ``name`` by one building ``spec`` (an
     ObjectSpec: the GUI's Objects tab would build the object differently; the rest of the plan
     is sent as loaded)."""
-    from gui.core.build import ObjectStep
+    from gui.core.plan import ObjectStep
     for k, step in enumerate(plan.steps):
         if isinstance(step, ObjectStep) and step.spec.name == name:
             plan.steps[k] = ObjectStep(spec)

@@ -41,10 +41,11 @@ from typing import Iterable, Optional, Tuple
 
 import numpy as np
 
-from gui.core.build import GROUND, BuildPlan, RobotHandle
+from gui.core.build import GROUND
 from gui.core.control_path import control_size
 from gui.core.kautham.environment import MANIPULABLE
 from gui.core.model import CAR, FREE_BODY, MOBILE
+from gui.core.plan import BuildPlan, RobotHandle
 from gui.errors import PlanningError
 from odin_common.rotations import quaternion_to_matrix
 

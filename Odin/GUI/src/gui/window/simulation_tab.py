@@ -25,7 +25,7 @@ from PyQt5.QtCore import Qt, pyqtSignal
 from PyQt5.QtWidgets import (QCheckBox, QFileDialog, QHBoxLayout, QLabel, QPushButton,
                              QTreeWidget, QTreeWidgetItem, QVBoxLayout, QWidget)
 
-from gui.core.build import SCENE_OBJECTS
+from gui.core.plan import SCENE_OBJECTS
 from odin_common.interface import motor_joint
 from odin_common.limits import MIN_STEP
 
