@@ -3,7 +3,7 @@
 A ``BuildPlan`` is an ordered list of steps, each wrapping one request (``WorldStep``: Set
 World, ``StepSizeStep``: Set Step, ``EntityStep``: EntitySpec, ``ObjectStep``: ObjectSpec,
 ``CompositeStep``: CompositeSpec, ``JointStep``: JointSpec, ``MotorStep``: MotorSpec), plus, per
-robot, what paths and controls need to drive it (``RobotHandle``). ``gui.core.build``
+robot, what paths and controls need to drive it (``RobotHandle``). ``gui.core.translate``
 makes the plan of a loaded Kautham problem.
 
 Every step answers the same calls:
@@ -271,7 +271,7 @@ class JointStep:
     def kinematic_axis(self) -> list:
         """The joint's axis (world frame) as the robot model states it (Kautham's sign): a
         robot's hinges and sliders are sent to the world with the axis reversed
-        (``gui.core.build``)."""
+        (``gui.core.translate.joints.link_joint``)."""
         spec = self.spec
         if spec.type in (JointType.HINGE, JointType.SLIDER) and spec.body1:
             return [-v for v in spec.axis1]
