@@ -227,16 +227,16 @@ def render() -> str:
 
 def render_kautham() -> str:
     """How the GUI builds a Kautham problem and applies a control path, from the docstring of
-    gui.core.build and gui.core.control_path.MAPPING (their one home)."""
-    from gui.core import build
+    gui.core.translate and gui.core.control_path.MAPPING (their one home)."""
+    from gui.core import translate
     from gui.core.control_path import MAPPING
     marker = "How a problem maps to the world:\n"
-    mapping = build.__doc__.split(marker, 1)[1].strip()
+    mapping = translate.__doc__.split(marker, 1)[1].strip()
     return ("## Kautham problems and control paths\n\n"
             "The GUI (`rosrun GUI gui`, `load_problem`, `problem_info`) builds a Kautham problem "
-            "with the services above (`gui.core.build`); `problem_info PROBLEM` shows the plan "
-            "as JSON, with what Odin does not use under `ignored`. How a problem maps to the "
-            f"world:\n\n{mapping}\n\n### Control paths\n\n{MAPPING.strip()}\n\n"
+            "with the services above (`gui.core.translate`); `problem_info PROBLEM` shows the "
+            "plan as JSON, with what Odin does not use under `ignored`. How a problem maps to "
+            f"the world:\n\n{mapping}\n\n### Control paths\n\n{MAPPING.strip()}\n\n"
             + render_tracked())
 
 

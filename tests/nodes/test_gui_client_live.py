@@ -45,7 +45,7 @@ def test_initial_position_and_paths_move_the_links(world, tmp_path, legacy):
     import rospy
     from Messages.msg import SpaceDistribution
 
-    from gui.core.build import plan_problem
+    from gui.core.translate import plan_problem
     from gui.ros.client import WorldClient
     from gui.core.kautham.problem import load_problem
 
@@ -87,7 +87,7 @@ def test_motor_goal_joint_value_and_forward_kinematics_share_one_sign(world, leg
     import rospy
     from Messages.msg import JointsData, SpaceDistribution
 
-    from gui.core.build import plan_problem
+    from gui.core.translate import plan_problem
     from gui.ros.client import WorldClient
     from gui.core.kautham.problem import load_problem
 

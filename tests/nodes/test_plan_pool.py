@@ -23,7 +23,7 @@ def _sphere_plan(kautham_dir):
 
 
 def _plan(problem_file):
-    from gui.core.build import plan_problem
+    from gui.core.translate import plan_problem
     from gui.core.kautham.problem import load_problem
     logging.disable(logging.WARNING)
     try:

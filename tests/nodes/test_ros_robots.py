@@ -71,7 +71,7 @@ def test_robot_state_publisher_reproduces_the_worlds_transforms(ros_master, kaut
     import rospy
     from sensor_msgs.msg import JointState
 
-    from gui.core.build import plan_problem
+    from gui.core.translate import plan_problem
     from gui.core.kautham.problem import load_problem
     from gui.ros.client import WorldClient
 
@@ -132,7 +132,7 @@ def test_robot_state_publisher_reproduces_the_worlds_transforms(ros_master, kaut
 def test_a_robot_goes_with_new_scene_and_its_description_with_it(ros_master, kautham_dir):
     import rospy
 
-    from gui.core.build import plan_problem
+    from gui.core.translate import plan_problem
     from gui.core.kautham.problem import load_problem
     from gui.ros.client import WorldClient
 

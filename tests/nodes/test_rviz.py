@@ -61,7 +61,7 @@ def _orange(image: np.ndarray) -> np.ndarray:
 
 
 def test_rviz_draws_the_running_grasp_scene(ros_master, kautham_dir):
-    from gui.core.build import plan_problem
+    from gui.core.translate import plan_problem
     from gui.core.kautham.problem import load_problem
     from gui.ros.client import WorldClient
 

@@ -46,7 +46,7 @@ def test_every_new_subscriber_gets_all_markers_and_the_last_transforms(ros_maste
     from tf2_msgs.msg import TFMessage
     from visualization_msgs.msg import Marker, MarkerArray
 
-    from gui.core.build import plan_problem
+    from gui.core.translate import plan_problem
     from gui.core.kautham.problem import load_problem
     from gui.ros.client import WorldClient
 

@@ -26,6 +26,9 @@ RULES = {
                                           "odin_common.messages"),
     "gui.core": ROS + MESSAGES + QT + ("gui.ros", "gui.window", "virtual_world", "viewer",
                                        "odin_common.messages"),
+    # a build plan and a shape's body, whatever file they come from: no Kautham reader
+    "gui.core.plan": ("gui.core.kautham", "gui.core.translate"),
+    "gui.core.bodies": ("gui.core.kautham", "gui.core.translate"),
     "gui.ros": QT + ("gui.window", "virtual_world", "viewer"),
     # the planning bridge runs the Core in process; its ROS back end lives outside it
     "gui.planning": ROS + MESSAGES + QT + ("gui.ros", "gui.window", "virtual_world.portal",

@@ -34,7 +34,7 @@ ROUNDS = int(os.environ.get("ODIN_BENCH_ROUNDS", "3"))
 def _hold(solver: int) -> dict:
     """The arm held for SECONDS under ``solver``: its largest sag (mm) and steps/s (step
     calls only)."""
-    from gui.core.build import plan_problem
+    from gui.core.translate import plan_problem
     from gui.core.kautham.problem import load_problem
     from gui_core_world import CoreWorld
     world = CoreWorld()

@@ -82,7 +82,7 @@ def _child(out_dir: pathlib.Path, cold_open_only: bool = False) -> None:
     from PyQt5.QtCore import QEvent, QObject, QTimer
     from PyQt5.QtWidgets import QApplication, QFileDialog
 
-    from gui.core.build import plan_problem
+    from gui.core.translate import plan_problem
     from gui.core.kautham.problem import load_problem
     from gui.window.testing import open_window, click, pump, wait_for
 

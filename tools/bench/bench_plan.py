@@ -40,7 +40,7 @@ SPHERE = ("current_2025", "demos", "OMPL_ode_demos", "Sphere", "Sphere.xml")
 
 
 def _sphere():
-    from gui.core.build import plan_problem
+    from gui.core.translate import plan_problem
     from gui.core.kautham.problem import load_problem
     from gui.planning.problem import planning_problem
     logging.disable(logging.WARNING)

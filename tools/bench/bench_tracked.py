@@ -27,7 +27,7 @@ from forked import in_child  # noqa: E402
 
 def _2drr(solver: int) -> dict:
     """(goal error, tracking error max) of the 2DRR .kps solution on the Core, ``solver``."""
-    from gui.core.build import BuildDefaults, plan_problem
+    from gui.core.translate import BuildDefaults, plan_problem
     from gui.core.execution import execute_tracked
     from gui.core.kautham.corpus import corpus_dir
     from gui.core.kautham.problem import load_problem

@@ -1,6 +1,6 @@
 """Viewer benchmarks on the TX90 + SAH hand + two cans grasp scene (Kautham legacy_2012,
 TX90_RHand_ICRA10_5PMD_TwoCan.xml), loaded with the GUI's Kautham loader (gui.core.kautham.problem,
-gui.core.build: the same requests the GUI sends, ~195k triangles).
+gui.core.translate: the same requests the GUI sends, ~195k triangles).
 
 viewer_frame_ms_grasp: median wall time (ms) to render one 640x480 frame of the scene and read
     it back as an array, Core + renderer in this process (no ROS), the default camera. Goal <= 15.
@@ -33,7 +33,7 @@ def _kautham_dir() -> pathlib.Path:
 def grasp_scene():
     """(view requests [(id, parameters, indices, position, orientation wxyz, color)],
     robot handle) for the grasp problem, composites split into parts as the world does."""
-    from gui.core.build import plan_problem
+    from gui.core.translate import plan_problem
     from gui.core.kautham.problem import load_problem
     from gui.core.kinematics import pose_to_position_quaternion
     from odin_common.rotations import quaternion_to_matrix
@@ -139,7 +139,8 @@ def run(out_dir: pathlib.Path) -> dict:
     ms, triangles, objects = frame_ms(out_dir)
     fps = fps_held()
     details = {"viewer_frame_ms_grasp": ms, "viewer_fps_held": fps, "triangles": triangles,
-               "objects": objects, "scene": PROBLEM, "loader": "gui.core.kautham + gui.core.build"}
+               "objects": objects, "scene": PROBLEM,
+               "loader": "gui.core.kautham + gui.core.translate"}
     (out_dir / "viewer_bench.json").write_text(json.dumps(details, indent=2) + "\n")
     return {"viewer_frame_ms_grasp": round(ms, 2), "viewer_fps_held": round(fps, 2)}
 

@@ -6,8 +6,9 @@ three parts of Odin as separate processes started by rosrun or acting as the GUI
 
     VirtualWorld  (``rosrun VirtualWorld virtualWorld`` with the experiment's parameters)
     Viewer        (``rosrun Viewer viewer``, fixed camera, frames into ``<out>/frames``)
-    GUI           this process: ``gui.core.kautham`` loads the problem, ``gui.core.build`` plans it and
-                  ``gui.ros.client.WorldClient`` sends it, exactly as ``rosrun GUI load_problem``
+    GUI           this process: ``gui.core.kautham`` loads the problem, ``gui.core.translate``
+                  plans it and ``gui.ros.client.WorldClient`` sends it, exactly as
+                  ``rosrun GUI load_problem``
 
 and they talk only through the world's and the Viewer's services and topics.
 
@@ -408,7 +409,7 @@ def session_tracking_port(session: Session, frame_every: int = 0):
 # -- the problem, as the GUI builds it --------------------------------------------------------
 def load_plan(problem_file: pathlib.Path):
     """(problem, BuildPlan) of a Kautham problem file, as ``rosrun GUI load_problem`` plans it."""
-    from gui.core.build import plan_problem
+    from gui.core.translate import plan_problem
     from gui.core.kautham.problem import load_problem
     problem = load_problem(problem_file)
     return problem, plan_problem(problem)
@@ -418,7 +419,7 @@ def replace_step(plan, name: str, spec) -> None:
     """Replaces the plan's Build Object step named ``name`` by one building ``spec`` (an
     ObjectSpec: the GUI's Objects tab would build the object differently; the rest of the plan
     is sent as loaded)."""
-    from gui.core.build import ObjectStep
+    from gui.core.plan import ObjectStep
     for k, step in enumerate(plan.steps):
         if isinstance(step, ObjectStep) and step.spec.name == name:
             plan.steps[k] = ObjectStep(spec)

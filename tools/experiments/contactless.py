@@ -51,7 +51,7 @@ CAMERA = common.Camera(eye=(0.62, -0.02, 0.45), target=(0.575, 0.40, 0.32))
 def can_request(position, mass: float, color):
     """The can as a movable mesh body (ObjectSpec), oriented as the TX90 problem places it
     (axis z)."""
-    from gui.core.build import shape_to_body
+    from gui.core.bodies import shape_to_body
     from gui.core.kinematics import pose_from_axis_angle
     from gui.core.shapes import read_shape
     shape = read_shape(common.EXAMPLES / CAN_FILE, 1.0)  # scale 1000 of a mm problem: metres

@@ -7,10 +7,10 @@ m long on four 0.01 kg wheels of 0.04 m radius), built at the query's start in t
 north-east corner, 0.5 m above the ground (it lands first), facing world -x; three 0.25 m cubes
 across its way, which it may push ("freeManipulatable"), and six walls it must not touch
 ("fixed"), all resting on an infinite ground plane. Kautham's car planner builds the car as its
-CarEnvironment does (gui.core.build): hinge-2 wheels with world axes (steering about +z for the
-first two wheels in link order, -z for the others, spinning about +y: a positive wheel speed
-rolls the car toward -x), a soft suspension, and its contact friction (the wheels grip the
-ground with 5, a cube slides on it with 0.1). Controls: a steering angle in [-0.5, 0.5] rad and
+CarEnvironment does (gui.core.translate.car): hinge-2 wheels with world axes (steering about +z
+for the first two wheels in link order, -z for the others, spinning about +y: a positive wheel
+speed rolls the car toward -x), a soft suspension, and its contact friction (the wheels grip
+the ground with 5, a cube slides on it with 0.1). Controls: a steering angle in [-0.5, 0.5] rad and
 a wheel speed in [-5, 10] rad/s.
 
 Planning (``gui.planning``, the in-process Core back end, as ``rosrun GUI plan`` runs it):

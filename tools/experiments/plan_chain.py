@@ -6,9 +6,9 @@ Scene: Kautham's ``OMPL_ode_demos/Chain/k-PMPChain.xml`` exactly as the GUI load
 scaled 11 times: two links of 2.2 m, a gripper with two fingers) whose base is held 0.5 m
 above the ground, its joints turning about the vertical; six obstacles resting on an infinite
 ground plane. Kautham's chain planner drives the chain as its PlanarChainEnvironment does: each
-joint at up to 1 rad/s under 7 N m, no joint damping or friction (gui.core.build). Its types
-decide what may be touched: box2 is "freeManipulatable", which only the gripper and fingers
-may push; box1 and the red cubes are "fixed", which nothing of the chain may touch. The
+joint at up to 1 rad/s under 7 N m, no joint damping or friction (gui.core.translate.chain).
+Its types decide what may be touched: box2 is "freeManipulatable", which only the gripper and
+fingers may push; box1 and the red cubes are "fixed", which nothing of the chain may touch. The
 query's ``<Goal>`` puts the gripper around box1 with link2 lying where box2 stands, so box2
 must be pushed out of the way first.
 

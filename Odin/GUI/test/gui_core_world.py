@@ -9,7 +9,7 @@ import logging
 
 import numpy as np
 
-from gui.core.build import plan_problem
+from gui.core.translate import plan_problem
 from gui.planning import backend as planning_backend
 
 

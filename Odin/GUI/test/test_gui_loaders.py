@@ -12,7 +12,8 @@ import sys
 import numpy as np
 import pytest
 
-from gui.core.build import EntityStep, JointStep, plan_problem
+from gui.core.plan import EntityStep, JointStep
+from gui.core.translate import plan_problem
 from odin_common.specs import CompositeSpec
 from gui.errors import GuiError, ProblemError, ShapeError
 from gui.core.kautham.corpus import corpus_dir

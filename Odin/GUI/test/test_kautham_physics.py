@@ -15,8 +15,8 @@ import sys
 import numpy as np
 import pytest
 
-from gui.core.build import (EntityStep, JointStep, MotorStep, ObjectStep, StepSizeStep,
-                            WorldStep, plan_problem, BuildDefaults)
+from gui.core.plan import EntityStep, JointStep, MotorStep, ObjectStep, StepSizeStep, WorldStep
+from gui.core.translate import BuildDefaults, plan_problem
 from gui.core.control_path import ControlRow, read_control_path, run_control_path
 from gui.core.kautham.corpus import corpus_dir
 from gui.core.kautham.problem import load_problem

@@ -7,7 +7,7 @@ import sys
 import numpy as np
 import pytest
 
-from gui.core.build import plan_problem
+from gui.core.translate import plan_problem
 from gui.core.control_path import (ControlRow, read_control_path, run_control_path,
                                    write_control_path)
 from gui.errors import PathFileError, PlanningError

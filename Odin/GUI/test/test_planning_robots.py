@@ -7,7 +7,7 @@ search's."""
 import numpy as np
 import pytest
 
-from gui.core.build import plan_problem
+from gui.core.translate import plan_problem
 from gui.core.control_path import ControlRow, run_control_path
 from gui.planning.backend import CoreBackend
 from gui.planning.bridge import plan, replay

@@ -10,7 +10,7 @@ import pathlib
 import numpy as np
 import pytest
 
-from gui.core.build import BuildDefaults, plan_problem
+from gui.core.translate import BuildDefaults, plan_problem
 from gui.core.execution import TrackingDefaults, execute_tracked
 from gui.core.kautham.corpus import corpus_dir
 from gui.core.kautham.problem import load_problem

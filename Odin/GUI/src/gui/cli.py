@@ -85,7 +85,7 @@ def describe(plan) -> dict:
 
 
 def _build_options(parser: argparse.ArgumentParser) -> None:
-    """The options that change how a problem is built (gui.core.build.BuildDefaults)."""
+    """The options that change how a problem is built (gui.core.translate.BuildDefaults)."""
     ground = parser.add_mutually_exclusive_group()
     ground.add_argument("--physics", dest="ground", action="store_const", const=True,
                         help="Kautham's ODE physics (world settings, a ground plane) for any "
@@ -103,7 +103,7 @@ def _build_options(parser: argparse.ArgumentParser) -> None:
 
 
 def _plan(args):
-    from gui.core.build import BuildDefaults, plan_problem
+    from gui.core.translate import BuildDefaults, plan_problem
     from gui.core.kautham.problem import load_problem
     defaults = BuildDefaults(ground=args.ground, start_at_query=args.start_at_query,
                              inertia=args.inertia)

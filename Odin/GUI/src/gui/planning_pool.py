@@ -17,7 +17,7 @@ from typing import List, Sequence
 
 import numpy as np
 
-from gui.core.build import BuildPlan
+from gui.core.plan import BuildPlan
 from gui.errors import PlanningError
 from gui.planning.backend import Outcome, force_requests, send_plan, step_actuation
 from gui.planning.problem import PlanningProblem

@@ -186,7 +186,7 @@ def _events(plan, solution: Solution, times: np.ndarray) -> List[_Event]:
 
 def _instance_of(body) -> str:
     """The instance a planned body belongs to: an object's name, a composite's parts'
-    ("name#k", gui.core.build's naming)."""
+    ("name#k", gui.core.bodies' naming)."""
     if hasattr(body, "name"):
         return body.name
     return body.parts[0].name.split("#")[0]

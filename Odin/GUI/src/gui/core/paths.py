@@ -120,7 +120,7 @@ def refine(rows: np.ndarray, times: int) -> np.ndarray:
 
 
 def load_robot_path(path: os.PathLike | str, handle, units: str) -> np.ndarray:
-    """Reads a path file for the robot ``handle`` (gui.core.build.RobotHandle) in SI units."""
+    """Reads a path file for the robot ``handle`` (gui.core.plan.RobotHandle) in SI units."""
     model = handle.instance.model
     kinds = [model.links[i].joint for i in model.movable_links()]
     rows = read_path(path, len(kinds))

@@ -2,7 +2,7 @@
 Set Robot tells the world (ROS-free; gui.ros.client sends it).
 
 ``describe_robot(handle, mesh_dir)`` takes a robot as the build plan drove it into the world
-(``gui.core.build.RobotHandle``: its model, its links' world bodies, its world joints) and
+(``gui.core.plan.RobotHandle``: its model, its links' world bodies, its world joints) and
 returns a ``RobotDescription``:
 
 - **URDF robots** keep their URDF as given, except that every ``<mesh filename>`` becomes the
@@ -67,7 +67,7 @@ class RobotDescription:
 
 
 def describe_robot(handle, mesh_dir: Optional[os.PathLike] = None) -> RobotDescription:
-    """The description of a robot the world built (gui.core.build.RobotHandle, with the
+    """The description of a robot the world built (gui.core.plan.RobotHandle, with the
     world's IDs recorded); ``mesh_dir``: where generated descriptions' mesh files go (None:
     meshes are left out of a generated URDF, primitives stay)."""
     model: RobotModel = handle.instance.model

@@ -18,7 +18,7 @@ Mapping a file to Odin (``Shape``):
 - Each primitive becomes a ``Primitive`` with Odin's parameters (sphere: radius; cylinder:
   radius, length along z -- Inventor's cylinders are along y, so the part's frame is rotated by
   -90 degrees about x; box: x, y, z sides) and its pose in the file's frame.
-- ``gui.core.build`` turns a shape made only of a mesh into a mesh object, one made of a single
+- ``gui.core.bodies`` turns a shape made only of a mesh into a mesh object, one made of a single
   primitive into a primitive object whose body sits at the primitive's pose, and anything mixed
   into a composite (one body, one part per primitive plus one for the mesh).
 - Colour: the diffuse colour (and 1 - transparency as alpha) of the first shape node; a mesh

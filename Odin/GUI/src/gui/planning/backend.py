@@ -19,8 +19,8 @@ from typing import List, NamedTuple, Optional, Protocol, Sequence, Tuple
 
 import numpy as np
 
-from gui.core.build import BuildPlan, BuiltIds
 from gui.core.control_path import Actuation, ControlRow, ServoCommand, actuation
+from gui.core.plan import BuildPlan, BuiltIds
 from gui.planning.problem import PlanningProblem
 from odin_common.interface import ForceKind
 from odin_common.step_values import StepValues

@@ -1,6 +1,6 @@
 """What a loaded Kautham problem asks of a planner (ROS-free, OMPL-free).
 
-A planning problem drives one robot of a world built from the problem (``gui.core.build``),
+A planning problem drives one robot of a world built from the problem (``gui.core.translate``),
 as Kautham's ODE environments drive the robots of its physics demos: a free body pushed by a
 force (its 2D environments: the Sphere demos), a car on hinge-2 wheels (CarEnvironment), a
 chain whose base is held to the world, driven at its joints (PlanarChainEnvironment):
@@ -41,10 +41,11 @@ from typing import Iterable, Optional, Tuple
 
 import numpy as np
 
-from gui.core.build import GROUND, BuildPlan, RobotHandle
 from gui.core.control_path import control_size
 from gui.core.kautham.environment import MANIPULABLE
 from gui.core.model import CAR, FREE_BODY, MOBILE
+from gui.core.plan import BuildPlan, RobotHandle
+from gui.core.translate import GROUND
 from gui.errors import PlanningError
 from odin_common.rotations import quaternion_to_matrix
 

@@ -6,7 +6,7 @@ fresh) and offers one typed method per thing a tool or the window asks of the wo
 go in as odin_common specs, enums and plain values (SI units, world frame, quaternions
 (w, x, y, z)), answers come back as IDs, ``WorldParameters`` or ``StepValues``. A refusal
 (``success: false``) or a broken connection raises ``gui.errors.WorldError`` carrying the
-world's message. ``execute(plan)`` sends a ``gui.core.build.BuildPlan`` (each step sends
+world's message. ``execute(plan)`` sends a ``gui.core.plan.BuildPlan`` (each step sends
 itself, then declares each robot it built with Set Robot: its robot_description, namespace and
 joint names, gui.core.robot_description); ``run_position_path`` / ``run_velocity_path`` drive a
 robot. Messages are built only by ``odin_common.messages`` and here.
@@ -25,7 +25,7 @@ from typing import Callable, Dict, NamedTuple, Optional, Sequence, Tuple
 
 import numpy as np
 
-from gui.core.build import BuildPlan, BuiltIds, RobotHandle
+from gui.core.plan import BuildPlan, BuiltIds, RobotHandle
 from gui.core.robot_description import RobotDescription, describe_robot
 from gui.errors import WorldError
 from odin_common.errors import InvalidArgument

@@ -4,7 +4,7 @@ Create: a free name, a shape from the chooser (sphere, cylinder, box, mesh from 
 parameter page comes up in a stacked widget with presets, mass (> 0), fixed or static flags,
 position and orientation (a non-zero quaternion, normalised before sending). A mesh file is read
 on the worker: STL/OBJ/PLY through trimesh, .wrl/.iv through Coin (``gui.core.shapes.read_shape``);
-a file holding primitives too becomes a composite (``gui.core.build.shape_to_body``).
+a file holding primitives too becomes a composite (``gui.core.bodies.shape_to_body``).
 The list below shows every object in the world, whoever built it (Get World).
 """
 from __future__ import annotations
@@ -257,7 +257,7 @@ class ObjectsTab(QWidget):
 
 def _build_mesh(client, name: str, path: str, scale: float, common: dict):
     """Reads a mesh file and builds it (worker thread); returns (ID, part names or None)."""
-    from gui.core.build import shape_to_body
+    from gui.core.bodies import shape_to_body
     from gui.core.shapes import read_shape
     shape = read_shape(path, scale)
     if shape.is_empty:

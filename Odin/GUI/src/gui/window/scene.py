@@ -9,7 +9,7 @@ window asks Get World again). ``SceneModel`` emits ``changed(str what)`` with ``
 "objects", "joints", "motors", "forces", "robots" only when that set really changes, so the
 topics cost the GUI thread a set comparison, not a list rebuild.
 
-``robots`` are the kinematic handles (``gui.core.build.RobotHandle``) of the robots this window
+``robots`` are the kinematic handles (``gui.core.plan.RobotHandle``) of the robots this window
 built (paths need them); ``world_robots`` every robot the world holds.
 """
 from __future__ import annotations
@@ -46,7 +46,7 @@ class SceneModel(QObject):
         self.world_robots: tuple = ()   # gui.ros.client.WorldRobot of every robot declared
         self.robots: dict = {}          # robot name -> RobotHandle, robots this window built
         self.problem_format: Optional[str] = None
-        self.plan = None                # the last opened problem's gui.core.build.BuildPlan
+        self.plan = None                # the last opened problem's gui.core.plan.BuildPlan
         self.inventory = None           # the last Get World answer
         self._joint_types: dict = {}    # joint ID -> JointType value, from joint_data
 

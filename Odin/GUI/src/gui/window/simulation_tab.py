@@ -6,9 +6,10 @@ declared with Set Robot with its Links (the robot's link names), Joints and Moto
 own joint names), then the Scene objects (under the Kautham instance that made them when this
 window built them), the Joints and Motors of no robot, and the Forces.
 
-Opening runs on the worker: the problem is read and planned (``gui.core.build.plan_problem``) and
-sent step by step (``WorldClient.execute``); while it is built each answer adds the step's
-entries to the tree as it comes; once built, the world's answer replaces them.
+Opening runs on the worker: the problem is read and planned
+(``gui.core.translate.plan_problem``) and sent step by step (``WorldClient.execute``); while it
+is built each answer adds the step's entries to the tree as it comes; once built, the world's
+answer replaces them.
 
 The button follows the world's real state: the Start answer, then the stamps of
 ``world_update`` (simulated time advancing = running), so a world started or paused by another
@@ -25,7 +26,7 @@ from PyQt5.QtCore import Qt, pyqtSignal
 from PyQt5.QtWidgets import (QCheckBox, QFileDialog, QHBoxLayout, QLabel, QPushButton,
                              QTreeWidget, QTreeWidgetItem, QVBoxLayout, QWidget)
 
-from gui.core.build import SCENE_OBJECTS
+from gui.core.plan import SCENE_OBJECTS
 from odin_common.interface import motor_joint
 from odin_common.limits import MIN_STEP
 
@@ -129,7 +130,7 @@ class SimulationTab(QWidget):
         self.status.setText(f"Reading {pathlib.Path(path).name} ...")
 
         def work(client, job):
-            from gui.core.build import plan_problem
+            from gui.core.translate import plan_problem
             from gui.core.kautham.problem import load_problem
             plan = plan_problem(load_problem(path))
             job.progress(("plan", plan))

@@ -1,0 +1,61 @@
+"""A loaded Kautham problem -> the build plan that makes it in the VirtualWorld (ROS-free).
+
+``plan_problem(problem, defaults)`` returns a ``gui.core.plan.BuildPlan``; ``BuildDefaults``
+holds the choices a caller may change. The general rules (instances, bodies, joints, motors,
+attachments, Kautham's physics) are ``planner``'s and ``joints``'; a car's wheels and the
+friction of Kautham's car planner ``car``'s; a fixed-base robot's base and the drive of
+Kautham's chain planner ``chain``'s; a shape's body ``gui.core.bodies``'.
+
+How a problem maps to the world:
+- Kautham's physics (``Problem.physics``: one of its ODE planners; ``BuildDefaults.ground``
+  asks for it in any problem): first Set World and Set Step with what Kautham's ODE
+  environment uses (``gui.core.world_settings``), then an infinite ground plane at z = 0
+  (``GROUND``, static).
+- A robot with joints -> one Build Entity (one object or composite per link, internal
+  collisions off), then per link one Set Joint: revolute -> HINGE, prismatic -> SLIDER (anchor
+  and axis from the joint frame where the robot is built, world frame; LO_STOP/HI_STOP from the
+  limits, relative to the value the joint is built at), a non-movable link -> FIXED joint to
+  its parent; a car's wheels -> HINGE2 with CarEnvironment's suspension (ERP 0.4 / CFM 0.8):
+  for a car of Kautham's car planner CarEnvironment's world axes (steering about +z for the
+  first two wheels, -z for the others, spin about +y, whatever the car's pose: a positive
+  wheel speed rolls it toward world -x) and its contact friction by body kind
+  (``environment.CAR_FRICTION``, the ground's too); for any other car axes from its own frame
+  (steering about the base's up, opposite for the wheels ahead of its centre and the others;
+  both reversed like a hinge's, so that a positive steering turns left and a positive wheel
+  speed rolls the car along its +x). Then one Set Motor per movable joint
+  (angular for hinges and hinge-2s, linear for sliders; zero speed, so the robot holds its
+  pose; the joint's effort limit as its force limit, infinite without one; the chain of
+  Kautham's chain planner gets PlanarChainEnvironment's 7 N m and 1 rad/s for every joint
+  instead, whatever its URDF says), id "motor:" + joint id; a joint with friction gets a second
+  motor at zero speed whose force limit is the friction ("friction:" + joint id), a joint
+  with damping a third at zero speed, unlimited force and CFM 1 / damping, which makes ODE
+  apply exactly -damping x the joint's rate ("damping:" + joint id); under Kautham's own
+  physics (one of its ODE planners) no joint has either, as in its ODE environment.
+- The base by the robot's kind (``gui.core.model``): FIXED_BASE -> in a 2012 problem a fixed
+  (kinematic) body that never moves; in a current one a dynamic body held by a FIXED joint to
+  the world (Kautham's chain); FREE_BODY, MOBILE, CAR -> a dynamic body, free.
+- A robot is built at its start (the query's ``<Init>``) in current problems, at Home in 2012
+  ones (``BuildDefaults.start_at_query``); ``RobotHandle.built_at`` keeps the joint values the
+  world's joint readings are relative to.
+- A robot made of one link (a bare shape or a one-link URDF) is a free-flying body: an entity
+  of one object, no joint.
+- A static obstacle -> Build Object/Composite with ``geometry_only``. A movable obstacle (a .rob
+  scene, a URDF with masses, ``<Scene movable="true">``, any obstacle under Kautham's physics,
+  an attached obstacle) -> bodies with masses; a multi-link one is built like a robot but its
+  base is left free. ``<InitialAttachedObstacle>`` -> a FIXED joint between the link and the
+  obstacle's (base) body, as they are placed.
+- Shapes: a mesh -> mesh object (vertices in the link frame); one primitive -> primitive
+  object whose body sits at the primitive's pose in the link; anything else -> a composite
+  whose frame is the link frame (one part per primitive, one for the mesh), id ">p1>p2...".
+- Masses: the file's mass, else ``BuildDefaults.link_mass`` (a .rob ``<Weight>`` is a planner
+  weight, not a mass); a composite's mass is shared among its parts in proportion to their
+  volumes. Inertia (``gui.core.inertia``): the URDF's tensor about its centre of mass where it
+  is a rigid body's and plausible for the link's shape, the shape's at uniform density
+  otherwise. Contact surfaces: the link's (URDF contact coefficients) on its object or parts.
+- Names (thesis 8.3): links are "robot/link" (Kautham's own .cntr naming), one-link instances
+  keep the instance name; instance names come from the robot's name or the obstacle's file
+  name, numbered "_2", "_3"... on collision; composite parts are "name#k".
+"""
+from gui.core.translate.planner import GROUND, BuildDefaults, plan_problem
+
+__all__ = ["GROUND", "BuildDefaults", "plan_problem"]

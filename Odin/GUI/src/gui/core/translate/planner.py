@@ -1,0 +1,237 @@
+"""The plan of one loaded problem: its instances in order, then its attachments, behind the
+world settings and ground plane of Kautham's physics where it applies (ROS-free). What it
+builds is told in ``gui.core.translate``'s docstring; a car's wheels are ``car``'s, a
+fixed-base robot's base and chain drive ``chain``'s, a link's joint and motors ``joints``'.
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import Dict, List, Optional, Tuple
+
+import numpy as np
+
+from gui.core import inertia as inertia_rule
+from gui.core.bodies import shape_to_body, with_surface
+from gui.core.kautham import environment
+from gui.core.kautham.problem import PHYSICS_PLANNERS
+from gui.core.model import CAR, FIXED_BASE, Instance, LinkModel, Problem, warn_once
+from gui.core.plan import (BodySpec, BuildPlan, EntityStep, JointStep, LinkBody, ObjectStep,
+                           RobotHandle, StepSizeStep, WorldStep, body_step)
+from gui.core.translate import car, chain
+from gui.core.translate.joints import (fixed_joint, joint_motors, link_drive, link_joint,
+                                       motor_kind)
+from gui.core.world_settings import kautham_world
+from odin_common.interface import MotorKind, Shape as ShapeKind, default_motor_id
+from odin_common.specs import (CompositeSpec, EntitySpec, JointSpec, ObjectSpec, Surface,
+                               WORLD_SURFACE)
+from odin_common.step_values import StepValues
+
+GROUND = "ground"
+"""The ground plane's object ID (another name is taken if an instance has it)."""
+
+
+@dataclass(frozen=True)
+class BuildDefaults:
+    """How a problem is built. ``ground``: Kautham's physics (Set World, Set Step, a ground
+    plane) for every problem (True), none (False), or where Kautham simulates the problem
+    (None: ``Problem.physics``). ``start_at_query``: robots built at the query's start (True),
+    at Home (False), or the start in current problems and Home in 2012 ones (None).
+    ``inertia``: "auto", "file" or "shape" (``gui.core.inertia``). ``max_contact_sink``: m,
+    the deepest a body may rest in a contact the planner's CFM softens
+    (``gui.core.world_settings``)."""
+    link_mass: float = 1.0          # kg, a link or movable obstacle without a mass
+    internal_collisions: bool = False
+    ground: Optional[bool] = None
+    start_at_query: Optional[bool] = None
+    inertia: str = inertia_rule.AUTO
+    placeholder_factor: float = 10.0
+    max_contact_sink: float = 0.01
+
+
+def plan_problem(problem: Problem, defaults: BuildDefaults = BuildDefaults()) -> BuildPlan:
+    """The plan that builds ``problem`` (``gui.core.translate``'s docstring)."""
+    return _Planner(problem, defaults).plan()
+
+
+class _Planner:
+    """One plan: the problem's instances in order, then attachments."""
+
+    def __init__(self, problem: Problem, defaults: BuildDefaults):
+        self.problem, self.defaults = problem, defaults
+        self.physics = problem.physics if defaults.ground is None else defaults.ground
+        start = defaults.start_at_query
+        self.start_at_query = problem.format == "current" if start is None else start
+        attached = {a.obstacle for a in problem.attachments}
+        # bodies: movable obstacles, attached ones, and every current obstacle under
+        # Kautham's physics (its ODE environment makes them all dynamic)
+        self.dynamic = {i.name for i in problem.obstacles
+                        if i.movable or i.name in attached
+                        or (self.physics and problem.format == "current")}
+        # Kautham's chain planner drives its chain's joints as PlanarChainEnvironment does,
+        # its car planner sets its car's wheel axes as CarEnvironment does
+        planned = PHYSICS_PLANNERS.get(problem.planner.name) if problem.physics else None
+        self.chain_environment = planned == FIXED_BASE
+        self.car_environment = planned == CAR
+        self.steps: list = []
+        self.handles: list = []
+        self.ignored: list = list(problem.ignored)
+        self.base_bodies: Dict[str, LinkBody] = {}     # instance name -> its base's body
+        self.link_bodies: Dict[Tuple[str, str], LinkBody] = {}
+        self.masses: list = []                          # (body ID, kg) of dynamic bodies
+
+    def plan(self) -> BuildPlan:
+        for inst in self.problem.instances:
+            self._instance(inst)
+        self._attachments()
+        world, front = None, []
+        if self.physics:
+            world, ignored = kautham_world(self.problem, self.masses, StepValues().step,
+                                           self.defaults.max_contact_sink)
+            self.ignored.extend(ignored)
+            front.append(WorldStep(world.parameters))
+            if world.step is not None:
+                front.append(StepSizeStep(world.step, world.steps_per_cycle, world.rate))
+            front.append(ObjectStep(self._ground()))
+        warn_once(self.ignored[len(self.problem.ignored):], "gui.core.translate")
+        return BuildPlan(problem=self.problem, steps=front + self.steps, robots=self.handles,
+                         world=world, ignored=self.ignored)
+
+    def _ground(self) -> ObjectSpec:
+        taken = {i.name for i in self.problem.instances}
+        name, n = GROUND, 1
+        while name in taken:
+            n += 1
+            name = f"{GROUND}_{n}"
+        surface = car.GROUND_SURFACE if self.car_environment else WORLD_SURFACE
+        return ObjectSpec(name=name, parameters=(), shape=ShapeKind.PLANE, geometry_only=True,
+                          color=environment.GROUND_COLOR, surface=surface)
+
+    # -- instances ----------------------------------------------------------------------------
+    def _configuration(self, inst: Instance) -> Tuple[np.ndarray, np.ndarray]:
+        """(base pose, joint values) the instance is built at."""
+        if inst.role == "robot" and self.start_at_query and inst.start is not None:
+            return inst.start.base_pose, np.asarray(inst.start.joints, dtype=float)
+        return inst.base_pose, inst.model.home()
+
+    def _instance(self, inst: Instance) -> None:
+        base_pose, built_at = self._configuration(inst)
+        static = inst.role == "obstacle" and inst.name not in self.dynamic
+        specs, bodies = self._links(inst, base_pose, built_at, static)
+        single = len(inst.model.links) == 1
+        if static or (single and inst.role == "obstacle"):
+            self.steps.extend(body_step(s) for s in specs)
+            return
+        robot = inst.role == "robot"
+        holding: List[JointStep] = []
+        if robot and inst.kind == FIXED_BASE and not single:
+            specs, holding = chain.hold_base(inst.name, specs, self.problem.format)
+        self.steps.append(EntityStep(EntitySpec(
+            name=inst.name,
+            objects=tuple(s for s in specs if isinstance(s, ObjectSpec)),
+            composites=tuple(s for s in specs if isinstance(s, CompositeSpec)),
+            internal_collisions=self.defaults.internal_collisions)))
+        handle = RobotHandle(inst, bodies, [], home=inst.model.home(), built_at=built_at,
+                             base_pose=base_pose, kind=inst.kind, base_mass=specs[0].mass)
+        if not single:
+            self.steps.extend(holding)
+            self._joints(inst, handle, base_pose, built_at)
+        if robot or not single:
+            self.handles.append(handle)
+
+    def _links(self, inst: Instance, base_pose: np.ndarray, built_at: np.ndarray,
+               static: bool) -> Tuple[List[BodySpec], List[LinkBody]]:
+        """The body spec of each of ``inst``'s links built at ``base_pose`` and ``built_at``,
+        and where each link's body is (recorded for attachments)."""
+        model = inst.model
+        single = len(model.links) == 1
+        specs, bodies = [], []
+        for link, pose in zip(model.links, model.link_poses(base_pose, built_at)):
+            name = inst.name if single else f"{inst.name}/{link.name}"
+            mass = link.mass if link.mass is not None else self.defaults.link_mass
+            spec, offset = shape_to_body(name, link.shape, pose, mass, static)
+            if not static:
+                spec = self._mass_properties(spec, link, name, mass, offset)
+                self.masses.append((name, mass))
+            specs.append(with_surface(spec, self._surface(inst, link, name)))
+            bodies.append(LinkBody(spec.id, offset))
+            self.link_bodies[(inst.name, link.name)] = bodies[-1]
+        self.base_bodies[inst.name] = bodies[0]
+        if not inst.collision:   # <Collision enabled="false">: the world never pairs it
+            specs = [dataclasses.replace(s, no_collisions=True) for s in specs]
+        return specs, bodies
+
+    def _surface(self, inst: Instance, link: LinkModel, name: str) -> Surface:
+        """The contact surface of ``inst``'s ``link`` (body ``name``): its URDF's, but for
+        the friction of Kautham's car planner (``car.car_environment_surface``)."""
+        if not self.car_environment:
+            return link.surface
+        surface, ignored = car.car_environment_surface(inst, link, name)
+        if ignored is not None:
+            self.ignored.append(ignored)
+        return surface
+
+    def _mass_properties(self, spec: BodySpec, link: LinkModel, name: str, mass: float,
+                         offset: np.ndarray) -> BodySpec:
+        given, ignored = inertia_rule.choose(link, name, mass, offset, self.defaults.inertia,
+                                             self.defaults.placeholder_factor)
+        if ignored is not None:
+            self.ignored.append(ignored)
+        if given is None:
+            return spec
+        return dataclasses.replace(spec, inertia=given.inertia,
+                                   center_of_mass=given.center_of_mass)
+
+    # -- joints and motors ---------------------------------------------------------------------
+    def _joints(self, inst: Instance, handle: RobotHandle, base_pose: np.ndarray,
+                built_at: np.ndarray) -> None:
+        """A joint step per link but the base, then the motor steps of the movable ones."""
+        model = inst.model
+        frames = model.joint_frames(base_pose, built_at)
+        value = dict(zip(model.movable_links(), built_at))
+        bodies = handle.bodies
+        motors, wheels = [], 0
+        for i, link in enumerate(model.links):
+            if link.parent is None:
+                continue
+            key = f"{inst.name}/{link.name}"
+            parent_id, child_id = bodies[link.parent].body_id, bodies[i].body_id
+            if not link.movable:
+                self.steps.append(JointStep(key, inst.name, fixed_joint(parent_id, child_id)))
+                continue
+            if car.is_wheel(inst, link):
+                steering, spin = car.wheel_axes(link, frames[i], base_pose, wheels,
+                                                self.car_environment)
+                joint = car.wheel_joint(frames[i], steering, spin, parent_id, child_id)
+                kind, axis, wheels = MotorKind.ANGULAR, 1, wheels + 1   # the URDF's joint spins
+            else:
+                joint = link_joint(link, frames[i], value[i], parent_id, child_id)
+                kind, axis = motor_kind(link), 0
+            motors.extend(self._movable_joint(inst, link, handle, key, joint, kind, axis))
+        self.steps.extend(motors)
+        handle.motor_ids = [default_motor_id(j) for j in handle.joint_ids]
+
+    def _movable_joint(self, inst: Instance, link: LinkModel, handle: RobotHandle, key: str,
+                       joint: JointSpec, kind: MotorKind, axis: int) -> list:
+        """Adds the joint's step and records it in ``handle``; returns its motor steps."""
+        self.steps.append(JointStep(key, inst.name, joint, limits=link.limits))
+        drive, ignored = link_drive(link, self.problem.physics)
+        if ignored is not None:
+            self.ignored.append(ignored)
+        if self.chain_environment and inst.kind == FIXED_BASE:
+            drive = chain.planar_chain_drive(drive)
+        handle.joint_keys.append(key)
+        handle.joint_ids.append(joint.default_id)
+        handle.joint_axes.append(axis)
+        handle.max_forces.append(drive.effort)
+        handle.max_speeds.append(drive.speed)
+        return joint_motors(key, inst.name, joint, drive, kind)
+
+    # -- attachments ---------------------------------------------------------------------------
+    def _attachments(self) -> None:
+        """A FIXED joint between each attached obstacle's base and its link, as placed."""
+        for a in self.problem.attachments:
+            link = self.link_bodies[(a.robot, a.link)]
+            obstacle = self.base_bodies[a.obstacle]
+            self.steps.append(JointStep(f"{a.robot}/{a.link}+{a.obstacle}", a.robot,
+                                        fixed_joint(link.body_id, obstacle.body_id)))
