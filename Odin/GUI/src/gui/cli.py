@@ -435,7 +435,7 @@ def _planning_backends(args):
                            f"--worlds names {len(namespaces)}")
 
         def pool_backend(k: int):
-            from gui.planning_pool import PoolBackend
+            from gui.planning.pool import PoolBackend
             return PoolBackend(plan, problem, namespaces[k::args.parallel],
                                timeout=args.world_timeout)
         return pool_backend, time_limit

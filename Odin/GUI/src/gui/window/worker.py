@@ -21,16 +21,14 @@ import queue
 import threading
 import time
 import traceback
-import xmlrpc.client
 from dataclasses import dataclass, field
 from typing import Any, Callable, Optional
 
 from PyQt5.QtCore import QThread, pyqtSignal
 
 from gui.errors import GuiError, WorldError
+from gui.ros.services import node_answers
 from odin_common.interface import WORLD_NAMESPACE
-
-PING_TIMEOUT = 2.0      # s: a world that does not answer its pid in this long is absent
 
 
 class Cancelled(GuiError):
@@ -189,7 +187,7 @@ class WorldWorker(QThread):
             self.failed_job.emit(job.id, str(error))
         except WorldError as error:
             self.failed_job.emit(job.id, str(error))
-            if "call failed" in error.world_message:
+            if "call failed" in error.reason:
                 self._check_connection()
         except GuiError as error:
             self.failed_job.emit(job.id, str(error))
@@ -202,26 +200,8 @@ class WorldWorker(QThread):
             self._current = None
             self.busy.emit("")
 
-    def _service_registered(self) -> bool:
-        """Whether the world's services are registered AND their node answers: a world that
-        crashed (SIGKILL, a segfault) never unregisters, so the master alone would call it
-        alive. The node is asked its pid over its XML-RPC API, as ``rosnode ping`` does."""
-        import rosgraph
-        import rospy
-        service = f"{self.namespace}/set_joint_force"
-        try:
-            master = rosgraph.Master(rospy.get_name() or "/gui")
-            providers = dict(master.getSystemState()[2]).get(service, [])
-            if not providers:
-                return False
-            api = master.lookupNode(providers[0])
-            xmlrpc.client.ServerProxy(api, transport=_QuickTransport()).getPid(master.caller_id)
-            return True
-        except Exception:  # master down, service not registered, node gone or not answering
-            return False
-
     def _check_connection(self) -> None:
-        if not self._service_registered():
+        if not node_answers(f"{self.namespace}/set_joint_force"):
             if self._connected or self._client is not None:
                 self._drop_client()
             self._set_connected(False, f"VirtualWorld absent: waiting for {self.namespace}")
@@ -250,12 +230,3 @@ class WorldWorker(QThread):
             except Exception:
                 pass
         self._client = None
-
-
-class _QuickTransport(xmlrpc.client.Transport):
-    """XML-RPC over HTTP that gives up after PING_TIMEOUT s: a hung node is an absent one."""
-
-    def make_connection(self, host):
-        connection = super().make_connection(host)
-        connection.timeout = PING_TIMEOUT
-        return connection
