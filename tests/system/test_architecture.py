@@ -30,6 +30,8 @@ RULES = {
     "gui.core.plan": ("gui.core.kautham", "gui.core.translate"),
     "gui.core.bodies": ("gui.core.kautham", "gui.core.translate"),
     "gui.ros": QT + ("gui.window", "virtual_world", "viewer"),
+    # the window reaches nodes through gui.ros only
+    "gui.window": ROS + MESSAGES,
     # the planning bridge runs the Core in process; its ROS back end (gui.planning.pool,
     # below) reaches the world nodes through gui.ros only
     "gui.planning": ROS + MESSAGES + QT + ("gui.ros", "gui.window", "virtual_world.portal",

@@ -8,8 +8,10 @@ Qt signals), ``scene`` (what the window knows of the scene), ``fields`` (input l
 
 Node ``gui``; parameters: ``~world`` ("/virtual_world": namespace of the world's services and
 topics), ``~viewer`` ("/viewer": namespace of the Viewer's image topic).
-Services called: every ``<~world>/*`` service. Topics read: ``<~world>/world_update``,
-``<~world>/joint_data``, ``<~world>/joint_states``, ``<~viewer>/image``.
+Services called: every ``<~world>/*`` service, ``<~viewer>/set_camera``. Topics read:
+``<~world>/world_update``, ``<~world>/joint_data``, ``<~world>/joint_states``,
+``<~viewer>/image``. Services and topics go through gui.ros: this package imports no ROS client
+library.
 """
 from __future__ import annotations
 
@@ -19,20 +21,14 @@ from typing import Optional, Sequence
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
-    import rospy
-
-    from odin_common.node import MasterWatch, init_ros_node
     from PyQt5.QtCore import QTimer
     from PyQt5.QtWidgets import QApplication
 
-    from gui.ros.parameters import DEFAULTS
+    from gui.ros.node import start_gui_node, stop_gui_node, without_remappings
     from gui.window.main_window import MainWindow
-    args = rospy.myargv(list(argv) if argv is not None else sys.argv)
-    app = QApplication(args)
-    init_ros_node("gui", disable_signals=True)
-    MasterWatch()
-    window = MainWindow(world=rospy.get_param("~world", DEFAULTS["world"]),
-                        viewer=rospy.get_param("~viewer", DEFAULTS["viewer"]))
+    app = QApplication(without_remappings(argv if argv is not None else sys.argv))
+    parameters = start_gui_node("gui")
+    window = MainWindow(world=parameters["world"], viewer=parameters["viewer"])
     window.show()
     signal.signal(signal.SIGINT, lambda *_: app.quit())
     tick = QTimer()
@@ -40,5 +36,5 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     tick.start(200)
     status = app.exec_()
     window.shutdown()
-    rospy.signal_shutdown("window closed")
+    stop_gui_node("window closed")
     return status
