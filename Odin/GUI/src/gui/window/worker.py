@@ -2,15 +2,16 @@
 
 ``WorldWorker`` is a ``QThread`` that owns one ``gui.ros.client.WorldClient`` (persistent service
 proxies are not shared between threads) and runs *jobs* from a queue one at a time; given
-``node=VIEWER`` it owns a ``gui.ros.viewer.ViewerClient`` instead (the Viewer panel's camera). A job is a
-callable ``fn(client, job) -> result``; its result or the error's message comes back to the GUI
-thread through Qt signals (queued connections), where the ``on_done`` / ``on_error``
-callbacks given to ``submit`` run.
+``node=VIEWER`` it owns a ``gui.ros.viewer.ViewerClient`` instead (the Viewer panel's camera).
+A job is a callable ``fn(client, job) -> result``; its result or the error's message comes
+back to the GUI thread through Qt signals (queued connections), where the ``on_done`` /
+``on_error`` callbacks given to ``submit`` run.
 
 Connection: while no world answers, the worker polls the master for the world's services every
 ``poll_period`` seconds; jobs submitted meanwhile fail at once with a message saying the world is
-absent. Once connected, the worker checks the world is still registered every
-``poll_period`` seconds while idle, and drops the connection when a call breaks.
+absent. Once connected, the worker checks the world is still registered, and its node answers
+(gui.ros.services.node_answers), every ``poll_period`` seconds while idle, and drops the
+connection when a call breaks.
 
 Long jobs (paths) look at ``job.cancelled`` / call ``job.sleep(seconds)``, which raises
 ``Cancelled`` as soon as ``cancel()`` is called.
