@@ -48,8 +48,6 @@ RULES = {
 EXCEPTIONS = {"odin_common.messages": ("Messages.msg",),
               "odin_common.node": ("rospy", "rosgraph"),
               "gui.planning.pool": ("gui.ros", "odin_common.messages")}
-# Qt tabs talk to the world through gui.ros' typed client only
-TAB_RULE = ROS + MESSAGES
 
 
 def _modules():
@@ -91,8 +89,6 @@ def test_every_source_module_is_in_a_layer():
 def test_module_imports_only_what_its_layer_may(name, path):
     forbidden = [prefix for layer, prefixes in RULES.items() if _matches(name, layer)
                  for prefix in prefixes]
-    if name.startswith("gui.window.") and name.endswith("_tab"):
-        forbidden += TAB_RULE
     allowed = EXCEPTIONS.get(name, ())
     wrong = [(imported, line) for imported, line in _imports(path)
              if any(_matches(imported, prefix) for prefix in forbidden)
