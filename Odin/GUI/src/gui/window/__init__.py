@@ -17,10 +17,14 @@ import signal
 import sys
 from typing import Optional, Sequence
 
+MASTER_TIMEOUT_S = 10.0
+"""s the window waits for a ROS master at start before it says none answers and exits 2."""
+
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
     import rospy
 
+    from odin_common.errors import NoMasterError
     from odin_common.node import MasterWatch, init_ros_node
     from PyQt5.QtCore import QTimer
     from PyQt5.QtWidgets import QApplication
@@ -29,7 +33,11 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     from gui.window.main_window import MainWindow
     args = rospy.myargv(list(argv) if argv is not None else sys.argv)
     app = QApplication(args)
-    init_ros_node("gui", disable_signals=True)
+    try:
+        init_ros_node("gui", disable_signals=True, master_timeout=MASTER_TIMEOUT_S)
+    except NoMasterError as error:
+        print(f"gui: error: {error}", file=sys.stderr)
+        return 2
     MasterWatch()
     window = MainWindow(world=rospy.get_param("~world", DEFAULTS["world"]),
                         viewer=rospy.get_param("~viewer", DEFAULTS["viewer"]))
