@@ -257,16 +257,42 @@ def run_path_main(argv: Optional[Sequence[str]] = None) -> int:
             print(f"{handle.name}: initial position set ({len(handle.bodies)} bodies)")
             return 0
         rate = args.rate if args.rate > 0 else client.publication_rate()
-        if args.position:
-            run_position_path(client, handle, rows, rate,
-                              progress=lambda k: print(f"[{k}/{len(rows)}]", flush=True))
-        else:
-            run_velocity_path(client, handle, rows, rate,
-                              progress=lambda k: print(f"[{k}/{len(rows)}]", flush=True))
+        done = [0]
+        with stop_on_ctrl_c() as stop:
+
+            def progress(k: int) -> None:
+                done[0] = k
+                print(f"[{k}/{len(rows)}]", flush=True)
+                if stop:                    # between two calls: none is cut in the middle
+                    raise _Stopped
+
+            try:
+                if args.position:
+                    run_position_path(client, handle, rows, rate, progress=progress)
+                else:
+                    run_velocity_path(client, handle, rows, rate, progress=progress)
+            except _Stopped:
+                pass
+            if stop:
+                if args.velocity:           # the last row's speeds would drive on
+                    client.set_velocities(handle.motor_ids, np.zeros(len(handle.motor_ids)))
+                return _interrupted(f"row {done[0]} of {len(rows)} ({done[0] / rate:.2f} s "
+                                    f"of {len(rows) / rate:.2f} s)")
         print(f"{handle.name}: {len(rows)} rows at {rate:g} Hz done")
     except OdinError as error:
         return _fail("run_path", error)
     return 0
+
+
+class _Stopped(Exception):
+    """Raised between two rows of a path when Ctrl-C asked to stop."""
+
+
+def _interrupted(where: str) -> int:
+    """run_path stopped by Ctrl-C, the robot held: says how far it got; 130 (128 + SIGINT)."""
+    from odin_common.tool import EXIT_INTERRUPTED
+    print(f"run_path: interrupted at {where}; the robot is held there", flush=True)
+    return EXIT_INTERRUPTED
 
 
 def _run_tracked(args, plan) -> int:
@@ -291,8 +317,17 @@ def _run_tracked(args, plan) -> int:
             shown[0] = int(t)
             print(f"t={t:.2f}/{total:.2f} s", flush=True)
 
-    report = run_tracked_on_client(client, plan, solution, progress=progress,
-                                   real_time=not args.fast)
+    reached = [0.0, 0.0]
+
+    def progress_of(t: float, total: float) -> None:
+        reached[:] = [t, total]
+        progress(t, total)
+
+    with stop_on_ctrl_c() as stop:
+        report = run_tracked_on_client(client, plan, solution, progress=progress_of,
+                                       real_time=not args.fast, stop=stop)
+    if stop:
+        return _interrupted(f"t={reached[0]:.2f} s of {reached[1]:.2f} s")
     print(f"{solution.format} path of {solution.waypoint_count} waypoints: goal error "
           f"{report.goal_error:.3g}, tracking error max {report.tracking_error_max:.3g}, "
           f"{report.duration_s:.2f} s simulated, {len(report.collisions)} colliding pairs, "
@@ -345,7 +380,13 @@ def _run_controls(args, handle) -> int:
         print(f"[{result.index}/{len(rows)}] t={elapsed[0]:.3f} s base at {where}{to_goal}",
               flush=True)
 
-    run_on_client(client, handle, rows, real_time=not args.fast, progress=progress)
+    with stop_on_ctrl_c() as stop:
+        results = run_on_client(client, handle, rows, real_time=not args.fast,
+                                progress=progress, stop=stop)
+    if stop:
+        total = sum(row.duration for row in rows)
+        return _interrupted(f"row {len(results)} of {len(rows)} ({elapsed[0]:.2f} s of "
+                            f"{total:.2f} s)")
     print(f"{handle.name}: {len(rows)} control rows done ({elapsed[0]:.3f} s simulated)")
     return 0
 
