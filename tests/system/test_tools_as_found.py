@@ -143,11 +143,18 @@ def test_a_tool_without_a_master_says_so_in_one_line_within_its_timeout(kautham_
     assert 3.0 <= took < 3.0 + 10.0, took       # the tool's own start: a few seconds here
 
 
+@pytest.mark.slow
 def test_the_window_without_a_master_says_so_and_exits(tmp_path):
+    """It waits for a roscore started beside it for a while (MASTER_TIMEOUT_S), saying so."""
+    from gui.window import MASTER_TIMEOUT_S
     env = dict(os.environ, ROS_MASTER_URI=NO_MASTER, ROS_HOME=str(tmp_path),
                QT_QPA_PLATFORM="offscreen", XDG_RUNTIME_DIR=str(tmp_path))
+    started = time.monotonic()
     run = subprocess.run(["rosrun", "GUI", "gui"], capture_output=True, text=True,
                          timeout=120, env=env)
+    assert time.monotonic() - started < MASTER_TIMEOUT_S + 15.0
     assert run.returncode == 2, run.stderr
-    assert f"gui: error: no ROS master answers at {NO_MASTER}" in run.stderr
+    assert f"gui: waiting for the ROS master at {NO_MASTER}" in run.stderr
+    assert f"gui: error: no ROS master answers at {NO_MASTER} after {MASTER_TIMEOUT_S:g} s" \
+        in run.stderr
     assert "Traceback" not in run.stderr

@@ -45,7 +45,7 @@ def _check_master(tool: str, timeout: float) -> None:
     """Before any work: a ROS master answers at ROS_MASTER_URI within ``timeout`` s (rospy
     would wait for one for ever, saying "Will keep trying")."""
     from odin_common.node import wait_for_master
-    wait_for_master(f"/{tool}", timeout=timeout)
+    wait_for_master(f"/{tool}", timeout=timeout, quiet=True)
 
 
 def _warnings_to_stderr(tool: str) -> None:

@@ -69,13 +69,14 @@ def _wake(cond: threading.Condition) -> None:
         cond.notify_all()
 
 
-def wait_for_master(caller_id: str, poll: float = 0.5, timeout: Optional[float] = None) -> None:
-    """Returns once the master at ROS_MASTER_URI answers, asking every ``poll`` seconds.
+def wait_for_master(caller_id: str, poll: float = 0.5, timeout: Optional[float] = None,
+                    quiet: bool = False) -> None:
+    """Returns once the master at ROS_MASTER_URI answers, asking every ``poll`` seconds and,
+    unless ``quiet``, saying once on stderr that it waits (roscpp's "waiting for master").
 
-    A node (``timeout`` None) waits for ever, saying once on stderr that it waits (roscpp's
-    "waiting for master"). A tool gives a ``timeout`` (s): it waits that long, quietly, each
-    question cut short at the deadline (a host that drops packets never refuses), then raises
-    ``NoMasterError`` naming the URI."""
+    A node (``timeout`` None) waits for ever. A tool gives a ``timeout`` (s): it waits that
+    long, each question cut short at the deadline (a host that drops packets never refuses),
+    then raises ``NoMasterError`` naming the URI."""
     uri = rosgraph.get_master_uri()
     deadline = None if timeout is None else time.monotonic() + max(0.0, timeout)
     said = False
@@ -85,12 +86,10 @@ def wait_for_master(caller_id: str, poll: float = 0.5, timeout: Optional[float] 
             _ask_master(uri, caller_id, left)
             return
         except (OSError, xmlrpc.client.Error, rosgraph.MasterError):
-            if deadline is not None:
-                if time.monotonic() >= deadline:
-                    raise NoMasterError(f"no ROS master answers at {uri} after {timeout:g} s "
-                                        "(is roscore running? is ROS_MASTER_URI right?)") \
-                        from None
-            elif not said:
+            if deadline is not None and time.monotonic() >= deadline:
+                raise NoMasterError(f"no ROS master answers at {uri} after {timeout:g} s "
+                                    "(is roscore running? is ROS_MASTER_URI right?)") from None
+            if not said and not quiet:
                 print(f"{caller_id}: waiting for the ROS master at {uri}",
                       file=sys.stderr, flush=True)
                 said = True

@@ -17,8 +17,9 @@ import signal
 import sys
 from typing import Optional, Sequence
 
-MASTER_TIMEOUT_S = 10.0
-"""s the window waits for a ROS master at start before it says none answers and exits 2."""
+MASTER_TIMEOUT_S = 30.0
+"""s the window waits for a ROS master at start, saying so, before it says none answers and
+exits 2: long enough for a roscore started beside it (a script, a launch, a test) to come up."""
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
