@@ -231,3 +231,17 @@ def test_a_stop_request_ends_the_search_at_once_with_keyboard_interrupt(sphere_b
         plan(sphere_backend, "KPIECE1", time_limit=120.0, seed=5, stop=stop)
     assert time.monotonic() - started < 10.0
     assert 50 <= sphere_backend.propagations <= 50 + 30     # one motion: at most 30 steps
+
+
+def test_a_control_path_cut_while_written_leaves_no_file(tmp_path, monkeypatch):
+    """Ctrl-C in the middle of writing: neither a half file nor the part file is left."""
+    import pathlib
+    write = pathlib.Path.write_text
+
+    def half_then_interrupted(self, text, *args, **kwargs):
+        write(self, text[:len(text) // 2])
+        raise KeyboardInterrupt
+    monkeypatch.setattr(pathlib.Path, "write_text", half_then_interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        write_control_path(tmp_path / "p.path", [ControlRow((0.5, 0.5), 0.1)] * 100)
+    assert list(tmp_path.iterdir()) == []

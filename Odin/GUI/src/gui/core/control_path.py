@@ -158,7 +158,8 @@ def write_control_path(path: os.PathLike | str, rows: Sequence[ControlRow],
     """Writes ``rows`` as a control path file (module docstring) that ``read_control_path``
     reads back exactly: each value in Python's shortest round-trip form; ``comments`` first,
     each a '#' line. Refuses rows of different sizes or with values out of range before
-    writing anything."""
+    writing anything; the file appears whole (written beside it, then renamed) or not at
+    all."""
     if not rows:
         raise PathFileError("no rows to write", path)
     size = len(rows[0].controls)
@@ -171,7 +172,13 @@ def write_control_path(path: os.PathLike | str, rows: Sequence[ControlRow],
                                 f"or duration {row.duration!r} s not positive", path)
     lines = [f"# {line}" for text in comments for line in str(text).splitlines()]
     lines += [" ".join(repr(float(v)) for v in (*row.controls, row.duration)) for row in rows]
-    pathlib.Path(path).write_text("\n".join(lines) + "\n")
+    target = pathlib.Path(path)
+    part = target.with_name(f".{target.name}.{os.getpid()}.part")
+    try:                        # whole or not at all, also when Ctrl-C comes mid-write
+        part.write_text("\n".join(lines) + "\n")
+        os.replace(part, target)
+    finally:
+        part.unlink(missing_ok=True)
 
 
 def actuation(handle, row: ControlRow, state: Optional[BodyState],
