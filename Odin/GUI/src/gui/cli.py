@@ -518,7 +518,7 @@ def _planning_backends(args):
     if args.backend == "pool":
 
         def pool_backend(k: int):
-            from gui.planning_pool import PoolBackend
+            from gui.planning.pool import PoolBackend
             return PoolBackend(plan, problem, namespaces[k::args.parallel],
                                timeout=args.world_timeout)
         return pool_backend, time_limit
