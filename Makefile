@@ -16,9 +16,9 @@ build:
 demo: setup
 	@$(ENV) python tools/demo.py
 
-# the whole suite on every core (pytest-xdist: each node test owns its roscore and ROS_HOME;
-# tests sharing one build stay on one worker by xdist_group), the 15 slowest listed at the end
-PYTEST := python -m pytest -p no:cacheprovider -n auto --dist loadgroup --durations=15
+# the whole suite on every core (pytest-xdist: each node test owns its roscore and ROS_HOME),
+# the 15 slowest listed at the end
+PYTEST := python -m pytest -p no:cacheprovider -n auto --durations=15
 
 test: setup
 	@$(ENV) $(PYTEST)

@@ -1,6 +1,7 @@
 """`catkin_make install` gives a working install space: every Python sub-package, the compiled
 cffi module, the nodes and scripts, the .msg/.srv files. Built from a clean workspace into a
 temporary folder, then used with nothing of the source tree or the devel space in sight."""
+import fcntl
 import os
 import pathlib
 import subprocess
@@ -9,9 +10,6 @@ import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 VENV_BIN = ROOT / ".venv" / "bin"
-
-# the install space is built once for the module (a catkin build): its tests share one worker
-pytestmark = pytest.mark.xdist_group("install_space")
 
 
 def _environment_of(setup: pathlib.Path) -> dict:
@@ -23,19 +21,31 @@ def _environment_of(setup: pathlib.Path) -> dict:
     return dict(item.split("=", 1) for item in dump.split("\0") if "=" in item)
 
 
-@pytest.fixture(scope="session")     # built once, whatever runs between its tests
-def install_env(tmp_path_factory) -> dict:
-    workspace = tmp_path_factory.mktemp("install_ws")
-    (workspace / "src").mkdir()
-    (workspace / "src" / "Odin").symlink_to(ROOT / "Odin")
-    prefix = workspace / "install"
+@pytest.fixture(scope="session")
+def install_env(tmp_path_factory, worker_id) -> dict:
+    """The install space, built once for the whole run (a catkin build takes a minute): under
+    pytest-xdist the first worker to need it builds it in the run's shared temporary folder
+    while the others wait on a lock, then all use it."""
+    base = tmp_path_factory.getbasetemp()
+    shared = base if worker_id == "master" else base.parent
+    workspace, prefix = shared / "install_ws", shared / "install_ws" / "install"
+    with open(shared / "install_ws.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not (prefix / "setup.bash").exists():
+            _build_install_space(workspace, prefix)
+    return _environment_of(prefix / "setup.bash")
+
+
+def _build_install_space(workspace: pathlib.Path, prefix: pathlib.Path) -> None:
+    (workspace / "src").mkdir(parents=True, exist_ok=True)
+    if not (workspace / "src" / "Odin").exists():
+        (workspace / "src" / "Odin").symlink_to(ROOT / "Odin")
     env = {"HOME": os.environ.get("HOME", "/root"), "PATH": f"{VENV_BIN}:/usr/bin:/bin"}
     result = subprocess.run(
         ["catkin_make", "-C", str(workspace), f"-DPYTHON_EXECUTABLE={VENV_BIN / 'python'}",
          "-DCATKIN_ENABLE_TESTING=OFF", f"-DCMAKE_INSTALL_PREFIX={prefix}", "install"],
         env=env, capture_output=True, text=True, timeout=900)
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
-    return _environment_of(prefix / "setup.bash")
 
 
 def _python(env: dict, code: str) -> str:
