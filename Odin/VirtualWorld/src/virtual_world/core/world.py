@@ -651,6 +651,13 @@ class Core:
         """The solver the last step used: QUICKSTEP or WORLDSTEP (the auto solver's choice)."""
         return Solver(self._scene.c.last_solver)
 
+    @property
+    def last_step_island_rows(self) -> Tuple[int, int]:
+        """What the auto solver measured before the last step (0, 0 under an explicit solver):
+        the largest island's constraint rows and the most rows of non-contact joints (motors
+        and limits included) in one island."""
+        return self._scene.c.last_island_rows
+
     @_locked
     def poses(self) -> Tuple[List[str], np.ndarray, np.ndarray]:
         """Every geometry (composite parts one by one, static ones too): names, positions
