@@ -653,9 +653,10 @@ class Core:
 
     @property
     def last_step_island_rows(self) -> Tuple[int, int]:
-        """What the auto solver measured before the last step (0, 0 under an explicit solver):
-        the largest island's constraint rows and the most rows of non-contact joints (motors
-        and limits included) in one island."""
+        """What the auto solver measured before the last step: the largest island's
+        constraint rows and the most rows of non-contact joints (motors and limits included)
+        in one island; 0, 0 under an explicit solver and when no awake body has a joint other
+        than a contact (the islands are not searched)."""
         return self._scene.c.last_island_rows
 
     @_locked

@@ -123,8 +123,9 @@ typedef struct OdinWorld {
                                 constraint rows, QuickStep otherwise */
     int auto_rows;           /* auto's bound (rows of one island; joint_rows() counts them) */
     int last_solver;         /* output: the solver the last step used (0 or 1) */
-    int island_rows;         /* output (auto): the last step's largest island's rows */
-    int articulated_rows;    /* output (auto): its most rows of non-contact joints in an island */
+    int island_rows;         /* output (auto): the last step's largest island's rows (0 when
+                                no awake body has a non-contact joint: not searched) */
+    int articulated_rows;    /* output (auto): the most rows of non-contact joints in an island */
     unsigned long rand_seed; /* the world's own state of ODE's random generator, which QuickStep
                                 uses to reorder constraints: set before each QuickStep and read
                                 back after, so no other world (or process history) changes it */

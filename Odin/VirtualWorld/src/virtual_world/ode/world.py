@@ -93,9 +93,9 @@ class CWorld:
 
     @property
     def last_island_rows(self) -> tuple:
-        """The auto solver's measure of the last step (0, 0 under an explicit solver): the
-        largest island's constraint rows and the most rows of non-contact joints in one
-        island (odin_step.c measure_islands)."""
+        """The auto solver's measure of the last step (0, 0 under an explicit solver or with
+        nothing articulated): the largest island's constraint rows and the most rows of
+        non-contact joints in one island (odin_step.c measure_islands)."""
         return int(self.struct.island_rows), int(self.struct.articulated_rows)
 
     @drains_ode_messages
