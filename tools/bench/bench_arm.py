@@ -4,7 +4,7 @@ The KUKA LWR of Kautham's public problem ``legacy_2012/examples/Kuka_two_columns
 in the Core by the GUI's build plan (ROS-free, as the GUI builds it), stretched out at its Home
 configuration (all joints 0: horizontal, gravity's worst case), every joint's motor a servo
 holding 0, gravity on, 10 s of 1 ms steps. The figure is the largest drop of the tip link's
-centre (mm) under the default solver (auto: dWorldStep on this arm's 63 rows), the fast
+centre (mm) under the default solver (auto: dWorldStep on this arm's island of 42 rows), the fast
 default the issue asks for; goal <= 1.0 mm.
 
 Beside it, each in a process of its own, rounds alternating: the same arm under explicit
