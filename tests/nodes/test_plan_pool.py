@@ -1,4 +1,4 @@
-"""The planning bridge's pool back end (gui.planning_pool, issue 17): two world nodes hold the
+"""The planning bridge's pool back end (gui.planning.pool, issue 17): two world nodes hold the
 Sphere problem; propagations from the planner's state vectors, fanned out over them, answer
 bit for bit what the Core back end answers, and a plan searched through the pool replays in the
 Core to the same place; the chain's servo controls answer the same through the pool;
@@ -45,7 +45,7 @@ def test_the_pool_answers_what_the_core_answers_and_plans_that_replay(ros_master
     from gui.planning.backend import CoreBackend
     from gui.planning.bridge import plan, replay
     from gui.planning.problem import planning_problem
-    from gui.planning_pool import PoolBackend
+    from gui.planning.pool import PoolBackend
     sphere = _sphere_plan(kautham_dir)
     problem = planning_problem(sphere)
     core = CoreBackend(sphere, problem)
@@ -83,7 +83,7 @@ def test_servo_controls_through_the_pool_answer_what_the_core_answers(ros_master
         ros_master.wait_for_service(f"{namespace}/propagate")
     from gui.planning.backend import CoreBackend
     from gui.planning.problem import planning_problem
-    from gui.planning_pool import PoolBackend
+    from gui.planning.pool import PoolBackend
     chain = _plan(ode_demos_dir / "demos" / "OMPL_ode_demos" / "Chain" / "k-PMPChain.xml")
     core = CoreBackend(chain, planning_problem(chain))
     pool = PoolBackend(chain, planning_problem(chain), NAMESPACES)
@@ -113,7 +113,7 @@ def test_parallel_searches_share_the_pool_one_world_each(ros_master, kautham_dir
                           "--parallel", "2", "--seed", "7", "--time", "60", "--out", str(out)],
                          capture_output=True, text=True, timeout=300, env=ros_master.env)
     assert run.returncode == 0, run.stderr
-    statistics = json.loads(run.stdout[:run.stdout.rindex("}") + 1])
+    statistics = json.loads(run.stdout[run.stdout.index("{"):run.stdout.rindex("}") + 1])
     assert statistics["solved"] and statistics["seed"] in (7, 8)
     assert sorted(s["seed"] for s in statistics["searches"]) == [7, 8]
     assert out.exists()

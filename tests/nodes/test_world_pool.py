@@ -1,4 +1,4 @@
-"""A pool of world nodes used as one (virtual_world.pool): the same scene in each, propagations
+"""A pool of world nodes used as one (gui.ros.pool): the same scene in each, propagations
 fanned out and gathered in order, every answer the one a single world gives (the worlds are
 deterministic), a refusal reported with the world that refused."""
 from __future__ import annotations
@@ -35,7 +35,7 @@ def test_a_pool_of_two_answers_in_order_as_one_world_does(ros_master):
         ros_master.rosrun("VirtualWorld", "virtualWorld", f"__ns:={namespace}")
     for namespace in NAMESPACES:
         ros_master.wait_for_service(f"{namespace}/propagate")
-    from virtual_world.pool import PoolError, WorldPool
+    from gui.ros.pool import PoolError, WorldPool
     with WorldPool(NAMESPACES) as pool:
         _scene(lambda service, **fields: pool.broadcast(service, **fields))
         assert [r.success for r in pool.broadcast("get_world")] == [True, True]

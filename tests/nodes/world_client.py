@@ -1,4 +1,5 @@
-"""A small rospy client of the VirtualWorld node for tests, benches and experiments."""
+"""A small client of the VirtualWorld node for tests, benches and experiments: raw service
+calls by name (gui.ros.services.ServiceCaller) and the world's poses."""
 from __future__ import annotations
 
 import time
@@ -6,28 +7,21 @@ import time
 import rospy
 
 from Messages import msg
-from Services import srv
+from gui.ros.services import ServiceCaller
 from odin_common.interface import WORLD_SERVICES
 
 
-
 class WorldClient:
-    """Calls ``/virtual_world/<name>`` with keyword fields; returns the response as it is."""
+    """Calls ``/virtual_world/<name>`` with keyword fields; returns the response as it is (a
+    broken call raises gui.errors.ServiceError). Requires ``rospy.init_node``."""
 
     def __init__(self, namespace: str = "/virtual_world", timeout: float = 30.0):
-        self.namespace = namespace
-        self._proxies = {}
-        rospy.wait_for_service(f"{namespace}/start", timeout=timeout)
+        self._caller = ServiceCaller(namespace, WORLD_SERVICES)
+        self.namespace = self._caller.namespace
+        self._caller.wait("start", timeout, f"no world answering after {timeout:g} s")
 
     def __call__(self, service: str, /, **fields):
-        proxy = self._proxies.get(service)
-        if proxy is None:
-            service_class = getattr(srv, WORLD_SERVICES[service])
-            proxy = rospy.ServiceProxy(f"{self.namespace}/{service}", service_class,
-                                       persistent=True)
-            self._proxies[service] = proxy
-        request = proxy.request_class(**fields)
-        return proxy(request)
+        return self._caller.ask(service, **fields)
 
     def ok(self, service: str, /, **fields):
         """Calls and insists on success."""
@@ -36,8 +30,7 @@ class WorldClient:
         return response
 
     def close(self) -> None:
-        for proxy in self._proxies.values():
-            proxy.close()
+        self._caller.close()
 
     def poses(self, timeout: float = 10.0) -> dict:
         """{geometry id: (position, orientation)} from the next world_update."""

@@ -218,7 +218,7 @@ def _pool_rate(size: int) -> dict:
         for namespace in namespaces:
             master.wait_for_service(f"{namespace}/propagate")
         master.apply_to_this_process()
-        from gui.planning_pool import PoolBackend
+        from gui.planning.pool import PoolBackend
         backend = PoolBackend(*_sphere(), namespaces)
         try:
             return {"per_s": _rate(backend)}

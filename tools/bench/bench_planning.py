@@ -70,7 +70,7 @@ def _pool_throughput(size: int) -> dict:
         master.apply_to_this_process()
         sys.path.insert(0, str(ROOT / "tests" / "nodes"))
         from world_client import box, sphere
-        from virtual_world.pool import WorldPool
+        from gui.ros.pool import WorldPool
         with WorldPool(namespaces) as pool:
             pool.broadcast("build_object", object=box("ground", (4, 4, 0.2), (0, 0, -0.1),
                                                       geometry_only=True))

@@ -16,9 +16,10 @@ import time
 
 import rospy
 
+from gui.errors import ServiceError
+from gui.ros.services import ServiceCaller
 from Messages.msg import Object
 from odin_common.interface import WORLD_NAMESPACE, WORLD_SERVICES
-from Services import srv
 
 # refusals another client's action (or a Restore State, which brings back joints the client's
 # books had dropped) explains: an ID taken away, a snapshot of a scene changed since it was
@@ -33,7 +34,7 @@ class Client:
     def __init__(self, number: int, seed: int):
         self.number = number
         self.rng = random.Random(seed)
-        self.proxies = {}
+        self.world = ServiceCaller(WORLD_NAMESPACE, WORLD_SERVICES)
         self.latencies: list = []
         self.calls = self.refusals = self.expected_refusals = 0
         self.errors: list = []
@@ -46,18 +47,12 @@ class Client:
         self.serial = 0
 
     def call(self, service: str, **fields):
-        proxy = self.proxies.get(service)
-        if proxy is None:
-            kind = getattr(srv, WORLD_SERVICES[service])
-            proxy = self.proxies[service] = rospy.ServiceProxy(
-                f"{WORLD_NAMESPACE}/{service}", kind, persistent=True)
         started = time.perf_counter()
         self.calls += 1
         try:
-            answer = proxy(**fields)
-        except (rospy.ServiceException, rospy.ROSException, OSError) as error:
+            answer = self.world.ask(service, **fields)
+        except (ServiceError, rospy.ROSException) as error:   # broken: the caller reconnects
             self.errors.append(f"{service}: {type(error).__name__}: {error}")
-            self.proxies.pop(service).close()
             return None
         finally:
             self.latencies.append(time.perf_counter() - started)
@@ -172,8 +167,8 @@ def main() -> int:
     parser.add_argument("--out", required=True)
     args = parser.parse_args()
     rospy.init_node(f"soak_client_{args.number}", disable_signals=True)
-    rospy.wait_for_service(f"{WORLD_NAMESPACE}/get_world", timeout=60)
     client = Client(args.number, seed=1000 + args.number)
+    client.world.wait("get_world", 60, "no world answering after 60 s")
     client.run(args.duration, args.new_scene_period)
     with open(args.out, "w") as f:
         json.dump(client.summary(), f)

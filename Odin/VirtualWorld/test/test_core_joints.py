@@ -50,6 +50,7 @@ import math
 import numpy as np
 import pytest
 
+from odin_common.rotations import quaternion_multiply
 from virtual_world.core import (ANGULAR, BALL, Core, FIXED, FORCE, HI_STOP, HINGE, HINGE2,
                                 LINEAR, LO_STOP, ObjectSpec, PISTON, PLANE2D, PR, PU, SLIDER,
                                 TORQUE, UNIVERSAL)
@@ -96,16 +97,6 @@ def unit(v):
 def quaternion(axis, angle):
     """(w, x, y, z) of the rotation by `angle` about `axis`."""
     return np.array([math.cos(angle / 2), *(math.sin(angle / 2) * unit(axis))])
-
-
-def qmul(a, b):
-    """The quaternion product a b: rotation b first, then a."""
-    w1, x1, y1, z1 = a
-    w2, x2, y2, z2 = b
-    return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
-                     w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-                     w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
-                     w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
 
 
 def rotate(q, v):
@@ -238,7 +229,8 @@ def test_ball_torque_turns_a_body_about_the_world_torque(core, bodies):
     np.testing.assert_allclose(w, rate_after(tau / I1), rtol=RATE_TOL)
     np.testing.assert_allclose(v, 0.0, atol=1e-12)
     np.testing.assert_allclose(position, 0.0, atol=1e-12)
-    turned = qmul(rotation_vector_quaternion(travel_after(tau / I1)), quaternion((1, 2, 3), 0.7))
+    turned = quaternion_multiply(rotation_vector_quaternion(travel_after(tau / I1)),
+                                 quaternion((1, 2, 3), 0.7))
     np.testing.assert_allclose(q, turned, rtol=ANGLE_TOL, atol=1e-9)
     assert joint_state(core, "ball").positions == ()
 
@@ -591,7 +583,7 @@ def turn(*rotations):
     """The quaternion of rotations (axis, angle) applied one after the other (world axes)."""
     q = np.array([1.0, 0, 0, 0])
     for axis, angle in rotations:
-        q = qmul(quaternion(axis, angle), q)
+        q = quaternion_multiply(quaternion(axis, angle), q)
     return q
 
 

@@ -41,13 +41,24 @@ class PathFileError(ProblemError):
     """A path or initial-position file that does not fit the robot it drives."""
 
 
-class WorldError(GuiError):
+class ServiceError(GuiError):
+    """A node answered a service call ``success: false`` (its message is kept as ``reason``)
+    or did not answer (the call broke: ``reason`` starts with "call failed"). ``service`` is the
+    service's path (``/virtual_world/build_object``), or the node's namespace when no service
+    of it was found; ``str(error)`` is ``"service: reason"``."""
+
+    def __init__(self, service: str, reason: str):
+        self.service = service
+        self.reason = reason
+        super().__init__(f"{service}: {reason}")
+
+
+class WorldError(ServiceError):
     """The VirtualWorld answered ``success: false`` (its message is kept) or did not answer."""
 
-    def __init__(self, service: str, message: str):
-        self.service = service
-        self.world_message = message
-        super().__init__(f"{service}: {message}")
+
+class ViewerError(ServiceError):
+    """The Viewer answered ``success: false`` (its message is kept) or did not answer."""
 
 
 class PlanningError(GuiError):

@@ -13,7 +13,16 @@ from typing import Any, Dict, NamedTuple, Sequence, Tuple
 from odin_common.errors import InvalidArgument
 
 
-class JointType(IntEnum):
+class _Labelled(IntEnum):
+    """An IntEnum whose members have a ``label`` for messages."""
+
+    @property
+    def label(self) -> str:
+        """Lower-case name for messages ("hinge2", "plane2d")."""
+        return self.name.lower()
+
+
+class JointType(_Labelled):
     """Messages/Joint: the joint types of Set Joint, JointData and joint IDs."""
     BALL = 0
     HINGE = 1
@@ -26,13 +35,8 @@ class JointType(IntEnum):
     FIXED = 8
     PLANE2D = 9
 
-    @property
-    def label(self) -> str:
-        """Lower-case name for messages ("hinge2", "plane2d")."""
-        return self.name.lower()
 
-
-class JointParameter(IntEnum):
+class JointParameter(_Labelled):
     """Messages/JointParameter: ODE joint (and motor) parameters, set per axis 1..3."""
     LO_STOP = 0          # rad or m
     HI_STOP = 1          # rad or m
@@ -46,10 +50,6 @@ class JointParameter(IntEnum):
     FUDGE_FACTOR = 9     # [0, 1]
     VELOCITY = 10        # motor goal: rad/s or m/s
     MAX_FORCE = 11       # motor limit: N m or N; negative means infinite
-
-    @property
-    def label(self) -> str:
-        return self.name.lower()
 
 
 class SetJointAction(IntEnum):
@@ -221,7 +221,7 @@ SERVO_MAX_SPEED = 2.0
 
 # ---------------------------------------------------------------------------------- shapes
 
-class Shape(IntEnum):
+class Shape(_Labelled):
     """Messages/Object, Part and View Object ``shape``. BY_COUNT (0, the default) keeps the
     thesis's rule: the number of ``parameters`` decides the shape (1 sphere, 2 cylinder, 3 box,
     a multiple of 3 >= 9 mesh). The others name it; their parameters (m, the object's frame):
@@ -236,10 +236,6 @@ class Shape(IntEnum):
     MESH = 4
     CAPSULE = 5
     PLANE = 6
-
-    @property
-    def label(self) -> str:
-        return self.name.lower()
 
 
 SHAPE_BY_PARAMETER_COUNT = {1: Shape.SPHERE, 2: Shape.CYLINDER, 3: Shape.BOX}

@@ -83,13 +83,14 @@ def matrix_to_quaternion(rotation: np.ndarray) -> np.ndarray:
 
 
 def quaternion_multiply(a_wxyz: Sequence[float], b_wxyz: Sequence[float]) -> np.ndarray:
-    """(4,) the Hamilton product a b: the rotation b followed by a (R(a b) = R(a) R(b))."""
-    w1, x1, y1, z1 = a_wxyz
-    w2, x2, y2, z2 = b_wxyz
-    return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
+    """(4,) the Hamilton product a b: the rotation b followed by a (R(a b) = R(a) R(b)); for
+    arrays of quaternions (n, 4), (n, 4) the n products."""
+    w1, x1, y1, z1 = np.moveaxis(np.asarray(a_wxyz, dtype=float), -1, 0)
+    w2, x2, y2, z2 = np.moveaxis(np.asarray(b_wxyz, dtype=float), -1, 0)
+    return np.stack([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
                      w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
                      w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
-                     w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
+                     w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2], axis=-1)
 
 
 def axis_angle_matrix(axis: Sequence[float], angle: float) -> np.ndarray:
@@ -124,15 +125,9 @@ def compose_poses(position_a: np.ndarray, quaternion_a: np.ndarray, position_b: 
     frame C in A: (p_a + R(q_a) p_b, q_a q_b). Quaternions are not renormalised."""
     pa, qa = np.asarray(position_a, float), np.asarray(quaternion_a, float)
     pb, qb = np.asarray(position_b, float), np.asarray(quaternion_b, float)
-    w1, x1, y1, z1 = np.moveaxis(qa, -1, 0)
-    w2, x2, y2, z2 = np.moveaxis(qb, -1, 0)
-    q = np.stack([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
-                  w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-                  w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
-                  w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2], axis=-1)
     u = qa[..., 1:]
     t = 2.0 * np.cross(u, pb)
-    return pa + pb + qa[..., :1] * t + np.cross(u, t), q
+    return pa + pb + qa[..., :1] * t + np.cross(u, t), quaternion_multiply(qa, qb)
 
 
 def invert_pose(position: Sequence[float], quaternion_wxyz: Sequence[float]) -> tuple:

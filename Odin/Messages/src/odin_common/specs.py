@@ -47,8 +47,24 @@ WORLD_SURFACE = Surface()
 """Nothing set: every contact value is the world's."""
 
 
+class _OneShape:
+    """What an ObjectSpec and a PartSpec, each one geometry, say of their shape."""
+    parameters: Sequence[float]
+    indices: Sequence[int]
+    shape: int
+
+    @property
+    def kind(self) -> str:
+        """"sphere", "cylinder", "box", "mesh", "capsule" or "plane"."""
+        return shape_kind(len(self.parameters), self.shape)
+
+    @property
+    def triangle_count(self) -> int:
+        return len(self.indices) // 3
+
+
 @dataclass(frozen=True, eq=False)
-class ObjectSpec:
+class ObjectSpec(_OneShape):
     """Messages/Object: one object, a body with one geometry (or a static geometry).
 
     parameters: the shape by their number (odin_common.interface.shape_kind): 1 sphere radius;
@@ -84,18 +100,9 @@ class ObjectSpec:
     def id(self) -> str:
         return self.name
 
-    @property
-    def kind(self) -> str:
-        """"sphere", "cylinder", "box", "mesh", "capsule" or "plane"."""
-        return shape_kind(len(self.parameters), self.shape)
-
-    @property
-    def triangle_count(self) -> int:
-        return len(self.indices) // 3
-
 
 @dataclass(frozen=True, eq=False)
-class PartSpec:
+class PartSpec(_OneShape):
     """Messages/Part: one geometry of a composite; pose in the composite's frame; shape (not a
     plane), mass, colour and surface as in ObjectSpec."""
     name: str
@@ -107,14 +114,6 @@ class PartSpec:
     color: Sequence[float] = NO_COLOR
     shape: int = Shape.BY_COUNT
     surface: Surface = WORLD_SURFACE
-
-    @property
-    def kind(self) -> str:
-        return shape_kind(len(self.parameters), self.shape)
-
-    @property
-    def triangle_count(self) -> int:
-        return len(self.indices) // 3
 
 
 @dataclass(frozen=True, eq=False)

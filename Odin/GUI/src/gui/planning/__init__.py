@@ -7,8 +7,10 @@ Odin's world (issue 17; docs/PLANNING.md).
   invalidate a motion (Kautham's rule), and the settings of a search.
 - ``gui.planning.backend``: the ``Backend`` interface (propagate a batch of (state, control)
   pairs: restore, apply the control for its duration, read the result) and ``CoreBackend``,
-  the VirtualWorld's Core in this process; the back end over a pool of world nodes is
-  ``gui.planning_pool.PoolBackend`` (outside this package: it uses ROS).
+  the VirtualWorld's Core in this process.
+- ``gui.planning.pool``: ``PoolBackend``, the back end over a pool of world nodes
+  (``gui.ros.pool.WorldPool``): the one module of this package that uses ROS, through gui.ros
+  only, imported only when a pool is asked for.
 - ``gui.planning.bridge``: OMPL's state space, control space, propagator, validity checker,
   goal region and planners over a back end; ``plan()`` answers a ``PlanResult`` whose rows
   are a Kautham control path (``gui.core.control_path.write_control_path``).

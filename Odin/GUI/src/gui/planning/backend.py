@@ -11,7 +11,7 @@ planner's propagation of a control for n steps is n such calls in a row, exactly
 that the written plan replays bit for bit in a fresh world.
 
 ``CoreBackend``: the VirtualWorld's Core in this process, built from the problem's plan
-(fastest: no messages). ``gui.planning_pool.PoolBackend``: world nodes over ROS.
+(fastest: no messages). ``gui.planning.pool.PoolBackend``: world nodes over ROS.
 """
 from __future__ import annotations
 

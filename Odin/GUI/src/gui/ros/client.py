@@ -1,15 +1,15 @@
 """The GUI's client of the VirtualWorld: rospy service proxies, no Qt.
 
-``WorldClient`` keeps one persistent ``rospy.ServiceProxy`` per world service
-(``odin_common.interface.WORLD_SERVICES``; a round trip is ~0.05 ms persistent against ~1.2 ms
-fresh) and offers one typed method per thing a tool or the window asks of the world: requests
-go in as odin_common specs, enums and plain values (SI units, world frame, quaternions
-(w, x, y, z)), answers come back as IDs, ``WorldParameters`` or ``StepValues``. A refusal
-(``success: false``) or a broken connection raises ``gui.errors.WorldError`` carrying the
-world's message. ``execute(plan)`` sends a ``gui.core.plan.BuildPlan`` (each step sends
-itself, then declares each robot it built with Set Robot: its robot_description, namespace and
-joint names, gui.core.robot_description); ``run_position_path`` / ``run_velocity_path`` drive a
-robot. Messages are built only by ``odin_common.messages`` and here.
+``WorldClient`` calls the world's services (``odin_common.interface.WORLD_SERVICES``) through
+one ``gui.ros.services.ServiceCaller`` (a persistent proxy per service) and offers one typed
+method per thing a tool or the window asks of the world: requests go in as odin_common specs,
+enums and plain values (SI units, world frame, quaternions (w, x, y, z)), answers come back as
+IDs, ``WorldParameters`` or ``StepValues``. A refusal (``success: false``) or a broken
+connection raises ``gui.errors.WorldError`` carrying the world's message. ``execute(plan)``
+sends a ``gui.core.plan.BuildPlan`` (each step sends itself, then declares each robot it built
+with Set Robot: its robot_description, namespace and joint names, gui.core.robot_description);
+``run_position_path`` / ``run_velocity_path`` drive a robot. Messages are built only by
+``odin_common.messages`` and here.
 
 The Qt window must not call these from its GUI thread (each call blocks until the world
 answers): run them in a worker thread and signal the results back (gui.window.worker).
@@ -28,6 +28,7 @@ import numpy as np
 from gui.core.plan import BuildPlan, BuiltIds, RobotHandle
 from gui.core.robot_description import RobotDescription, describe_robot
 from gui.errors import WorldError
+from gui.ros.services import ServiceCaller, join_ros_graph
 from odin_common.errors import InvalidArgument
 from odin_common.interface import WORLD_NAMESPACE, WORLD_SERVICES, ForceKind, SetJointAction
 from odin_common.messages import (body_force_message, composite_message, object_message,
@@ -120,49 +121,24 @@ class WorldClient:
 
     def __init__(self, namespace: str = WORLD_NAMESPACE, timeout: float = 10.0,
                  node_name: str = "gui"):
-        import rospy
-        from Services import srv
-        self._rospy = rospy
-        self._srv = srv
-        if not rospy.core.is_initialized():
-            rospy.init_node(node_name, anonymous=True, disable_signals=True)
-            from odin_common.node import prompt_shutdown
-            prompt_shutdown()
-        self.namespace = namespace.rstrip("/")
-        self._proxies: dict = {}
-        try:
-            rospy.wait_for_service(f"{self.namespace}/build_entity", timeout=timeout)
-        except rospy.ROSException:
-            raise WorldError(f"{self.namespace}", f"no VirtualWorld answering after {timeout:g} s "
-                             "(is `rosrun VirtualWorld virtualWorld` running?)") from None
+        join_ros_graph(node_name)
+        self._caller = ServiceCaller(namespace, WORLD_SERVICES, WorldError)
+        self.namespace = self._caller.namespace
+        self._caller.wait("build_entity", timeout,
+                          f"no VirtualWorld answering after {timeout:g} s "
+                          "(is `rosrun VirtualWorld virtualWorld` running?)")
 
     def call(self, service: str, /, **fields):
         """Calls one service with request ``fields``; returns the response or raises."""
-        response = self.ask(service, **fields)
-        if not response.success:
-            raise WorldError(f"{self.namespace}/{service}", response.message)
-        return response
+        return self._caller.call(service, **fields)
 
     def ask(self, service: str, /, **fields):
         """Calls one service and returns its response, refused or not (a refused Set Step or
         Set World still reports the values in force); raises only if the call fails."""
-        proxy = self._proxies.get(service)
-        if proxy is None:
-            service_class = getattr(self._srv, WORLD_SERVICES[service])
-            proxy = self._rospy.ServiceProxy(f"{self.namespace}/{service}", service_class,
-                                             persistent=True)
-            self._proxies[service] = proxy
-        try:
-            response = proxy(proxy.request_class(**fields))
-        except (self._rospy.ServiceException, OSError) as error:
-            self._proxies.pop(service, None)
-            raise WorldError(f"{self.namespace}/{service}", f"call failed: {error}") from None
-        return response
+        return self._caller.ask(service, **fields)
 
     def close(self) -> None:
-        for proxy in self._proxies.values():
-            proxy.close()
-        self._proxies.clear()
+        self._caller.close()
 
     # -- the scene and the simulation ----------------------------------------------------------
     def new_scene(self) -> None:

@@ -8,8 +8,10 @@ Qt signals), ``scene`` (what the window knows of the scene), ``fields`` (input l
 
 Node ``gui``; parameters: ``~world`` ("/virtual_world": namespace of the world's services and
 topics), ``~viewer`` ("/viewer": namespace of the Viewer's image topic).
-Services called: every ``<~world>/*`` service. Topics read: ``<~world>/world_update``,
-``<~world>/joint_data``, ``<~world>/joint_states``, ``<~viewer>/image``.
+Services called: every ``<~world>/*`` service, ``<~viewer>/set_camera``. Topics read:
+``<~world>/world_update``, ``<~world>/joint_data``, ``<~world>/joint_states``,
+``<~viewer>/image``. Services and topics go through gui.ros: this package imports no ROS client
+library.
 """
 from __future__ import annotations
 
@@ -17,22 +19,25 @@ import signal
 import sys
 from typing import Optional, Sequence
 
+MASTER_TIMEOUT_S = 30.0
+"""s the window waits for a ROS master at start, saying so, before it says none answers and
+exits 2: long enough for a roscore started beside it (a script, a launch, a test) to come up."""
+
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
-    import rospy
-
-    from odin_common.node import MasterWatch, init_ros_node
     from PyQt5.QtCore import QTimer
     from PyQt5.QtWidgets import QApplication
 
-    from gui.ros.parameters import DEFAULTS
+    from gui.ros.node import start_gui_node, stop_gui_node, without_remappings
     from gui.window.main_window import MainWindow
-    args = rospy.myargv(list(argv) if argv is not None else sys.argv)
-    app = QApplication(args)
-    init_ros_node("gui", disable_signals=True)
-    MasterWatch()
-    window = MainWindow(world=rospy.get_param("~world", DEFAULTS["world"]),
-                        viewer=rospy.get_param("~viewer", DEFAULTS["viewer"]))
+    from odin_common.errors import NoMasterError
+    app = QApplication(without_remappings(argv if argv is not None else sys.argv))
+    try:
+        parameters = start_gui_node("gui", master_timeout=MASTER_TIMEOUT_S)
+    except NoMasterError as error:
+        print(f"gui: error: {error}", file=sys.stderr)
+        return 2
+    window = MainWindow(world=parameters["world"], viewer=parameters["viewer"])
     window.show()
     signal.signal(signal.SIGINT, lambda *_: app.quit())
     tick = QTimer()
@@ -40,5 +45,5 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     tick.start(200)
     status = app.exec_()
     window.shutdown()
-    rospy.signal_shutdown("window closed")
+    stop_gui_node("window closed")
     return status

@@ -7,12 +7,13 @@ for a malformed number. Quaternions are checked and normalised by ``unit_quatern
 from __future__ import annotations
 
 import math
-from typing import Sequence
+import re
+from typing import Optional, Sequence
 
 from PyQt5.QtCore import QRegExp
-from PyQt5.QtGui import QRegExpValidator
-from PyQt5.QtWidgets import (QCheckBox, QDoubleSpinBox, QHBoxLayout, QLabel, QLineEdit,
-                             QSpinBox, QWidget)
+from PyQt5.QtGui import QRegExpValidator, QValidator
+from PyQt5.QtWidgets import (QBoxLayout, QButtonGroup, QCheckBox, QDoubleSpinBox, QHBoxLayout,
+                             QLabel, QLineEdit, QRadioButton, QSpinBox, QWidget)
 
 from gui.errors import GuiError
 
@@ -25,8 +26,86 @@ class InputError(GuiError):
     """What the user typed cannot be sent (the window says why; nothing is sent)."""
 
 
-def spin(value: float = 0.0, low: float = -BIG, high: float = BIG, decimals: int = 3,
-         step: float = 0.1, suffix: str = "", tip: str = "") -> QDoubleSpinBox:
+#: what may be typed on the way to a number: "-", "1.", "2e", "2e-"
+_PARTIAL_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d*)?([eE][+-]?\d*)?")
+
+
+class FloatSpin(QDoubleSpinBox):
+    """A spin box that shows its value with the digits it has (1e-05, 0.2, 10000) and takes
+    what is typed in any notation: for values spanning orders of magnitude, which fixed
+    decimals would round away. Up and down change the value by a tenth of its order of
+    magnitude (0.2 by 0.01, 1000 by 100), or by ``zero_step`` at zero; a typed value out of
+    range becomes the nearest bound."""
+
+    DIGITS = 12         # significant digits shown: a double's noise (0.21000000000000002) hides
+
+    def __init__(self, value: float, low: float, high: float, suffix: str = "",
+                 zero_step: float = 0.01, parent=None):
+        super().__init__(parent)
+        self.zero_step = zero_step
+        self.setDecimals(15)           # Qt rounds every value to this many decimals
+        self.setRange(low, high)
+        self.setValue(value)
+        self.setKeyboardTracking(False)
+        self.setAccelerated(True)
+        if suffix:
+            self.setSuffix(" " + suffix)
+
+    def textFromValue(self, value: float) -> str:
+        return f"{value:.{self.DIGITS}g}"
+
+    def valueFromText(self, text: str) -> float:
+        try:
+            return self._clamped(float(self._number(text)))
+        except ValueError:
+            return self.value()
+
+    def validate(self, text: str, position: int):
+        number = self._number(text)
+        try:
+            value = float(number)
+        except ValueError:
+            partial = _PARTIAL_NUMBER.fullmatch(number) is not None
+            return (QValidator.Intermediate if partial else QValidator.Invalid), text, position
+        inside = math.isfinite(value) and self.minimum() <= value <= self.maximum()
+        return (QValidator.Acceptable if inside else QValidator.Intermediate), text, position
+
+    def fixup(self, text: str) -> str:
+        try:
+            value = self._clamped(float(self._number(text)))
+        except ValueError:
+            return text
+        return self.prefix() + self.textFromValue(value) + self.suffix()
+
+    def stepBy(self, steps: int) -> None:
+        magnitude = abs(self.value())
+        step = 10.0 ** (math.floor(math.log10(magnitude)) - 1) if magnitude else self.zero_step
+        self.setValue(self.value() + steps * step)
+
+    def _number(self, text: str) -> str:
+        """``text`` without the prefix and suffix the box shows."""
+        if self.prefix() and text.startswith(self.prefix()):
+            text = text[len(self.prefix()):]
+        if self.suffix() and text.endswith(self.suffix()):
+            text = text[:-len(self.suffix())]
+        return text.strip()
+
+    def _clamped(self, value: float) -> float:
+        if math.isnan(value):
+            return self.value()
+        return min(max(value, self.minimum()), self.maximum())
+
+
+def spin(value: float = 0.0, low: float = -BIG, high: float = BIG,
+         decimals: Optional[int] = 3, step: float = 0.1, suffix: str = "",
+         tip: str = "") -> QDoubleSpinBox:
+    """A spin box of ``decimals`` decimals stepping by ``step``; decimals None: a FloatSpin
+    (the digits the value has, steps of a tenth of its order of magnitude)."""
+    if decimals is None:
+        box = FloatSpin(value, low, high, suffix)
+        if tip:
+            box.setToolTip(tip)
+        return box
     box = QDoubleSpinBox()
     box.setRange(low, high)
     box.setDecimals(decimals)
@@ -80,6 +159,29 @@ class VectorRow(QWidget):
     def set_values(self, values: Sequence[float]) -> None:
         for box, value in zip(self.boxes, values):
             box.setValue(float(value))
+
+
+class ChoiceButtons(QWidget):
+    """One radio button per name, in a row (or one under the other): ``buttons[i]`` and
+    ``value()`` i stand for the i-th name (a bool's: false, true)."""
+
+    def __init__(self, names: Sequence[str], value: int = 0, vertical: bool = False,
+                 parent=None):
+        super().__init__(parent)
+        layout = QBoxLayout(QBoxLayout.TopToBottom if vertical else QBoxLayout.LeftToRight,
+                            self)
+        layout.setContentsMargins(0, 0, 0, 0)
+        self.group = QButtonGroup(self)
+        self.buttons = []
+        for index, name in enumerate(names):
+            button = QRadioButton(name)
+            self.group.addButton(button, index)
+            self.buttons.append(button)
+            layout.addWidget(button)
+        self.buttons[value].setChecked(True)
+
+    def value(self) -> int:
+        return self.group.checkedId()
 
 
 def quaternion_row(values: Sequence[float] = (1, 0, 0, 0)) -> VectorRow:

@@ -9,10 +9,11 @@ list (Set parameters). A motor can be put on the chosen joint (then driven from 
 from __future__ import annotations
 
 from PyQt5.QtCore import Qt
-from PyQt5.QtWidgets import (QComboBox, QGridLayout, QGroupBox, QHBoxLayout, QLabel,
-                             QListWidget, QListWidgetItem, QPushButton, QVBoxLayout, QWidget)
+from PyQt5.QtWidgets import (QComboBox, QGroupBox, QHBoxLayout, QListWidget, QListWidgetItem,
+                             QPushButton, QVBoxLayout, QWidget)
 
 from gui.window.fields import InputError, VectorRow, checked_spin, int_spin
+from gui.window.forms import form_grid
 from gui.window.scene import JOINT_TYPE_NAMES
 from odin_common.interface import (JOINT_AXES_USED, JOINT_USES_ANCHOR, JointParameter,
                                    JointType, MotorKind)
@@ -57,32 +58,23 @@ class JointsTab(QWidget):
         self.create_button = QPushButton("Create joint")
 
         create = QGroupBox("New joint")
-        grid = QGridLayout(create)
-        grid.addWidget(QLabel("Joint type"), 0, 0)
-        grid.addWidget(self.type, 0, 1)
-        grid.addWidget(QLabel("First object"), 1, 0)
-        grid.addWidget(self.body1, 1, 1)
-        grid.addWidget(QLabel("Second object"), 2, 0)
-        grid.addWidget(self.body2, 2, 1)
-        grid.addWidget(QLabel("Anchor"), 3, 0)
-        grid.addWidget(self.anchor, 3, 1)
-        for k, row in enumerate(self.axes):
-            grid.addWidget(QLabel(["First axis", "Second axis", "Third axis"][k]), 4 + k, 0)
-            grid.addWidget(row, 4 + k, 1)
-        grid.addWidget(self.create_button, 7, 1)
+        axis_rows = [[title, row] for title, row in
+                     zip(("First axis", "Second axis", "Third axis"), self.axes)]
+        form_grid([["Joint type", self.type], ["First object", self.body1],
+                   ["Second object", self.body2], ["Anchor", self.anchor], *axis_rows,
+                   [None, self.create_button]], create)
 
         params = QGroupBox("Parameters (for a new joint, or Set on the chosen one)")
-        pgrid = QGridLayout(params)
         self.param_axis = int_spin(1, 1, 3, "axis the parameters apply to")
-        pgrid.addWidget(QLabel("Axis"), 0, 0)
-        pgrid.addWidget(self.param_axis, 0, 1)
         self.param_fields = {}
-        for k, (parameter, label, value, low, high) in enumerate(PARAMETERS):
+        cells = []
+        for parameter, label, value, low, high in PARAMETERS:
             check, box = checked_spin(label, value, low, high, 6, 0.05)
             box.valueChanged.connect(lambda _v, c=check: c.setChecked(True))
             self.param_fields[parameter] = (check, box)
-            pgrid.addWidget(check, 1 + k // 2, 2 * (k % 2))
-            pgrid.addWidget(box, 1 + k // 2, 2 * (k % 2) + 1)
+            cells += [check, box]
+        pairs = [cells[k:k + 4] for k in range(0, len(cells), 4)]    # two parameters a row
+        form_grid([["Axis", self.param_axis], *pairs], params)
 
         self.list = QListWidget()
         self.remove_button = QPushButton("Remove")

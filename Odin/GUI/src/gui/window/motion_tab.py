@@ -17,12 +17,12 @@ from __future__ import annotations
 
 import pathlib
 
-from PyQt5.QtWidgets import (QButtonGroup, QCheckBox, QComboBox, QFileDialog, QGridLayout,
-                             QHBoxLayout, QLabel, QListWidget, QPushButton, QRadioButton,
-                             QToolBox, QVBoxLayout, QWidget)
+from PyQt5.QtWidgets import (QCheckBox, QComboBox, QFileDialog, QLabel, QListWidget,
+                             QPushButton, QToolBox, QVBoxLayout, QWidget)
 
 from gui.errors import GuiError
-from gui.window.fields import VectorRow, int_spin, spin
+from gui.window.fields import ChoiceButtons, VectorRow, int_spin
+from gui.window.forms import form_grid, growing, span
 from gui.window.scene import JOINT_TYPE_NAMES
 from gui.window.tracking_plot import TrackingPlot
 from odin_common.interface import JOINT_FORCE_MAGNITUDES, ForceKind
@@ -42,17 +42,9 @@ class MotionTab(QWidget):
 
         # -- move object
         page = QWidget()
-        grid = QGridLayout(page)
         self.object = QComboBox()
-        self.action_group = QButtonGroup(page)
-        actions = QHBoxLayout()
-        self.action_buttons = []
-        for k, label in enumerate(ACTIONS):
-            button = QRadioButton(label)
-            self.action_group.addButton(button, k)
-            self.action_buttons.append(button)
-            actions.addWidget(button)
-        self.action_buttons[0].setChecked(True)
+        actions = ChoiceButtons(ACTIONS)          # index = action
+        self.action_group, self.action_buttons = actions.group, actions.buttons
         self.vector = VectorRow("xyz", (0.0, 0.0, 10.0), -1e6, 1e6, 3, 1.0)
         self.vector_relative = QCheckBox("relative (body frame)")
         self.at_point = QCheckBox("at point")
@@ -61,55 +53,40 @@ class MotionTab(QWidget):
         self.move_button = QPushButton("Move")
         self.forces = QListWidget()
         self.delete_force_button = QPushButton("Delete")
-        grid.addWidget(QLabel("Object"), 0, 0)
-        grid.addWidget(self.object, 0, 1, 1, 2)
-        grid.addLayout(actions, 1, 0, 1, 3)
-        grid.addWidget(QLabel("Intensity"), 2, 0)
-        grid.addWidget(self.vector, 2, 1)
-        grid.addWidget(self.vector_relative, 2, 2)
-        grid.addWidget(self.at_point, 3, 0)
-        grid.addWidget(self.point, 3, 1)
-        grid.addWidget(self.point_relative, 3, 2)
-        grid.addWidget(self.move_button, 4, 2)
-        grid.addWidget(self.forces, 5, 0, 1, 2)
-        grid.addWidget(self.delete_force_button, 5, 2)
+        form_grid([["Object", span(self.object, 2)],
+                   [span(actions, 3)],
+                   ["Intensity", self.vector, self.vector_relative],
+                   [self.at_point, self.point, self.point_relative],
+                   [None, None, self.move_button],
+                   [span(self.forces, 2), self.delete_force_button]], page)
         self.toolbox.addItem(page, "Move object")
 
         # -- move joint
         page = QWidget()
-        grid = QGridLayout(page)
         self.joint = QComboBox()
         self.magnitudes = VectorRow(["1", "2", "3"], (1.0, 0.0, 0.0), -1e6, 1e6, 3, 0.5)
         self.joint_force_button = QPushButton("Add force")
         self.joint_forces = QListWidget()
         self.delete_joint_force_button = QPushButton("Delete")
-        grid.addWidget(QLabel("Joint"), 0, 0)
-        grid.addWidget(self.joint, 0, 1, 1, 2)
-        grid.addWidget(QLabel("Magnitudes per axis\n(N m rotations, N translations)"), 1, 0)
-        grid.addWidget(self.magnitudes, 1, 1)
-        grid.addWidget(self.joint_force_button, 1, 2)
-        grid.addWidget(QLabel("Forces and torques"), 2, 0)
-        grid.addWidget(self.joint_forces, 3, 0, 1, 2)
-        grid.addWidget(self.delete_joint_force_button, 3, 2)
+        form_grid([["Joint", span(self.joint, 2)],
+                   ["Magnitudes per axis\n(N m rotations, N translations)", self.magnitudes,
+                    self.joint_force_button],
+                   ["Forces and torques"],
+                   [span(self.joint_forces, 2), self.delete_joint_force_button]], page)
         self.toolbox.addItem(page, "Move joint")
 
         # -- move motor
         page = QWidget()
-        grid = QGridLayout(page)
         self.motor = QComboBox()
         self.motor_speeds = VectorRow(["1", "2", "3"], (0.5, 0.0, 0.0), -1e3, 1e3, 3, 0.1)
         self.motor_button = QPushButton("Set velocity")
-        grid.addWidget(QLabel("Motor"), 0, 0)
-        grid.addWidget(self.motor, 0, 1, 1, 2)
-        grid.addWidget(QLabel("Goal speed per axis\n(rad/s or m/s)"), 1, 0)
-        grid.addWidget(self.motor_speeds, 1, 1)
-        grid.addWidget(self.motor_button, 1, 2)
-        grid.setRowStretch(2, 1)
+        form_grid([["Motor", span(self.motor, 2)],
+                   ["Goal speed per axis\n(rad/s or m/s)", self.motor_speeds, self.motor_button],
+                   growing()], page)
         self.toolbox.addItem(page, "Move motor")
 
         # -- move robot
         page = QWidget()
-        grid = QGridLayout(page)
         self.robot = QComboBox()
         self.units = QComboBox()
         self.units.addItems(["degrees (mm)", "radians (m)"])
@@ -127,21 +104,14 @@ class MotionTab(QWidget):
         self.stop_button = QPushButton("Stop path")
         self.stop_button.setEnabled(False)
         self.path_status = QLabel("No path running.")
-        grid.addWidget(QLabel("Robot"), 0, 0)
-        grid.addWidget(self.robot, 0, 1, 1, 2)
-        grid.addWidget(QLabel("Units in files"), 1, 0)
-        grid.addWidget(self.units, 1, 1)
-        grid.addWidget(self.initial_button, 2, 1)
-        grid.addWidget(self.velocity_button, 3, 0)
-        grid.addWidget(self.position_button, 3, 1)
-        grid.addWidget(self.controls_button, 3, 2)
-        grid.addWidget(QLabel("Double path precision (times)"), 4, 0)
-        grid.addWidget(self.double, 4, 1)
-        grid.addWidget(self.tracked_button, 5, 0)
-        grid.addWidget(self.stop_button, 5, 1)
-        grid.addWidget(self.path_status, 6, 0, 1, 3)
-        grid.addWidget(self.tracking_plot, 7, 0, 1, 3)
-        grid.setRowStretch(7, 1)
+        form_grid([["Robot", span(self.robot, 2)],
+                   ["Units in files", self.units],
+                   [None, self.initial_button],
+                   [self.velocity_button, self.position_button, self.controls_button],
+                   ["Double path precision (times)", self.double],
+                   [self.tracked_button, self.stop_button],
+                   [span(self.path_status, 3)],
+                   growing(span(self.tracking_plot, 3))], page)
         self.toolbox.addItem(page, "Move robot")
 
         layout = QVBoxLayout(self)

@@ -13,12 +13,13 @@ import pathlib
 from dataclasses import replace
 
 import numpy as np
-from PyQt5.QtWidgets import (QCheckBox, QComboBox, QFileDialog, QFormLayout, QGridLayout,
-                             QGroupBox, QHBoxLayout, QLabel, QLineEdit, QListWidget,
-                             QPushButton, QStackedWidget, QVBoxLayout, QWidget)
+from PyQt5.QtWidgets import (QCheckBox, QComboBox, QFileDialog, QFormLayout, QGroupBox,
+                             QHBoxLayout, QLabel, QLineEdit, QListWidget, QPushButton,
+                             QStackedWidget, QVBoxLayout, QWidget)
 
 from gui.window.fields import InputError, VectorRow, name_edit, quaternion_row, spin, \
     unit_quaternion
+from gui.window.forms import form_grid, span
 from odin_common.rotations import quaternion_to_matrix
 from odin_common.specs import CompositeSpec, ObjectSpec
 
@@ -84,25 +85,13 @@ class ObjectsTab(QWidget):
         self.create_button = QPushButton("Create it!")
 
         create = QGroupBox("Create object")
-        grid = QGridLayout(create)
-        grid.addWidget(QLabel("Name"), 0, 0)
-        grid.addWidget(self.name, 0, 1)
-        grid.addWidget(QLabel("Shape"), 1, 0)
-        grid.addWidget(self.shape, 1, 1)
-        grid.addWidget(QLabel("Preset"), 2, 0)
-        grid.addWidget(self.preset, 2, 1)
-        grid.addWidget(self.stack, 3, 0, 1, 2)
-        row = QHBoxLayout()
-        row.addWidget(self.mass, 1)
-        row.addWidget(self.fixed)
-        row.addWidget(self.static)
-        grid.addWidget(QLabel("Mass"), 4, 0)
-        grid.addLayout(row, 4, 1)
-        grid.addWidget(QLabel("Position"), 5, 0)
-        grid.addWidget(self.position, 5, 1)
-        grid.addWidget(QLabel("Orientation"), 6, 0)
-        grid.addWidget(self.orientation, 6, 1)
-        grid.addWidget(self.create_button, 7, 1)
+        mass_row = QHBoxLayout()
+        mass_row.addWidget(self.mass, 1)
+        mass_row.addWidget(self.fixed)
+        mass_row.addWidget(self.static)
+        form_grid([["Name", self.name], ["Shape", self.shape], ["Preset", self.preset],
+                   [span(self.stack, 2)], ["Mass", mass_row], ["Position", self.position],
+                   ["Orientation", self.orientation], [None, self.create_button]], create)
 
         self.list = QListWidget()
         self.remove_button = QPushButton("Remove")

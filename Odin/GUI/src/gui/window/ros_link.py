@@ -1,11 +1,11 @@
-"""rospy topics -> Qt signals. Subscriber callbacks run on rospy's threads; they only convert the
-message (an image into a ``QImage`` copy) and emit a signal, which Qt queues to the GUI thread.
+"""The window's topics (gui.ros.topics) -> Qt signals. The callbacks run on the ROS client's
+threads; they only convert the message (an image into a ``QImage`` copy) and emit a signal,
+which Qt queues to the GUI thread.
 
-Topics subscribed (names are relative to the world's and Viewer's namespaces):
-  ``<world>/world_update`` Messages/SpaceDistribution -> ``world_update(msg)``;
-  ``<world>/joint_data``   Messages/JointsData -> ``joint_data(msg)``;
-  ``<world>/joint_states`` sensor_msgs/JointState (world joint IDs) -> ``joint_states(msg)``;
-  ``<viewer>/image``       sensor_msgs/Image (rgb8 / bgr8 / mono8) -> ``image(QImage)``.
+  ``<world>/world_update`` -> ``world_update(msg)``;
+  ``<world>/joint_data``   -> ``joint_data(msg)``;
+  ``<world>/joint_states`` -> ``joint_states(msg)``;
+  ``<viewer>/image``       (rgb8 / bgr8 / mono8 / rgba8) -> ``image(QImage)``.
 
 Only the latest image is ever queued: a frame arriving while the previous one has not been
 drawn yet replaces it (so a busy GUI thread never piles up frames).
@@ -17,6 +17,7 @@ import threading
 from PyQt5.QtCore import QObject, pyqtSignal
 from PyQt5.QtGui import QImage
 
+from gui.ros.topics import WindowTopics
 from odin_common.interface import VIEWER_NAMESPACE, WORLD_NAMESPACE
 
 _FORMATS = {"rgb8": (QImage.Format_RGB888, 3), "bgr8": (QImage.Format_RGB888, 3),
@@ -36,7 +37,8 @@ def image_to_qimage(msg) -> QImage:
 
 
 class RosLink(QObject):
-    """Subscribes once (rospy must be initialised); signals carry messages to the GUI thread."""
+    """Subscribes once (the process must be a ROS node); signals carry messages to the GUI
+    thread."""
 
     world_update = pyqtSignal(object)
     joint_data = pyqtSignal(object)
@@ -47,24 +49,11 @@ class RosLink(QObject):
     def __init__(self, world: str = WORLD_NAMESPACE, viewer: str = VIEWER_NAMESPACE,
                  parent=None):
         super().__init__(parent)
-        import rospy
-        from sensor_msgs.msg import Image, JointState
-
-        from Messages.msg import JointsData, SpaceDistribution
         self._lock = threading.Lock()
         self._latest_image = None
         self._image_ready.connect(self._emit_image)
-        world = world.rstrip("/")
-        self._subscribers = [
-            rospy.Subscriber(f"{world}/world_update", SpaceDistribution,
-                             self.world_update.emit, queue_size=2),
-            rospy.Subscriber(f"{world}/joint_data", JointsData, self.joint_data.emit,
-                             queue_size=2),
-            rospy.Subscriber(f"{world}/joint_states", JointState, self.joint_states.emit,
-                             queue_size=2),
-            rospy.Subscriber(f"{viewer.rstrip('/')}/image", Image, self._on_image,
-                             queue_size=1, buff_size=4 << 20),
-        ]
+        self._topics = WindowTopics(self.world_update.emit, self.joint_data.emit,
+                                    self.joint_states.emit, self._on_image, world, viewer)
 
     def _on_image(self, msg) -> None:
         image = image_to_qimage(msg)
@@ -81,6 +70,4 @@ class RosLink(QObject):
             self.image.emit(image)
 
     def close(self) -> None:
-        for subscriber in self._subscribers:
-            subscriber.unregister()
-        self._subscribers.clear()
+        self._topics.close()

@@ -2,67 +2,35 @@
 
 Step: any subset of the four step values (a check box each; unchecked means "not given"); the
 world resolves conflicts and answers the values in force, which are shown beside the fields.
-World parameters: each with a check box (zero is a valid value of most), sent together in one
-Set World (all-or-nothing); the values in force come back and are shown. Their first values,
-units and ranges are odin_common.world_parameters'. The values in force are read through the
-client when the world comes up (an empty Set Step / Set World answers them).
+World parameters: one row each, generated from odin_common.world_parameters.PARAMETERS (its
+title, field, unit, range, first value, tool tip and page: ``gui.window.forms``), so a new
+parameter shows up here with no edit. Each Set World flag has a check box (zero is a valid
+value of most) that sends the parameters it applies; the checked ones go together in one Set
+World (all-or-nothing) and the values in force come back and are shown. The values in force
+are read through the client when the world comes up (an empty Set Step / Set World answers
+them).
 """
 from __future__ import annotations
 
-from typing import Optional
+from typing import Dict, List
 
-from PyQt5.QtWidgets import (QButtonGroup, QCheckBox, QComboBox, QGridLayout, QHBoxLayout,
-                             QLabel, QPushButton, QRadioButton, QToolBox, QVBoxLayout, QWidget)
+from PyQt5.QtWidgets import (QCheckBox, QHBoxLayout, QLabel, QPushButton, QToolBox,
+                             QVBoxLayout, QWidget)
 
-from gui.window.fields import VectorRow, checked_spin, int_spin, spin
-from odin_common.interface import Solver
+from gui.window.fields import checked_spin, int_spin
+from gui.window.forms import (ParameterField, form_grid, growing, parameter_text,
+                              parameter_tip, parameter_title)
 from odin_common.step_values import MAX_RATE, MAX_STEP, MAX_STEPS_PER_CYCLE, StepValues
-from odin_common.world_parameters import PARAMETER_INFO, default
-
-#: (parameter, label, decimals, step, bound of the field where the parameter has none) of the
-#: scalar parameters, per page
-SCALARS = {
-    "ERP and CFM": [
-        ("erp", "Error reduction parameter (ERP)", 4, 0.05, None),
-        ("cfm", "Constraint force mixing (CFM)", 7, 1e-5, 1.0),
-    ],
-    "Speed limits and contact layer": [
-        ("max_angular_speed", "Maximum angular speed (0: none)", 3, 1.0, 1e4),
-        ("contact_max_correcting_velocity", "Contact max correcting velocity (0: unlimited)",
-         3, 0.1, 1e4),
-        ("contact_surface_layer", "Contact surface layer", 4, 0.001, 1.0),
-    ],
-    "Damping": [
-        ("linear_damping", "Linear damping", 4, 0.01, None),
-        ("linear_damping_threshold", "Linear damping threshold", 4, 0.01, 1e3),
-        ("angular_damping", "Angular damping", 4, 0.01, None),
-        ("angular_damping_threshold", "Angular damping threshold", 4, 0.01, 1e3),
-    ],
-    "Contacts": [
-        ("friction", "Friction (Coulomb mu; negative: infinite)", 3, 0.1, 1e3),
-        ("bounce", "Bounce (restitution)", 3, 0.05, None),
-        ("bounce_velocity", "Bounce velocity", 3, 0.05, 1e3),
-        ("collision_mesh_tolerance", "Collision mesh tolerance (0: as given; meshes built "
-         "afterwards)", 4, 0.001, None),
-    ],
-}
-SOLVER_NAMES = {Solver.QUICKSTEP: "QuickStep", Solver.WORLDSTEP: "WorldStep", Solver.AUTO: "Auto"}
-SOLVER_ITEMS = {Solver.QUICKSTEP: "QuickStep (iterative, handles piles)",
-                Solver.WORLDSTEP: "WorldStep (exact, the thesis's)",
-                Solver.AUTO: "Auto (WorldStep on few constraints, else QuickStep)"}
+from odin_common.world_parameters import (PARAMETER_INFO, PARAMETERS, ParameterInfo, default,
+                                          set_world_flags)
 
 
-def _unit(name: str) -> str:
-    unit = PARAMETER_INFO[name].unit
-    return "" if unit == "-" else unit.replace("^2", "²")
-
-
-def _range(name: str, bound: Optional[float]) -> tuple:
-    """(low, high) of a parameter's field: its range, ``bound`` above where it has no upper
-    bound, ``-bound`` below where it has no lower one (friction: negative is infinite)."""
-    info = PARAMETER_INFO[name]
-    return (float(info.low if info.low is not None else -bound),
-            float(info.high if info.high is not None else bound))
+def _pages() -> Dict[str, List[ParameterInfo]]:
+    """Page title -> its parameters, pages in the order of their first parameter."""
+    pages: Dict[str, List[ParameterInfo]] = {}
+    for info in PARAMETERS:
+        pages.setdefault(info.group, []).append(info)
+    return pages
 
 
 class SettingsTab(QWidget):
@@ -72,10 +40,27 @@ class SettingsTab(QWidget):
         self.toolbox = QToolBox()
         self.in_force: dict = {}
         self.in_force_labels: dict = {}
+        self.toolbox.addItem(self._step_page(), "Step sizes")
 
-        # -- step page
-        page = QWidget()
-        grid = QGridLayout(page)
+        self.world_fields: Dict[str, ParameterField] = {}
+        self.world_boxes: dict = {}         # parameter -> its input widget
+        self.world_checks: dict = {}        # parameter -> the check box that sends it
+        self.flags = set_world_flags()
+        self.flag_checks = {flag: self._send_check(PARAMETER_INFO[names[0]])
+                            for flag, names in self.flags.items()}
+        for title, infos in _pages().items():
+            self.toolbox.addItem(self._world_page(infos), title)
+        self.set_world_button = QPushButton("Set checked world parameters")
+        self.set_world_button.clicked.connect(self.send_world)
+
+        layout = QVBoxLayout(self)
+        layout.addWidget(self.toolbox, 1)
+        row = QHBoxLayout()
+        row.addStretch(1)
+        row.addWidget(self.set_world_button)
+        layout.addLayout(row)
+
+    def _step_page(self) -> QWidget:
         first = StepValues()   # shown until the world answers with the values in force
         self.step_fields = {
             "step": checked_spin("Step", first.step, 1e-6, MAX_STEP, 6, 0.0005, "s"),
@@ -86,125 +71,77 @@ class SettingsTab(QWidget):
             "rate": checked_spin("Rate (publications / s)", first.rate, 0.01, MAX_RATE, 2, 1.0,
                                  "Hz"),
         }
-        grid.addWidget(QLabel("<b>send</b>"), 0, 0)
-        grid.addWidget(QLabel("<b>in force</b>"), 0, 2)
-        for row, (key, (check, box)) in enumerate(self.step_fields.items(), start=1):
-            grid.addWidget(check, row, 0)
-            grid.addWidget(box, row, 1)
-            label = QLabel("?")
-            self.in_force_labels[key] = label
-            grid.addWidget(label, row, 2)
+        rows = [["<b>send</b>", None, "<b>in force</b>"]]
+        for key, (check, box) in self.step_fields.items():
+            rows.append([check, box, self._in_force_label(key)])
             box.valueChanged.connect(lambda _v, c=check: c.setChecked(True))
         self.set_step_button = QPushButton("Set step")
-        grid.addWidget(self.set_step_button, 5, 1)
-        grid.setRowStretch(6, 1)
-        self.toolbox.addItem(page, "Step sizes")
         self.set_step_button.clicked.connect(self.send_step)
-
-        # -- world pages
-        self.world_checks: dict = {}
-        self.world_boxes: dict = {}
+        rows += [[None, self.set_step_button], growing()]
         page = QWidget()
-        grid = QGridLayout(page)
-        self.gravity_check = QCheckBox("Set gravity")
-        self.gravity = VectorRow("xyz", default("gravity"), -1e3, 1e3, 3, 0.1,
-                                 _unit("gravity"))
-        grid.addWidget(self.gravity_check, 0, 0)
-        grid.addWidget(self.gravity, 0, 1)
-        grid.addWidget(QLabel("in force:"), 1, 0)
-        self._in_force_label(grid, "gravity", 1, 1)
-        grid.setRowStretch(2, 1)
-        self.toolbox.addItem(page, "Gravity")
+        form_grid(rows, page)
+        return page
 
+    def _world_page(self, infos: List[ParameterInfo]) -> QWidget:
+        """One row per parameter: the check box of its Set World flag (the first parameter of
+        a flag holds it; the others show it, disabled), its field, its value in force."""
+        rows = []
+        for info in infos:
+            field = ParameterField(info, default(info.name))
+            sender = self.flag_checks[info.set_flag]
+            first = PARAMETER_INFO[self.flags[info.set_flag][0]]
+            check = sender if first is info else self._sent_with(info, first, sender)
+            field.on_edit(lambda c=sender: c.setChecked(True))
+            self.world_fields[info.name] = field
+            self.world_boxes[info.name] = field.widget
+            self.world_checks[info.name] = sender
+            rows.append([check, field.widget, self._in_force_label(info.name)])
         page = QWidget()
-        grid = QGridLayout(page)
-        self.policy_check = QCheckBox("Set collision policy")
-        self.contacts_radio = QRadioButton("Create contacts")
-        self.highlight_radio = QRadioButton("Detect and report only (highlight objects)")
-        self.contacts_radio.setChecked(True)
-        group = QButtonGroup(page)
-        group.addButton(self.contacts_radio)
-        group.addButton(self.highlight_radio)
-        grid.addWidget(self.policy_check, 0, 0)
-        grid.addWidget(self.contacts_radio, 0, 1)
-        grid.addWidget(self.highlight_radio, 1, 1)
-        self.max_contacts_check = QCheckBox("Maximum contacts per pair")
-        info = PARAMETER_INFO["max_contacts"]
-        self.max_contacts = int_spin(default("max_contacts"), int(info.low), int(info.high))
-        grid.addWidget(self.max_contacts_check, 2, 0)
-        grid.addWidget(self.max_contacts, 2, 1)
-        self._in_force_label(grid, "contact_less", 0)
-        self._in_force_label(grid, "max_contacts", 2)
-        grid.setRowStretch(3, 1)
-        self.toolbox.addItem(page, "Collision policy")
+        form_grid(rows + [growing()], page)
+        return page
 
-        for title, rows in SCALARS.items():
-            page = QWidget()
-            grid = QGridLayout(page)
-            for row, (key, label, decimals, step, bound) in enumerate(rows):
-                value, (low, high), unit = default(key), _range(key, bound), _unit(key)
-                if key == "bounce_velocity":
-                    check = QCheckBox(label + " (sent with bounce)")
-                    check.setEnabled(False)
-                    box = spin(value, low, high, decimals, step, unit)
-                else:
-                    check, box = checked_spin(label, value, low, high, decimals, step, unit)
-                    box.valueChanged.connect(lambda _v, c=check: c.setChecked(True))
-                self.world_checks[key] = check
-                self.world_boxes[key] = box
-                grid.addWidget(check, row, 0)
-                grid.addWidget(box, row, 1)
-                self._in_force_label(grid, key, row)
-            grid.setRowStretch(len(rows), 1)
-            self.toolbox.addItem(page, title)
+    @staticmethod
+    def _sent_with(info: ParameterInfo, first: ParameterInfo, sender: QCheckBox) -> QCheckBox:
+        """A disabled check box that follows ``sender``: Set World applies ``info`` with
+        ``first``, its flag's first parameter."""
+        check = QCheckBox(parameter_title(info))
+        check.setEnabled(False)
+        check.setToolTip(f"sent with {first.label}: tick {first.label} to send it")
+        sender.toggled.connect(check.setChecked)
+        return check
 
-        page = QWidget()
-        grid = QGridLayout(page)
-        self.solver_check = QCheckBox("Set solver")
-        self.solver = QComboBox()
-        self.solver.addItems([SOLVER_ITEMS[s] for s in Solver])        # index = Solver
-        self.solver.setCurrentIndex(default("solver"))
-        info = PARAMETER_INFO["quickstep_iterations"]
-        self.iterations = int_spin(default("quickstep_iterations"), int(info.low),
-                                   int(info.high), "QuickStep iterations")
-        grid.addWidget(self.solver_check, 0, 0)
-        grid.addWidget(self.solver, 0, 1)
-        grid.addWidget(QLabel("QuickStep iterations"), 1, 0)
-        grid.addWidget(self.iterations, 1, 1)
-        self._in_force_label(grid, "solver", 0)
-        self.sleep_check = QCheckBox("Set auto-disable")
-        self.sleep = QCheckBox("Resting bodies sleep until touched or changed")
-        self.sleep.setChecked(default("auto_disable"))
-        self.sleep.setToolTip(PARAMETER_INFO["auto_disable"].what)
-        grid.addWidget(self.sleep_check, 2, 0)
-        grid.addWidget(self.sleep, 2, 1)
-        self._in_force_label(grid, "auto_disable", 2)
-        grid.setRowStretch(3, 1)
-        self.toolbox.addItem(page, "Solver")
+    @staticmethod
+    def _send_check(info: ParameterInfo) -> QCheckBox:
+        check = QCheckBox(parameter_title(info))
+        check.setToolTip(parameter_tip(info))
+        return check
 
-        self.set_world_button = QPushButton("Set checked world parameters")
-        self.set_world_button.clicked.connect(self.send_world)
-        self.gravity_check.setChecked(False)
-        for box in self.gravity.boxes:
-            box.valueChanged.connect(lambda _v: self.gravity_check.setChecked(True))
-        self.solver.currentIndexChanged.connect(lambda _i: self.solver_check.setChecked(True))
-        self.iterations.valueChanged.connect(lambda _i: self.solver_check.setChecked(True))
-        self.max_contacts.valueChanged.connect(lambda _i: self.max_contacts_check.setChecked(True))
-        self.contacts_radio.toggled.connect(lambda _b: self.policy_check.setChecked(True))
-        self.sleep.toggled.connect(lambda _b: self.sleep_check.setChecked(True))
-
-        layout = QVBoxLayout(self)
-        layout.addWidget(self.toolbox, 1)
-        row = QHBoxLayout()
-        row.addStretch(1)
-        row.addWidget(self.set_world_button)
-        layout.addLayout(row)
-
-    def _in_force_label(self, grid: QGridLayout, key: str, row: int, column: int = 2) -> None:
+    def _in_force_label(self, key: str) -> QLabel:
         label = QLabel("?")
         label.setToolTip("value in force in the world")
         self.in_force_labels[key] = label
-        grid.addWidget(label, row, column)
+        return label
+
+    # the widgets tests drive the tab by
+    @property
+    def gravity(self):
+        return self.world_boxes["gravity"]
+
+    @property
+    def highlight_radio(self):
+        return self.world_boxes["contact_less"].buttons[1]     # true: detect only
+
+    @property
+    def solver(self):
+        return self.world_boxes["solver"]
+
+    @property
+    def sleep(self):
+        return self.world_boxes["auto_disable"]
+
+    @property
+    def sleep_check(self):
+        return self.world_checks["auto_disable"]
 
     # -- step ---------------------------------------------------------------------------------
     def step_request(self) -> dict:
@@ -231,25 +168,12 @@ class SettingsTab(QWidget):
 
     # -- world --------------------------------------------------------------------------------
     def world_changes(self) -> dict:
-        """{world parameter: value} of the checked parameters (the names of
+        """{world parameter: value} of the checked flags' parameters (the names of
         odin_common.world_parameters)."""
         changes: dict = {}
-        if self.gravity_check.isChecked():
-            changes["gravity"] = self.gravity.values()
-        if self.policy_check.isChecked():
-            changes["contact_less"] = self.highlight_radio.isChecked()
-        if self.max_contacts_check.isChecked():
-            changes["max_contacts"] = int(self.max_contacts.value())
-        for key, check in self.world_checks.items():
-            if key != "bounce_velocity" and check.isChecked():
-                changes[key] = float(self.world_boxes[key].value())
-        if "bounce" in changes:
-            changes["bounce_velocity"] = float(self.world_boxes["bounce_velocity"].value())
-        if self.solver_check.isChecked():
-            changes["solver"] = Solver(self.solver.currentIndex())
-            changes["quickstep_iterations"] = int(self.iterations.value())
-        if self.sleep_check.isChecked():
-            changes["auto_disable"] = self.sleep.isChecked()
+        for flag, names in self.flags.items():
+            if self.flag_checks[flag].isChecked():
+                changes.update({name: self.world_fields[name].value() for name in names})
         return changes
 
     def send_world(self) -> None:
@@ -262,25 +186,11 @@ class SettingsTab(QWidget):
 
     def show_world(self, parameters) -> None:
         """Shows the world parameters in force (odin_common WorldParameters)."""
-        for key, label in self.in_force_labels.items():
-            if key in self.step_fields:
-                continue
-            value = getattr(parameters, key)
-            self.in_force[key] = value
-            if key == "gravity":
-                text = "(" + ", ".join(f"{v:g}" for v in value) + ")"
-            elif key == "contact_less":
-                text = "detect only" if value else "contacts"
-            elif key == "auto_disable":
-                text = "on" if value else "off"
-            elif key == "solver":
-                text = SOLVER_NAMES.get(value, str(value)) + \
-                    f", {parameters.quickstep_iterations} it."
-            else:
-                text = f"{value:g}"
-            label.setText(text)
-        for check in [self.gravity_check, self.policy_check, self.max_contacts_check,
-                      self.solver_check, self.sleep_check, *self.world_checks.values()]:
+        for info in PARAMETERS:
+            value = getattr(parameters, info.name)
+            self.in_force[info.name] = value
+            self.in_force_labels[info.name].setText(parameter_text(info, value))
+        for check in self.flag_checks.values():
             check.setChecked(False)
 
     def refresh(self) -> None:

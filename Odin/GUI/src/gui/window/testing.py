@@ -23,10 +23,10 @@ def app() -> QApplication:
 def open_window(poll_period: float = 0.2):
     """The process's QApplication, this process as the ROS node "gui", and a shown MainWindow
     polling the world every ``poll_period`` s (the caller shuts it down)."""
-    import rospy
+    from gui.ros.node import join_as_gui
     from gui.window.main_window import MainWindow
     app()
-    rospy.init_node("gui", anonymous=False, disable_signals=True)
+    join_as_gui("gui")
     window = MainWindow(poll_period=poll_period)
     window.show()
     return window

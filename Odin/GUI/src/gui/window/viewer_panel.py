@@ -5,16 +5,16 @@ Left drag orbits about the camera's target (horizontal: about world z; vertical:
 never over the poles), right or middle drag (or shift + left drag) pans, the wheel zooms towards
 the target. "Frame the robot" aims the camera at the robots the world holds (every object when
 it holds none), "Fit scene" gives the camera back to the Viewer's own fitting. Every move is a
-Set Camera (``set_pose``) sent on a thread of the panel's own; while one is on its way only the
-latest move waits, so a fast drag never queues calls. The camera the panel moves from is the
-Viewer's answer (``camera``), in the world frame (REP 103), metres.
+Set Camera (``gui.ros.viewer.ViewerClient.set_camera``) sent on a worker of the panel's own
+(gui.window.worker); while one is on its way only the latest move waits, so a fast drag never
+queues calls. The camera the panel moves from is the Viewer's answer (``camera``), in the world
+frame (REP 103), metres.
 """
 from __future__ import annotations
 
 import math
-import threading
 import time
-from typing import Callable, NamedTuple, Optional, Sequence
+from typing import Callable, Optional, Sequence
 
 import numpy as np
 from PyQt5.QtCore import QObject, Qt, pyqtSignal
@@ -22,6 +22,8 @@ from PyQt5.QtGui import QPixmap
 from PyQt5.QtWidgets import (QHBoxLayout, QLabel, QPushButton, QSizePolicy, QVBoxLayout,
                              QWidget)
 
+from gui.ros.viewer import CameraAnswer, CameraPose
+from gui.window.worker import VIEWER, WorldWorker
 from odin_common.interface import VIEWER_NAMESPACE
 
 ORBIT_PER_PIXEL = 0.01      # rad of orbit per pixel dragged
@@ -29,16 +31,6 @@ ZOOM_PER_STEP = 0.85        # distance factor per wheel notch (120 eighths of a 
 MAX_ELEVATION = 1.5         # rad: the orbit stops short of the poles (up stays world z)
 MIN_DISTANCE = 0.02         # m: the eye never reaches the target
 FRAME_MARGIN = 0.3          # m added to a framed set of origins' radius (links have extent)
-
-
-class CameraPose(NamedTuple):
-    """eye, target, up: world frame, metres; fov_y: rad; width, height: pixels."""
-    eye: tuple
-    target: tuple
-    up: tuple
-    fov_y: float
-    width: int
-    height: int
 
 
 # -- navigation (pure) --------------------------------------------------------------------------
@@ -96,61 +88,58 @@ def frame(camera: CameraPose, points: Sequence, margin: float = FRAME_MARGIN) ->
 
 # -- Set Camera off the GUI thread --------------------------------------------------------------
 class CameraLink(QObject):
-    """Sends Set Camera requests on a thread of its own, the latest one only; ``answered``
-    carries the request's number and the Viewer's camera (CameraPose), ``failed`` a message."""
+    """Sends Set Camera requests (keyword arguments of ``ViewerClient.set_camera``) through a
+    worker of its own (gui.window.worker with the Viewer's client), the latest one only: while
+    one is on its way, a newer request replaces the one waiting. ``answered`` carries the
+    request's number and the Viewer's camera (CameraPose), ``failed`` a message. GUI thread
+    only."""
 
     answered = pyqtSignal(int, object)
     failed = pyqtSignal(str)
 
     def __init__(self, viewer: str = VIEWER_NAMESPACE, parent=None):
         super().__init__(parent)
-        self.service = f"{viewer.rstrip('/')}/set_camera"
-        self._wake = threading.Condition()
-        self._request: Optional[tuple] = None     # (number, fields)
+        self.worker = WorldWorker(viewer, name="viewer", parent=self, node=VIEWER)
+        self._waiting: Optional[tuple] = None     # (number, request) not sent yet
+        self._on_its_way = False
         self._numbers = 0
-        self._closing = False
-        self._thread = threading.Thread(target=self._run, name="set-camera", daemon=True)
-        self._thread.start()
+        self._closed = False
+        self.worker.start()
 
-    def send(self, **fields) -> int:
-        """Queues a Set Camera (its fields), replacing one not sent yet; returns its number."""
-        with self._wake:
-            self._numbers += 1
-            self._request = (self._numbers, fields)
-            self._wake.notify()
-            return self._numbers
+    def send(self, **request) -> int:
+        """Queues a Set Camera, replacing one not sent yet; returns its number."""
+        self._numbers += 1
+        self._waiting = (self._numbers, request)
+        if not self._on_its_way:
+            self._send_waiting()
+        return self._numbers
 
     def close(self) -> None:
-        with self._wake:
-            self._closing = True
-            self._wake.notify()
-        self._thread.join(2.0)
+        self._closed = True     # the requests the worker drops now are nobody's concern
+        self.worker.stop(2000)
 
-    def _run(self) -> None:
-        import rospy
-        from Services.srv import SetCamera
-        proxy = None
-        while True:
-            with self._wake:
-                while self._request is None and not self._closing:
-                    self._wake.wait()
-                if self._closing:
-                    break
-                (number, fields), self._request = self._request, None
-            try:
-                if proxy is None:
-                    proxy = rospy.ServiceProxy(self.service, SetCamera)
-                answer = proxy(**fields)
-            except Exception as error:      # Viewer absent or gone: say so, try again later
-                proxy = None
-                self.failed.emit(f"Set Camera: the Viewer does not answer ({self.service}): "
-                                 f"{error}")
-                continue
-            if not answer.success:
-                self.failed.emit(f"Set Camera refused: {answer.message}")
-            self.answered.emit(number, CameraPose(tuple(answer.eye), tuple(answer.target),
-                                          tuple(answer.up), float(answer.fov_y),
-                                          int(answer.width), int(answer.height)))
+    def _send_waiting(self) -> None:
+        (number, request), self._waiting = self._waiting, None
+        self._on_its_way = True
+        self.worker.submit("Set Camera", lambda viewer, job: viewer.set_camera(**request),
+                           lambda answer: self._answered(number, answer), self._failed)
+
+    def _answered(self, number: int, answer: CameraAnswer) -> None:
+        if answer.refusal:
+            self.failed.emit(f"Set Camera refused: {answer.refusal}")
+        self.answered.emit(number, answer.camera)
+        self._send_next()
+
+    def _failed(self, message: str) -> None:      # Viewer absent or gone: said, tried again
+        if self._closed:
+            return
+        self.failed.emit(message)
+        self._send_next()
+
+    def _send_next(self) -> None:
+        self._on_its_way = False
+        if self._waiting is not None:
+            self._send_waiting()
 
 
 class _ImageLabel(QLabel):
@@ -247,7 +236,7 @@ class ViewerPanel(QWidget):
     def move_to(self, camera: CameraPose) -> None:
         """Fixes the Viewer's camera at ``camera`` (shown at once; the answer confirms it)."""
         self.camera = camera
-        self._send(set_pose=True, eye=camera.eye, target=camera.target, up=camera.up)
+        self._send(eye=camera.eye, target=camera.target, up=camera.up)
 
     def _drag(self, dx: int, dy: int, buttons, modifiers) -> None:
         if self.camera is None:

@@ -1,15 +1,17 @@
 """The Qt side of the world client: service calls on a thread of their own, never the GUI's.
 
 ``WorldWorker`` is a ``QThread`` that owns one ``gui.ros.client.WorldClient`` (persistent service
-proxies are not shared between threads) and runs *jobs* from a queue one at a time. A job is a
-callable ``fn(client, job) -> result``; its result or the error's message comes back to the GUI
-thread through Qt signals (queued connections), where the ``on_done`` / ``on_error``
-callbacks given to ``submit`` run.
+proxies are not shared between threads) and runs *jobs* from a queue one at a time; given
+``node=VIEWER`` it owns a ``gui.ros.viewer.ViewerClient`` instead (the Viewer panel's camera).
+A job is a callable ``fn(client, job) -> result``; its result or the error's message comes
+back to the GUI thread through Qt signals (queued connections), where the ``on_done`` /
+``on_error`` callbacks given to ``submit`` run.
 
 Connection: while no world answers, the worker polls the master for the world's services every
 ``poll_period`` seconds; jobs submitted meanwhile fail at once with a message saying the world is
-absent. Once connected, the worker checks the world is still registered every
-``poll_period`` seconds while idle, and drops the connection when a call breaks.
+absent. Once connected, the worker checks the world is still registered, and its node answers
+(gui.ros.services.node_answers), every ``poll_period`` seconds while idle, and drops the
+connection when a call breaks.
 
 Long jobs (paths) look at ``job.cancelled`` / call ``job.sleep(seconds)``, which raises
 ``Cancelled`` as soon as ``cancel()`` is called.
@@ -21,16 +23,36 @@ import queue
 import threading
 import time
 import traceback
-import xmlrpc.client
 from dataclasses import dataclass, field
-from typing import Any, Callable, Optional
+from typing import Any, Callable, NamedTuple, Optional
 
 from PyQt5.QtCore import QThread, pyqtSignal
 
-from gui.errors import GuiError, WorldError
+from gui.errors import GuiError, ServiceError
+from gui.ros.services import node_answers
 from odin_common.interface import WORLD_NAMESPACE
 
-PING_TIMEOUT = 2.0      # s: a world that does not answer its pid in this long is absent
+
+def _world_client(namespace: str, timeout: float):
+    from gui.ros.client import WorldClient
+    return WorldClient(namespace, timeout=timeout)
+
+
+def _viewer_client(namespace: str, timeout: float):
+    from gui.ros.viewer import ViewerClient
+    return ViewerClient(namespace, timeout=timeout)
+
+
+class NodeKind(NamedTuple):
+    """What a worker serves: the node's name in the window's messages, the service whose
+    registration says the node is up, and its client's constructor ``(namespace, timeout s)``."""
+    title: str
+    probe: str
+    connect: Callable[[str, float], Any]
+
+
+WORLD = NodeKind("VirtualWorld", "set_joint_force", _world_client)
+VIEWER = NodeKind("Viewer", "set_camera", _viewer_client)
 
 
 class Cancelled(GuiError):
@@ -81,9 +103,10 @@ class WorldWorker(QThread):
     progressed = pyqtSignal(int, object)
 
     def __init__(self, namespace: str = WORLD_NAMESPACE, poll_period: float = 0.5,
-                 name: str = "world", parent=None):
+                 name: str = "world", parent=None, node: NodeKind = WORLD):
         super().__init__(parent)
         self.namespace = namespace.rstrip("/")
+        self.node = node
         self.poll_period = poll_period
         self.name = name
         self._queue: "queue.Queue[Optional[Job]]" = queue.Queue()
@@ -177,8 +200,8 @@ class WorldWorker(QThread):
         if job.needs_world and not self._connected:
             self._check_connection()
             if not self._connected:
-                self.failed_job.emit(job.id, f"{job.label}: the VirtualWorld is not running "
-                                     f"({self.namespace}/* absent); waiting for it")
+                self.failed_job.emit(job.id, f"{job.label}: the {self.node.title} is not "
+                                     f"running ({self.namespace}/* absent); waiting for it")
                 return
         self._current = job
         job.started = time.monotonic()
@@ -187,9 +210,9 @@ class WorldWorker(QThread):
             result = job.fn(self._client, job)
         except Cancelled as error:
             self.failed_job.emit(job.id, str(error))
-        except WorldError as error:
+        except ServiceError as error:
             self.failed_job.emit(job.id, str(error))
-            if "call failed" in error.world_message:
+            if "call failed" in error.reason:
                 self._check_connection()
         except GuiError as error:
             self.failed_job.emit(job.id, str(error))
@@ -202,39 +225,21 @@ class WorldWorker(QThread):
             self._current = None
             self.busy.emit("")
 
-    def _service_registered(self) -> bool:
-        """Whether the world's services are registered AND their node answers: a world that
-        crashed (SIGKILL, a segfault) never unregisters, so the master alone would call it
-        alive. The node is asked its pid over its XML-RPC API, as ``rosnode ping`` does."""
-        import rosgraph
-        import rospy
-        service = f"{self.namespace}/set_joint_force"
-        try:
-            master = rosgraph.Master(rospy.get_name() or "/gui")
-            providers = dict(master.getSystemState()[2]).get(service, [])
-            if not providers:
-                return False
-            api = master.lookupNode(providers[0])
-            xmlrpc.client.ServerProxy(api, transport=_QuickTransport()).getPid(master.caller_id)
-            return True
-        except Exception:  # master down, service not registered, node gone or not answering
-            return False
-
     def _check_connection(self) -> None:
-        if not self._service_registered():
+        title = self.node.title
+        if not node_answers(f"{self.namespace}/{self.node.probe}"):
             if self._connected or self._client is not None:
                 self._drop_client()
-            self._set_connected(False, f"VirtualWorld absent: waiting for {self.namespace}")
+            self._set_connected(False, f"{title} absent: waiting for {self.namespace}")
             return
         if self._client is None:
-            from gui.ros.client import WorldClient
             try:
-                self._client = WorldClient(self.namespace, timeout=2.0)
-            except (WorldError, Exception) as error:  # a world coming up or going down
+                self._client = self.node.connect(self.namespace, 2.0)
+            except Exception as error:  # a node coming up or going down
                 self._client = None
-                self._set_connected(False, f"VirtualWorld not answering: {error}")
+                self._set_connected(False, f"{title} not answering: {error}")
                 return
-        self._set_connected(True, f"VirtualWorld connected ({self.namespace})")
+        self._set_connected(True, f"{title} connected ({self.namespace})")
 
     def _set_connected(self, connected: bool, text: str) -> None:
         changed = connected != self._connected
@@ -250,12 +255,3 @@ class WorldWorker(QThread):
             except Exception:
                 pass
         self._client = None
-
-
-class _QuickTransport(xmlrpc.client.Transport):
-    """XML-RPC over HTTP that gives up after PING_TIMEOUT s: a hung node is an absent one."""
-
-    def make_connection(self, host):
-        connection = super().make_connection(host)
-        connection.timeout = PING_TIMEOUT
-        return connection

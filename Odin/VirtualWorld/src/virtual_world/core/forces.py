@@ -8,7 +8,7 @@ acts on body1 along (about) +axis and the reaction on body2.
 """
 from __future__ import annotations
 
-from typing import Dict, Iterable, Sequence
+from typing import Callable, Dict, Iterable, NamedTuple, Sequence
 
 import numpy as np
 
@@ -42,33 +42,18 @@ def add_body_force(scene: Scene, object_id: str, kind: int, vector,
         raise InvalidArgument("a torque has no point of application (at_point=True)")
     if at_point and point_in_body_frame:
         point = point - obj.com  # object frame -> ODE body frame (centre of mass)
-    force_id = _free_id(scene.body_forces, f"{kind.name.lower()}:{object_id}")
-    scene.body_forces[force_id] = BodyForceRecord(object_id, kind, vector_in_body_frame,
-                                                  at_point, point_in_body_frame, vector, point)
-    obj.forces.add(force_id)
-    _rebuild_body_forces(scene)
-    return force_id
+    return _keep(scene, _BODY, f"{kind.name.lower()}:{object_id}",
+                 BodyForceRecord(object_id, kind, vector_in_body_frame, at_point,
+                                 point_in_body_frame, vector, point))
 
 
 def remove_body_force(scene: Scene, force_id: str) -> None:
-    if force_id not in scene.body_forces:
-        raise UnknownName(f"no body force {force_id!r}")
-    scene.objects[scene.body_forces[force_id].object_id].forces.discard(force_id)
-    drop_body_forces(scene, [force_id])
+    _remove(scene, _BODY, force_id)
 
 
 def drop_body_forces(scene: Scene, force_ids: Iterable[str]) -> None:
     """Forgets body forces (their object is going) and hands C the rest."""
-    for force_id in list(force_ids):
-        del scene.body_forces[force_id]
-    _rebuild_body_forces(scene)
-
-
-def _rebuild_body_forces(scene: Scene) -> None:
-    scene.c.set_body_forces([
-        (scene.objects[f.object_id].body.ptr, f.kind, f.vector_in_body_frame, f.at_point,
-         f.point_in_body_frame, f.vector.tolist(), f.point.tolist())
-        for f in scene.body_forces.values()])
+    _drop(scene, _BODY, force_ids)
 
 
 def add_joint_force(scene: Scene, joint_id: str, magnitudes: Sequence[float]) -> str:
@@ -89,31 +74,16 @@ def add_joint_force(scene: Scene, joint_id: str, magnitudes: Sequence[float]) ->
     values = check.vector("joint force magnitudes", magnitudes, count)
     check.at_most(f"joint force on {joint_id!r}", float(np.max(np.abs(values))),
                   limits.MAX_FORCE, "N or N m")
-    force_id = _free_id(scene.joint_forces, f"jointforce:{joint_id}")
-    scene.joint_forces[force_id] = JointForceRecord(joint_id, values)
-    joint.forces.add(force_id)
-    _rebuild_joint_forces(scene)
-    return force_id
+    return _keep(scene, _JOINT, f"jointforce:{joint_id}", JointForceRecord(joint_id, values))
 
 
 def remove_joint_force(scene: Scene, force_id: str) -> None:
-    if force_id not in scene.joint_forces:
-        raise UnknownName(f"no joint force {force_id!r}")
-    scene.joints[scene.joint_forces[force_id].joint_id].forces.discard(force_id)
-    drop_joint_forces(scene, [force_id])
+    _remove(scene, _JOINT, force_id)
 
 
 def drop_joint_forces(scene: Scene, force_ids: Iterable[str]) -> None:
     """Forgets joint forces (their joint is going) and hands C the rest."""
-    for force_id in list(force_ids):
-        del scene.joint_forces[force_id]
-    _rebuild_joint_forces(scene)
-
-
-def _rebuild_joint_forces(scene: Scene) -> None:
-    scene.c.set_joint_forces([
-        (scene.joints[f.joint_id].owner.ptr, ODE_JOINT_TYPE[scene.joints[f.joint_id].type],
-         f.magnitudes.tolist()) for f in scene.joint_forces.values()])
+    _drop(scene, _JOINT, force_ids)
 
 
 def replace_all(scene: Scene, body_forces: Dict[str, BodyForceRecord],
@@ -122,12 +92,65 @@ def replace_all(scene: Scene, body_forces: Dict[str, BodyForceRecord],
     ids on their objects and joints, and C's arrays."""
     scene.body_forces = dict(body_forces)
     scene.joint_forces = dict(joint_forces)
-    for obj in scene.objects.values():
-        obj.forces = {i for i, f in body_forces.items() if f.object_id == obj.id}
-    for joint in scene.joints.values():
-        joint.forces = {i for i, f in joint_forces.items() if f.joint_id == joint.id}
-    _rebuild_body_forces(scene)
-    _rebuild_joint_forces(scene)
+    for kind in (_BODY, _JOINT):
+        records = kind.records(scene)
+        for owner in kind.owners(scene).values():
+            owner.forces = {i for i, f in records.items() if kind.owner_id(f) == owner.id}
+        kind.to_c(scene)
+
+
+def _body_forces_to_c(scene: Scene) -> None:
+    scene.c.set_body_forces([
+        (scene.objects[f.object_id].body.ptr, f.kind, f.vector_in_body_frame, f.at_point,
+         f.point_in_body_frame, f.vector.tolist(), f.point.tolist())
+        for f in scene.body_forces.values()])
+
+
+def _joint_forces_to_c(scene: Scene) -> None:
+    scene.c.set_joint_forces([
+        (scene.joints[f.joint_id].owner.ptr, ODE_JOINT_TYPE[scene.joints[f.joint_id].type],
+         f.magnitudes.tolist()) for f in scene.joint_forces.values()])
+
+
+class _Kind(NamedTuple):
+    """One kind of persistent force, kept alike: its records by force ID, the objects or
+    joints they act on (each with the set ``forces`` of its force IDs), and C's copy."""
+    noun: str                                   # in errors: "body force", "joint force"
+    records: Callable[[Scene], dict]            # {force ID: record}
+    owners: Callable[[Scene], dict]             # {object or joint ID: its record}
+    owner_id: Callable[[object], str]           # record -> the ID it acts on
+    to_c: Callable[[Scene], None]               # hands C every record of the kind
+
+
+_BODY = _Kind("body force", lambda scene: scene.body_forces, lambda scene: scene.objects,
+              lambda record: record.object_id, _body_forces_to_c)
+_JOINT = _Kind("joint force", lambda scene: scene.joint_forces, lambda scene: scene.joints,
+               lambda record: record.joint_id, _joint_forces_to_c)
+
+
+def _keep(scene: Scene, kind: _Kind, prefix: str, record) -> str:
+    """Keeps ``record`` under "<prefix>:<n>", n the first free number; returns that ID."""
+    records = kind.records(scene)
+    force_id = _free_id(records, prefix)
+    records[force_id] = record
+    kind.owners(scene)[kind.owner_id(record)].forces.add(force_id)
+    kind.to_c(scene)
+    return force_id
+
+
+def _remove(scene: Scene, kind: _Kind, force_id: str) -> None:
+    records = kind.records(scene)
+    if force_id not in records:
+        raise UnknownName(f"no {kind.noun} {force_id!r}")
+    kind.owners(scene)[kind.owner_id(records[force_id])].forces.discard(force_id)
+    _drop(scene, kind, [force_id])
+
+
+def _drop(scene: Scene, kind: _Kind, force_ids: Iterable[str]) -> None:
+    records = kind.records(scene)
+    for force_id in list(force_ids):
+        del records[force_id]
+    kind.to_c(scene)
 
 
 def _free_id(taken, prefix: str) -> str:

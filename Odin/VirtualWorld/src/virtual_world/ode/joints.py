@@ -36,22 +36,22 @@ _ODE_PARAMETER = {
     JointParameter.MAX_FORCE: lib.dParamFMax,
 }
 
-_SET_PARAMETER = {
-    T.BALL: lib.dJointSetBallParam, T.HINGE: lib.dJointSetHingeParam,
-    T.SLIDER: lib.dJointSetSliderParam, T.PISTON: lib.dJointSetPistonParam,
-    T.UNIVERSAL: lib.dJointSetUniversalParam, T.HINGE2: lib.dJointSetHinge2Param,
-    T.PR: lib.dJointSetPRParam, T.PU: lib.dJointSetPUParam, T.FIXED: lib.dJointSetFixedParam,
+_PARAMETER_NAME = {  # per joint type and motor kind: <Name> in ODE's dJoint{Set,Get}<Name>Param
+    T.BALL: "Ball", T.HINGE: "Hinge", T.SLIDER: "Slider", T.PISTON: "Piston",
+    T.UNIVERSAL: "Universal", T.HINGE2: "Hinge2", T.PR: "PR", T.PU: "PU", T.FIXED: "Fixed",
 }
-_SET_MOTOR_PARAMETER = {MotorKind.ANGULAR: lib.dJointSetAMotorParam,
-                        MotorKind.LINEAR: lib.dJointSetLMotorParam}
-_GET_PARAMETER = {
-    T.BALL: lib.dJointGetBallParam, T.HINGE: lib.dJointGetHingeParam,
-    T.SLIDER: lib.dJointGetSliderParam, T.PISTON: lib.dJointGetPistonParam,
-    T.UNIVERSAL: lib.dJointGetUniversalParam, T.HINGE2: lib.dJointGetHinge2Param,
-    T.PR: lib.dJointGetPRParam, T.PU: lib.dJointGetPUParam, T.FIXED: lib.dJointGetFixedParam,
-}
-_GET_MOTOR_PARAMETER = {MotorKind.ANGULAR: lib.dJointGetAMotorParam,
-                        MotorKind.LINEAR: lib.dJointGetLMotorParam}
+_MOTOR_PARAMETER_NAME = {MotorKind.ANGULAR: "AMotor", MotorKind.LINEAR: "LMotor"}
+
+
+def _parameter_functions(names: dict, verb: str) -> dict:
+    """{kind: lib.dJoint<verb><Name>Param} for ``names`` {kind: Name}; verb "Set" or "Get"."""
+    return {kind: getattr(lib, f"dJoint{verb}{name}Param") for kind, name in names.items()}
+
+
+_SET_PARAMETER = _parameter_functions(_PARAMETER_NAME, "Set")
+_SET_MOTOR_PARAMETER = _parameter_functions(_MOTOR_PARAMETER_NAME, "Set")
+_GET_PARAMETER = _parameter_functions(_PARAMETER_NAME, "Get")
+_GET_MOTOR_PARAMETER = _parameter_functions(_MOTOR_PARAMETER_NAME, "Get")
 
 _STATE = {  # per joint type: (position getters, rate getters), one per reported axis
     T.HINGE: ((lib.dJointGetHingeAngle,), (lib.dJointGetHingeAngleRate,)),

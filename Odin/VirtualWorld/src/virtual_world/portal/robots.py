@@ -76,17 +76,32 @@ def _unique(names: Sequence[str], what: str) -> None:
         seen.add(name)
 
 
+_LINK_NAMES = ("links", "objects", "link name", "object")
+_JOINT_NAMES = ("joint_names", "joints", "joint name", "joint")
+"""A robot's own names and the world IDs they name: (their fields of Messages/Robot, what one of
+each is called in an error)."""
+
+
+def _paired_names(message: RobotMessage, robot: str,
+                  fields: Tuple[str, str, str, str]) -> Tuple[List[str], List[str]]:
+    """The lists ``fields`` (_LINK_NAMES or _JOINT_NAMES) name: as many own names as world IDs,
+    neither with an empty or repeated entry."""
+    names_field, ids_field, name_noun, id_noun = fields
+    names, ids = list(getattr(message, names_field)), list(getattr(message, ids_field))
+    if len(names) != len(ids):
+        raise InvalidArgument(f"Set Robot {robot!r}: {len(names)} {name_noun}(s) for "
+                              f"{len(ids)} {id_noun}(s)")
+    _unique(names, f"Set Robot {robot!r} {names_field}")
+    _unique(ids, f"Set Robot {robot!r} {ids_field}")
+    return names, ids
+
+
 def robot_of(message: RobotMessage) -> Robot:
     """Messages/Robot -> Robot, every list checked (lengths, names, poses)."""
     name = message.name
     if not name:
         raise InvalidArgument("Set Robot: the robot needs a name")
-    links, objects = list(message.links), list(message.objects)
-    if len(links) != len(objects):
-        raise InvalidArgument(f"Set Robot {name!r}: {len(links)} link name(s) for "
-                              f"{len(objects)} object(s)")
-    _unique(links, f"Set Robot {name!r} links")
-    _unique(objects, f"Set Robot {name!r} objects")
+    links, objects = _paired_names(message, name, _LINK_NAMES)
     positions = _per_item(message.link_positions, len(links), 3, "link_positions (m)")
     if len(message.link_orientations) == 0:
         orientations = [IDENTITY_WXYZ] * len(links)
@@ -95,12 +110,7 @@ def robot_of(message: RobotMessage) -> Robot:
                         "link_orientations (w, x, y, z)")
         orientations = [tuple(shared(unit_quaternion, q, f"link_orientations of {link!r}"))
                         for q, link in zip(raw, links)]
-    joint_names, joints = list(message.joint_names), list(message.joints)
-    if len(joint_names) != len(joints):
-        raise InvalidArgument(f"Set Robot {name!r}: {len(joint_names)} joint name(s) for "
-                              f"{len(joints)} joint(s)")
-    _unique(joint_names, f"Set Robot {name!r} joint_names")
-    _unique(joints, f"Set Robot {name!r} joints")
+    joint_names, joints = _paired_names(message, name, _JOINT_NAMES)
     offsets = np.asarray(message.joint_offsets, dtype=float).reshape(-1)
     if offsets.size == 0:
         offsets = np.zeros(len(joints))

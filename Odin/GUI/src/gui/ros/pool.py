@@ -14,21 +14,24 @@ fans its propagations out over them and gets the answers back in the order it as
 Each world has one thread and one persistent service connection of its own (rospy's proxies
 are not shared between threads); a request goes to whichever world is free next, so a slow
 world takes fewer. The worlds are deterministic, so the same request gives the same answer
-whichever world serves it. Requires ``rospy.init_node`` (done here, without signals, unless
-already done).
+whichever world serves it. Each world's calls go through a ``gui.ros.services.ServiceCaller``
+of its thread, whose failures are ``PoolError``. Requires ``rospy.init_node`` (done here,
+without signals, unless already done).
 """
 from __future__ import annotations
 
 import queue
 import threading
-from typing import Any, Dict, Sequence
+from typing import Sequence
 
-from odin_common import OdinError
+from gui.errors import ServiceError
+from gui.ros.services import ServiceCaller, join_ros_graph
+from odin_common.errors import InvalidArgument
 from odin_common.interface import WORLD_SERVICES
 
 
-class PoolError(OdinError):
-    """A world of the pool refused a request or could not be reached (the message says which
+class PoolError(ServiceError):
+    """A world of the pool refused a request or could not be reached (``service`` says which
     world and which request)."""
 
 
@@ -37,17 +40,11 @@ class _World:
     and after a task of ``map`` says it is free again."""
 
     def __init__(self, namespace: str, free: queue.Queue, timeout: float):
-        import rospy
-        self.namespace = namespace.rstrip("/")
-        self._rospy = rospy
-        try:
-            rospy.wait_for_service(f"{self.namespace}/propagate", timeout=timeout)
-        except rospy.ROSException:
-            raise PoolError(f"{self.namespace}: no world answering after {timeout:g} s") \
-                from None
+        self._caller = ServiceCaller(namespace, WORLD_SERVICES, PoolError)
+        self.namespace = self._caller.namespace
+        self._caller.wait("propagate", timeout, f"no world answering after {timeout:g} s")
         self.tasks: queue.Queue = queue.Queue()
         self._free = free
-        self._proxies: Dict[str, Any] = {}
         self.thread = threading.Thread(target=self._work, name=f"pool{self.namespace}",
                                        daemon=True)
         self.thread.start()
@@ -60,32 +57,14 @@ class _World:
             index, calls, answers, done, from_free = task
             try:
                 for service, fields in calls:
-                    answers[index] = self._call(service, fields)
+                    answers[index] = self._caller.call(service, **fields)
             except Exception as error:   # handed back to the caller's thread
                 answers[index] = error
             finally:
                 if from_free:
                     self._free.put(self)
                 done.release()
-        for proxy in self._proxies.values():
-            proxy.close()
-
-    def _call(self, service: str, fields: dict):
-        from Services import srv
-        proxy = self._proxies.get(service)
-        if proxy is None:
-            proxy = self._rospy.ServiceProxy(f"{self.namespace}/{service}",
-                                             getattr(srv, WORLD_SERVICES[service]),
-                                             persistent=True)
-            self._proxies[service] = proxy
-        try:
-            response = proxy(proxy.request_class(**fields))
-        except (self._rospy.ServiceException, OSError) as error:
-            self._proxies.pop(service, None)
-            raise PoolError(f"{self.namespace}/{service}: call failed: {error}") from None
-        if not response.success:
-            raise PoolError(f"{self.namespace}/{service}: {response.message}")
-        return response
+        self._caller.close()
 
 
 class WorldPool:
@@ -94,13 +73,9 @@ class WorldPool:
 
     def __init__(self, namespaces: Sequence[str], timeout: float = 30.0,
                  node_name: str = "world_pool"):
-        import rospy
         if not namespaces:
-            raise PoolError("a pool needs at least one world")
-        if not rospy.core.is_initialized():
-            rospy.init_node(node_name, anonymous=True, disable_signals=True)
-            from odin_common.node import prompt_shutdown
-            prompt_shutdown()
+            raise InvalidArgument("a pool needs at least one world")
+        join_ros_graph(node_name)
         self._free: queue.Queue = queue.Queue()
         self._worlds = [_World(n, self._free, timeout) for n in namespaces]
         for world in self._worlds:

@@ -33,7 +33,7 @@ class PoolBackend:
     def __init__(self, plan: BuildPlan, problem: PlanningProblem, namespaces: Sequence[str],
                  timeout: float = 30.0):
         from gui.ros.client import WorldClient
-        from virtual_world.pool import PoolError, WorldPool
+        from gui.ros.pool import PoolError, WorldPool
         self.problem = problem
         self.propagations = 0
         self._pool_error = PoolError

@@ -13,7 +13,7 @@ import pytest
 
 pytestmark = pytest.mark.forked
 
-ROOT = pathlib.Path(__file__).resolve().parents[3]
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 SHOTS = ROOT / "out" / "gui"
 
 
