@@ -14,7 +14,7 @@ repository is never touched: the runner lays a project of its own out in a scrat
 and reads the verdicts back from mutmut's ``*.meta`` files, and each mutant's change from the
 mutated source (the ``__mutmut_orig`` function against the ``__mutmut_<n>`` one).
 
-What mutmut 3 does not mutate: decorated functions (here the Core's ``@_locked`` methods in
+What mutmut 3 does not mutate: decorated functions (here the Core's ``@locked`` methods in
 world.py, which forward to the topic modules) and module-level code (tables, constants).
 """
 from __future__ import annotations

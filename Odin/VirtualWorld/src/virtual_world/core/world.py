@@ -13,7 +13,6 @@ moved by forces or contacts, infinite mass for them.
 """
 from __future__ import annotations
 
-import functools
 import math
 import threading
 import time
@@ -27,6 +26,7 @@ from odin_common.specs import CompositeSpec, EntitySpec, JointSpec, MotorSpec, O
 from odin_common.world_parameters import WorldParameters
 from virtual_world.core import (forces, guard, joints, motors, objects, readout, snapshots,
                                 validation as check)
+from virtual_world.core.requests import changes_contents, changes_state, disturbs, locked
 from virtual_world.core.records import (BodyState, Built, BuiltEntity, Collision, Divergence,
                                         JointReaction, JointState, MotorState, ObjectState,
                                         Propagation, Removed, ServoState)
@@ -34,61 +34,6 @@ from virtual_world.core.scene import Scene
 from virtual_world.errors import Closed, InvalidArgument, UnknownName
 from virtual_world.ode import bodies
 from virtual_world.ode.runtime import init_ode
-
-
-def _locked(method):
-    @functools.wraps(method)
-    def wrapper(self, *args, **kwargs):
-        with self._lock:
-            if self._scene is None:
-                raise Closed(f"Core is closed ({method.__name__})")
-            return method(self, *args, **kwargs)
-    return wrapper
-
-
-def _wake_sleepers(scene) -> None:
-    """Under auto_disable, a request that changed the world wakes every body: a body asleep on
-    a support just removed must fall, one given a velocity or a force must move. ODE itself
-    wakes a sleeper only when an awake body touches it."""
-    if scene.parameters.auto_disable:
-        scene.c.wake()
-
-
-def _changes_contents(method):
-    """A call that may add or remove objects, joints or motors: the next change of state takes
-    a new reset point."""
-    @functools.wraps(method)
-    def wrapper(self, *args, **kwargs):
-        result = method(self, *args, **kwargs)
-        self._scene.contents_changed = True
-        _wake_sleepers(self._scene)
-        return result
-    return _locked(wrapper)
-
-
-def _changes_state(method):
-    """A call that changes the dynamic state: first, if the contents changed since the reset
-    point was taken, the state as the last build left it becomes the reset point."""
-    @functools.wraps(method)
-    def wrapper(self, *args, **kwargs):
-        scene = self._scene
-        if scene.contents_changed:
-            scene.reset_point = snapshots.take(scene)
-            scene.contents_changed = False
-        return method(self, *args, **kwargs)
-    return _locked(wrapper)
-
-
-def _disturbs(method):
-    """A request that changes the dynamic state from outside (poses, velocities, forces, motor
-    goals, surfaces): ``_changes_state``, and then the sleepers wake. Putting back a recorded
-    state, stepping and propagating do not wake: the state says which bodies sleep."""
-    @functools.wraps(method)
-    def wrapper(self, *args, **kwargs):
-        result = method(self, *args, **kwargs)
-        _wake_sleepers(self._scene)
-        return result
-    return _changes_state(wrapper)
 
 
 class Core:
@@ -111,7 +56,7 @@ class Core:
 
     # ------------------------------------------------------------------ lifetime
 
-    @_locked
+    @locked
     def new_scene(self) -> None:
         """Frees every object, joint, motor and force and starts an empty world with the
         same world parameters; sim_time restarts at 0."""
@@ -152,7 +97,7 @@ class Core:
             raise Closed("Core is closed (world_parameters)")
         return scene.parameters
 
-    @_locked
+    @locked
     def set_world_parameters(self, **changes) -> WorldParameters:
         """Checks every change, then applies them all; returns the values in force.
         At least one change; switching the collision policy forgets recorded collisions."""
@@ -169,54 +114,54 @@ class Core:
 
     # ------------------------------------------------------------------ objects
 
-    @_changes_contents
+    @changes_contents
     def build_object(self, spec: ObjectSpec) -> Built:
         """Creates one object (see ObjectSpec); returns its id and geometries as built."""
         return objects.build_object(self._scene, spec)
 
-    @_changes_contents
+    @changes_contents
     def build_composite(self, spec: CompositeSpec) -> Built:
         """Creates a composite: its parts are geometries on one body placed at the centre of
         mass (part masses rotated, translated and added); its id is ">part1>part2..."."""
         return objects.build_composite(self._scene, spec)
 
-    @_changes_contents
+    @changes_contents
     def build_entity(self, spec: EntitySpec) -> BuiltEntity:
         """Builds objects and composites as one entity, all or nothing (see EntitySpec)."""
         return objects.build_entity(self._scene, spec)
 
-    @_locked
+    @locked
     def entities(self) -> Dict[str, List[str]]:
         """Entity name -> ids of its objects still alive."""
         return objects.entity_members(self._scene)
 
-    @_changes_contents
+    @changes_contents
     def remove_object(self, object_id: str) -> Removed:
         """Removes an object with its joints, motors and forces; returns every removed id."""
         return objects.remove_object(self._scene, object_id)
 
-    @_locked
+    @locked
     def object_ids(self) -> List[str]:
         return list(self._scene.objects)
 
-    @_locked
+    @locked
     def object_spec(self, object_id: str):
         """The ObjectSpec or CompositeSpec the object was built from."""
         return self._scene.object(object_id).spec
 
-    @_locked
+    @locked
     def geometry_names(self, object_id: str) -> List[str]:
         """Names of the object's geometries (one, or a composite's parts)."""
         return [g.name for g in self._scene.object(object_id).geometries]
 
-    @_disturbs
+    @disturbs
     def set_surface(self, name: str, surface) -> None:
         """The contact properties (odin_common.specs.Surface) of an object's geometries (an
         object ID) or of one part of a composite (its geometry name), from now on; how two
         surfaces mix in a contact: Messages/Surface."""
         objects.set_surface(self._scene, name, surface)
 
-    @_locked
+    @locked
     def collision_triangle_count(self, geometry_name: str) -> int:
         """Triangles ODE collides with for a mesh geometry (fewer than given when it was built
         under a collision_mesh_tolerance); 0 for a primitive."""
@@ -225,20 +170,20 @@ class Core:
             return 0
         return bodies.triangle_count(geometry.owner.ptr)
 
-    @_disturbs
+    @disturbs
     def set_poses(self, poses: Sequence[Tuple[str, Sequence[float], Sequence[float]]],
                   reset_velocity: bool = False) -> None:
         """Moves objects: (object id, position m world, orientation wxyz) each, all or
         nothing. reset_velocity zeroes the bodies' linear and angular velocities."""
         objects.set_poses(self._scene, poses, reset_velocity)
 
-    @_disturbs
+    @disturbs
     def set_velocity(self, object_id: str, linear=None, angular=None) -> None:
         """Sets the linear velocity of the centre of mass (m/s, world) and/or the angular
         velocity (rad/s, world) of a body; None keeps the current one."""
         objects.set_velocity(self._scene, object_id, linear, angular)
 
-    @_disturbs
+    @disturbs
     def set_velocities(self, object_id: str = "", linear=None, angular=None,
                        motor_ids: Sequence[str] = (), velocities: Sequence[float] = ()) -> None:
         """Set Velocity: an object's velocities and/or motor goal speeds (one flat list, each
@@ -259,7 +204,7 @@ class Core:
 
     # ------------------------------------------------------------------ joints and motors
 
-    @_changes_contents
+    @changes_contents
     def add_joint(self, spec: JointSpec) -> str:
         """Creates a joint and sets its parameters, all or nothing (see JointSpec); returns
         its id."""
@@ -274,11 +219,11 @@ class Core:
         return self.add_joint(JointSpec(joint_type, body1, body2, anchor, axis1, axis2, axis3,
                                         parameters, joint_id))
 
-    @_locked
+    @locked
     def joint_ids(self) -> List[str]:
         return list(self._scene.joints)
 
-    @_disturbs
+    @disturbs
     def set_joint_parameters(self, joint_id: str,
                              parameters: Sequence[Tuple[int, int, float]]) -> None:
         """(parameter, axis 1..3, value) triples on a joint or a motor, all or nothing (see
@@ -287,17 +232,17 @@ class Core:
             raise InvalidArgument(f"no parameter to set on {joint_id!r}")
         joints.set_joint_parameters(self._scene, joint_id, parameters)
 
-    @_changes_contents
+    @changes_contents
     def remove_joint(self, joint_id: str) -> Removed:
         """Removes a joint with its motors and joint forces."""
         return joints.remove_joint(self._scene, joint_id)
 
-    @_locked
+    @locked
     def joint_states(self) -> List[JointState]:
         """Positions and rates of every joint, per axis (see JointState)."""
         return joints.joint_states(self._scene)
 
-    @_changes_contents
+    @changes_contents
     def add_motor(self, spec: MotorSpec) -> str:
         """Creates a motor (see MotorSpec) at zero goal speed; returns its id."""
         return motors.create_motor(self._scene, spec)
@@ -309,16 +254,16 @@ class Core:
         return self.add_motor(MotorSpec(joint, kind, body1, body2, axes, axis_frames,
                                         max_forces, motor_id))
 
-    @_locked
+    @locked
     def motor_ids(self) -> List[str]:
         return list(self._scene.motors)
 
-    @_locked
+    @locked
     def motor_axis_counts(self, motor_ids: Sequence[str]) -> List[int]:
         """Number of axes of each motor (how many goal speeds it takes); unknown ids raise."""
         return motors.axis_counts(self._scene, motor_ids)
 
-    @_locked
+    @locked
     def split_per_axis(self, motor_ids: Sequence[str], values: Sequence[float],
                        what: str = "velocities") -> Dict[str, Tuple[float, ...]]:
         """{motor id: its values} from one flat list (Set Velocity's, Propagate's and Set
@@ -327,39 +272,39 @@ class Core:
             return {}
         return motors.split_per_axis(self._scene, motor_ids, values, what)
 
-    @_disturbs
+    @disturbs
     def set_servos(self, servos: Mapping[str, Mapping]) -> None:
         """Servo mode for motors, all checked first (core.motors.set_servos): each tracks a
         position target on its joint's axes."""
         motors.set_servos(self._scene, servos)
 
-    @_disturbs
+    @disturbs
     def release_servos(self, motor_ids: Sequence[str]) -> None:
         """Motors back from servo mode to speed goals, at zero."""
         motors.release_servos(self._scene, motor_ids)
 
-    @_locked
+    @locked
     def servo_states(self) -> List[ServoState]:
         """Every servo's targets, its joint's values when the last step began, and errors."""
         return motors.servo_states(self._scene)
 
-    @_locked
+    @locked
     def motor_goals(self) -> Dict[str, List[float]]:
         """Every motor's goal speeds per axis (rad/s or m/s)."""
         return {motor_id: list(m.velocity) for motor_id, m in self._scene.motors.items()}
 
-    @_changes_contents
+    @changes_contents
     def remove_motor(self, motor_id: str) -> None:
         motors.remove_motor(self._scene, motor_id)
 
-    @_disturbs
+    @disturbs
     def set_motor_velocities(self, velocities: Mapping[str, Sequence[float]]) -> None:
         """Goal speeds (rad/s or m/s) per motor axis; all checked before any is set."""
         motors.set_velocities(self._scene, velocities)
 
     # ------------------------------------------------------------------ forces
 
-    @_disturbs
+    @disturbs
     def add_body_force(self, object_id: str, kind: int, vector,
                        vector_in_body_frame: bool = False, at_point: bool = False,
                        point=(0.0, 0.0, 0.0), point_in_body_frame: bool = False) -> str:
@@ -370,32 +315,32 @@ class Core:
         return forces.add_body_force(self._scene, object_id, kind, vector,
                                      vector_in_body_frame, at_point, point, point_in_body_frame)
 
-    @_disturbs
+    @disturbs
     def remove_body_force(self, force_id: str) -> None:
         forces.remove_body_force(self._scene, force_id)
 
-    @_locked
+    @locked
     def body_force_ids(self) -> List[str]:
         return list(self._scene.body_forces)
 
-    @_disturbs
+    @disturbs
     def add_joint_force(self, joint_id: str, magnitudes: Sequence[float]) -> str:
         """A persistent force/torque along a joint's axes, applied before every step until
         removed (odin_common.interface.JOINT_FORCE_MAGNITUDES). Returns
         "jointforce:<joint>:<n>"."""
         return forces.add_joint_force(self._scene, joint_id, magnitudes)
 
-    @_disturbs
+    @disturbs
     def remove_joint_force(self, force_id: str) -> None:
         forces.remove_joint_force(self._scene, force_id)
 
-    @_locked
+    @locked
     def joint_force_ids(self) -> List[str]:
         return list(self._scene.joint_forces)
 
     # ------------------------------------------------------------------ snapshots
 
-    @_locked
+    @locked
     def save_state(self, name: str) -> None:
         """Keeps the whole dynamic state under ``name`` (replacing a snapshot of that name):
         poses, velocities, joint and motor parameters, motor goals, persistent forces,
@@ -411,7 +356,7 @@ class Core:
             self._scene.c.restart_rest_counts()
         held[name] = snapshots.take(self._scene)
 
-    @_changes_state
+    @changes_state
     def restore_state(self, name: str) -> None:
         """Puts back the state saved under ``name``: stepping on from it gives bit-identical
         results to stepping on from when it was saved. Refused when the scene's objects,
@@ -420,11 +365,11 @@ class Core:
         snapshots.check_fits(self._scene, snapshot, f"snapshot {name!r}")
         snapshots.put_back(self._scene, snapshot)
 
-    @_locked
+    @locked
     def snapshot_names(self) -> List[str]:
         return list(self._scene.snapshots)
 
-    @_locked
+    @locked
     def remove_state(self, name: str) -> None:
         self._snapshot(name)
         del self._scene.snapshots[name]
@@ -435,7 +380,7 @@ class Core:
             raise UnknownName(f"no snapshot {name!r} (saved: {sorted(self._scene.snapshots)})")
         return snapshot
 
-    @_locked
+    @locked
     def body_state_vector(self) -> np.ndarray:
         """The bodies' dynamic state as one flat float64 vector, for planners that keep
         states themselves (OMPL): ODE's random generator state (QuickStep's constraint order),
@@ -454,7 +399,7 @@ class Core:
     def _body_ptrs(self) -> list:
         return [o.body.ptr for o in self._scene.objects.values() if o.body is not None]
 
-    @_changes_state
+    @changes_state
     def set_body_state_vector(self, vector: Sequence[float]) -> None:
         """Puts back a vector read by ``body_state_vector`` (the same objects), bit for bit:
         stepping on from it gives the results stepping on from when it was read gave. Under
@@ -483,7 +428,7 @@ class Core:
         scene.carried = {}
         scene.c.rand_seed = int(vector[0])
 
-    @_locked
+    @locked
     def reset(self) -> None:
         """Back to the state right after the last build or removal (of an object, joint or
         motor): the poses, velocities, parameters, goals, forces and simulated time the world
@@ -493,7 +438,7 @@ class Core:
             return   # nothing has changed the state since the last build
         snapshots.put_back(scene, scene.reset_point)
 
-    @_changes_state
+    @changes_state
     def propagate(self, duration: float, step_size: float,
                   motor_goals: Optional[Mapping[str, Sequence[float]]] = None,
                   body_forces: Sequence[Mapping] = (), start: str = "",
@@ -569,7 +514,7 @@ class Core:
         return Propagation(start_time, step_size, steps, states, collisions, 0.0, False,
                            self._state_vector())
 
-    @_locked
+    @locked
     def check_collision(self, poses: Sequence[Tuple[str, Sequence[float], Sequence[float]]]
                         ) -> List[Collision]:
         """The pairs that collide with the objects at ``poses`` ((object id, position m,
@@ -595,7 +540,7 @@ class Core:
 
     # ------------------------------------------------------------------ step and read-out
 
-    @_changes_state
+    @changes_state
     def step(self, step_size: float, count: int = 1) -> None:
         """Runs ``count`` steps of ``step_size`` s, all in one C call: collide (contacts or
         recording), body forces, joint forces and motor goals, (Quick)Step, empty contacts."""
@@ -610,18 +555,18 @@ class Core:
         scene.sim_time += step_size * taken
         guard.collect(scene, step_size)
 
-    @_locked
+    @locked
     def take_divergences(self) -> List[Divergence]:
         """The bodies the divergence guard parked since the last call (each reported once)."""
         found, self._scene.divergences = self._scene.divergences, []
         return found
 
-    @_locked
+    @locked
     def parked_objects(self) -> List[str]:
         """The objects the divergence guard parked (kinematic, still, colliding with nothing)."""
         return list(self._scene.parked)
 
-    @_locked
+    @locked
     def sleeping_objects(self) -> List[str]:
         """The objects ODE's auto-disabling has put to sleep (world parameter auto_disable):
         not stepped until an awake body touches them or a request changes the world."""
@@ -629,7 +574,7 @@ class Core:
         return [object_id for object_id in guard.guarded(scene)
                 if not bodies.is_awake(scene.objects[object_id].body.ptr)]
 
-    @_locked
+    @locked
     def detect_collisions(self) -> None:
         """Contact-less policy: collision detection on the present poses without a step, so
         that read_collisions() reports what touches now in a paused world whose objects were
@@ -659,25 +604,25 @@ class Core:
         than a contact (the islands are not searched)."""
         return self._scene.c.last_island_rows
 
-    @_locked
+    @locked
     def poses(self) -> Tuple[List[str], np.ndarray, np.ndarray]:
         """Every geometry (composite parts one by one, static ones too): names, positions
         (n, 3) m and quaternions (n, 4) wxyz, world frame; read in one C call."""
         return readout.poses(self._scene)
 
-    @_locked
+    @locked
     def body_state(self, object_id: str) -> Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(position of the object origin m, orientation wxyz, linear velocity of the centre of
         mass m/s, angular velocity rad/s), world frame."""
         return readout.body_state(self._scene, object_id)
 
-    @_locked
+    @locked
     def mass_properties(self, object_id: str) -> Tuple[float, np.ndarray, np.ndarray]:
         """(mass kg, centre of mass (3,) m in the object frame, inertia (3,3) kg m^2 about the
         centre of mass, object axes) as ODE holds them."""
         return readout.mass_properties(self._scene, object_id)
 
-    @_locked
+    @locked
     def state(self, objects: Sequence[str] = (), joints: Sequence[str] = (),
               motors: Sequence[str] = ()) -> Tuple[List[ObjectState], List[JointReaction],
                                                    List[MotorState]]:
@@ -695,7 +640,7 @@ class Core:
         return (readout.object_states(scene, objects), readout.joint_reactions(scene, joints),
                 readout.motor_states(scene, motors))
 
-    @_locked
+    @locked
     def read_collisions(self) -> List[Collision]:
         """Colliding geometry pairs (names sorted within a pair), deepest depth and points.
         Contact-less policy: every pair seen since the last read; reading clears the set.
