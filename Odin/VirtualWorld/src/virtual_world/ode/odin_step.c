@@ -101,12 +101,6 @@ void odin_world_free_buffers(OdinWorld *w) {
     w->feedback_record = w->feedback_point = w->feedback_sign = NULL;
     w->n_feedback = w->cap_feedback = 0;
     w->n_diverged = w->cap_diverged = 0;
-    free(w->island_keys);
-    free(w->island_index);
-    free(w->island_stack);
-    w->island_keys = NULL;
-    w->island_index = w->island_stack = NULL;
-    w->island_cap = 0;
     free(w->pairs);
     free(w->pairs_sorted);
     free(w->contacts);
@@ -547,158 +541,47 @@ static void clear_sleepers_forces(const OdinWorld *w) {
 
 /* ---------------------------------------------------------------- step (thesis 5.5) */
 
-/* ---------------------------------------------------------------- the auto solver's measure */
-
-/* ODE's testRotationalLimit: a limit [lo, hi] (lo <= hi) is active at `value` on or past it. */
-static int limit_active(double lo, double hi, double value) {
-    return lo <= hi && (value <= lo || value >= hi);
-}
-
-/* 1 when axis `axis` (0..2) of a motor or of a joint's own motor/limit adds a row: powered
- * (FMax > 0) or at an active limit. */
-static int axis_row(dReal (*get)(dJointID, int), dJointID j, int axis, double value) {
-    int g = dParamGroup * axis;
-    return get(j, dParamFMax + g) > 0 ||
-           limit_active(get(j, dParamLoStop + g), get(j, dParamHiStop + g), value);
-}
-
-/* The rows a joint adds to ODE's constraint system this step (its getInfo1's m, ODE 0.16):
- * the fixed rows of its type, plus one per axis that is powered or at an active limit. A
- * contact is counted at 3 (friction on; its surface is not readable through ODE's API). */
+/* The rows a joint adds to ODE's constraint system at most (its getInfo1's m with a limit or
+ * motor active): the auto solver's measure of the work a step asks for. */
 static int joint_rows(dJointID j) {
-    int m = 0;
     switch (dJointGetType(j)) {
-    case dJointTypeContact: case dJointTypeBall:
+    case dJointTypeContact: case dJointTypeBall: case dJointTypePlane2D:
+    case dJointTypeAMotor: case dJointTypeLMotor:
         return 3;
-    case dJointTypeFixed:
-        return 6;
     case dJointTypeDBall: case dJointTypeTransmission:
         return 1;
-    case dJointTypeHinge:
-        return 5 + axis_row(dJointGetHingeParam, j, 0, dJointGetHingeAngle(j));
-    case dJointTypeSlider:
-        return 5 + axis_row(dJointGetSliderParam, j, 0, dJointGetSliderPosition(j));
-    case dJointTypeUniversal:
-        return 4 + axis_row(dJointGetUniversalParam, j, 0, dJointGetUniversalAngle1(j))
-                 + axis_row(dJointGetUniversalParam, j, 1, dJointGetUniversalAngle2(j));
-    case dJointTypeHinge2:
-        return 4 + axis_row(dJointGetHinge2Param, j, 0, dJointGetHinge2Angle1(j))
-                 + (dJointGetHinge2Param(j, dParamFMax2) > 0);
-    case dJointTypeAMotor:
-        for (int i = 0; i < dJointGetAMotorNumAxes(j); ++i)
-            m += axis_row(dJointGetAMotorParam, j, i, dJointGetAMotorAngle(j, i));
-        return m;
-    case dJointTypeLMotor:
-        for (int i = 0; i < dJointGetLMotorNumAxes(j); ++i)
-            m += dJointGetLMotorParam(j, dParamFMax + dParamGroup * i) > 0;
-        return m;
-    default:                  /* PR, PU, piston, plane-2D, double hinge: their most */
+    default:                  /* hinge, slider, universal, hinge-2, fixed, PR, PU, piston... */
         return 6;
     }
 }
 
-static int dynamic(dBodyID b) { return b && !dBodyIsKinematic(b); }
-
-/* The guarded body's index, or -1 (a hash of the guarded bodies' addresses, built per step). */
-static int guarded_index(const OdinWorld *w, dBodyID b) {
-    size_t mask = (size_t)(w->island_cap - 1);
-    for (size_t h = pair_hash(b, b) & mask; w->island_keys[h]; h = (h + 1) & mask)
-        if (w->island_keys[h] == b) return w->island_index[h];
-    return -1;
-}
-
-/* 1 when an awake dynamic body has an enabled joint other than a contact: without one every
- * island is contacts only (a pile, bodies at rest) and auto takes QuickStep without searching
- * the islands (a walk over the bodies' joints, no hash: cheap on 10,000 bodies at rest). */
-static int articulated(const OdinWorld *w) {
+/* The constraint rows of the step about to be taken, counting stops above `bound`. Each joint
+ * is counted at its first dynamic body (a parked body is kinematic, hence fixed); a sleeping
+ * body's joints are not stepped. */
+static int constraint_rows(const OdinWorld *w, int bound) {
+    int rows = 0;
     for (int i = 0; i < w->n_guarded; ++i) {
         dBodyID b = w->guarded[i];
-        if (!dBodyIsEnabled(b) || dBodyIsKinematic(b)) continue;
-        int nj = dBodyGetNumJoints(b);
-        for (int k = 0; k < nj; ++k) {
+        if (!dBodyIsEnabled(b)) continue;
+        int n = dBodyGetNumJoints(b);
+        for (int k = 0; k < n; ++k) {
             dJointID j = dBodyGetJoint(b, k);
-            if (dJointGetType(j) != dJointTypeContact && dJointIsEnabled(j)) return 1;
+            dBodyID first = dJointGetBody(j, 0);
+            if (!first || dBodyIsKinematic(first)) first = dJointGetBody(j, 1);
+            if (first != b || !dJointIsEnabled(j)) continue;
+            if ((rows += joint_rows(j)) > bound) return rows;
         }
     }
-    return 0;
+    return rows;
 }
 
-/* Finds ODE's islands this step (the awake dynamic bodies joined by enabled joints; static
- * and kinematic bodies join nothing, as in ODE's dxProcessIslands) and sets island_rows (the
- * largest island's rows) and articulated_rows (the most rows of non-contact joints, motors and
- * limits included, in one island); both 0 when nothing is articulated. Each joint is counted
- * once, at its first dynamic body. 0 when memory ran out (auto then takes QuickStep). */
-static int measure_islands(OdinWorld *w) {
-    int n = w->n_guarded;
-    w->island_rows = w->articulated_rows = 0;
-    if (!articulated(w)) return 1;
-    if (w->island_cap < 2 * n) {
-        int cap = 16;
-        while (cap < 2 * n) cap *= 2;
-        dBodyID *keys = realloc(w->island_keys, (size_t)cap * sizeof(dBodyID));
-        if (keys) w->island_keys = keys;
-        int *index = realloc(w->island_index, (size_t)cap * sizeof(int));
-        if (index) w->island_index = index;
-        int *stack = realloc(w->island_stack, (size_t)cap * sizeof(int));
-        if (stack) w->island_stack = stack;
-        if (!keys || !index || !stack) return 0;
-        w->island_cap = cap;
-    }
-    size_t mask = (size_t)(w->island_cap - 1);
-    memset(w->island_keys, 0, (size_t)w->island_cap * sizeof(dBodyID));
-    for (int i = 0; i < n; ++i) {
-        size_t h = pair_hash(w->guarded[i], w->guarded[i]) & mask;
-        while (w->island_keys[h]) h = (h + 1) & mask;
-        w->island_keys[h] = w->guarded[i];
-        w->island_index[h] = i;
-    }
-    /* island_stack's upper half marks the bodies already in an island */
-    int *seen = w->island_stack + w->island_cap / 2;
-    memset(seen, 0, (size_t)n * sizeof(int));
-    for (int i = 0; i < n; ++i) {
-        dBodyID start = w->guarded[i];
-        if (seen[i] || !dBodyIsEnabled(start) || dBodyIsKinematic(start)) continue;
-        int top = 0, rows = 0, articulated = 0;
-        seen[i] = 1;
-        w->island_stack[top++] = i;
-        while (top) {
-            dBodyID b = w->guarded[w->island_stack[--top]];
-            int nj = dBodyGetNumJoints(b);
-            for (int k = 0; k < nj; ++k) {
-                dJointID j = dBodyGetJoint(b, k);
-                if (!dJointIsEnabled(j)) continue;
-                dBodyID first = dJointGetBody(j, 0), second = dJointGetBody(j, 1);
-                if (!dynamic(first)) first = second;
-                if (first == b) {
-                    int r = joint_rows(j);
-                    rows += r;
-                    if (dJointGetType(j) != dJointTypeContact) articulated += r;
-                }
-                dBodyID other = dJointGetBody(j, 0) == b ? second : dJointGetBody(j, 0);
-                if (!dynamic(other)) continue;
-                int o = guarded_index(w, other);
-                if (o < 0 || seen[o]) continue;
-                seen[o] = 1;
-                w->island_stack[top++] = o;
-            }
-        }
-        if (rows > w->island_rows) w->island_rows = rows;
-        if (articulated > w->articulated_rows) w->articulated_rows = articulated;
-    }
-    return 1;
-}
-
-/* 0 QuickStep or 1 dWorldStep for this step. Auto takes the exact solver when an island is
- * articulated (joints or motors, not contacts only: QuickStep's iterations let a chain held by
- * its motors sag) and the largest island has at most auto_rows rows. ODE steps each island
- * on its own and dWorldStep's cost is cubic in an island's rows, so the largest island is what
- * bounds its cost; a step of contacts only (piles, bodies at rest on the ground) takes
- * QuickStep, which handles them at a cost linear in the rows. docs/PERFORMANCE.md has the
- * measurements behind the bound. The choice depends on the state only: deterministic. */
-static int step_solver(OdinWorld *w) {
+/* 0 QuickStep or 1 dWorldStep for this step. Auto chooses by the rows to solve: on a small
+ * system (an arm held by its motors) the exact solver is both exact and faster than
+ * QuickStep's iterations, which let such an arm sag; on a large one (piles, thousands of
+ * contacts) its cubic cost loses. The choice depends on the state only: deterministic. */
+static int step_solver(const OdinWorld *w) {
     if (w->solver != 2) return w->solver;
-    if (!measure_islands(w)) return 0;
-    return w->articulated_rows > 0 && w->island_rows <= w->auto_rows;
+    return constraint_rows(w, w->auto_rows) <= w->auto_rows;
 }
 
 int odin_world_step(OdinWorld *w, double h, int count) {
