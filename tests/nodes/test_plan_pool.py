@@ -113,7 +113,7 @@ def test_parallel_searches_share_the_pool_one_world_each(ros_master, kautham_dir
                           "--parallel", "2", "--seed", "7", "--time", "60", "--out", str(out)],
                          capture_output=True, text=True, timeout=300, env=ros_master.env)
     assert run.returncode == 0, run.stderr
-    statistics = json.loads(run.stdout[:run.stdout.rindex("}") + 1])
+    statistics = json.loads(run.stdout[run.stdout.index("{"):run.stdout.rindex("}") + 1])
     assert statistics["solved"] and statistics["seed"] in (7, 8)
     assert sorted(s["seed"] for s in statistics["searches"]) == [7, 8]
     assert out.exists()

@@ -3,6 +3,7 @@ file, the Core back end's exact restore, OMPL's search on the Sphere demo, the c
 it writes and its replay in a fresh world, and the plan tool's answers to bad input."""
 import subprocess
 import sys
+import time
 
 import numpy as np
 import pytest
@@ -217,3 +218,30 @@ def test_the_plan_tool_refuses_bad_parallel_searches_in_one_line(kautham_dir, tm
     assert run.returncode == 2, run.stderr
     assert len(errors) == 1 and errors[0].startswith("plan: error:") and message in errors[0]
     assert not out.exists()
+
+
+def test_a_stop_request_ends_the_search_at_once_with_keyboard_interrupt(sphere_backend):
+    """What Ctrl-C does to ``plan`` (odin_common.tool.stop_on_ctrl_c): the C++ search asks
+    the request at every iteration and ends within one propagation, not at its time limit."""
+    def stop() -> bool:
+        return sphere_backend.propagations >= 50
+
+    started = time.monotonic()
+    with pytest.raises(KeyboardInterrupt):
+        plan(sphere_backend, "KPIECE1", time_limit=120.0, seed=5, stop=stop)
+    assert time.monotonic() - started < 10.0
+    assert 50 <= sphere_backend.propagations <= 50 + 30     # one motion: at most 30 steps
+
+
+def test_a_control_path_cut_while_written_leaves_no_file(tmp_path, monkeypatch):
+    """Ctrl-C in the middle of writing: neither a half file nor the part file is left."""
+    import pathlib
+    write = pathlib.Path.write_text
+
+    def half_then_interrupted(self, text, *args, **kwargs):
+        write(self, text[:len(text) // 2])
+        raise KeyboardInterrupt
+    monkeypatch.setattr(pathlib.Path, "write_text", half_then_interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        write_control_path(tmp_path / "p.path", [ControlRow((0.5, 0.5), 0.1)] * 100)
+    assert list(tmp_path.iterdir()) == []

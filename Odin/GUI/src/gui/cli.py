@@ -10,7 +10,7 @@ from __future__ import annotations
 import argparse
 import json
 import logging
-import random
+import os
 import sys
 import time
 from typing import Optional, Sequence
@@ -18,12 +18,34 @@ from typing import Optional, Sequence
 import numpy as np
 
 from gui.errors import GuiError
+from odin_common.errors import OdinError
+from odin_common.tool import stop_on_ctrl_c
 
 
 def _fail(tool: str, error: Exception) -> int:
     text = " ".join(str(error).split())
     print(f"{tool}: error: {text}", file=sys.stderr)
     return 2
+
+
+def _check_output(option: str, path: Optional[str]) -> None:
+    """Before any work: the folder ``path`` is to be written in exists and is writable."""
+    if path is None:
+        return
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        raise GuiError(f"{option} {path}: no folder {folder}")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise GuiError(f"{option} {path}: folder {folder} is not writable")
+    if os.path.isdir(path):
+        raise GuiError(f"{option} {path}: is a folder, not a file")
+
+
+def _check_master(tool: str, timeout: float) -> None:
+    """Before any work: a ROS master answers at ROS_MASTER_URI within ``timeout`` s (rospy
+    would wait for one for ever, saying "Will keep trying")."""
+    from odin_common.node import wait_for_master
+    wait_for_master(f"/{tool}", timeout=timeout, quiet=True)
 
 
 def _warnings_to_stderr(tool: str) -> None:
@@ -135,14 +157,16 @@ def load_problem_main(argv: Optional[Sequence[str]] = None) -> int:
     parser.add_argument("--keep", action="store_true",
                         help="add to the current scene instead of calling New Scene first")
     parser.add_argument("--timeout", type=float, default=10.0,
-                        help="seconds to wait for the world's services")
+                        help="seconds to wait for the ROS master, then for the world's "
+                        "services [10]")
     _build_options(parser)
     args = parser.parse_args(argv)
     _warnings_to_stderr("load_problem")
     started = time.monotonic()
     try:
+        _check_master("load_problem", args.timeout)
         plan = _plan(args)
-    except GuiError as error:
+    except OdinError as error:
         return _fail("load_problem", error)
     total = len(plan.steps)
     print(f"loaded {args.problem} in {time.monotonic() - started:.2f} s: {total} requests",
@@ -157,7 +181,7 @@ def load_problem_main(argv: Optional[Sequence[str]] = None) -> int:
             print(f"[{k}/{total}] {step.label()} -> {answer_id}", flush=True)
 
         client.execute(plan, progress=progress)
-    except GuiError as error:
+    except OdinError as error:
         return _fail("load_problem", error)
     print(f"built {args.problem} in {time.monotonic() - started:.2f} s", flush=True)
     return 0
@@ -200,12 +224,17 @@ def run_path_main(argv: Optional[Sequence[str]] = None) -> int:
     parser.add_argument("--fast", action="store_true",
                         help="control and tracked paths: as fast as the world steps, not in "
                         "real time")
-    parser.add_argument("--timeout", type=float, default=10.0)
+    parser.add_argument("--timeout", type=float, default=10.0,
+                        help="seconds to wait for the ROS master, then for the world's "
+                        "services [10]")
     _build_options(parser)
     args = parser.parse_args(argv)
     _warnings_to_stderr("run_path")
     from gui.core.paths import DEGREES, RADIANS, load_robot_path, refine
     try:
+        _check_output("--summary", args.summary)
+        _check_output("--plot", args.plot)
+        _check_master("run_path", args.timeout)
         plan = _plan(args)
         try:
             handle = plan.robot(args.robot)
@@ -228,16 +257,42 @@ def run_path_main(argv: Optional[Sequence[str]] = None) -> int:
             print(f"{handle.name}: initial position set ({len(handle.bodies)} bodies)")
             return 0
         rate = args.rate if args.rate > 0 else client.publication_rate()
-        if args.position:
-            run_position_path(client, handle, rows, rate,
-                              progress=lambda k: print(f"[{k}/{len(rows)}]", flush=True))
-        else:
-            run_velocity_path(client, handle, rows, rate,
-                              progress=lambda k: print(f"[{k}/{len(rows)}]", flush=True))
+        done = [0]
+        with stop_on_ctrl_c() as stop:
+
+            def progress(k: int) -> None:
+                done[0] = k
+                print(f"[{k}/{len(rows)}]", flush=True)
+                if stop:                    # between two calls: none is cut in the middle
+                    raise _Stopped
+
+            try:
+                if args.position:
+                    run_position_path(client, handle, rows, rate, progress=progress)
+                else:
+                    run_velocity_path(client, handle, rows, rate, progress=progress)
+            except _Stopped:
+                pass
+            if stop:
+                if args.velocity:           # the last row's speeds would drive on
+                    client.set_velocities(handle.motor_ids, np.zeros(len(handle.motor_ids)))
+                return _interrupted(f"row {done[0]} of {len(rows)} ({done[0] / rate:.2f} s "
+                                    f"of {len(rows) / rate:.2f} s)")
         print(f"{handle.name}: {len(rows)} rows at {rate:g} Hz done")
-    except GuiError as error:
+    except OdinError as error:
         return _fail("run_path", error)
     return 0
+
+
+class _Stopped(Exception):
+    """Raised between two rows of a path when Ctrl-C asked to stop."""
+
+
+def _interrupted(where: str) -> int:
+    """run_path stopped by Ctrl-C, the robot held: says how far it got; 130 (128 + SIGINT)."""
+    from odin_common.tool import EXIT_INTERRUPTED
+    print(f"run_path: interrupted at {where}; the robot is held there", flush=True)
+    return EXIT_INTERRUPTED
 
 
 def _run_tracked(args, plan) -> int:
@@ -262,8 +317,17 @@ def _run_tracked(args, plan) -> int:
             shown[0] = int(t)
             print(f"t={t:.2f}/{total:.2f} s", flush=True)
 
-    report = run_tracked_on_client(client, plan, solution, progress=progress,
-                                   real_time=not args.fast)
+    reached = [0.0, 0.0]
+
+    def progress_of(t: float, total: float) -> None:
+        reached[:] = [t, total]
+        progress(t, total)
+
+    with stop_on_ctrl_c() as stop:
+        report = run_tracked_on_client(client, plan, solution, progress=progress_of,
+                                       real_time=not args.fast, stop=stop)
+    if stop:
+        return _interrupted(f"t={reached[0]:.2f} s of {reached[1]:.2f} s")
     print(f"{solution.format} path of {solution.waypoint_count} waypoints: goal error "
           f"{report.goal_error:.3g}, tracking error max {report.tracking_error_max:.3g}, "
           f"{report.duration_s:.2f} s simulated, {len(report.collisions)} colliding pairs, "
@@ -316,7 +380,13 @@ def _run_controls(args, handle) -> int:
         print(f"[{result.index}/{len(rows)}] t={elapsed[0]:.3f} s base at {where}{to_goal}",
               flush=True)
 
-    run_on_client(client, handle, rows, real_time=not args.fast, progress=progress)
+    with stop_on_ctrl_c() as stop:
+        results = run_on_client(client, handle, rows, real_time=not args.fast,
+                                progress=progress, stop=stop)
+    if stop:
+        total = sum(row.duration for row in rows)
+        return _interrupted(f"row {len(results)} of {len(rows)} ({elapsed[0]:.2f} s of "
+                            f"{total:.2f} s)")
     print(f"{handle.name}: {len(rows)} control rows done ({elapsed[0]:.3f} s simulated)")
     return 0
 
@@ -341,7 +411,9 @@ def plan_main(argv: Optional[Sequence[str]] = None) -> int:
                         "\"_Max Planning Time\", else 10]")
     parser.add_argument("--out", required=True, metavar="PATH",
                         help="control path file to write (rows: controls, duration s)")
-    parser.add_argument("--seed", type=int, default=None, help="OMPL's random seed")
+    parser.add_argument("--seed", type=int, default=None,
+                        help="OMPL's random seed [drawn at random, printed and written with "
+                        "the path: --seed repeats a run]")
     parser.add_argument("--backend", choices=("core", "pool"), default="core",
                         help="core: the world in this process [default]; pool: the world "
                         "nodes of --worlds over ROS (cleared and built from the problem)")
@@ -365,7 +437,9 @@ def plan_main(argv: Optional[Sequence[str]] = None) -> int:
     args = parser.parse_args(argv)
     _warnings_to_stderr("plan")
     try:
-        result, time_limit, seed = _search(args)
+        _check_output("--out", args.out)
+        with stop_on_ctrl_c() as stop:
+            result, time_limit, seed = _search(args, stop)
         if not result.solved:
             return _fail("plan", GuiError(
                 f"{args.problem}: no solution within {time_limit:g} s ({args.planner}, seed "
@@ -378,7 +452,7 @@ def plan_main(argv: Optional[Sequence[str]] = None) -> int:
             f"ends {result.goal_distance:.4f} m from the goal",
             "each row: the robot's controls in [0, 1], then the duration (s)"))
         print(f"plan: {len(result.rows)} rows ({result.duration:.3f} s) written to {args.out}")
-    except (GuiError, OSError) as error:
+    except (OdinError, OSError) as error:
         return _fail("plan", error)
     return 0
 
@@ -387,27 +461,34 @@ def _searches(args) -> str:
     return f" and the next {args.parallel - 1}" if args.parallel > 1 else ""
 
 
-def _search(args):
-    """(the plan's result, the time limit s, the (first) seed); prints the statistics."""
+def _search(args, stop):
+    """(the plan's result, the time limit s, the (first) seed); says what it searches, with
+    the seed, then prints the statistics. ``stop()`` true (Ctrl-C) ends the search and
+    raises KeyboardInterrupt, nothing written."""
     from gui.planning.bridge import plan
     make_backend, time_limit = _planning_backends(args)
-    seed = args.seed
+    seed = args.seed if args.seed is not None else _fresh_seed(args.parallel)
+    print(f"plan: {args.planner} searching for up to {time_limit:g} s, seed {seed}"
+          f"{_searches(args)} (--seed {seed} repeats it)", flush=True)
     if args.parallel == 1:
         backend = make_backend(0)
         try:
-            result = plan(backend, args.planner, time_limit, seed)
+            result = plan(backend, args.planner, time_limit, seed, stop)
         finally:
             backend.close()
         print(json.dumps(result.statistics(), indent=1), flush=True)
         return result, time_limit, seed
     from gui.planning.parallel import plan_in_parallel
-    if seed is None:
-        seed = random.randrange(1, 2 ** 31)
     result, outcomes = plan_in_parallel(make_backend, args.parallel, args.planner,
-                                        time_limit, seed)
+                                        time_limit, seed, stop)
     print(json.dumps({**result.statistics(), "searches": [o.summary() for o in outcomes]},
                      indent=1), flush=True)
     return result, time_limit, seed
+
+
+def _fresh_seed(searches: int) -> int:
+    """A seed for OMPL from the system's entropy, in [1, 2^31) (room for ``searches``)."""
+    return 1 + int.from_bytes(os.urandom(4), "little") % (2 ** 31 - 1 - searches)
 
 
 def _planning_backends(args):
@@ -418,6 +499,14 @@ def _planning_backends(args):
     from gui.planning.problem import SearchSettings, planning_problem
     if args.parallel < 1:
         raise GuiError(f"--parallel {args.parallel}: need 1 or more searches")
+    if args.backend == "pool":
+        namespaces = [n.strip() for n in args.worlds.split(",") if n.strip()]
+        if not namespaces:
+            raise GuiError(f"--worlds {args.worlds!r}: no namespace given")
+        if len(namespaces) < args.parallel:
+            raise GuiError(f"--parallel {args.parallel} searches need as many worlds; "
+                           f"--worlds names {len(namespaces)}")
+        _check_master("plan", args.world_timeout)
     plan = _plan(args)
     settings = SearchSettings.of_problem(plan, goal_tolerance=args.goal_tolerance,
                                          min_control_steps=args.min_control_steps,
@@ -427,12 +516,6 @@ def _planning_backends(args):
     time_limit = args.time if args.time is not None else \
         (planner.search.time_limit if planner and planner.search.time_limit else 10.0)
     if args.backend == "pool":
-        namespaces = [n.strip() for n in args.worlds.split(",") if n.strip()]
-        if not namespaces:
-            raise GuiError(f"--worlds {args.worlds!r}: no namespace given")
-        if len(namespaces) < args.parallel:
-            raise GuiError(f"--parallel {args.parallel} searches need as many worlds; "
-                           f"--worlds names {len(namespaces)}")
 
         def pool_backend(k: int):
             from gui.planning.pool import PoolBackend

@@ -17,3 +17,8 @@ class InvalidArgument(OdinError, ValueError):
     """A value is malformed: not finite, out of its range, the wrong count, not a unit
     quaternion... Raised by the checks every node shares (``odin_common``); each node's own
     errors of this kind derive from it."""
+
+
+class NoMasterError(OdinError):
+    """No ROS master answered at ROS_MASTER_URI in the time a tool waits for one (nodes wait
+    for theirs for ever; ``odin_common.node.wait_for_master``)."""

@@ -17,13 +17,18 @@ import sys
 import threading
 import time
 import xmlrpc.client
+from typing import Optional
 
 import rosgraph
 import rospy
 from rospy.impl.registration import RegManager, get_service_manager, get_topic_manager
 
+from odin_common.errors import NoMasterError
+from odin_common.ros_master import _TimeoutTransport
 
-def init_ros_node(name: str, disable_signals: bool = False, poll: float = 0.5) -> None:
+
+def init_ros_node(name: str, disable_signals: bool = False, poll: float = 0.5,
+                  master_timeout: Optional[float] = None) -> None:
     """``rospy.init_node(name)`` once the master answers, with rospy's own signal handling
     unless ``disable_signals`` (a Qt window handles Ctrl-C itself).
 
@@ -33,8 +38,9 @@ def init_ros_node(name: str, disable_signals: bool = False, poll: float = 0.5) -
     Odin node, so that nodes started together with roscore (a launch, a script, a test) come
     up in any order. Ctrl-C while waiting ends the node like any tool (``odin_common.tool.run``:
     130, no traceback); rospy turns a Ctrl-C during its own start into a ROSInitException
-    ("Failed to initialize time")."""
-    wait_for_master(name, poll)
+    ("Failed to initialize time"). ``master_timeout`` (s): a tool's wait for its master,
+    ``NoMasterError`` after it (``wait_for_master``)."""
+    wait_for_master(name, poll, master_timeout)
     try:
         rospy.init_node(name, disable_signals=disable_signals)
     except rospy.ROSInitException:
@@ -63,21 +69,43 @@ def _wake(cond: threading.Condition) -> None:
         cond.notify_all()
 
 
-def wait_for_master(caller_id: str, poll: float = 0.5) -> None:
-    """Returns once the master at ROS_MASTER_URI answers, asking every ``poll`` seconds and
-    saying once on stderr that the node waits (roscpp's "waiting for master")."""
-    master = rosgraph.Master(caller_id)
+def wait_for_master(caller_id: str, poll: float = 0.5, timeout: Optional[float] = None,
+                    quiet: bool = False) -> None:
+    """Returns once the master at ROS_MASTER_URI answers, asking every ``poll`` seconds and,
+    unless ``quiet``, saying once on stderr that it waits (roscpp's "waiting for master").
+
+    A node (``timeout`` None) waits for ever. A tool gives a ``timeout`` (s): it waits that
+    long, each question cut short at the deadline (a host that drops packets never refuses),
+    then raises ``NoMasterError`` naming the URI."""
+    uri = rosgraph.get_master_uri()
+    deadline = None if timeout is None else time.monotonic() + max(0.0, timeout)
     said = False
     while True:
+        left = None if deadline is None else max(0.05, deadline - time.monotonic())
         try:
-            master.getPid()
+            _ask_master(uri, caller_id, left)
             return
         except (OSError, xmlrpc.client.Error, rosgraph.MasterError):
-            if not said:
-                print(f"{caller_id}: waiting for the ROS master at {master.master_uri}",
+            if deadline is not None and time.monotonic() >= deadline:
+                raise NoMasterError(f"no ROS master answers at {uri} after {timeout:g} s "
+                                    "(is roscore running? is ROS_MASTER_URI right?)") from None
+            if not said and not quiet:
+                print(f"{caller_id}: waiting for the ROS master at {uri}",
                       file=sys.stderr, flush=True)
                 said = True
-            time.sleep(poll)
+            time.sleep(poll if deadline is None else
+                       max(0.0, min(poll, deadline - time.monotonic())))
+
+
+def _ask_master(uri: str, caller_id: str, timeout: Optional[float]) -> None:
+    """The master's getPid, within ``timeout`` s (None: the socket's default)."""
+    if timeout is None:
+        rosgraph.Master(caller_id, master_uri=uri).getPid()
+        return
+    proxy = xmlrpc.client.ServerProxy(uri, transport=_TimeoutTransport(timeout))
+    code, message, _ = proxy.getPid(caller_id)
+    if code != 1:
+        raise rosgraph.MasterError(message)
 
 
 class MasterWatch:

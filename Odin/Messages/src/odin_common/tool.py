@@ -8,10 +8,12 @@ its main through ``run``.
 """
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import sys
-from typing import Callable, Optional
+import threading
+from typing import Callable, Iterator, Optional
 
 EXIT_BROKEN_PIPE = 128 + signal.SIGPIPE
 EXIT_INTERRUPTED = 128 + signal.SIGINT
@@ -39,3 +41,41 @@ def _silence_stdout() -> None:
     except (OSError, ValueError):
         pass
 
+
+
+class StopRequest:
+    """Set by Ctrl-C (SIGINT) while ``stop_on_ctrl_c`` is in force: ``bool(request)`` is
+    whether the user asked to stop. Work that must not be cut in the middle (a service call
+    whose answer is still in its socket, a C++ search) checks it between its steps, stops
+    cleanly and raises KeyboardInterrupt itself."""
+
+    def __init__(self) -> None:
+        self.requested = False
+
+    def __bool__(self) -> bool:
+        return self.requested
+
+    def __call__(self) -> bool:
+        return self.requested
+
+
+@contextlib.contextmanager
+def stop_on_ctrl_c() -> Iterator[StopRequest]:
+    """Within the block, the first Ctrl-C only sets the yielded ``StopRequest``; a second one
+    raises KeyboardInterrupt at once (the user insists). Outside the main thread, where no
+    signal handler can be set, the request is never set."""
+    request = StopRequest()
+    if threading.current_thread() is not threading.main_thread():
+        yield request
+        return
+
+    def handler(signum, frame) -> None:
+        if request.requested:
+            raise KeyboardInterrupt
+        request.requested = True
+
+    previous = signal.signal(signal.SIGINT, handler)
+    try:
+        yield request
+    finally:
+        signal.signal(signal.SIGINT, previous)

@@ -158,7 +158,8 @@ def write_control_path(path: os.PathLike | str, rows: Sequence[ControlRow],
     """Writes ``rows`` as a control path file (module docstring) that ``read_control_path``
     reads back exactly: each value in Python's shortest round-trip form; ``comments`` first,
     each a '#' line. Refuses rows of different sizes or with values out of range before
-    writing anything."""
+    writing anything; the file appears whole (written beside it, then renamed) or not at
+    all."""
     if not rows:
         raise PathFileError("no rows to write", path)
     size = len(rows[0].controls)
@@ -171,7 +172,13 @@ def write_control_path(path: os.PathLike | str, rows: Sequence[ControlRow],
                                 f"or duration {row.duration!r} s not positive", path)
     lines = [f"# {line}" for text in comments for line in str(text).splitlines()]
     lines += [" ".join(repr(float(v)) for v in (*row.controls, row.duration)) for row in rows]
-    pathlib.Path(path).write_text("\n".join(lines) + "\n")
+    target = pathlib.Path(path)
+    part = target.with_name(f".{target.name}.{os.getpid()}.part")
+    try:                        # whole or not at all, also when Ctrl-C comes mid-write
+        part.write_text("\n".join(lines) + "\n")
+        os.replace(part, target)
+    finally:
+        part.unlink(missing_ok=True)
 
 
 def actuation(handle, row: ControlRow, state: Optional[BodyState],
@@ -243,9 +250,11 @@ class RowResult:
 
 def run_control_path(port: ControlPort, handle, rows: Sequence[ControlRow],
                      defaults: ControlDefaults = ControlDefaults(),
-                     progress: Optional[Callable[[RowResult], None]] = None) -> List[RowResult]:
+                     progress: Optional[Callable[[RowResult], None]] = None,
+                     stop: Optional[Callable[[], bool]] = None) -> List[RowResult]:
     """Applies ``rows`` in order to ``handle``'s robot through ``port``; returns the base's
-    position after each row."""
+    position after each row. ``stop()`` true (asked before each row) ends the path there:
+    the rows run so far are returned."""
     size = control_size(handle)
     for k, row in enumerate(rows, start=1):
         if len(row.controls) != size:
@@ -254,6 +263,8 @@ def run_control_path(port: ControlPort, handle, rows: Sequence[ControlRow],
     base_id = handle.bodies[0].body_id
     results = []
     for k, row in enumerate(rows, start=1):
+        if stop is not None and stop():
+            break
         state = port.body_state(base_id)
         act = actuation(handle, row, state, defaults)
         if act.servo is not None:
@@ -297,20 +308,60 @@ class ClientPort:
 
 def run_on_client(client, handle, rows: Sequence[ControlRow], real_time: bool = True,
                   progress: Optional[Callable[[RowResult], None]] = None,
-                  sleep: Callable[[float], None] = time.sleep) -> List[RowResult]:
+                  sleep: Callable[[float], None] = time.sleep,
+                  stop: Optional[Callable[[], bool]] = None) -> List[RowResult]:
     """``run_control_path`` through a ``ClientPort``, the world paused meanwhile (and running
-    again afterwards if it was)."""
+    again afterwards if it was). Stopped by ``stop()``, the robot is held where it is
+    (``hold_on_client``) before the world runs again."""
     running = client.world().simulating
     if running:
         client.pause()
     try:
-        return run_control_path(ClientPort(client, real_time, sleep), handle, rows,
-                                progress=progress)
+        results = run_control_path(ClientPort(client, real_time, sleep), handle, rows,
+                                   progress=progress, stop=stop)
+        if stop is not None and stop():
+            hold_on_client(client, handle)
+        return results
     finally:
         if running:
             client.start()
 
 
+def hold_servo(handle, present: Sequence[float]) -> ServoCommand:
+    """Set Servo that holds ``handle``'s robot still: each joint's motor toward its
+    ``present`` value (rad or m, Kautham's joint values: ``built_at`` plus what the world
+    measures, one per joint of ``handle.joint_ids``) at no feed-forward rate; a car's wheels
+    stopped, its steering straight."""
+    if handle.kind == CAR:
+        wheels = len(handle.motor_ids)
+        low, high = environment.STEERING_RANGE
+        return ServoCommand(
+            tuple(handle.motor_ids), (0.0, 0.0) * wheels, rates=(0.0, 0.0) * wheels,
+            gains=(environment.STEERING_GAIN, 0.0) * wheels,
+            max_speeds=(environment.STEERING_GAIN * (high - low), SERVO_MAX_SPEED) * wheels,
+            max_forces=(environment.STEERING_MAX_TORQUE, environment.WHEEL_MAX_TORQUE) * wheels)
+    relative = np.asarray(present, dtype=float) - np.asarray(handle.built_at, dtype=float)
+    speeds = tuple(float(v) if v else SERVO_MAX_SPEED for v in
+                   (handle.max_speeds or [None] * len(relative)))
+    return ServoCommand(tuple(handle.motor_ids), tuple(float(v) for v in relative),
+                        rates=(0.0,) * len(relative), max_speeds=speeds)
+
+
+def hold_on_client(client, handle) -> None:
+    """Holds ``handle``'s robot where it is through a ``gui.ros.client.WorldClient``: its
+    servos toward the joints' present values (``hold_servo``), a free base's velocity
+    zero (what Ctrl-C leaves of a path)."""
+    if handle.motor_ids and (handle.kind == CAR or
+                             len(handle.motor_ids) == len(handle.joint_ids)):
+        response = client.call("get_state", joints=list(handle.joint_ids))
+        moved = np.array([j.positions[0] for j in response.joints], dtype=float)
+        client.set_servo(hold_servo(handle, np.asarray(handle.built_at, dtype=float) + moved))
+    if handle.kind in (FREE_BODY, MOBILE, CAR):
+        client.set_body_velocity(handle.bodies[0].body_id, linear=[0.0, 0.0, 0.0],
+                                 angular=[0.0, 0.0, 0.0])
+
+
 __all__ = ["MAPPING", "ControlDefaults", "ControlRow", "ServoCommand", "Actuation",
            "ControlPort", "control_size", "read_control_path", "write_control_path", "actuation",
-           "run_control_path", "RowResult", "ClientPort", "run_on_client"]
+           "run_control_path", "RowResult", "ClientPort", "run_on_client", "hold_servo",
+           "hold_on_client"]

@@ -29,7 +29,7 @@ from typing import Callable, Dict, List, Optional, Protocol, Sequence, Tuple
 
 import numpy as np
 
-from gui.core.control_path import ServoCommand
+from gui.core.control_path import ServoCommand, hold_on_client
 from gui.core.kautham.solutions import ATTACH, Solution
 from gui.core.model import PRISMATIC
 from gui.core.trajectory import BaseLimits, Trajectory, rotation_error
@@ -245,11 +245,12 @@ def plan_tracking(port: TrackingPort, plan, solution: Solution,
 def execute_tracked(port: TrackingPort, plan, solution: Solution,
                     defaults: TrackingDefaults = TrackingDefaults(),
                     progress: Optional[Callable[[float, float], None]] = None,
-                    real_time: bool = False, sleep: Callable[[float], None] = time.sleep
-                    ) -> TrackingReport:
+                    real_time: bool = False, sleep: Callable[[float], None] = time.sleep,
+                    stop: Optional[Callable[[], bool]] = None) -> TrackingReport:
     """Runs ``solution`` on ``plan``'s robots through ``port`` (module docstring).
     ``progress(t, duration)`` after each period; ``real_time``: each period takes at least
-    its simulated time of wall-clock time."""
+    its simulated time of wall-clock time. ``stop()`` true (asked before each period) ends
+    the run there: the report covers the periods run (``duration_s``)."""
     robots, trajectory, events = plan_tracking(port, plan, solution, defaults)
     step = port.step()
     period = step * max(1, round(defaults.period / step))
@@ -262,7 +263,11 @@ def execute_tracked(port: TrackingPort, plan, solution: Solution,
     times, targets, actuals = [], [], []
     pending = sorted(events, key=lambda e: e.time)
     started = time.monotonic()
+    done = 0
     for k in range(ticks):
+        if stop is not None and stop():
+            break
+        done = k + 1
         t = k * period
         while pending and pending[0].time <= t + 1e-9:
             _apply(port, pending.pop(0), made)
@@ -298,8 +303,9 @@ def execute_tracked(port: TrackingPort, plan, solution: Solution,
         solution.source, solution.format,
         goal_error=float(np.max(np.abs(goal_actual - goal_target), initial=0.0)),
         tracking_error_max=float(np.max(errors, initial=0.0)),
-        duration_s=ticks * period, trajectory_s=trajectory.duration,
-        settle_s=ticks * period - trajectory.duration, period_s=period, wall_time_s=wall_time,
+        duration_s=done * period, trajectory_s=trajectory.duration,
+        settle_s=max(0.0, done * period - trajectory.duration), period_s=period,
+        wall_time_s=wall_time,
         collisions=[dict(first=a, second=b, first_time_s=v[0], depth_m=v[1])
                     for (a, b), v in sorted(collisions.items(), key=lambda i: i[1][0])],
         events=[dict(time_s=e.time, what=e.label) for e in events],
@@ -418,15 +424,21 @@ class ClientTrackingPort:
 def run_tracked_on_client(client, plan, solution: Solution,
                           defaults: TrackingDefaults = TrackingDefaults(),
                           progress: Optional[Callable[[float, float], None]] = None,
-                          real_time: bool = False) -> TrackingReport:
+                          real_time: bool = False,
+                          stop: Optional[Callable[[], bool]] = None) -> TrackingReport:
     """``execute_tracked`` through a ``ClientTrackingPort``, the world paused meanwhile (and
-    running again afterwards if it was)."""
+    running again afterwards if it was). Stopped by ``stop()``, each robot of the solution
+    is held where it is (``hold_on_client``) before the world runs again."""
     running = client.world().simulating
     if running:
         client.pause()
     try:
-        return execute_tracked(ClientTrackingPort(client), plan, solution, defaults,
-                               progress=progress, real_time=real_time)
+        report = execute_tracked(ClientTrackingPort(client), plan, solution, defaults,
+                                 progress=progress, real_time=real_time, stop=stop)
+        if stop is not None and stop():
+            for name in solution.paths:
+                hold_on_client(client, plan.robot(name))
+        return report
     finally:
         if running:
             client.start()

@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
-from typing import List, Optional, Tuple
+from typing import Callable, List, Optional, Tuple
 
 import numpy as np
 
@@ -237,9 +237,12 @@ def seed_ompl(seed: int) -> None:
 
 
 def plan(backend, planner: str = "KPIECE1", time_limit: float = 10.0,
-         seed: Optional[int] = None) -> PlanResult:
+         seed: Optional[int] = None, stop: Optional[Callable[[], bool]] = None) -> PlanResult:
     """Searches ``backend.problem`` with ``planner`` for at most ``time_limit`` s of wall
-    clock (``seed``: OMPL's seed, see ``seed_ompl``)."""
+    clock (``seed``: OMPL's seed, see ``seed_ompl``). ``stop()`` true ends the search at the
+    planner's next iteration (one propagation at most) and raises KeyboardInterrupt: what
+    Ctrl-C does under ``odin_common.tool.stop_on_ctrl_c`` (OMPL's solve runs in C++, where
+    no Python signal handler can raise; a propagation cut by an exception would be lost)."""
     if not (math.isfinite(time_limit) and time_limit > 0):
         raise PlanningError(f"time {time_limit!r} s must be positive")
     if seed is not None:
@@ -247,9 +250,20 @@ def plan(backend, planner: str = "KPIECE1", time_limit: float = 10.0,
     setup = _Setup(backend, planner)
     before = _propagations(backend)
     started = time.perf_counter()
-    status = setup.setup.solve(time_limit)
+    deadline = time.monotonic() + time_limit
+    callbacks = setup.callbacks
+
+    def over() -> bool:
+        """OMPL's termination condition, asked once per planner iteration."""
+        return time.monotonic() >= deadline or callbacks.error is not None or \
+            (stop is not None and bool(stop()))
+
+    ob, _, _ = _ompl()
+    status = setup.setup.solve(ob.PlannerTerminationCondition(over))
     elapsed = time.perf_counter() - started
     propagations = _propagations(backend) - before
+    if stop is not None and stop():
+        raise KeyboardInterrupt
     if setup.callbacks.error is not None:
         error = setup.callbacks.error
         raise PlanningError(f"propagation failed: {error}") from error

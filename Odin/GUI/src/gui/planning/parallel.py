@@ -46,12 +46,12 @@ class SearchOutcome:
 
 
 def _search(make_backend, index: int, planner: str, time_limit: float, seed: int,
-            answers) -> None:
+            answers, stop) -> None:
     """A child's work: its back end, its search, its answer on the queue."""
     try:
         backend = make_backend(index)
         try:
-            answers.put((index, plan(backend, planner, time_limit, seed), ""))
+            answers.put((index, plan(backend, planner, time_limit, seed, stop), ""))
         finally:
             backend.close()
     except BaseException as error:     # noqa: B902 - told to the parent, never lost
@@ -59,11 +59,14 @@ def _search(make_backend, index: int, planner: str, time_limit: float, seed: int
 
 
 def plan_in_parallel(make_backend: Callable[[int], object], count: int, planner: str,
-                     time_limit: float, seed: int) -> Tuple[PlanResult, List[SearchOutcome]]:
+                     time_limit: float, seed: int, stop: Optional[Callable[[], bool]] = None
+                     ) -> Tuple[PlanResult, List[SearchOutcome]]:
     """``count`` searches of ``planner`` at once, search k with ``make_backend(k)`` and seed
     ``seed + k``, each for at most ``time_limit`` s: (the first exact solution, or the
     closest approximate one when none solved; every search's outcome). PlanningError when
-    every search failed."""
+    every search failed. ``stop()`` true (asked every 0.1 s; each child asks its own copy,
+    which its own Ctrl-C sets: a terminal's Ctrl-C reaches the whole process group) ends
+    every search, waits for the children to be gone and raises KeyboardInterrupt."""
     if isinstance(count, bool) or not isinstance(count, int) or count < 1:
         raise PlanningError(f"parallel searches {count!r}: need a whole number >= 1")
     if isinstance(seed, bool) or not isinstance(seed, int) or not 0 < seed < 2 ** 32 - count:
@@ -71,7 +74,8 @@ def plan_in_parallel(make_backend: Callable[[int], object], count: int, planner:
     context = multiprocessing.get_context("fork")
     answers = context.Queue()
     children = [context.Process(target=_search, daemon=True, name=f"search{k}",
-                                args=(make_backend, k, planner, time_limit, seed + k, answers))
+                                args=(make_backend, k, planner, time_limit, seed + k, answers,
+                                      stop))
                 for k in range(count)]
     for child in children:
         child.start()
@@ -79,10 +83,14 @@ def plan_in_parallel(make_backend: Callable[[int], object], count: int, planner:
     deadline = time.monotonic() + time_limit + START_GRACE_S
     try:
         while any(o is None for o in outcomes):
-            try:
-                index, result, error = answers.get(timeout=max(0.1, deadline - time.monotonic()))
-            except queue.Empty:
+            if stop is not None and stop():
                 break
+            try:
+                index, result, error = answers.get(timeout=0.1)
+            except queue.Empty:
+                if time.monotonic() >= deadline:
+                    break
+                continue
             outcomes[index] = SearchOutcome(seed + index, result, error)
             if result is not None and result.solved:
                 break
@@ -92,6 +100,8 @@ def plan_in_parallel(make_backend: Callable[[int], object], count: int, planner:
                 child.terminate()
         for child in children:
             child.join(timeout=5.0)
+    if stop is not None and stop():
+        raise KeyboardInterrupt
     outcomes = [o or SearchOutcome(seed + k, error="" if _solved(outcomes) else "no answer")
                 for k, o in enumerate(outcomes)]
     return _best(outcomes), outcomes

@@ -19,6 +19,10 @@ import signal
 import sys
 from typing import Optional, Sequence
 
+MASTER_TIMEOUT_S = 30.0
+"""s the window waits for a ROS master at start, saying so, before it says none answers and
+exits 2: long enough for a roscore started beside it (a script, a launch, a test) to come up."""
+
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
     from PyQt5.QtCore import QTimer
@@ -26,8 +30,13 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
 
     from gui.ros.node import start_gui_node, stop_gui_node, without_remappings
     from gui.window.main_window import MainWindow
+    from odin_common.errors import NoMasterError
     app = QApplication(without_remappings(argv if argv is not None else sys.argv))
-    parameters = start_gui_node("gui")
+    try:
+        parameters = start_gui_node("gui", master_timeout=MASTER_TIMEOUT_S)
+    except NoMasterError as error:
+        print(f"gui: error: {error}", file=sys.stderr)
+        return 2
     window = MainWindow(world=parameters["world"], viewer=parameters["viewer"])
     window.show()
     signal.signal(signal.SIGINT, lambda *_: app.quit())
