@@ -5,6 +5,7 @@ child sends its reports back through pytest's own report serialisation."""
 import json
 import os
 import pathlib
+import signal
 import sys
 import tempfile
 
@@ -16,6 +17,16 @@ ROOT = pathlib.Path(__file__).resolve().parent
 sys.path.insert(0, str(ROOT / "tests" / "nodes"))
 
 from odin_common.ros_master import RosMaster  # noqa: E402
+
+
+def pytest_configure(config):
+    """A suite started in the background (a non-interactive shell's ``&``, nohup, some CI
+    runners) inherits SIGINT ignored, and so would every node and tool it starts: the tests
+    of Ctrl-C would fail and every node stopped with SIGINT would sit out its 8 s to SIGKILL.
+    A Python handler here makes the processes started from now on begin with SIGINT's default
+    (an ignored signal stays ignored across exec, a handled one does not)."""
+    if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 @pytest.fixture
