@@ -17,14 +17,6 @@ SPHERE = ("current_2025", "demos", "OMPL_ode_demos", "Sphere", "Sphere.xml")
 TRO = ("legacy_2012", "examples", "TRO")
 
 
-@pytest.fixture
-def world(ros_master):
-    node = ros_master.rosrun("VirtualWorld", "virtualWorld")
-    ros_master.wait_for_service("/virtual_world/set_servo")
-    yield ros_master
-    assert node.poll() is None, "virtualWorld died:\n" + ros_master.log_text(node)[-3000:]
-
-
 def _interrupt_after(world, args, line: str) -> tuple[int, str, str, float]:
     """Starts ``rosrun GUI run_path *args``, sends Ctrl-C to its group once it printed a line
     starting with ``line``: (status, stdout, stderr, seconds from Ctrl-C to exit)."""

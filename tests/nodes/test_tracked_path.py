@@ -9,14 +9,6 @@ import pytest
 pytestmark = pytest.mark.forked
 
 
-@pytest.fixture
-def world(ros_master):
-    node = ros_master.rosrun("VirtualWorld", "virtualWorld")
-    ros_master.wait_for_service("/virtual_world/set_servo")
-    yield ros_master
-    assert node.poll() is None, "virtualWorld died:\n" + ros_master.log_text(node)[-3000:]
-
-
 def test_the_2drr_kps_solution_runs_to_its_goal_with_a_summary_and_a_plot(world, kautham_dir,
                                                                          tmp_path):
     tro = kautham_dir / "legacy_2012" / "examples" / "TRO"
