@@ -13,13 +13,13 @@ from viewer.core.renderer import Renderer
 from viewer.core.scene import Scene, prepare_view
 
 
-def make_loop(rate=50.0, frames=None):
+def make_loop(rate=50.0, frames=None, wanted=None):
     scene = Scene(Camera(width=160, height=120))
 
     def on_frame(frame, number):
         if frames is not None:
             frames.append((number, frame, threading.current_thread().name))
-    return RenderLoop(scene, lambda: Renderer(160, 120), rate, on_frame)
+    return RenderLoop(scene, lambda: Renderer(160, 120), rate, on_frame, wanted)
 
 
 def test_work_runs_on_the_render_thread_and_answers():
@@ -54,6 +54,30 @@ def test_frames_come_at_the_rate_on_the_render_thread():
     assert 20 <= len(frames) <= 27
     assert [n for n, _, _ in frames] == list(range(1, len(frames) + 1))
     assert {thread for _, _, thread in frames} == {"viewer-render"}
+
+
+def test_no_frame_is_rendered_while_nobody_wants_one_and_work_still_runs():
+    frames, watched = [], threading.Event()
+    with make_loop(rate=50.0, frames=frames, wanted=watched.is_set) as loop:
+        time.sleep(0.3)
+        assert frames == []
+        request = prepare_view("ball", [0.5], [], (0, 0, 0.5), (1, 0, 0, 0), (1, 0, 0, 1))
+        assert loop.call(lambda scene, _: scene.view(request)) is False
+        watched.set()
+        time.sleep(0.3)
+        assert len(frames) >= 5 and frames[0][0] == 1
+        watched.clear()
+        time.sleep(0.1)
+        seen = len(frames)
+        time.sleep(0.3)
+        assert len(frames) == seen
+
+
+def test_a_failing_wanted_question_renders_rather_than_stops():
+    frames = []
+    with make_loop(frames=frames, wanted=lambda: 1 / 0):
+        time.sleep(0.3)
+    assert len(frames) >= 5
 
 
 def test_posted_updates_apply_in_order():

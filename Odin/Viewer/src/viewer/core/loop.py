@@ -4,7 +4,9 @@ Other threads (rospy's service and subscriber threads) never touch the scene or 
 work to the loop. :meth:`RenderLoop.call` runs a function on the render thread between frames
 and returns its result (or raises its exception) in the caller's thread; :meth:`RenderLoop.post`
 queues one without waiting. Work is done in the order it arrived, as soon as the thread is free,
-and a frame is rendered every 1/rate seconds whatever arrives, then handed to ``on_frame``.
+and a frame is rendered every 1/rate seconds whatever arrives, then handed to ``on_frame`` --
+while someone wants frames (``wanted``): a Viewer nobody watches renders nothing and costs
+no CPU beyond keeping its scene up to date (a frame of the TX90 scene is tens of ms of a core).
 ROS-free: the Portal wires it to topics and services.
 """
 from __future__ import annotations
@@ -38,18 +40,22 @@ class RenderLoop:
 
     on_frame(frame (h, w, 3) uint8 RGB, number) is called on the render thread after each frame
     (number counts from 1); it must be quick (publish, queue for writing).
+    wanted() is asked once a period on the render thread: False skips that period's frame (it
+    must be quick too: a subscriber count). None: always wanted.
     renderer_factory() is called on the render thread and returns an object with
     ``render(scene) -> frame`` and ``close()`` (normally :class:`viewer.core.renderer.Renderer`).
     """
 
     def __init__(self, scene: Scene, renderer_factory: Callable, rate_hz: float = 25.0,
-                 on_frame: Optional[Callable] = None) -> None:
+                 on_frame: Optional[Callable] = None,
+                 wanted: Optional[Callable[[], bool]] = None) -> None:
         if not (rate_hz > 0 and rate_hz < 1000):
             raise ViewerError(f"render rate must be in (0, 1000) Hz, got {rate_hz}")
         self.scene = scene
         self.period = 1.0 / rate_hz
         self._renderer_factory = renderer_factory
         self._on_frame = on_frame
+        self._wanted = wanted
         self._jobs: collections.deque = collections.deque()
         self._wake = threading.Condition()
         self._running = False
@@ -134,7 +140,8 @@ class RenderLoop:
                     self._do(job)
                 now = time.monotonic()
                 if now >= deadline:
-                    self._render_one()
+                    if self._frame_wanted():
+                        self._render_one()
                     deadline += self.period
                     if deadline < time.monotonic():   # late: next frame at once, no burst
                         deadline = time.monotonic()
@@ -159,6 +166,17 @@ class RenderLoop:
                 log.exception("viewer job failed")
         finally:
             job.done.set()
+
+    def _frame_wanted(self) -> bool:
+        if self._wanted is None:
+            return True
+        try:
+            return bool(self._wanted())
+        except Exception:  # a failing question must not stop the frames: render
+            self.render_errors += 1
+            if self.render_errors <= 5:
+                log.exception("asking whether a frame is wanted failed")
+            return True
 
     def _render_one(self) -> None:
         try:

@@ -1,8 +1,10 @@
-"""PNG files of rendered frames, always inside one folder (ROS 1 has no authentication, so a
-caller must not be able to write anywhere else)."""
+"""Rendered frames encoded: PNG files, always inside one folder (ROS 1 has no authentication,
+so a caller must not be able to write anywhere else), and JPEG bytes for the compressed image
+topic."""
 from __future__ import annotations
 
 import logging
+import io
 import os
 import pathlib
 import queue
@@ -50,6 +52,22 @@ def write_png(path: os.PathLike, frame: np.ndarray) -> pathlib.Path:
     with os.fdopen(fd, "wb") as file:
         Image.fromarray(frame, "RGB").save(file, format="PNG", compress_level=1)
     return path
+
+
+JPEG_QUALITY = 80
+"""image_transport's default JPEG quality (compressed_image_transport's ``jpeg_quality``)."""
+
+COMPRESSED_FORMAT = "rgb8; jpeg compressed bgr8"
+"""sensor_msgs/CompressedImage ``format`` as compressed_image_transport writes it for an rgb8
+image (its encoder works in OpenCV's BGR order; the JPEG itself is plain), so that
+``image_transport republish compressed`` and rqt_image_view decode it."""
+
+
+def encode_jpeg(frame: np.ndarray, quality: int = JPEG_QUALITY) -> bytes:
+    """``frame`` (height, width, 3) uint8 RGB as JPEG bytes (about 1/20 of the raw frame)."""
+    buffer = io.BytesIO()
+    Image.fromarray(frame, "RGB").save(buffer, format="JPEG", quality=quality)
+    return buffer.getvalue()
 
 
 class FrameWriter:

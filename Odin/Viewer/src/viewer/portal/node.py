@@ -18,6 +18,12 @@ Subscribed topics
 Published topics
     ``~image`` (sensor_msgs/Image): every rendered frame, rgb8, ``~width`` x ``~height``,
         at ``~rate``; header.stamp = wall time of rendering, frame_id ``odin_camera``.
+    ``~image/compressed`` (sensor_msgs/CompressedImage): the same frames as JPEG (format
+        ``rgb8; jpeg compressed bgr8``, as image_transport's compressed plugin names them),
+        about 1/20 of the raw bytes: the topic to record (docs/ROS.md, rosbag).
+    Frames are rendered only while one of the two topics has a subscriber or ``~snapshot_every``
+    writes frames (Save Snapshot always renders): an unwatched Viewer costs no CPU, and each
+    topic is encoded only for its own subscribers.
 
 Services (odin_common.interface.VIEWER_SERVICES, each answered by the Portal's method of the
 same name)
@@ -47,7 +53,7 @@ from typing import Optional, Tuple
 
 import rospy
 import rospkg
-from sensor_msgs.msg import Image
+from sensor_msgs.msg import CompressedImage, Image
 from visualization_msgs.msg import MarkerArray
 
 from Messages.msg import Collided, SpaceDistribution
@@ -61,7 +67,8 @@ from viewer.core.loop import RenderLoop
 from viewer.core.scene import Scene, prepare_view
 from viewer.portal.markers import IDENTITY, MarkerIntake
 from viewer.portal.parameters import DEFAULTS
-from viewer.core.snapshots import FrameWriter, snapshot_path, write_png
+from viewer.core.snapshots import (COMPRESSED_FORMAT, FrameWriter, encode_jpeg, snapshot_path,
+                                   write_png)
 
 FRAME_ID = "odin_camera"
 
@@ -106,10 +113,11 @@ class Portal:
         self.frame_writer = FrameWriter(self.snapshot_dir) if self.snapshot_every > 0 else None
 
         self.image_pub = rospy.Publisher("~image", Image, queue_size=2)
+        self.compressed_pub = rospy.Publisher("~image/compressed", CompressedImage, queue_size=2)
         from viewer.core.renderer import Renderer  # GL only in the render thread's process
         self.loop = RenderLoop(Scene(camera, camera_fixed=fixed, background=background),
                                lambda: Renderer(camera.width, camera.height), rate,
-                               on_frame=self._on_frame)
+                               on_frame=self._on_frame, wanted=self._frames_wanted)
         self.loop.start()
 
         self._serve()
@@ -127,16 +135,30 @@ class Portal:
             self.frame_writer.close()
 
     # -- frames ----------------------------------------------------------------------------
+    def _frames_wanted(self) -> bool:
+        return (self.frame_writer is not None or self.image_pub.get_num_connections() > 0
+                or self.compressed_pub.get_num_connections() > 0)
+
     def _on_frame(self, frame, number: int) -> None:
         height, width = frame.shape[:2]
-        msg = Image(height=height, width=width, encoding="rgb8", is_bigendian=0,
-                    step=width * 3, data=frame.tobytes())
-        msg.header.stamp = rospy.Time.now()
-        msg.header.frame_id = FRAME_ID
-        msg.header.seq = number
-        self.image_pub.publish(msg)
+        stamp = rospy.Time.now()
+        if self.image_pub.get_num_connections() > 0:
+            msg = Image(height=height, width=width, encoding="rgb8", is_bigendian=0,
+                        step=width * 3, data=frame.tobytes())
+            self._stamp(msg.header, stamp, number)
+            self.image_pub.publish(msg)
+        if self.compressed_pub.get_num_connections() > 0:
+            msg = CompressedImage(format=COMPRESSED_FORMAT, data=encode_jpeg(frame))
+            self._stamp(msg.header, stamp, number)
+            self.compressed_pub.publish(msg)
         if self.frame_writer is not None and number % self.snapshot_every == 0:
             self.frame_writer.put(frame)
+
+    @staticmethod
+    def _stamp(header, stamp, number: int) -> None:
+        header.stamp = stamp
+        header.frame_id = FRAME_ID
+        header.seq = number
 
     # -- topics ----------------------------------------------------------------------------
     def _world_update(self, msg: SpaceDistribution) -> None:
