@@ -108,6 +108,10 @@ class RosMaster:
         """None once the master answers, else why it will not."""
         deadline = time.monotonic() + self._startup_timeout
         while time.monotonic() < deadline:
+            # before asking: whatever squats a port may accept and never answer (each question
+            # would then wait out its timeout), and roscore waits on it silently for minutes
+            if _held_by_others(self.port, {roscore.pid} | _descendants(roscore.pid)):
+                return "port already in use by another process"
             if self._master_answers():
                 return None
             log = self.log_text(roscore)
@@ -264,6 +268,36 @@ def _descendants(pid: int) -> set[int]:
                 found.add(child)
                 frontier.append(child)
     return found
+
+
+def _held_by_others(port: int, ours: set[int]) -> bool:
+    """Some process outside ``ours`` listens on TCP ``port`` (any address; from /proc)."""
+    listening = _listening_socket_inodes(port)
+    if not listening:
+        return False
+    for pid in ours:
+        try:
+            links = {os.readlink(fd) for fd in pathlib.Path(f"/proc/{pid}/fd").iterdir()}
+        except OSError:
+            continue  # exited meanwhile
+        if any(f"socket:[{inode}]" in links for inode in listening):
+            return False
+    return True
+
+
+def _listening_socket_inodes(port: int) -> set[str]:
+    """Inodes of the sockets in state LISTEN on TCP ``port`` (IPv4 and IPv6)."""
+    inodes = set()
+    for table in ("/proc/net/tcp", "/proc/net/tcp6"):
+        try:
+            rows = pathlib.Path(table).read_text().splitlines()[1:]
+        except OSError:
+            continue
+        for row in rows:
+            fields = row.split()   # sl local_address rem_address st ... uid timeout inode
+            if fields[3] == "0A" and int(fields[1].rsplit(":", 1)[1], 16) == port:
+                inodes.add(fields[9])
+    return inodes
 
 
 def run_rostest(test_file: str, env: dict | None = None,
