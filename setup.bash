@@ -20,9 +20,5 @@ if [ -z "${ROS_IP:-}${ROS_HOSTNAME:-}" ]; then
   export ROS_IP=127.0.0.1
   export ROS_MASTER_URI="${ROS_MASTER_URI:-http://127.0.0.1:11311}"
 fi
-# no display (CI, Docker, ssh): Qt draws off-screen
-if [ -z "${DISPLAY:-}${WAYLAND_DISPLAY:-}" ]; then
-  export QT_QPA_PLATFORM="${QT_QPA_PLATFORM:-offscreen}"
-fi
 [ "$_odin_had_u" = 1 ] && set -u
 unset _odin_had_u
