@@ -27,6 +27,19 @@ def pytest_configure(config):
     (an ignored signal stays ignored across exec, a handled one does not)."""
     if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
         signal.signal(signal.SIGINT, signal.default_int_handler)
+    # shapes read by the tests (hostile files among them) stay out of the user's cache; the
+    # tools and nodes the tests start inherit the folder
+    if "ODIN_CACHE_DIR" not in os.environ:
+        os.environ["ODIN_CACHE_DIR"] = tempfile.mkdtemp(prefix="odin_test_cache_")
+        config._odin_cache_dir = os.environ["ODIN_CACHE_DIR"]
+
+
+def pytest_unconfigure(config):
+    import shutil
+    folder = getattr(config, "_odin_cache_dir", None)
+    if folder is not None:
+        shutil.rmtree(folder, ignore_errors=True)
+        os.environ.pop("ODIN_CACHE_DIR", None)
 
 
 @pytest.fixture

@@ -122,11 +122,17 @@ def _build_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--inertia", choices=("auto", "file", "shape"), default="auto",
                         help="links' inertia: the file's where plausible (auto), always the "
                         "file's, or the shape's")
+    parser.add_argument("--no-cache", action="store_true",
+                        help="read every geometry file, bypassing the cache of shapes read "
+                        "before (~/.cache/odin/shapes, gui.core.shape_cache)")
 
 
 def _plan(args):
+    from gui.core import shape_cache
     from gui.core.translate import BuildDefaults, plan_problem
     from gui.core.kautham.problem import load_problem
+    if args.no_cache:
+        shape_cache.set_enabled(False)
     defaults = BuildDefaults(ground=args.ground, start_at_query=args.start_at_query,
                              inertia=args.inertia)
     return plan_problem(load_problem(args.problem), defaults)

@@ -36,6 +36,7 @@ from typing import Optional
 
 import numpy as np
 
+from gui.core import shape_cache
 from gui.errors import ShapeError
 from gui.core.kinematics import rot_x
 from gui.core.sizes import check_file_size
@@ -168,13 +169,14 @@ def read_shape(path: os.PathLike | str, scale: float = 1.0,
     """Reads a geometry file and returns its ``Shape`` with coordinates multiplied by
     ``scale`` (the file unit in metres times the problem's scale: 0.001 for a millimetre file
     at scale 1). Reading is cached in this process by (file, scale): the SAH hand uses each
-    finger file four times."""
+    finger file four times; and on disk by the file's content (gui.core.shape_cache)."""
     p = pathlib.Path(path)
     key = (str(p.resolve()) if p.exists() else str(p), float(scale), defaults)
     shape = _CACHE.get(key)
     if shape is None:
-        raw = _read_raw(p, defaults)
-        shape = _finish(raw, scale, defaults, str(p))
+        shape = shape_cache.cached(p, f"scale={float(scale)!r} {defaults!r}",
+                                   lambda: _finish(_read_raw(p, defaults), scale, defaults,
+                                                   str(p)))
         _CACHE[key] = shape
     return shape
 
