@@ -17,7 +17,7 @@ from typing import Optional, Sequence
 
 import numpy as np
 
-from gui.errors import GuiError
+from gui.errors import GuiError, PlanningError
 from odin_common.errors import OdinError
 from odin_common.tool import stop_on_ctrl_c
 
@@ -197,7 +197,8 @@ def run_path_main(argv: Optional[Sequence[str]] = None) -> int:
     kind.add_argument("--velocity", metavar="FILE", help="velocity path: one row per cycle")
     kind.add_argument("--controls", metavar="FILE", help="control path: rows of the robot's "
                       "Kautham controls in [0, 1] and a duration (s), applied as Kautham's "
-                      "ODE environment does (docs/INTERFACE.md)")
+                      "ODE environment does (docs/INTERFACE.md); prints the distance to the "
+                      "goal as plan measures it")
     kind.add_argument("--tracked", metavar="FILE", help="a Kautham plan (.kps solution, task "
                       "file, OMPL rows or raw rows), timed within the joints' limits and "
                       "followed by the joint servos under full physics (docs/INTERFACE.md)")
@@ -241,7 +242,7 @@ def run_path_main(argv: Optional[Sequence[str]] = None) -> int:
         except KeyError as error:
             raise GuiError(f"{args.problem}: {error.args[0]}") from None
         if args.controls:
-            return _run_controls(args, handle)
+            return _run_controls(args, plan, handle)
         if args.tracked:
             return _run_tracked(args, plan)
         unit = DEGREES if args.degrees else RADIANS if args.radians else (
@@ -362,33 +363,55 @@ def _save_plot(report, path: str) -> None:
     del application
 
 
-def _run_controls(args, handle) -> int:
+def _run_controls(args, plan, handle) -> int:
     """run_path --controls: the control path through Propagate (the world paused meanwhile);
-    one line per row: its time, the base's position and distance to the goal."""
+    one line per row: its time, where the link the planner tracks is and, for a problem with
+    a query, its distance to the goal in the planner's metric (``_goal_meter``): the figure
+    ``plan`` printed for the same path."""
     from gui.core.control_path import control_size, read_control_path, run_on_client
     rows = read_control_path(args.controls, control_size(handle))
+    meter = _goal_meter(plan, handle)
     from gui.ros.client import WorldClient
     client = WorldClient(timeout=args.timeout)
-    goal = handle.goal.base_pose[:3, 3] if handle.goal is not None else None
-    elapsed = [0.0]
+    watched = handle.bodies[0].body_id if meter is None else meter.tracked_body
+    elapsed, distance = [0.0], [None]
 
     def progress(result):
         elapsed[0] += result.actuation.duration
-        where = np.round(result.base_position, 3).tolist()
-        to_goal = "" if goal is None else \
-            f", {float(np.linalg.norm(result.base_position - goal)):.3f} m from the goal"
-        print(f"[{result.index}/{len(rows)}] t={elapsed[0]:.3f} s base at {where}{to_goal}",
-              flush=True)
+        position, quaternion = result.watched[0], result.watched[1]
+        where = np.round(position, 3).tolist()
+        to_goal = ""
+        if meter is not None:
+            distance[0] = meter.body_goal_distance(position, quaternion)
+            to_goal = f", {distance[0]:.4f} m from the goal"
+        print(f"[{result.index}/{len(rows)}] t={elapsed[0]:.3f} s {watched} at {where}"
+              f"{to_goal}", flush=True)
 
     with stop_on_ctrl_c() as stop:
         results = run_on_client(client, handle, rows, real_time=not args.fast,
-                                progress=progress, stop=stop)
+                                progress=progress, stop=stop, watch=watched)
     if stop:
         total = sum(row.duration for row in rows)
         return _interrupted(f"row {len(results)} of {len(rows)} ({elapsed[0]:.2f} s of "
                             f"{total:.2f} s)")
-    print(f"{handle.name}: {len(rows)} control rows done ({elapsed[0]:.3f} s simulated)")
+    ends = "" if distance[0] is None else f", ends {distance[0]:.4f} m from the goal"
+    print(f"{handle.name}: {len(rows)} control rows done ({elapsed[0]:.3f} s simulated)"
+          f"{ends}")
     return 0
+
+
+def _goal_meter(plan, handle):
+    """The planning problem whose metric ``plan`` reports (``PlanningProblem.goal_distance``:
+    the tracked link, in the plane), or None, said on stderr, when the problem has no query
+    or the planner cannot take it (then only where the base is is printed)."""
+    if handle.goal is None:
+        return None
+    from gui.planning.problem import planning_problem
+    try:
+        return planning_problem(plan, handle.name)
+    except PlanningError as error:
+        print(f"run_path: note: no distance to the goal: {error}", file=sys.stderr)
+        return None
 
 
 # ------------------------------------------------------------------------------ plan (issue 17)

@@ -1,0 +1,64 @@
+"""What ``run_path`` reports means what it says (issue 28) against a live VirtualWorld: a
+control path's distance to the goal is the planner's (the link it tracks, in the plane), the
+very figure ``plan`` prints for the same path, for each kind of robot Kautham's ODE demos
+drive: a free body (the Sphere), a car and a held chain."""
+from __future__ import annotations
+
+import logging
+
+import pytest
+
+from gui.core.control_path import ControlRow, write_control_path
+
+pytestmark = pytest.mark.forked
+
+SPHERE = ("current_2025", "demos", "OMPL_ode_demos", "Sphere", "Sphere.xml")
+CAR = ("demos", "OMPL_ode_demos", "Car", "k-PMPCar.xml")
+CHAIN = ("demos", "OMPL_ode_demos", "Chain", "k-PMPChain.xml")
+
+
+def _planned_figure(problem_file, controls) -> tuple:
+    """(rows, the distance ``plan`` prints for them): the rows replayed from the problem's
+    start in a world of this process, measured as the planner measures (gui.planning)."""
+    from gui.core.kautham.problem import load_problem
+    from gui.core.translate import plan_problem
+    from gui.planning.backend import CoreBackend
+    from gui.planning.bridge import replay
+    from gui.planning.problem import planning_problem
+    logging.disable(logging.WARNING)
+    try:
+        built = plan_problem(load_problem(problem_file))
+    finally:
+        logging.disable(logging.NOTSET)
+    problem = planning_problem(built)
+    backend = CoreBackend(built, problem)
+    try:
+        rows = [ControlRow(c, problem.step) for c in controls]
+        return rows, problem.goal_distance(replay(backend, rows))
+    finally:
+        backend.close()
+
+
+@pytest.mark.parametrize("kind,controls", [
+    ("free body", [(0.426, 0.578, 0.4)] * 20),
+    ("car", [(0.7, 1.0)] * 30 + [(0.2, 0.9)] * 20),
+    ("chain", [(0.9, 0.2, 0.5)] * 20 + [(0.1, 0.8, 0.5)] * 20),
+])
+def test_a_control_path_ends_as_far_from_the_goal_as_plan_said(world, kautham_dir,
+                                                               ode_demos_dir, tmp_path,
+                                                               kind, controls):
+    problem = {"free body": kautham_dir.joinpath(*SPHERE), "car": ode_demos_dir.joinpath(*CAR),
+               "chain": ode_demos_dir.joinpath(*CHAIN)}[kind]
+    rows, figure = _planned_figure(problem, controls)
+    path = tmp_path / "planned.path"
+    write_control_path(path, rows)
+    world.run(["rosrun", "GUI", "load_problem", str(problem)], timeout=120)
+    result = world.run(["rosrun", "GUI", "run_path", str(problem), "--controls", str(path),
+                        "--fast"], timeout=180)
+    lines = result.stdout.splitlines()
+    assert lines[-1].endswith(f", ends {figure:.4f} m from the goal"), (lines[-1], figure)
+    assert lines[-2].endswith(f", {figure:.4f} m from the goal")
+    # the link the planner tracks: a held chain's gripper, not its fixed base
+    tracked = {"free body": "SphereDE", "car": "SimpleCar/base_link",
+               "chain": "Chain/gripper"}[kind]
+    assert f" s {tracked} at [" in lines[-2]
