@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import logging
 
+import numpy as np
 import pytest
 
 from gui.core.control_path import ControlRow, write_control_path
@@ -62,3 +63,23 @@ def test_a_control_path_ends_as_far_from_the_goal_as_plan_said(world, kautham_di
     tracked = {"free body": "SphereDE", "car": "SimpleCar/base_link",
                "chain": "Chain/gripper"}[kind]
     assert f" s {tracked} at [" in lines[-2]
+
+
+def test_the_readme_s_position_path_runs_word_for_word(world):
+    """The README's hand session names a position path for the Kuka problem: the file is in
+    the repository and the README's two lines run as written (in bash, after setup.bash)."""
+    import os
+    import pathlib
+    readme = pathlib.Path(os.environ["ODIN_ROOT"], "README.md").read_text().splitlines()
+    lines = [l for l in readme if l.startswith("rosrun GUI ")
+             and "Kuka_two_columns.xml" in l and ("load_problem" in l or "--position" in l)]
+    assert len(lines) == 2 and "load_problem" in lines[0], lines
+    for line in lines:
+        result = world.run(["bash", "-c", line], timeout=180)
+    assert result.stdout.splitlines()[-1].startswith("KukaLWR: 100 rows at ")
+    from gui.ros.client import WorldClient
+    client = WorldClient()
+    state = client.call("get_state", joints=[j for j in client.world().joints
+                                             if j.endswith("&KukaLWR/Link1")])
+    assert state.joints[0].positions[0] == pytest.approx(np.radians(90.0), abs=0.02)
+    client.close()
