@@ -4,6 +4,7 @@ very figure ``plan`` prints for the same path, for each kind of robot Kautham's 
 drive: a free body (the Sphere), a car and a held chain."""
 from __future__ import annotations
 
+import json
 import logging
 
 import numpy as np
@@ -63,6 +64,46 @@ def test_a_control_path_ends_as_far_from_the_goal_as_plan_said(world, kautham_di
     tracked = {"free body": "SphereDE", "car": "SimpleCar/base_link",
                "chain": "Chain/gripper"}[kind]
     assert f" s {tracked} at [" in lines[-2]
+
+
+def test_a_kps_run_backwards_is_refused_away_from_its_start_and_moved_there_when_asked(
+        world, tro_singularity, tmp_path):
+    """Kautham's 2DRR_singularity solution runs its query backwards (Query Init="1"
+    Goal="0"); the robot built at the problem's start is 1.8 rad from the path's: refused in
+    one line, nothing changed (not even --solver); --from-here moves it there first, a
+    segment of the summary and of the last line."""
+    problem = tro_singularity / "2DRR_singularity.xml"
+    solution = tro_singularity / "2DRR_singularity_sol.kps"
+    world.run(["rosrun", "GUI", "load_problem", str(problem), "--at-start"], timeout=120)
+    from gui.ros.client import WorldClient
+    from odin_common.interface import Solver
+    client = WorldClient()
+    joints = [j for j in client.world().joints]
+    before = [j.positions[0] for j in client.call("get_state", joints=joints).joints]
+    result = world.run(["rosrun", "GUI", "run_path", str(problem), "--at-start", "--tracked",
+                        str(solution), "--fast", "--solver", "worldstep"], check=False,
+                       timeout=120)
+    errors = [l for l in result.stderr.splitlines() if not l.startswith("run_path: warning:")]
+    assert result.returncode == 2 and errors == [
+        "run_path: error: the robot is 1.8 rad from the path's start (2D-Robot/link2); "
+        "--from-here to move it there first"], result.stderr
+    assert client.world_parameters().solver == Solver.AUTO
+    after = [j.positions[0] for j in client.call("get_state", joints=joints).joints]
+    assert after == before
+    summary = tmp_path / "summary.json"
+    result = world.run(["rosrun", "GUI", "run_path", str(problem), "--at-start", "--tracked",
+                        str(solution), "--fast", "--solver", "worldstep", "--from-here",
+                        "--summary", str(summary)], timeout=180)
+    last = result.stdout.splitlines()[-1]
+    assert last.startswith("kps path of 3 waypoints from sample 1 to sample 0, after a 1.8 "
+                           "rad move to its start ("), last
+    report = json.loads(summary.read_text())
+    assert report["query"] == {"init": 1, "goal": 0}
+    move = report["segments"][0]
+    assert move["what"] == "to the path's start" and move["distance"] == pytest.approx(
+        1.803, abs=1e-3)
+    assert report["goal_error"] <= 0.01
+    client.close()
 
 
 def test_the_readme_s_position_path_runs_word_for_word(world):

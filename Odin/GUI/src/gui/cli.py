@@ -202,8 +202,13 @@ def run_path_main(argv: Optional[Sequence[str]] = None) -> int:
     kind.add_argument("--tracked", metavar="FILE", help="a Kautham plan (.kps solution, task "
                       "file, OMPL rows or raw rows), timed within the joints' limits and "
                       "followed by the joint servos under full physics (docs/INTERFACE.md)")
+    parser.add_argument("--from-here", action="store_true",
+                        help="tracked: a robot away from the path's first sample (a .kps "
+                        "query's Init) is first moved there, a segment of the summary [it is "
+                        "refused]")
     parser.add_argument("--summary", metavar="OUT.json", help="tracked: write the execution's "
-                        "summary (goal and tracking errors, collisions, per-joint series)")
+                        "summary (goal and tracking errors, collisions, per-joint series, "
+                        "segments)")
     parser.add_argument("--plot", metavar="OUT.png", help="tracked: plot target against "
                         "actual per joint")
     parser.add_argument("--solver", choices=["auto", "quickstep", "worldstep"],
@@ -308,6 +313,7 @@ def _run_tracked(args, plan) -> int:
     from odin_common.interface import Solver
     client = WorldClient(timeout=args.timeout)
     _record_world_ids(client, plan)
+    _check_start(client, plan, solution, args.from_here)       # before --solver changes a thing
     if args.solver:
         client.set_world(solver=Solver[args.solver.upper()])
     solver = Solver(client.world_parameters().solver).name.lower()
@@ -326,13 +332,15 @@ def _run_tracked(args, plan) -> int:
 
     with stop_on_ctrl_c() as stop:
         report = run_tracked_on_client(client, plan, solution, progress=progress_of,
-                                       real_time=not args.fast, stop=stop)
+                                       real_time=not args.fast, stop=stop,
+                                       from_here=args.from_here)
     if stop:
         return _interrupted(f"t={reached[0]:.2f} s of {reached[1]:.2f} s")
-    print(f"{solution.format} path of {solution.waypoint_count} waypoints: goal error "
-          f"{report.goal_error:.3g}, tracking error max {report.tracking_error_max:.3g}, "
-          f"{report.duration_s:.2f} s simulated, {len(report.collisions)} colliding pairs, "
-          f"solver {solver}")
+    query = f" from {solution.query.describe()}" if solution.query is not None else ""
+    print(f"{solution.format} path of {solution.waypoint_count} waypoints{query}"
+          f"{report.start_move()}: goal error {report.goal_error:.3g}, tracking error max "
+          f"{report.tracking_error_max:.3g}, {report.duration_s:.2f} s simulated, "
+          f"{len(report.collisions)} colliding pairs, solver {solver}")
     if args.summary:
         with open(args.summary, "w") as out:
             json.dump(dict(report.to_json(), solver=solver), out, indent=1)
@@ -341,13 +349,24 @@ def _run_tracked(args, plan) -> int:
     return 0
 
 
+def _check_start(client, plan, solution, from_here: bool) -> None:
+    """Unless ``from_here``: the robots are where the path starts (``gui.core.execution``'s
+    rule), else one line saying how far they are and what would move them there."""
+    from gui.core.execution import AwayFromStart, ClientTrackingPort, plan_tracking
+    try:
+        plan_tracking(ClientTrackingPort(client), plan, solution, from_here=from_here)
+    except AwayFromStart as error:
+        raise GuiError(f"{error}; --from-here to move it there first") from None
+
+
 def _record_world_ids(client, plan) -> None:
-    """The world's joint and motor IDs for the plan's robots: the ones it holds that the plan
-    predicts (the scene was built by load_problem, whose answers are not at hand here)."""
+    """The world's body, joint and motor IDs for the plan's robots: the ones it holds that the
+    plan predicts (the scene was built by load_problem, whose answers are not at hand here)."""
     inventory = client.world()
+    held = set(inventory.objects) | set(inventory.joints) | set(inventory.motors)
     for handle in plan.robots:
-        missing = [i for i in list(handle.joint_ids) + list(handle.motor_ids)
-                   if i not in inventory.joints + inventory.motors]
+        missing = [i for i in [b.body_id for b in handle.bodies] + list(handle.joint_ids)
+                   + list(handle.motor_ids) if i not in held]
         if missing:
             raise GuiError(f"the world holds no {missing[0]!r} of robot {handle.name}: build "
                            f"the problem first (rosrun GUI load_problem {plan.problem.source})")
@@ -373,6 +392,7 @@ def _run_controls(args, plan, handle) -> int:
     meter = _goal_meter(plan, handle)
     from gui.ros.client import WorldClient
     client = WorldClient(timeout=args.timeout)
+    _record_world_ids(client, plan)
     watched = handle.bodies[0].body_id if meter is None else meter.tracked_body
     elapsed, distance = [0.0], [None]
 
