@@ -10,7 +10,6 @@ import numpy as np
 import pytest
 
 from gui.core.execution import AwayFromStart, TrackingDefaults, execute_tracked
-from gui.core.kautham.corpus import corpus_dir
 from gui.core.kautham.problem import load_problem
 from gui.core.kautham.solutions import read_solution
 from gui.core.translate import BuildDefaults, plan_problem

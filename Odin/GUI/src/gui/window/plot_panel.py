@@ -14,7 +14,7 @@ from typing import Callable, Optional
 
 from PyQt5.QtCore import QPointF, QRectF, Qt, QTimer
 from PyQt5.QtGui import QColor, QPainter, QPen, QPolygonF
-from PyQt5.QtWidgets import (QHBoxLayout, QListWidget, QListWidgetItem, QSplitter,
+from PyQt5.QtWidgets import (QListWidget, QListWidgetItem, QSplitter,
                              QVBoxLayout, QWidget)
 
 COLORS = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2",
