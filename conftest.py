@@ -81,6 +81,21 @@ def ode_demos_dir() -> pathlib.Path:
     return ROOT / "tools" / "kautham" / "ode_demos"
 
 
+@pytest.fixture
+def tro_singularity(kautham_dir, tmp_path) -> pathlib.Path:
+    """The folder ``examples/TRO`` holding Kautham 2012's 2DRR_singularity problem and its
+    solution (vendored: tools/kautham/tro_singularity/MANIFEST.md) beside the corpus's
+    ``robots`` and ``scenes`` (linked), so that the problem's ``../`` references resolve."""
+    examples = tmp_path / "tro_singularity" / "examples"
+    (examples / "TRO").mkdir(parents=True)
+    for folder in ("robots", "scenes"):
+        (examples / folder).symlink_to(kautham_dir / "legacy_2012" / "examples" / folder)
+    for vendored in (ROOT / "tools" / "kautham" / "tro_singularity" / "examples" /
+                     "TRO").iterdir():
+        (examples / "TRO" / vendored.name).write_bytes(vendored.read_bytes())
+    return examples / "TRO"
+
+
 def pytest_collection_modifyitems(items):
     """Tests marked ``slow`` run first: pytest-xdist hands them out while every worker is
     free, instead of one worker finishing a 40 s test while the others wait."""

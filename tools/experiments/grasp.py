@@ -230,7 +230,8 @@ class Drive:
         defaults = TrackingDefaults(acceleration=p["tracked_acceleration_rad_s2"],
                                     settle=p["hold_s"])
         port = common.session_tracking_port(s, self.every)
-        _, trajectory, _ = plan_tracking(port, plan, solution, defaults)
+        # from where the arm is: the path's first segment turns the thumb aside (below)
+        _, trajectory, _ = plan_tracking(port, plan, solution, defaults, from_here=True)
         started = s.sim_time
         approach_rows = solution.waypoint_count - 3
         marks = [("position_path", 0, None), ("close", approach_rows, "approach done"),
@@ -244,7 +245,8 @@ class Drive:
             while pending and s.sim_time >= pending[0][0] - 1e-9:
                 self.closeup(pending.pop(0)[1])
 
-        report = execute_tracked(port, plan, solution, defaults, progress=progress)
+        report = execute_tracked(port, plan, solution, defaults, progress=progress,
+                                 from_here=True)
         while pending:
             self.closeup(pending.pop(0)[1])
         self.tracking = tracking_facts(report, self.handle)

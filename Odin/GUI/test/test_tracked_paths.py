@@ -212,7 +212,7 @@ def test_a_free_flying_sphere_follows_an_se3_task_path(kautham_dir, world, tmp_p
         f"<Conf> -0.5 0.5 {z} 0 0 0.7071068 0.7071068 </Conf>\n"
         "</Transit>\n</Task>\n")
     report = execute_tracked(CoreTrackingPort(world), plan, read_solution(task, problem),
-                             TrackingDefaults(settle=1.0))
+                             TrackingDefaults(settle=1.0), from_here=True)
     assert report.names == ["SphereDE/base x", "SphereDE/base y", "SphereDE/base z",
                             "SphereDE/base rotation"]
     assert report.goal_error < 0.01                           # m and rad
@@ -267,7 +267,8 @@ def test_a_transfer_carries_the_object_on_a_fixed_joint_made_and_removed_at_its_
     port = _RecordingPort(world)
 
     before = port.body_state(can)[0]
-    report = execute_tracked(port, plan, solution, TrackingDefaults(settle=0.2))
+    report = execute_tracked(port, plan, solution, TrackingDefaults(settle=0.2),
+                             from_here=True)
     made = [c for c in port.calls if c[0] == "attach"]
     removed = [c for c in port.calls if c[0] == "detach"]
     assert len(made) == 1 and len(removed) == 1 and made[0][2:4] == (link_body, can)

@@ -17,7 +17,7 @@ from typing import Optional, Sequence
 
 import numpy as np
 
-from gui.errors import GuiError
+from gui.errors import GuiError, PlanningError
 from odin_common.errors import OdinError
 from odin_common.tool import stop_on_ctrl_c
 
@@ -203,12 +203,18 @@ def run_path_main(argv: Optional[Sequence[str]] = None) -> int:
     kind.add_argument("--velocity", metavar="FILE", help="velocity path: one row per cycle")
     kind.add_argument("--controls", metavar="FILE", help="control path: rows of the robot's "
                       "Kautham controls in [0, 1] and a duration (s), applied as Kautham's "
-                      "ODE environment does (docs/INTERFACE.md)")
+                      "ODE environment does (docs/INTERFACE.md); prints the distance to the "
+                      "goal as plan measures it")
     kind.add_argument("--tracked", metavar="FILE", help="a Kautham plan (.kps solution, task "
                       "file, OMPL rows or raw rows), timed within the joints' limits and "
                       "followed by the joint servos under full physics (docs/INTERFACE.md)")
+    parser.add_argument("--from-here", action="store_true",
+                        help="tracked: a robot away from the path's first sample (a .kps "
+                        "query's Init) is first moved there, a segment of the summary [it is "
+                        "refused]")
     parser.add_argument("--summary", metavar="OUT.json", help="tracked: write the execution's "
-                        "summary (goal and tracking errors, collisions, per-joint series)")
+                        "summary (goal and tracking errors, collisions, per-joint series, "
+                        "segments)")
     parser.add_argument("--plot", metavar="OUT.png", help="tracked: plot target against "
                         "actual per joint")
     parser.add_argument("--solver", choices=["auto", "quickstep", "worldstep"],
@@ -247,7 +253,7 @@ def run_path_main(argv: Optional[Sequence[str]] = None) -> int:
         except KeyError as error:
             raise GuiError(f"{args.problem}: {error.args[0]}") from None
         if args.controls:
-            return _run_controls(args, handle)
+            return _run_controls(args, plan, handle)
         if args.tracked:
             return _run_tracked(args, plan)
         unit = DEGREES if args.degrees else RADIANS if args.radians else (
@@ -313,6 +319,7 @@ def _run_tracked(args, plan) -> int:
     from odin_common.interface import Solver
     client = WorldClient(timeout=args.timeout)
     _record_world_ids(client, plan)
+    _check_start(client, plan, solution, args.from_here)       # before --solver changes a thing
     if args.solver:
         client.set_world(solver=Solver[args.solver.upper()])
     solver = Solver(client.world_parameters().solver).name.lower()
@@ -331,13 +338,15 @@ def _run_tracked(args, plan) -> int:
 
     with stop_on_ctrl_c() as stop:
         report = run_tracked_on_client(client, plan, solution, progress=progress_of,
-                                       real_time=not args.fast, stop=stop)
+                                       real_time=not args.fast, stop=stop,
+                                       from_here=args.from_here)
     if stop:
         return _interrupted(f"t={reached[0]:.2f} s of {reached[1]:.2f} s")
-    print(f"{solution.format} path of {solution.waypoint_count} waypoints: goal error "
-          f"{report.goal_error:.3g}, tracking error max {report.tracking_error_max:.3g}, "
-          f"{report.duration_s:.2f} s simulated, {len(report.collisions)} colliding pairs, "
-          f"solver {solver}")
+    query = f" from {solution.query.describe()}" if solution.query is not None else ""
+    print(f"{solution.format} path of {solution.waypoint_count} waypoints{query}"
+          f"{report.start_move()}: goal error {report.goal_error:.3g}, tracking error max "
+          f"{report.tracking_error_max:.3g}, {report.duration_s:.2f} s simulated, "
+          f"{len(report.collisions)} colliding pairs, solver {solver}")
     if args.summary:
         with open(args.summary, "w") as out:
             json.dump(dict(report.to_json(), solver=solver), out, indent=1)
@@ -346,13 +355,24 @@ def _run_tracked(args, plan) -> int:
     return 0
 
 
+def _check_start(client, plan, solution, from_here: bool) -> None:
+    """Unless ``from_here``: the robots are where the path starts (``gui.core.execution``'s
+    rule), else one line saying how far they are and what would move them there."""
+    from gui.core.execution import AwayFromStart, ClientTrackingPort, plan_tracking
+    try:
+        plan_tracking(ClientTrackingPort(client), plan, solution, from_here=from_here)
+    except AwayFromStart as error:
+        raise GuiError(f"{error}; --from-here to move it there first") from None
+
+
 def _record_world_ids(client, plan) -> None:
-    """The world's joint and motor IDs for the plan's robots: the ones it holds that the plan
-    predicts (the scene was built by load_problem, whose answers are not at hand here)."""
+    """The world's body, joint and motor IDs for the plan's robots: the ones it holds that the
+    plan predicts (the scene was built by load_problem, whose answers are not at hand here)."""
     inventory = client.world()
+    held = set(inventory.objects) | set(inventory.joints) | set(inventory.motors)
     for handle in plan.robots:
-        missing = [i for i in list(handle.joint_ids) + list(handle.motor_ids)
-                   if i not in inventory.joints + inventory.motors]
+        missing = [i for i in [b.body_id for b in handle.bodies] + list(handle.joint_ids)
+                   + list(handle.motor_ids) if i not in held]
         if missing:
             raise GuiError(f"the world holds no {missing[0]!r} of robot {handle.name}: build "
                            f"the problem first (rosrun GUI load_problem {plan.problem.source})")
@@ -368,33 +388,56 @@ def _save_plot(report, path: str) -> None:
     del application
 
 
-def _run_controls(args, handle) -> int:
+def _run_controls(args, plan, handle) -> int:
     """run_path --controls: the control path through Propagate (the world paused meanwhile);
-    one line per row: its time, the base's position and distance to the goal."""
+    one line per row: its time, where the link the planner tracks is and, for a problem with
+    a query, its distance to the goal in the planner's metric (``_goal_meter``): the figure
+    ``plan`` printed for the same path."""
     from gui.core.control_path import control_size, read_control_path, run_on_client
     rows = read_control_path(args.controls, control_size(handle))
+    meter = _goal_meter(plan, handle)
     from gui.ros.client import WorldClient
     client = WorldClient(timeout=args.timeout)
-    goal = handle.goal.base_pose[:3, 3] if handle.goal is not None else None
-    elapsed = [0.0]
+    _record_world_ids(client, plan)
+    watched = handle.bodies[0].body_id if meter is None else meter.tracked_body
+    elapsed, distance = [0.0], [None]
 
     def progress(result):
         elapsed[0] += result.actuation.duration
-        where = np.round(result.base_position, 3).tolist()
-        to_goal = "" if goal is None else \
-            f", {float(np.linalg.norm(result.base_position - goal)):.3f} m from the goal"
-        print(f"[{result.index}/{len(rows)}] t={elapsed[0]:.3f} s base at {where}{to_goal}",
-              flush=True)
+        position, quaternion = result.watched[0], result.watched[1]
+        where = np.round(position, 3).tolist()
+        to_goal = ""
+        if meter is not None:
+            distance[0] = meter.body_goal_distance(position, quaternion)
+            to_goal = f", {distance[0]:.4f} m from the goal"
+        print(f"[{result.index}/{len(rows)}] t={elapsed[0]:.3f} s {watched} at {where}"
+              f"{to_goal}", flush=True)
 
     with stop_on_ctrl_c() as stop:
         results = run_on_client(client, handle, rows, real_time=not args.fast,
-                                progress=progress, stop=stop)
+                                progress=progress, stop=stop, watch=watched)
     if stop:
         total = sum(row.duration for row in rows)
         return _interrupted(f"row {len(results)} of {len(rows)} ({elapsed[0]:.2f} s of "
                             f"{total:.2f} s)")
-    print(f"{handle.name}: {len(rows)} control rows done ({elapsed[0]:.3f} s simulated)")
+    ends = "" if distance[0] is None else f", ends {distance[0]:.4f} m from the goal"
+    print(f"{handle.name}: {len(rows)} control rows done ({elapsed[0]:.3f} s simulated)"
+          f"{ends}")
     return 0
+
+
+def _goal_meter(plan, handle):
+    """The planning problem whose metric ``plan`` reports (``PlanningProblem.goal_distance``:
+    the tracked link, in the plane), or None, said on stderr, when the problem has no query
+    or the planner cannot take it (then only where the base is is printed)."""
+    if handle.goal is None:
+        return None
+    from gui.planning.problem import planning_problem
+    try:
+        return planning_problem(plan, handle.name)
+    except PlanningError as error:
+        print(f"run_path: note: no distance to the goal: {error}", file=sys.stderr)
+        return None
 
 
 # ------------------------------------------------------------------------------ plan (issue 17)

@@ -66,6 +66,13 @@ kind of robot:
 
 The last row's servo settings stay in force after it (its forces act only for its duration).
 A row whose values leave [0, 1] is refused with its file and line.
+
+After each row `run_path --controls` prints where the link the planner tracks is (its body's
+position, m, world: a held chain's tool, any other robot's base) and, for a problem with a
+query, that link's distance to where the query's `<Goal>` puts it in the plane (x, y), the
+planner's own metric (`gui.planning`); its last line gives the figure the path ends at
+("ends d m from the goal"), which is the one `rosrun GUI plan` printed and wrote for the same
+path when the robot starts where the problem builds it.
 """
 
 
@@ -242,19 +249,23 @@ def _base_force(handle, target_pose: np.ndarray, state: Optional[BodyState], dur
 
 @dataclass
 class RowResult:
-    """After one row: its index, the base's position (m, world) and the actuation used."""
+    """After one row: its index, the base's position (m, world), the actuation used and the
+    state of the watched body (``run_control_path``'s ``watch``; None: no body watched)."""
     index: int
     base_position: np.ndarray
     actuation: Actuation
+    watched: Optional[BodyState] = None
 
 
 def run_control_path(port: ControlPort, handle, rows: Sequence[ControlRow],
                      defaults: ControlDefaults = ControlDefaults(),
                      progress: Optional[Callable[[RowResult], None]] = None,
-                     stop: Optional[Callable[[], bool]] = None) -> List[RowResult]:
+                     stop: Optional[Callable[[], bool]] = None,
+                     watch: Optional[str] = None) -> List[RowResult]:
     """Applies ``rows`` in order to ``handle``'s robot through ``port``; returns the base's
-    position after each row. ``stop()`` true (asked before each row) ends the path there:
-    the rows run so far are returned."""
+    position after each row, and the state of body ``watch`` (a world ID: the link a planner
+    tracked) when given. ``stop()`` true (asked before each row) ends the path there: the
+    rows run so far are returned."""
     size = control_size(handle)
     for k, row in enumerate(rows, start=1):
         if len(row.controls) != size:
@@ -270,7 +281,8 @@ def run_control_path(port: ControlPort, handle, rows: Sequence[ControlRow],
         if act.servo is not None:
             port.set_servo(act.servo)
         port.advance(row.duration, act.forces)
-        result = RowResult(k, port.body_state(base_id)[0], act)
+        result = RowResult(k, port.body_state(base_id)[0], act,
+                           None if watch is None else port.body_state(watch))
         results.append(result)
         if progress is not None:
             progress(result)
@@ -309,16 +321,17 @@ class ClientPort:
 def run_on_client(client, handle, rows: Sequence[ControlRow], real_time: bool = True,
                   progress: Optional[Callable[[RowResult], None]] = None,
                   sleep: Callable[[float], None] = time.sleep,
-                  stop: Optional[Callable[[], bool]] = None) -> List[RowResult]:
-    """``run_control_path`` through a ``ClientPort``, the world paused meanwhile (and running
-    again afterwards if it was). Stopped by ``stop()``, the robot is held where it is
-    (``hold_on_client``) before the world runs again."""
+                  stop: Optional[Callable[[], bool]] = None,
+                  watch: Optional[str] = None) -> List[RowResult]:
+    """``run_control_path`` through a ``ClientPort`` (``watch``: its body to report), the
+    world paused meanwhile (and running again afterwards if it was). Stopped by ``stop()``,
+    the robot is held where it is (``hold_on_client``) before the world runs again."""
     running = client.world().simulating
     if running:
         client.pause()
     try:
         results = run_control_path(ClientPort(client, real_time, sleep), handle, rows,
-                                   progress=progress, stop=stop)
+                                   progress=progress, stop=stop, watch=watch)
         if stop is not None and stop():
             hold_on_client(client, handle)
         return results

@@ -10,15 +10,22 @@ free-flying base gets the velocity rate + ``base_gain`` error (linear and angula
 and a force cancelling gravity on the robot's mass, as a velocity servo of its own; then the
 world runs the period with contacts on (one kept Propagate), and the joints are read.
 Attach/detach events become a FIXED joint between the link's body and the obstacle's, made and
-removed at their waypoint's time (the robot is at rest there). The path starts from where the
-robot is: its present configuration is the first waypoint. After the last waypoint the
+removed at their waypoint's time (the robot is at rest there). The path starts where the robot
+is: its present configuration is the first waypoint, the path's first sample (a ``.kps``
+query's ``Init``) the second. A robot farther from that sample than ``start_tolerance`` (rad
+or m: the largest difference of a joint, of a base's coordinate or of its rotation) is refused
+before anything moves (``AwayFromStart``: "the robot is 1.8 rad from the path's start"),
+unless the run is asked to move it there first (``run_path --tracked --from-here``): that move
+is then the report's first segment, timed as the path's are. After the last waypoint the
 targets are held ``settle`` s; the servos stay on afterwards (they hold the goal).
 
 The report: ``goal_error`` (largest joint error from the last waypoint when execution ends,
 rad or m; a base's position error in m and its rotation error in rad count as joints),
 ``tracking_error_max`` (the largest along the way, against the trajectory's value at the same
 time), ``duration_s`` (simulated, trajectory and settling), the collisions met (pairs of
-geometries, first time, deepest depth) and per-joint series of target, actual and error.
+geometries, first time, deepest depth), per-joint series of target, actual and error, the
+``segments`` run (the move to the path's start, with how far it was; the path; the settling;
+each with its start and end, s) and a ``.kps`` file's ``query`` (its Init and Goal samples).
 """
 from __future__ import annotations
 
@@ -33,7 +40,7 @@ from gui.core.control_path import ServoCommand, hold_on_client
 from gui.core.kautham.solutions import ATTACH, Solution
 from gui.core.model import PRISMATIC
 from gui.core.trajectory import BaseLimits, Trajectory, rotation_error
-from gui.errors import PathFileError
+from gui.errors import GuiError, PathFileError
 from odin_common.interface import SERVO_GAIN, SERVO_MAX_SPEED, JointType
 from odin_common.rotations import quaternion_to_matrix
 from odin_common.specs import JointSpec
@@ -45,7 +52,9 @@ class TrackingDefaults:
     trajectory uses (the rest is the servo's room to correct); ``acceleration``: rad/s^2 or
     m/s^2 per joint; ``gain``: the servos' position gain, 1/s; the free-flying base's limits
     (m/s, m/s^2, rad/s, rad/s^2) and ``base_gain`` (1/s); ``period``: s between servo updates
-    (rounded to whole world steps); ``settle``: s the last target is held."""
+    (rounded to whole world steps); ``settle``: s the last target is held;
+    ``start_tolerance``: rad or m, how far the robot may be from the path's first sample for
+    the path to run from where it is (module docstring)."""
     speed_fraction: float = 0.8
     acceleration: float = 2.0
     gain: float = SERVO_GAIN
@@ -56,6 +65,7 @@ class TrackingDefaults:
     base_gain: float = 10.0
     period: float = 0.01
     settle: float = 0.5
+    start_tolerance: float = 0.01
 
     def base_limits(self) -> BaseLimits:
         return BaseLimits(self.base_speed, self.base_acceleration, self.base_angular_speed,
@@ -91,6 +101,17 @@ class TrackingPort(Protocol):
     def attach(self, body1: str, body2: str) -> str: ...
 
     def detach(self, joint_id: str) -> None: ...
+
+
+class AwayFromStart(GuiError):
+    """The robot is farther from the path's first sample than ``TrackingDefaults.
+    start_tolerance``: ``distance`` (in ``unit``, "rad" or "m") on channel ``channel``
+    ("robot/joint", "robot/base x"...)."""
+
+    def __init__(self, distance: float, unit: str, channel: str):
+        self.distance, self.unit, self.channel = distance, unit, channel
+        super().__init__(f"the robot is {distance:.3g} {unit} from the path's start "
+                         f"({channel})")
 
 
 @dataclass
@@ -130,10 +151,22 @@ class TrackingReport:
     times: np.ndarray
     targets: np.ndarray               # (ticks, channels)
     actuals: np.ndarray
+    segments: List[dict] = field(default_factory=list)
+    query: Optional[dict] = None
+    start_tolerance: float = TrackingDefaults.start_tolerance
 
     @property
     def errors(self) -> np.ndarray:
         return self.actuals - self.targets
+
+    def start_move(self) -> str:
+        """", after a 1.8 rad move to its start (2.10 s)" when the run began by moving a robot
+        farther than ``start_tolerance`` to the path's start (``from_here``), else ""."""
+        move = self.segments[0] if self.segments else None
+        if move is None or move["distance"] <= self.start_tolerance:
+            return ""
+        return (f", after a {move['distance']:.3g} {move['unit']} move to its start "
+                f"({move['end_s'] - move['start_s']:.2f} s)")
 
     @property
     def real_time_factor(self) -> float:
@@ -145,8 +178,8 @@ class TrackingReport:
             tracking_error_max=self.tracking_error_max, duration_s=self.duration_s,
             trajectory_s=self.trajectory_s, settle_s=self.settle_s, period_s=self.period_s,
             wall_time_s=self.wall_time_s, real_time_factor=self.real_time_factor,
-            collisions=self.collisions, events=self.events,
-            units=dict(angle="rad", length="m", time="s"),
+            collisions=self.collisions, events=self.events, segments=self.segments,
+            query=self.query, units=dict(angle="rad", length="m", time="s"),
             series=dict(time=self.times.tolist(), joints=[
                 dict(name=n, unit=u, target=self.targets[:, k].tolist(),
                      actual=self.actuals[:, k].tolist(), error=self.errors[:, k].tolist())
@@ -209,8 +242,10 @@ def _present(port: TrackingPort, robot: _Robot) -> Tuple[np.ndarray, Optional[np
 
 
 def plan_tracking(port: TrackingPort, plan, solution: Solution,
-                  defaults: TrackingDefaults = TrackingDefaults()):
-    """(robots, trajectory, events) for ``solution`` from the robots' present state."""
+                  defaults: TrackingDefaults = TrackingDefaults(), from_here: bool = False):
+    """(robots, trajectory, events) for ``solution`` from the robots' present state;
+    ``AwayFromStart`` when a robot is farther from the path's first sample than
+    ``defaults.start_tolerance`` unless ``from_here`` (module docstring)."""
     robots, columns, start, waypoints, bases, base_start = [], 0, [], [], [], []
     speeds = []
     for name, path in solution.paths.items():
@@ -239,19 +274,56 @@ def plan_tracking(port: TrackingPort, plan, solution: Solution,
         base_poses = np.concatenate([np.array(base_start)[None], np.stack(bases, axis=1)])
     trajectory = Trajectory.of(q, speeds, [defaults.acceleration] * q.shape[1], base_poses,
                                defaults.base_limits())
+    distance, unit, channel = start_offset(robots, trajectory)
+    if distance > defaults.start_tolerance and not from_here:
+        raise AwayFromStart(distance, unit, channel)
     return robots, trajectory, _events(plan, solution, trajectory.times)
+
+
+def start_offset(robots: Sequence[_Robot], trajectory: Trajectory) -> Tuple[float, str, str]:
+    """(distance, its unit, its channel): how far the trajectory's first waypoint (where the
+    robots are) is from its second (the path's first sample), the channel that differs most
+    (``_compare``'s channels: joints, a base's coordinates and its rotation)."""
+    present, first = trajectory.sample(0.0), trajectory.sample(float(trajectory.times[1]))
+    names, units = _channels(robots)
+    differences = []
+    for r in robots:
+        differences.extend(np.abs(first.joints[r.columns] - present.joints[r.columns]))
+        if r.base is not None:
+            a, b = present.base_pose[r.base], first.base_pose[r.base]
+            differences.extend(np.abs(b[:3, 3] - a[:3, 3]))
+            differences.append(float(np.linalg.norm(rotation_error(b[:3, :3], a[:3, :3]))))
+    if not differences:
+        return 0.0, "rad", ""
+    k = int(np.argmax(differences))
+    return float(differences[k]), units[k], names[k]
+
+
+def _segments(robots: Sequence[_Robot], trajectory: Trajectory, done_s: float) -> List[dict]:
+    """The report's segments: the move to the path's start (with its distance), the path,
+    the settling; each clipped to the ``done_s`` s run."""
+    distance, unit, channel = start_offset(robots, trajectory)
+    reached, end = float(trajectory.times[1]), trajectory.duration
+    out = [dict(what="to the path's start", start_s=0.0, end_s=min(reached, done_s),
+                distance=distance, unit=unit, channel=channel),
+           dict(what="path", start_s=min(reached, done_s), end_s=min(end, done_s))]
+    if done_s > end:
+        out.append(dict(what="settle", start_s=end, end_s=done_s))
+    return out
 
 
 def execute_tracked(port: TrackingPort, plan, solution: Solution,
                     defaults: TrackingDefaults = TrackingDefaults(),
                     progress: Optional[Callable[[float, float], None]] = None,
                     real_time: bool = False, sleep: Callable[[float], None] = time.sleep,
-                    stop: Optional[Callable[[], bool]] = None) -> TrackingReport:
+                    stop: Optional[Callable[[], bool]] = None,
+                    from_here: bool = False) -> TrackingReport:
     """Runs ``solution`` on ``plan``'s robots through ``port`` (module docstring).
     ``progress(t, duration)`` after each period; ``real_time``: each period takes at least
     its simulated time of wall-clock time. ``stop()`` true (asked before each period) ends
-    the run there: the report covers the periods run (``duration_s``)."""
-    robots, trajectory, events = plan_tracking(port, plan, solution, defaults)
+    the run there: the report covers the periods run (``duration_s``). ``from_here``: a
+    robot away from the path's start is moved there first (else ``AwayFromStart``)."""
+    robots, trajectory, events = plan_tracking(port, plan, solution, defaults, from_here)
     step = port.step()
     period = step * max(1, round(defaults.period / step))
     ticks = int(math.ceil((trajectory.duration + defaults.settle) / period - 1e-9))
@@ -309,7 +381,11 @@ def execute_tracked(port: TrackingPort, plan, solution: Solution,
         collisions=[dict(first=a, second=b, first_time_s=v[0], depth_m=v[1])
                     for (a, b), v in sorted(collisions.items(), key=lambda i: i[1][0])],
         events=[dict(time_s=e.time, what=e.label) for e in events],
-        names=names, units=units, times=np.array(times), targets=targets, actuals=actuals)
+        names=names, units=units, times=np.array(times), targets=targets, actuals=actuals,
+        segments=_segments(robots, trajectory, done * period),
+        start_tolerance=defaults.start_tolerance,
+        query=None if solution.query is None else dict(init=solution.query.init,
+                                                       goal=solution.query.goal))
 
 
 def _servo(handle, targets: np.ndarray, rates: np.ndarray,
@@ -425,16 +501,19 @@ def run_tracked_on_client(client, plan, solution: Solution,
                           defaults: TrackingDefaults = TrackingDefaults(),
                           progress: Optional[Callable[[float, float], None]] = None,
                           real_time: bool = False,
-                          stop: Optional[Callable[[], bool]] = None) -> TrackingReport:
-    """``execute_tracked`` through a ``ClientTrackingPort``, the world paused meanwhile (and
-    running again afterwards if it was). Stopped by ``stop()``, each robot of the solution
-    is held where it is (``hold_on_client``) before the world runs again."""
+                          stop: Optional[Callable[[], bool]] = None,
+                          from_here: bool = False) -> TrackingReport:
+    """``execute_tracked`` through a ``ClientTrackingPort`` (``from_here`` as there), the
+    world paused meanwhile (and running again afterwards if it was). Stopped by ``stop()``,
+    each robot of the solution is held where it is (``hold_on_client``) before the world
+    runs again."""
     running = client.world().simulating
     if running:
         client.pause()
     try:
         report = execute_tracked(ClientTrackingPort(client), plan, solution, defaults,
-                                 progress=progress, real_time=real_time, stop=stop)
+                                 progress=progress, real_time=real_time, stop=stop,
+                                 from_here=from_here)
         if stop is not None and stop():
             for name in solution.paths:
                 hold_on_client(client, plan.robot(name))
@@ -444,5 +523,6 @@ def run_tracked_on_client(client, plan, solution: Solution,
             client.start()
 
 
-__all__ = ["TrackingDefaults", "TrackingPort", "TrackingReport", "plan_tracking",
-           "execute_tracked", "ClientTrackingPort", "run_tracked_on_client"]
+__all__ = ["TrackingDefaults", "TrackingPort", "TrackingReport", "AwayFromStart",
+           "plan_tracking", "start_offset", "execute_tracked", "ClientTrackingPort",
+           "run_tracked_on_client"]

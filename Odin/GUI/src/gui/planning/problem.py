@@ -136,9 +136,15 @@ class PlanningProblem:
             quaternion_to_matrix(body_quaternion) @ self.tracked_link_origin
 
     def goal_distance(self, tracked_position) -> float:
-        """m: how far the tracked link is from the goal in the plane."""
+        """m: how far the tracked link is from the goal in the plane: the planner's metric,
+        the figure ``plan`` prints and ``run_path --controls`` reports."""
         return float(math.hypot(tracked_position[0] - self.goal_xy[0],
                                 tracked_position[1] - self.goal_xy[1]))
+
+    def body_goal_distance(self, body_position, body_quaternion) -> float:
+        """m: ``goal_distance`` of the tracked link when its body's frame is at
+        ``body_position`` with ``body_quaternion`` (w, x, y, z), world frame."""
+        return self.goal_distance(self.tracked_origin(body_position, body_quaternion))
 
     def in_goal(self, tracked_position) -> bool:
         return self.goal_distance(tracked_position) < self.settings.goal_tolerance

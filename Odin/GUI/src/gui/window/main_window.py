@@ -19,7 +19,7 @@ from PyQt5.QtWidgets import (QLabel, QMainWindow, QPlainTextEdit, QSplitter, QTa
 from gui.window.joints_tab import JointsTab
 from gui.window.motion_tab import MotionTab
 from gui.window.objects_tab import ObjectsTab
-from gui.window.plot_panel import JointPlotPanel
+from gui.window.plot_panel import JointPlotPanel, channel_label
 from gui.window.scene import SceneModel
 from gui.window.settings_tab import SettingsTab
 from gui.window.simulation_tab import SimulationTab
@@ -67,7 +67,9 @@ class MainWindow(QMainWindow):
         self.viewer_panel = ViewerPanel(viewer=viewer if ros else None,
                                         frame_points=self.scene.robot_points)
         self.viewer_panel.message.connect(self.show_error)
-        self.plot = JointPlotPanel()
+        self.plot = JointPlotPanel(label=lambda channel: channel_label(channel, self.scene))
+        self.scene.changed.connect(
+            lambda what: self.plot.relabel() if what in ("robots", "joints") else None)
         self.log = QPlainTextEdit()
         self.log.setReadOnly(True)
         self.log.setMaximumBlockCount(500)

@@ -350,7 +350,8 @@ class MotionTab(QWidget):
     def run_tracked_path(self, handle, path: str, units: str) -> None:
         """The plan in ``path`` (raw rows drive ``handle``'s robot, in ``units``), read and
         checked whole here, then executed in real time on the path worker (the world paused
-        meanwhile, running again afterwards if it was); the report is plotted."""
+        meanwhile, running again afterwards if it was); a robot away from the path's start is
+        moved there first, which the status line says; the report is plotted."""
         from gui.core.kautham.solutions import read_solution
         plan = self.window.scene.plan
         if plan is None:
@@ -372,7 +373,7 @@ class MotionTab(QWidget):
                     raise Cancelled()
                 job.progress((t, total))
             return run_tracked_on_client(client, plan, solution, progress=progress,
-                                         real_time=True)
+                                         real_time=True, from_here=True)
 
         def progress(value):
             t, total = value
@@ -381,7 +382,8 @@ class MotionTab(QWidget):
         def finished(report):
             self.stop_button.setEnabled(False)
             self.tracking_plot.show_report(report)
-            text = (f"tracked path {name}: goal error {report.goal_error:.3g}, tracking error "
+            text = (f"tracked path {name}{report.start_move()}: goal error "
+                    f"{report.goal_error:.3g}, tracking error "
                     f"max {report.tracking_error_max:.3g}, {report.duration_s:.2f} s, "
                     f"{len(report.collisions)} colliding pairs")
             self.path_status.setText(text)

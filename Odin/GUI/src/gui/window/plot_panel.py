@@ -2,16 +2,19 @@
 
 Samples go into one bounded deque per joint axis (``history`` seconds of simulated time); the
 plot is repainted by a timer at ``fps`` (never per message), with QPainter: positions on top,
-speeds below, one colour per chosen joint, a shared time axis (simulated seconds).
+speeds below, one colour per chosen joint, a shared time axis (simulated seconds). The list
+names each channel as the window names its joint ("KukaLWR: Link1", ``channel_label``), the
+world's ID in its tooltip; ``relabel()`` when the scene's robots change.
 """
 from __future__ import annotations
 
 import collections
 import math
+from typing import Callable, Optional
 
 from PyQt5.QtCore import QPointF, QRectF, Qt, QTimer
 from PyQt5.QtGui import QColor, QPainter, QPen, QPolygonF
-from PyQt5.QtWidgets import (QHBoxLayout, QListWidget, QListWidgetItem, QSplitter,
+from PyQt5.QtWidgets import (QListWidget, QListWidgetItem, QSplitter,
                              QVBoxLayout, QWidget)
 
 COLORS = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2",
@@ -66,11 +69,28 @@ class PlotCanvas(QWidget):
         painter.end()
 
 
-class JointPlotPanel(QWidget):
-    """Check joints in the list to plot them."""
+def channel_label(channel: str, scene) -> str:
+    """How the list names a ``~joint_states`` channel ("<joint id>", or "<joint id>/<axis>" for
+    a joint of several axes): ``scene.joint_label`` of its joint ("<robot>: <joint name>" for
+    a robot's joint, else the world ID; ``gui.window.scene.SceneModel``), " axis k" added for a
+    joint of several axes."""
+    joint, axis = channel, ""
+    if channel not in scene.joints:
+        head, _, tail = channel.rpartition("/")
+        if tail.isdigit() and head in scene.joints:
+            joint, axis = head, tail
+    text = scene.joint_label(joint)
+    return f"{text} axis {axis}" if axis else text
 
-    def __init__(self, history: float = 10.0, fps: float = 10.0, parent=None):
+
+class JointPlotPanel(QWidget):
+    """Check joints in the list to plot them. ``label(channel)``: the text a channel is listed
+    under (None: its name, the world's ID)."""
+
+    def __init__(self, history: float = 10.0, fps: float = 10.0,
+                 label: Optional[Callable[[str], str]] = None, parent=None):
         super().__init__(parent)
+        self.label = label or (lambda channel: channel)
         self.history = history
         self.samples: dict = {}
         self.latest_time = 0.0
@@ -93,13 +113,23 @@ class JointPlotPanel(QWidget):
         self._timer.start(int(1000 / fps))
 
     def chosen(self) -> list:
-        return [self.list.item(i).text() for i in range(self.list.count())
+        """The checked channels' names (world IDs, as ``~joint_states`` names them)."""
+        return [self.list.item(i).data(Qt.UserRole) for i in range(self.list.count())
                 if self.list.item(i).checkState() == Qt.Checked]
 
     def choose(self, name: str, on: bool = True) -> None:
+        """Checks (or unchecks) the channel ``name``: its world ID or the text it is listed
+        under."""
         for i in range(self.list.count()):
-            if self.list.item(i).text() == name:
-                self.list.item(i).setCheckState(Qt.Checked if on else Qt.Unchecked)
+            item = self.list.item(i)
+            if name in (item.data(Qt.UserRole), item.text()):
+                item.setCheckState(Qt.Checked if on else Qt.Unchecked)
+
+    def relabel(self) -> None:
+        """Lists every channel under ``label`` again (the scene's robots changed)."""
+        for i in range(self.list.count()):
+            item = self.list.item(i)
+            item.setText(self.label(item.data(Qt.UserRole)))
 
     def on_joint_states(self, msg) -> None:
         t = msg.header.stamp.to_sec()
@@ -115,7 +145,9 @@ class JointPlotPanel(QWidget):
             data = self.samples.get(name)
             if data is None:
                 data = self.samples[name] = collections.deque(maxlen=keep)
-                item = QListWidgetItem(name)
+                item = QListWidgetItem(self.label(name))
+                item.setData(Qt.UserRole, name)
+                item.setToolTip(name)
                 item.setCheckState(Qt.Checked if name in self._rechoose else Qt.Unchecked)
                 self.list.addItem(item)
             position = msg.position[k] if k < len(msg.position) else math.nan

@@ -7,7 +7,11 @@ space, with the attach/detach events of a task (ROS-free).
   holding ``<SampleSet>`` (``<Sample>`` rows of normalised control values in [0, 1]) and
   ``<Queries>``; the first ``<Query Solved="True">``'s ``<Result name="Path">`` lists sample
   indices. Each sample maps through every robot's controls and limits as the query's
-  ``<Init>`` does (``gui.core.kautham.controls``);
+  ``<Init>`` does (``gui.core.kautham.controls``). The query's ``Init`` and ``Goal`` are
+  indices into the ``<SampleSet>`` (``Planner::loadData`` sets its start and goal samples from
+  them and moves the robots to the path's first sample): the path runs from ``Init`` to
+  ``Goal``, which may be the problem's query reversed, so a file whose path starts or ends
+  elsewhere is refused (``Solution.query``);
 - a task file (current Kautham, ``PlannerWidget::saveDataOMPL`` / ``taskmotionPathLoad``): a
   root ``<Task>`` of ``<Transit>``, ``<Transfer object robot link>`` and ``<MultiTransfer
   numobjects object1.. robot link>`` sections holding ``<Conf>`` rows. ``robot`` and ``link``
@@ -77,14 +81,29 @@ class AttachEvent:
     line: int
 
 
+@dataclass(frozen=True)
+class KpsQuery:
+    """A ``.kps`` query: the indices of its ``Init`` and ``Goal`` samples in the file's
+    ``<SampleSet>`` (where its path starts and ends) and the ``<Query>``'s line."""
+    init: int
+    goal: int
+    line: int
+
+    def describe(self) -> str:
+        """"sample i to sample g"."""
+        return f"sample {self.init} to sample {self.goal}"
+
+
 @dataclass(frozen=True, eq=False)
 class Solution:
     """What a plan file holds: ``format`` (KPS, TASK, OMPL or ROWS), one ``RobotWaypoints``
-    per robot it moves (same number of waypoints each), and its attach/detach events."""
+    per robot it moves (same number of waypoints each), its attach/detach events and, for a
+    ``.kps`` whose query names them, the query's samples (``KpsQuery``)."""
     source: str
     format: str
     paths: Dict[str, RobotWaypoints]
     events: Tuple[AttachEvent, ...] = ()
+    query: Optional[KpsQuery] = None
 
     @property
     def waypoint_count(self) -> int:
@@ -130,7 +149,7 @@ def _read_kps(p: pathlib.Path, root: Node, problem: Problem) -> Solution:
     if sample_set is None:
         raise PathFileError("<Planner> holds no <SampleSet>: no configuration", p, root.line)
     samples = list(sample_set.findall("Sample"))
-    result = _kps_path_result(p, root)
+    query_node, result = _kps_path_result(p, root)
     try:
         indices = [int(t) for t in result.text.split()]
     except ValueError:
@@ -138,6 +157,7 @@ def _read_kps(p: pathlib.Path, root: Node, problem: Problem) -> Solution:
                             "sample indices", p, result.line) from None
     if not indices:
         raise PathFileError("<Result name=\"Path\"> lists no sample", p, result.line)
+    query = _kps_query(p, query_node, indices, len(samples))
     robots = _mapped_robots(p, problem)
     size = robots[0].controls.size
     vectors, lines = [], []
@@ -165,10 +185,37 @@ def _read_kps(p: pathlib.Path, root: Node, problem: Problem) -> Solution:
         paths[instance.name] = RobotWaypoints(
             instance.name, np.array([c.joints for c in configurations], dtype=float), base,
             tuple(lines))
-    return Solution(str(p), KPS, paths)
+    return Solution(str(p), KPS, paths, query=query)
 
 
-def _kps_path_result(p: pathlib.Path, root: Node) -> Node:
+def _kps_query(p: pathlib.Path, query: Node, path: Sequence[int],
+               sample_count: int) -> Optional[KpsQuery]:
+    """The query's Init and Goal sample indices (None when it names neither), checked
+    against the SampleSet and the path's ends."""
+    named = {}
+    for name in ("Init", "Goal"):
+        raw = query.get(name)
+        if raw is None:
+            continue
+        try:
+            named[name] = int(raw.strip())
+        except ValueError:
+            raise PathFileError(f"<Query {name}=\"{raw}\">: not a sample index", p,
+                                query.line) from None
+        if not 0 <= named[name] < sample_count:
+            raise PathFileError(f"<Query {name}=\"{raw}\">: no such sample in the "
+                                f"<SampleSet> (0..{sample_count - 1})", p, query.line)
+    if not named:
+        return None
+    init, goal = named.get("Init", path[0]), named.get("Goal", path[-1])
+    if (path[0], path[-1]) != (init, goal):
+        raise PathFileError(f"the query runs from sample {init} to sample {goal}, its path "
+                            f"from sample {path[0]} to sample {path[-1]}", p, query.line)
+    return KpsQuery(init, goal, query.line)
+
+
+def _kps_path_result(p: pathlib.Path, root: Node) -> Tuple[Node, Node]:
+    """(the first solved ``<Query>``, its ``<Result name="Path">``)."""
     queries = root.find("Queries")
     found = list(queries.findall("Query")) if queries is not None else []
     if not found:
@@ -179,7 +226,7 @@ def _kps_path_result(p: pathlib.Path, root: Node) -> Node:
             continue
         for result in query.findall("Result"):
             if result.get("name", "").strip() == "Path":
-                return result
+                return query, result
     raise PathFileError("no solved <Query> has a <Result name=\"Path\">", p, found[0].line)
 
 
@@ -416,4 +463,4 @@ def _robot(p: pathlib.Path, problem: Problem, name: Optional[str]) -> Instance:
 
 
 __all__ = ["KPS", "TASK", "OMPL", "ROWS", "ATTACH", "DETACH", "SE3_VALUES", "RobotWaypoints",
-           "AttachEvent", "Solution", "RowLayout", "read_solution"]
+           "AttachEvent", "KpsQuery", "Solution", "RowLayout", "read_solution"]
