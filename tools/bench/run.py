@@ -21,6 +21,7 @@ figure is missing, a figure was refused or a module failed.
 README is left alone and only the figures measured are checked). ``ODIN_BENCH_ROUNDS=3`` runs
 fewer rounds in the modules that repeat rounds (for development on a shared machine).
 """
+import odin_common  # noqa: F401  (first, before numpy: the reference BLAS, odin_common.blas)
 import datetime
 import importlib.util
 import json

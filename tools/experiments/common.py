@@ -25,6 +25,7 @@ policy). Every message is stamped with simulated time; lost messages are counted
 """
 from __future__ import annotations
 
+import odin_common  # noqa: F401  (first, before numpy: the reference BLAS, odin_common.blas)
 import json
 import math
 import os
