@@ -58,6 +58,9 @@ def test_every_new_subscriber_gets_all_markers_and_the_last_transforms(ros_maste
     client = WorldClient()
     client.execute(plan_problem(load_problem(kautham_dir / GRASP)))
     objects = len(client.world().objects)
+    # cycles at the usual 25 Hz of one step each: the markers and transforms flow as at any
+    # rate, and the arm's 40 steps a cycle would hold a core for the whole test
+    client.set_step(steps_per_cycle=1, rate=25.0)
     client.start()
     counts = []
     try:
