@@ -69,7 +69,8 @@ def test_rviz_draws_the_running_grasp_scene(ros_master, kautham_dir):
     ros_master.wait_for_service("/virtual_world/set_robot")
     client = WorldClient()
     client.execute(plan_problem(load_problem(kautham_dir / GRASP)))
-    client.start()
+    client.set_step(steps_per_cycle=1, rate=25.0)   # running, without holding a core: RViz
+    client.start()                                   # needs the CPU to start and draw
     screen = Xvfb()
     try:
         env = dict(ros_master.env, DISPLAY=screen.display, QT_QPA_PLATFORM="xcb")
