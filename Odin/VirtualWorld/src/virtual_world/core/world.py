@@ -596,6 +596,14 @@ class Core:
         """The solver the last step used: QUICKSTEP or WORLDSTEP (the auto solver's choice)."""
         return Solver(self._scene.c.last_solver)
 
+    @property
+    def last_step_island_rows(self) -> Tuple[int, int]:
+        """What the auto solver measured before the last step: the largest island's
+        constraint rows and the most rows of non-contact joints (motors and limits included)
+        in one island; 0, 0 under an explicit solver, when the small-system clause held and when
+        no awake body has a joint other than a contact (the islands are not searched)."""
+        return self._scene.c.last_island_rows
+
     @locked
     def poses(self) -> Tuple[List[str], np.ndarray, np.ndarray]:
         """Every geometry (composite parts one by one, static ones too): names, positions
