@@ -97,14 +97,21 @@ def _short_value(value) -> str:
 
 @dataclass(frozen=True, eq=False)
 class WorldStep:
-    """Set World with ``parameters`` {name: value} (odin_common.world_parameters names, SI)."""
+    """Set World with ``parameters`` {name: value} (odin_common.world_parameters names, SI);
+    ``own``: the names the problem sets itself (the others are defaults)."""
     parameters: dict
+    own: Tuple[str, ...] = ()
     owner: ClassVar[Optional[str]] = None
     bodies: ClassVar[Tuple[BodySpec, ...]] = ()
 
     def label(self) -> str:
-        """"world name=value, ..."."""
-        return "world " + ", ".join(f"{k}={_short_value(v)}" for k, v in self.parameters.items())
+        """"world name=value, ... (n more at their defaults)": the problem's own values."""
+        own = [k for k in self.parameters if k in self.own]
+        rest = len(self.parameters) - len(own)
+        shown = ", ".join(f"{k}={_short_value(self.parameters[k])}" for k in own)
+        if not rest:
+            return "world " + shown
+        return "world " + (shown + ", " if shown else "") + f"{rest} more at their defaults"
 
     def describe(self) -> dict:
         """No bodies, no joints."""
@@ -423,14 +430,23 @@ class RobotHandle:
 @dataclass
 class BuildPlan:
     """Steps in the order they must be sent (WorldStep, StepSizeStep, EntityStep, ObjectStep,
-    CompositeStep, JointStep, MotorStep). ``world``: the world settings the plan sets (None:
-    it leaves the world as it is); ``ignored``: the problem's, and what the plan set aside
+    CompositeStep, JointStep, MotorStep). ``world``: the world settings the plan sets (every
+    world parameter and step value); ``physics``: whether they and a ground plane are
+    Kautham's physics; ``ignored``: the problem's, and what the plan set aside
     (``gui.core.model.Ignored``)."""
     problem: Problem
     steps: list
     robots: list                     # RobotHandle per robot (and per movable multi-link obstacle)
-    world: Optional[WorldSettings] = None
+    world: "WorldSettings"
+    physics: bool = False
     ignored: list = field(default_factory=list)
+
+    def set_world(self, world: "WorldSettings") -> None:
+        """The plan sets ``world`` instead (its Set World and Set Step steps replaced)."""
+        self.world = world
+        replaced = {WorldStep: WorldStep(world.parameters, world.own_parameters),
+                    StepSizeStep: StepSizeStep(world.step, world.steps_per_cycle, world.rate)}
+        self.steps = [replaced.get(type(s), s) for s in self.steps]
 
     def counts(self) -> dict:
         """{step class name: how many}."""

@@ -7,9 +7,14 @@ friction of Kautham's car planner ``car``'s; a fixed-base robot's base and the d
 Kautham's chain planner ``chain``'s; a shape's body ``gui.core.bodies``'.
 
 How a problem maps to the world:
-- Kautham's physics (``Problem.physics``: one of its ODE planners; ``BuildDefaults.ground``
-  asks for it in any problem): first Set World and Set Step with what Kautham's ODE
-  environment uses (``gui.core.world_settings``), then an infinite ground plane at z = 0
+- The world first (``gui.core.world_settings``): one Set World with every world parameter and
+  one Set Step with every step value, the problem's own where it has them, else the documented
+  defaults (docs/parameters.md, Set Step's 0.001 s x 40 at 25 Hz), never what the world held
+  before: loading a problem (load_problem, the window's Open, plan, the experiments) gives the
+  same world in a node that ran anything before as in a fresh one. A problem has values of its
+  own under Kautham's physics (``Problem.physics``: one of its ODE planners;
+  ``BuildDefaults.ground`` asks for it in any problem): what Kautham's ODE environment uses
+  (gravity, ERP, CFM, contacts per pair, the step), then an infinite ground plane at z = 0
   (``GROUND``, static).
 - A robot with joints -> one Build Entity (one object or composite per link, internal
   collisions off), then per link one Set Joint: revolute -> HINGE, prismatic -> SLIDER (anchor

@@ -21,11 +21,10 @@ from gui.core.plan import (BodySpec, BuildPlan, EntityStep, JointStep, LinkBody,
 from gui.core.translate import car, chain
 from gui.core.translate.joints import (fixed_joint, joint_motors, link_drive, link_joint,
                                        motor_kind)
-from gui.core.world_settings import kautham_world
+from gui.core.world_settings import default_world, kautham_world
 from odin_common.interface import MotorKind, Shape as ShapeKind, default_motor_id
 from odin_common.specs import (CompositeSpec, EntitySpec, JointSpec, ObjectSpec, Surface,
                                WORLD_SURFACE)
-from odin_common.step_values import StepValues
 
 GROUND = "ground"
 """The ground plane's object ID (another name is taken if an instance has it)."""
@@ -33,10 +32,12 @@ GROUND = "ground"
 
 @dataclass(frozen=True)
 class BuildDefaults:
-    """How a problem is built. ``ground``: Kautham's physics (Set World, Set Step, a ground
-    plane) for every problem (True), none (False), or where Kautham simulates the problem
-    (None: ``Problem.physics``). ``start_at_query``: robots built at the query's start (True),
-    at Home (False), or the start in current problems and Home in 2012 ones (None).
+    """How a problem is built. ``ground``: Kautham's physics (its world settings, a ground
+    plane) for every problem (True), none (False: Odin's default world settings, no ground
+    plane), or where Kautham simulates the problem (None: ``Problem.physics``); every plan
+    sets every world parameter and step value either way (``gui.core.world_settings``).
+    ``start_at_query``: robots built at the query's start (True), at Home (False), or the
+    start in current problems and Home in 2012 ones (None).
     ``inertia``: "auto", "file" or "shape" (``gui.core.inertia``). ``max_contact_sink``: m,
     the deepest a body may rest in a contact the planner's CFM softens
     (``gui.core.world_settings``)."""
@@ -84,18 +85,19 @@ class _Planner:
         for inst in self.problem.instances:
             self._instance(inst)
         self._attachments()
-        world, front = None, []
+        # every world parameter and step value, whatever the world held before (issue 28)
+        world = default_world()
         if self.physics:
-            world, ignored = kautham_world(self.problem, self.masses, StepValues().step,
+            world, ignored = kautham_world(self.problem, self.masses,
                                            self.defaults.max_contact_sink)
             self.ignored.extend(ignored)
-            front.append(WorldStep(world.parameters))
-            if world.step is not None:
-                front.append(StepSizeStep(world.step, world.steps_per_cycle, world.rate))
+        front = [WorldStep(world.parameters, world.own_parameters),
+                 StepSizeStep(world.step, world.steps_per_cycle, world.rate)]
+        if self.physics:
             front.append(ObjectStep(self._ground()))
         warn_once(self.ignored[len(self.problem.ignored):], "gui.core.translate")
         return BuildPlan(problem=self.problem, steps=front + self.steps, robots=self.handles,
-                         world=world, ignored=self.ignored)
+                         world=world, physics=self.physics, ignored=self.ignored)
 
     def _ground(self) -> ObjectSpec:
         taken = {i.name for i in self.problem.instances}
