@@ -93,6 +93,23 @@ def _short_value(value) -> str:
     return f"{value:g}" if isinstance(value, float) else str(value)
 
 
+@dataclass(frozen=True)
+class ServoCommand:
+    """Set Servo's lists, one value per motor axis (motors in order)."""
+    motors: Tuple[str, ...]
+    targets: Tuple[float, ...]
+    rates: Tuple[float, ...] = ()
+    gains: Tuple[float, ...] = ()
+    max_speeds: Tuple[float, ...] = ()
+    max_forces: Tuple[float, ...] = ()
+
+    def request_fields(self) -> dict:
+        """The Set Servo request's fields (lists)."""
+        return dict(motors=list(self.motors), targets=list(self.targets),
+                    rates=list(self.rates), gains=list(self.gains),
+                    max_speeds=list(self.max_speeds), max_forces=list(self.max_forces))
+
+
 # ---------------------------------------------------------------------------------- steps
 
 @dataclass(frozen=True, eq=False)
@@ -108,10 +125,10 @@ class WorldStep:
         """"world name=value, ... (n more at their defaults)": the problem's own values."""
         own = [k for k in self.parameters if k in self.own]
         rest = len(self.parameters) - len(own)
+        if not own:
+            return f"world: all {rest} parameters at their defaults"
         shown = ", ".join(f"{k}={_short_value(self.parameters[k])}" for k in own)
-        if not rest:
-            return "world " + shown
-        return "world " + (shown + ", " if shown else "") + f"{rest} more at their defaults"
+        return f"world {shown}" + (f" ({rest} more at their defaults)" if rest else "")
 
     def describe(self) -> dict:
         """No bodies, no joints."""
@@ -350,8 +367,41 @@ class MotorStep:
         return world_id
 
 
+@dataclass(frozen=True, eq=False)
+class HoldStep:
+    """Set Servo that holds robot ``owner`` where it was built: each joint's driving motor
+    (the MotorSteps of ``joint_keys``) a servo toward 0, the value the world reads at the
+    built pose, at no feed-forward rate, ``max_speeds`` rad/s or m/s. A motor at zero speed
+    alone lets an arm creep (its position error is never corrected: 3.3 mm in 10 s for the
+    KUKA LWR); a servo holds it. A Set Velocity of a motor, or a Set Position of the robot,
+    then takes over (docs/INTERFACE.md)."""
+    owner: str
+    joint_keys: Tuple[str, ...]
+    max_speeds: Tuple[float, ...]
+    bodies: ClassVar[Tuple[BodySpec, ...]] = ()
+
+    def label(self) -> str:
+        """"hold robot: n servos at the built pose"."""
+        return f"hold {self.owner}: {len(self.joint_keys)} servos at the built pose"
+
+    def describe(self) -> dict:
+        """No bodies, no joints."""
+        return {"bodies": [], "joints": []}
+
+    def entries(self, answer) -> List[StepEntry]:
+        """Nothing new to list (the motors are listed)."""
+        return []
+
+    def send(self, client, ids: BuiltIds) -> str:
+        """Sets the servos on the world's motor IDs; answers "held"."""
+        zeros = (0.0,) * len(self.joint_keys)
+        client.set_servo(ServoCommand(tuple(ids.motors[k] for k in self.joint_keys), zeros,
+                                      rates=zeros, max_speeds=self.max_speeds))
+        return "held"
+
+
 PlanStep = Union[WorldStep, StepSizeStep, EntityStep, ObjectStep, CompositeStep, JointStep,
-                 MotorStep]
+                 MotorStep, HoldStep]
 
 
 def body_step(spec: BodySpec) -> PlanStep:

@@ -174,8 +174,10 @@ class Core:
     def set_poses(self, poses: Sequence[Tuple[str, Sequence[float], Sequence[float]]],
                   reset_velocity: bool = False) -> None:
         """Moves objects: (object id, position m world, orientation wxyz) each, all or
-        nothing. reset_velocity zeroes the bodies' linear and angular velocities."""
+        nothing. reset_velocity zeroes the bodies' linear and angular velocities. Servos on
+        joints of moved objects then hold the joints where they were put."""
         objects.set_poses(self._scene, poses, reset_velocity)
+        motors.retarget_servos(self._scene, {object_id for object_id, *_ in poses})
 
     @disturbs
     def set_velocity(self, object_id: str, linear=None, angular=None) -> None:

@@ -28,14 +28,18 @@ How a problem maps to the world:
   (steering about the base's up, opposite for the wheels ahead of its centre and the others;
   both reversed like a hinge's, so that a positive steering turns left and a positive wheel
   speed rolls the car along its +x). Then one Set Motor per movable joint
-  (angular for hinges and hinge-2s, linear for sliders; zero speed, so the robot holds its
-  pose; the joint's effort limit as its force limit, infinite without one; the chain of
+  (angular for hinges and hinge-2s, linear for sliders; zero speed; the joint's effort limit as its force limit, infinite without one; the chain of
   Kautham's chain planner gets PlanarChainEnvironment's 7 N m and 1 rad/s for every joint
   instead, whatever its URDF says), id "motor:" + joint id; a joint with friction gets a second
   motor at zero speed whose force limit is the friction ("friction:" + joint id), a joint
   with damping a third at zero speed, unlimited force and CFM 1 / damping, which makes ODE
   apply exactly -damping x the joint's rate ("damping:" + joint id); under Kautham's own
-  physics (one of its ODE planners) no joint has either, as in its ODE environment.
+  physics (one of its ODE planners) no joint has either, as in its ODE environment. Last, a
+  robot (not a car, whose wheels' motors at zero speed hold it) gets one Set Servo that holds
+  every joint at the value it is built at (``gui.core.plan.HoldStep``): motors at zero speed
+  alone let an arm creep (3.3 mm in 10 s for the KUKA LWR), servos hold it within 0.1 mm; a
+  Set Velocity of a motor takes it out of servo mode, a Set Position of the robot moves the
+  servos' targets with it.
 - The base by the robot's kind (``gui.core.model``): FIXED_BASE -> in a 2012 problem a fixed
   (kinematic) body that never moves; in a current one a dynamic body held by a FIXED joint to
   the world (Kautham's chain); FREE_BODY, MOBILE, CAR -> a dynamic body, free.

@@ -16,13 +16,14 @@ from gui.core.bodies import shape_to_body, with_surface
 from gui.core.kautham import environment
 from gui.core.kautham.problem import PHYSICS_PLANNERS
 from gui.core.model import CAR, FIXED_BASE, Instance, LinkModel, Problem, warn_once
-from gui.core.plan import (BodySpec, BuildPlan, EntityStep, JointStep, LinkBody, ObjectStep,
-                           RobotHandle, StepSizeStep, WorldStep, body_step)
+from gui.core.plan import (BodySpec, BuildPlan, EntityStep, HoldStep, JointStep, LinkBody,
+                           ObjectStep, RobotHandle, StepSizeStep, WorldStep, body_step)
 from gui.core.translate import car, chain
 from gui.core.translate.joints import (fixed_joint, joint_motors, link_drive, link_joint,
                                        motor_kind)
 from gui.core.world_settings import default_world, kautham_world
-from odin_common.interface import MotorKind, Shape as ShapeKind, default_motor_id
+from odin_common.interface import (SERVO_MAX_SPEED, MotorKind, Shape as ShapeKind,
+                                   default_motor_id)
 from odin_common.specs import (CompositeSpec, EntitySpec, JointSpec, ObjectSpec, Surface,
                                WORLD_SURFACE)
 
@@ -85,6 +86,7 @@ class _Planner:
         for inst in self.problem.instances:
             self._instance(inst)
         self._attachments()
+        self._holds()
         # every world parameter and step value, whatever the world held before (issue 28)
         world = default_world()
         if self.physics:
@@ -228,6 +230,16 @@ class _Planner:
         handle.max_forces.append(drive.effort)
         handle.max_speeds.append(drive.speed)
         return joint_motors(key, inst.name, joint, drive, kind)
+
+    def _holds(self) -> None:
+        """A HoldStep per robot whose joints all have a driving motor: its servos hold it
+        where it is built (a car's wheels are left to their motors at zero speed)."""
+        for handle in self.handles:
+            if (handle.instance.role != "robot" or handle.kind == CAR or not handle.joint_keys
+                    or len(handle.motor_ids) != len(handle.joint_keys)):
+                continue
+            speeds = tuple(float(v) if v else SERVO_MAX_SPEED for v in handle.max_speeds)
+            self.steps.append(HoldStep(handle.name, tuple(handle.joint_keys), speeds))
 
     # -- attachments ---------------------------------------------------------------------------
     def _attachments(self) -> None:
