@@ -633,3 +633,14 @@ def test_an_experiments_own_world_replaces_the_defaults_and_keeps_the_problems_o
     assert set(world.own) == {"gravity", "erp", "cfm", "max_contacts", "solver"}
     assert (step.step, step.steps_per_cycle) == (pytest.approx(0.03), 10)
     assert plan.world.parameters == world.parameters and plan.steps[0] is world
+
+
+@pytest.mark.usefixtures("kautham_dir")
+def test_a_robot_with_joints_ends_its_plan_held_by_its_servos_unless_asked_not_to():
+    from gui.core.plan import HoldStep
+    problem = load_problem(KAUTHAM / "legacy_2012" / "examples" / "Kuka_two_columns.xml")
+    plan = plan_problem(problem)
+    hold = plan.steps[-1]
+    assert isinstance(hold, HoldStep) and hold.owner == "KukaLWR"
+    assert hold.joint_keys == tuple(plan.robot().joint_keys) and len(hold.joint_keys) == 7
+    assert not _steps(plan_problem(problem, BuildDefaults(hold_start=False)), HoldStep)

@@ -39,6 +39,8 @@ class BuildDefaults:
     sets every world parameter and step value either way (``gui.core.world_settings``).
     ``start_at_query``: robots built at the query's start (True), at Home (False), or the
     start in current problems and Home in 2012 ones (None).
+    ``hold_start``: robots' joints held by servos where they are built (``HoldStep``), or
+    left to their motors at zero speed (False: as the thesis's experiments were run).
     ``inertia``: "auto", "file" or "shape" (``gui.core.inertia``). ``max_contact_sink``: m,
     the deepest a body may rest in a contact the planner's CFM softens
     (``gui.core.world_settings``)."""
@@ -46,6 +48,7 @@ class BuildDefaults:
     internal_collisions: bool = False
     ground: Optional[bool] = None
     start_at_query: Optional[bool] = None
+    hold_start: bool = True
     inertia: str = inertia_rule.AUTO
     placeholder_factor: float = 10.0
     max_contact_sink: float = 0.01
@@ -234,6 +237,8 @@ class _Planner:
     def _holds(self) -> None:
         """A HoldStep per robot whose joints all have a driving motor: its servos hold it
         where it is built (a car's wheels are left to their motors at zero speed)."""
+        if not self.defaults.hold_start:
+            return
         for handle in self.handles:
             if (handle.instance.role != "robot" or handle.kind == CAR or not handle.joint_keys
                     or len(handle.motor_ids) != len(handle.joint_keys)):
