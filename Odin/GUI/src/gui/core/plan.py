@@ -135,9 +135,10 @@ class WorldStep:
         return {"bodies": [], "joints": []}
 
     def entries(self, answer) -> List[StepEntry]:
-        """One "World" line per parameter, with its value."""
+        """One "World" line per parameter the problem sets, with its value (the defaults
+        are not listed)."""
         return [StepEntry("World", name, _short_value(value))
-                for name, value in self.parameters.items()]
+                for name, value in self.parameters.items() if name in self.own]
 
     def send(self, client, ids: BuiltIds) -> str:
         """Sets the parameters; answers "set"."""
@@ -147,10 +148,12 @@ class WorldStep:
 
 @dataclass(frozen=True, eq=False)
 class StepSizeStep:
-    """Set Step: ``step`` s, ``steps_per_cycle``, ``rate`` Hz."""
+    """Set Step: ``step`` s, ``steps_per_cycle``, ``rate`` Hz; ``own``: the problem's values
+    (False: the defaults)."""
     step: float
     steps_per_cycle: int
     rate: float
+    own: bool = True
     owner: ClassVar[Optional[str]] = None
     bodies: ClassVar[Tuple[BodySpec, ...]] = ()
 
@@ -164,8 +167,8 @@ class StepSizeStep:
         return {"bodies": [], "joints": []}
 
     def entries(self, answer) -> List[StepEntry]:
-        """One "World" line: the step."""
-        return [StepEntry("World", "step", f"{self.step:g} s")]
+        """One "World" line: the step, when it is the problem's."""
+        return [StepEntry("World", "step", f"{self.step:g} s")] if self.own else []
 
     def send(self, client, ids: BuiltIds) -> str:
         """Sets the step; answers the step the world took ("h s")."""
@@ -495,7 +498,8 @@ class BuildPlan:
         """The plan sets ``world`` instead (its Set World and Set Step steps replaced)."""
         self.world = world
         replaced = {WorldStep: WorldStep(world.parameters, world.own_parameters),
-                    StepSizeStep: StepSizeStep(world.step, world.steps_per_cycle, world.rate)}
+                    StepSizeStep: StepSizeStep(world.step, world.steps_per_cycle, world.rate,
+                                               "step" in world.own)}
         self.steps = [replaced.get(type(s), s) for s in self.steps]
 
     def counts(self) -> dict:

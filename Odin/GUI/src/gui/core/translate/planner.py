@@ -97,7 +97,8 @@ class _Planner:
                                            self.defaults.max_contact_sink)
             self.ignored.extend(ignored)
         front = [WorldStep(world.parameters, world.own_parameters),
-                 StepSizeStep(world.step, world.steps_per_cycle, world.rate)]
+                 StepSizeStep(world.step, world.steps_per_cycle, world.rate,
+                              "step" in world.own)]
         if self.physics:
             front.append(ObjectStep(self._ground()))
         warn_once(self.ignored[len(self.problem.ignored):], "gui.core.translate")
