@@ -29,8 +29,13 @@ def test_load_problem_builds_the_hand_and_prints_progress(world, legacy):
                         str(legacy / "TX90_RHand_ICRA10_5PMD_TwoCan.xml")], timeout=120)
     lines = result.stdout.splitlines()
     assert lines[-1].startswith("built ")
-    assert any("[1/53] entity TX90 SAHand Right: 25 bodies" in l for l in lines)
+    # the whole world first (every parameter at its default: a 2012 problem sets none), the
+    # robot last held by its 24 servos
+    assert any(l.startswith("[1/56] world: all 23 parameters at their defaults") for l in lines)
+    assert any(l.startswith("[2/56] step 0.001 s, 40 per cycle, 25 Hz") for l in lines)
+    assert any("[3/56] entity TX90 SAHand Right: 25 bodies" in l for l in lines)
     assert sum(" motor on " in l for l in lines) == 24
+    assert any("[56/56] hold TX90 SAHand Right: 24 servos at the built pose" in l for l in lines)
 
 
 def test_load_problem_error_builds_nothing(world, tmp_path):

@@ -141,10 +141,25 @@ def test_a_robot_goes_with_new_scene_and_its_description_with_it(ros_master, kau
     client = WorldClient()
     ids = client.execute(plan_problem(load_problem(kautham_dir / PROBLEMS["rob"])))
     namespace = ids["robots"]["KukaLWR"]
+    topic = f"/{namespace}/joint_states"
     _wait(lambda: rospy.has_param(f"/{namespace}/robot_description"), 5, "the description")
+    _wait(lambda: _advertised(topic), 5, "the robot's joint_states advertised")
     client.new_scene()
     client.step_once(1)     # the world applies robot changes at its next publication
     _wait(lambda: not rospy.has_param(f"/{namespace}/robot_description"), 5,
           "the description to go")
+    _wait(lambda: not _advertised(topic), 5, "the robot's joint_states no longer advertised")
     assert client.world().robots == ()
+    # loaded again, it is advertised again; Remove Object of one of its links takes it away
+    ids = client.execute(plan_problem(load_problem(kautham_dir / PROBLEMS["rob"])))
+    _wait(lambda: _advertised(topic), 5, "the robot's joint_states advertised again")
+    client.remove_object(ids["bodies"]["KukaLWR/Link7"])
+    client.step_once(1)
+    _wait(lambda: not _advertised(topic), 5, "the joint_states gone with the robot's link")
     client.close()
+
+
+def _advertised(topic: str) -> bool:
+    """Whether the master lists a publisher of ``topic``."""
+    import rospy
+    return topic in {name for name, _ in rospy.get_published_topics()}

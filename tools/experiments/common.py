@@ -408,12 +408,21 @@ def session_tracking_port(session: Session, frame_every: int = 0):
 
 
 # -- the problem, as the GUI builds it --------------------------------------------------------
-def load_plan(problem_file: pathlib.Path):
-    """(problem, BuildPlan) of a Kautham problem file, as ``rosrun GUI load_problem`` plans it."""
-    from gui.core.translate import plan_problem
+def load_plan(problem_file: pathlib.Path, world: Optional[dict] = None,
+              hold_start: bool = True):
+    """(problem, BuildPlan) of a Kautham problem file, as ``rosrun GUI load_problem`` plans it.
+    ``world``: the experiment's own world (its node's ~parameters): the plan sets these values
+    over the problem's, as a load sets every world parameter (docs/INTERFACE.md).
+    ``hold_start`` False: the robot's motors left at zero speed, without the servos that hold
+    a loaded robot (``BuildDefaults.hold_start``)."""
+    from gui.core.translate import BuildDefaults, plan_problem
     from gui.core.kautham.problem import load_problem
+    from gui.core.world_settings import with_values
     problem = load_problem(problem_file)
-    return problem, plan_problem(problem)
+    plan = plan_problem(problem, BuildDefaults(hold_start=hold_start))
+    if world:
+        plan.set_world(with_values(plan.world, world))
+    return problem, plan
 
 
 def replace_step(plan, name: str, spec) -> None:

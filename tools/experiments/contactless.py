@@ -63,7 +63,7 @@ def can_request(position, mass: float, color):
 
 def run(frames: bool = True) -> dict:
     p = dict(PARAMETERS)
-    problem, plan = common.load_plan(common.EXAMPLES / PROBLEM)
+    problem, plan = common.load_plan(common.EXAMPLES / PROBLEM, WORLD)
     geometry = geometric_contact(plan, p)
     with common.Session("contactless", WORLD, CAMERA, track={CAN, TIP},
                         frames=frames) as s:

@@ -111,7 +111,9 @@ def run(frames: bool = True, out_root=None, mode: str = "tracked", viewer: bool 
         raise common.ExperimentError(f"grasp mode {mode!r}: choose from {', '.join(MODES)}")
     from gui.core.paths import RADIANS, load_robot_path
     p = dict(PARAMETERS, mode=mode)
-    problem, plan = common.load_plan(common.EXAMPLES / PROBLEM)
+    # the thesis's grasp, as pinned: the arm's motors at zero speed between the commands (the
+    # servos that hold a loaded robot let the opening hand release the can 0.16 s late)
+    problem, plan = common.load_plan(common.EXAMPLES / PROBLEM, WORLD, hold_start=False)
     common.replace_step(plan, CAN, common.cylinder_can(
         CAN, (-0.35, 1.18, 0.6803), p["can_mass_kg"], p["can_color"], p["can_radius_m"],
         p["can_length_m"]))

@@ -161,7 +161,7 @@ def arm_reaches_pile(plan, handle, q: np.ndarray, p: dict) -> dict:
 
 def run(frames: bool = True) -> dict:
     p = dict(PARAMETERS)
-    problem, plan = common.load_plan(common.EXAMPLES / PROBLEM)
+    problem, plan = common.load_plan(common.EXAMPLES / PROBLEM, WORLD)
     for name in CANS:
         common.replace_step(plan, name, common.cylinder_can(
             name, p["can_centres_m"][name], p["can_mass_kg"], p["can_colors"][name],

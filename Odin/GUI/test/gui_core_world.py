@@ -29,6 +29,19 @@ class CoreWorld(planning_backend.CoreWorld):
     def speed(self, object_id: str) -> float:
         return float(np.linalg.norm(self.core.body_state(object_id)[2]))
 
+    def drift_mm(self, object_ids, seconds: float, chunk: int = 500) -> dict:
+        """Steps ``seconds`` at the step in force, reading every ``chunk`` steps: {object:
+        its largest distance (mm) from where it was when called}."""
+        start = {i: self.position(i) for i in object_ids}
+        worst = dict.fromkeys(object_ids, 0.0)
+        h = self.step_values.step
+        for _ in range(max(1, round(seconds / h / chunk))):
+            self.core.step(h, chunk)
+            for i in object_ids:
+                moved = 1000.0 * float(np.linalg.norm(self.position(i) - start[i]))
+                worst[i] = max(worst[i], moved)
+        return worst
+
 
 CorePort = planning_backend.CorePort
 

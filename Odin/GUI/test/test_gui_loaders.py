@@ -331,8 +331,9 @@ def test_problem_with_relative_parent_paths_and_free_flying_robot(corpus):
         ' <Scene scene="../robots/2DRR.rob" scale="1"><Location X="0" Y="500" Z="0" WX="0" '
         'WY="0" WZ="1" TH="0"/></Scene>\n</Problem>\n')
     plan = plan_problem(load_problem(corpus / "TRO" / "free.xml"))
-    entity = plan.steps[0].spec
-    assert isinstance(plan.steps[0], EntityStep) and len(entity.objects) == 1
+    built = plan.steps[2]                  # after the world's Set World and Set Step
+    entity = built.spec
+    assert isinstance(built, EntityStep) and len(entity.objects) == 1
     assert entity.objects[0].position == pytest.approx((0.1, 0, 0))
     assert plan.robots[0].joint_keys == []
     # the .rob scene: a movable obstacle with joints but no fixed base joint

@@ -24,11 +24,17 @@ from gui.core.model import CAR, FIXED_BASE, FREE_BODY, MOBILE
 from gui.errors import PathFileError, ProblemError
 from gui_core_world import CorePort, CoreWorld
 from odin_common.interface import JointParameter, JointType, Shape
+from odin_common.world_parameters import WorldParameters
 
 KAUTHAM = corpus_dir() or pathlib.Path("/no-kautham-corpus")
 SPHERE_DIR = KAUTHAM / "current_2025" / "demos" / "OMPL_ode_demos" / "Sphere"
 SCRIPTS = pathlib.Path(__file__).resolve().parents[1] / "scripts"
 WALL = 4.8 - 0.25          # the inner faces of the arena's walls (centre 4.8, 0.5 thick)
+
+
+def _default_parameters() -> dict:
+    """Odin's documented world parameters, gravity as a tuple (as a plan carries it)."""
+    return {**WorldParameters().as_dict(), "gravity": WorldParameters().gravity}
 
 
 def _steps(plan, kind):
@@ -50,8 +56,10 @@ def test_sphere_demos_get_kautham_world_ground_and_dynamic_obstacles(name):
     world, step = _steps(plan, WorldStep), _steps(plan, StepSizeStep)
     # Kautham's ODE world (gravity -9.8), the planner's ERP 0.5 and Max Contacts 3; its CFM
     # 0.3 would sink the 25 kg sphere metres deep: the world keeps Kautham's 1e-5, listed
-    assert world[0].parameters == {"gravity": (0.0, 0.0, -9.8), "erp": 0.5, "cfm": 1e-5,
-                                   "max_contacts": 3}
+    own = {"gravity": (0.0, 0.0, -9.8), "erp": 0.5, "cfm": 1e-5, "max_contacts": 3}
+    assert set(world[0].own) == set(own)
+    # every other world parameter at its documented default, whatever the world held
+    assert world[0].parameters == {**_default_parameters(), **own}
     assert step[0].step == pytest.approx(0.03)
     assert any("Constraint Force Mixing" in i.what for i in plan.ignored)
     ground = _steps(plan, ObjectStep)[0].spec
@@ -142,7 +150,12 @@ def test_problem_info_lists_what_odin_does_not_use_and_warns_once_each():
 def test_a_2012_problem_gets_no_physics_and_is_built_at_home():
     plan = plan_problem(load_problem(KAUTHAM / "legacy_2012" / "examples" /
                                      "Staubli_R6_two_columns.xml"))
-    assert not _steps(plan, WorldStep) and plan.world is None
+    assert not plan.physics
+    # no physics of Kautham's, but the whole world still set: every default, no ground plane
+    (world,), (step,) = _steps(plan, WorldStep), _steps(plan, StepSizeStep)
+    assert world.parameters == _default_parameters() and world.own == ()
+    assert (step.step, step.steps_per_cycle, step.rate) == (0.001, 40, 25.0)
+    assert not any(s.spec.shape == Shape.PLANE for s in _steps(plan, ObjectStep))
     handle = plan.robot()
     assert handle.start is not None               # the query is known...
     np.testing.assert_allclose(handle.built_at, handle.home)   # ...but the build is at Home
@@ -520,8 +533,13 @@ def test_2012_scene_movable_attribute_overrides_the_kind_of_file(tmp_path):
 
 def test_ground_option_for_any_problem_and_none_for_a_physics_one(tmp_path):
     problem = load_problem(_arm(tmp_path))
-    assert not _steps(plan_problem(problem, BuildDefaults(ground=False)), WorldStep)
-    assert _steps(plan_problem(problem), WorldStep)
+    without = plan_problem(problem, BuildDefaults(ground=False))
+    # no Kautham physics: Odin's defaults, every one of them, and no ground plane
+    assert not without.physics
+    assert _steps(without, WorldStep)[0].parameters == _default_parameters()
+    assert not any(s.spec.shape == Shape.PLANE for s in _steps(without, ObjectStep))
+    physics = plan_problem(problem)
+    assert physics.physics and _steps(physics, WorldStep)[0].parameters["erp"] == 0.8
 
 
 # -- control path files ---------------------------------------------------------------------------
@@ -600,3 +618,29 @@ def test_a_mobile_robot_has_a_free_base_its_controls_drive_with_its_arm(tmp_path
     assert np.linalg.norm(results[-1].base_position[:2] - (1.0, -1.0)) < 0.03
     pan = {j.id: j.positions[0] for j in world.core.joint_states()}[handle.joint_ids[0]]
     assert pan + handle.built_at[0] == pytest.approx(1.2, abs=0.02)
+
+
+# -- a problem's world is the problem's (issue 28) ------------------------------------------------
+@pytest.mark.usefixtures("kautham_dir")
+def test_an_experiments_own_world_replaces_the_defaults_and_keeps_the_problems_other_values():
+    from gui.core.world_settings import with_values
+    plan = plan_problem(load_problem(SPHERE_DIR / "Sphere.xml"))
+    plan.set_world(with_values(plan.world, {"solver": 1, "gravity": [0.0, 0.0, -1.62],
+                                            "steps_per_cycle": 10, "free_run": True}))
+    (world,), (step,) = _steps(plan, WorldStep), _steps(plan, StepSizeStep)
+    assert world.parameters == {**_default_parameters(), "erp": 0.5, "cfm": 1e-5,
+                                "max_contacts": 3, "solver": 1, "gravity": (0.0, 0.0, -1.62)}
+    assert set(world.own) == {"gravity", "erp", "cfm", "max_contacts", "solver"}
+    assert (step.step, step.steps_per_cycle) == (pytest.approx(0.03), 10)
+    assert plan.world.parameters == world.parameters and plan.steps[0] is world
+
+
+@pytest.mark.usefixtures("kautham_dir")
+def test_a_robot_with_joints_ends_its_plan_held_by_its_servos_unless_asked_not_to():
+    from gui.core.plan import HoldStep
+    problem = load_problem(KAUTHAM / "legacy_2012" / "examples" / "Kuka_two_columns.xml")
+    plan = plan_problem(problem)
+    hold = plan.steps[-1]
+    assert isinstance(hold, HoldStep) and hold.owner == "KukaLWR"
+    assert hold.joint_keys == tuple(plan.robot().joint_keys) and len(hold.joint_keys) == 7
+    assert not _steps(plan_problem(problem, BuildDefaults(hold_start=False)), HoldStep)

@@ -1,12 +1,18 @@
-"""The auto solver (the default): each step dWorldStep while the constraint rows to solve are
-at most AUTO_SOLVER_MAX_ROWS, QuickStep above. An arm held by its servos must not sag (it does
-under QuickStep), a pile must still go to QuickStep, and the choice, depending on the state
-only, keeps results bit-identical."""
+"""The auto solver (the default): each step dWorldStep while the whole step is small (at most
+AUTO_SOLVER_MAX_ROWS rows, each joint counted at its most) or an island is articulated (joints,
+motors) and the largest island has at most AUTO_SOLVER_MAX_ISLAND_ROWS rows (ODE's own count),
+QuickStep otherwise. An arm held by its servos must not sag (it does under QuickStep), a few
+bodies on the ground keep the exact solver (the pinned planning experiments were recorded so),
+a pile and many bodies at rest take QuickStep, a big articulated island with contacts takes the
+exact solver up to the bound, and the choice, depending on the state only, keeps results
+bit-identical."""
 import math
 
 import pytest
 
-from odin_common.interface import AUTO_SOLVER_MAX_ROWS, JointType, Shape, Solver
+import virtual_world.ode.world
+from odin_common.interface import (AUTO_SOLVER_MAX_ISLAND_ROWS, AUTO_SOLVER_MAX_ROWS, JointType,
+                                   Shape, Solver)
 from virtual_world.core import Core, ObjectSpec, WorldParameters
 
 from test_core_snapshots import pile, state_bytes
@@ -46,6 +52,22 @@ def sag_mm(core, tip, seconds=2.0):
     return 1000.0 * worst
 
 
+GROUND = ObjectSpec("ground", [20, 20, 1], position=(0, 0, -0.5), geometry_only=True)
+
+
+def resting_spheres(core, n, first_row_y=-2):
+    """``n`` spheres of 0.1 m resting apart on GROUND, rows of ten along x from y =
+    ``first_row_y`` (m): one contact each, no two touching."""
+    for i in range(n):
+        core.build_object(ObjectSpec(f"s{i}", [0.1], position=(i % 10 - 4.5,
+                                                               i // 10 + first_row_y, 0.0999)))
+
+
+def last_step(core):
+    """What the last step met and chose: (contacts, (island rows, articulated rows), solver)."""
+    return core.last_step_contacts, core.last_step_island_rows, core.last_step_solver
+
+
 def test_auto_is_the_default():
     assert WorldParameters().solver == Solver.AUTO
 
@@ -66,6 +88,14 @@ def test_an_arm_held_by_its_servos_does_not_sag_under_the_default_solver(solver,
         core.close()
 
 
+@pytest.fixture
+def island_rule_only(monkeypatch):
+    """AUTO_SOLVER_MAX_ROWS at 0: the small-system clause narrowed to steps without a joint
+    (free fall) and any articulation large, so a test sees the island rule alone on scenes
+    the small-system clause would send to dWorldStep anyway."""
+    monkeypatch.setattr(virtual_world.ode.world, "AUTO_SOLVER_MAX_ROWS", 0)
+
+
 def _run(solver, build, steps):
     core = Core(WorldParameters(solver=solver))
     try:
@@ -76,32 +106,119 @@ def _run(solver, build, steps):
         core.close()
 
 
+def test_an_arm_held_by_servos_counts_ode_rows_a_hinge_5_and_its_powered_motor_1(
+        island_rule_only):
+    core = Core()
+    try:
+        arm(core)
+        core.step(H, 1)
+        assert core.last_step_island_rows == (7 * 6, 7 * 6)    # one island, no contact
+        assert core.last_step_solver == Solver.WORLDSTEP
+    finally:
+        core.close()
+
+
 def test_auto_is_dworldstep_on_the_arm_and_quickstep_on_a_pile_bit_for_bit():
     arm_auto, chosen = _run(Solver.AUTO, arm, 300)
     assert chosen == Solver.WORLDSTEP
     assert arm_auto == _run(Solver.WORLDSTEP, arm, 300)[0]
-    # 60 spheres resting in a box: hundreds of contact rows, far above the bound
+    # 60 spheres piled in a box: hundreds of contact rows, contacts only
     assert 60 * 3 * 3 > AUTO_SOLVER_MAX_ROWS
     settled = _run(Solver.AUTO, pile, 1500)
     assert settled[1] == Solver.QUICKSTEP
-    # while they fall (no contact yet) auto takes dWorldStep: the runs differ, both land
+    # while they fall (no rows: a small system) auto takes dWorldStep: the runs differ
     assert settled[0] != _run(Solver.QUICKSTEP, pile, 1500)[0]
 
 
-def test_a_pile_that_crosses_the_bound_is_bit_identical_run_after_run_and_from_a_snapshot():
-    """The spheres fall freely (no rows: dWorldStep) and land (contacts: QuickStep), so the
-    choice changes mid-run; the same calls give the same bytes, and a snapshot taken while
-    falling replays them."""
-    first = _run(Solver.AUTO, pile, 1200)[0]
-    assert _run(Solver.AUTO, pile, 1200)[0] == first
+@pytest.mark.parametrize("bodies", [1, AUTO_SOLVER_MAX_ROWS // 3])
+def test_a_few_bodies_resting_on_the_ground_keep_the_exact_solver(bodies):
+    """Contacts only, but few: the small-system clause holds (3 rows a contact), as it did when
+    the planning experiments (a sphere, a car on the ground) were pinned; one more body and the
+    step is a pile's business (QuickStep)."""
+    for n, solver in ((bodies, Solver.WORLDSTEP), (AUTO_SOLVER_MAX_ROWS // 3 + 1,
+                                                   Solver.QUICKSTEP)):
+        core = Core()
+        try:
+            core.build_object(GROUND)
+            resting_spheres(core, n)
+            core.step(H, 5)
+            assert core.last_step_contacts == n
+            assert core.last_step_solver == solver, n
+        finally:
+            core.close()
+
+
+def test_a_small_arm_among_many_contacts_keeps_quickstep_as_before_the_island_rule():
+    """The 7-link arm (42 rows of joints, within the small-system bound) beside 50 spheres
+    resting on the ground (150 contact rows): the step is no small system and the arm no large
+    articulation, so auto keeps QuickStep, as it did when the planning experiments (a car
+    among contacts) were pinned."""
     core = Core()
     try:
+        arm(core)
+        core.build_object(GROUND)
+        resting_spheres(core, 50, first_row_y=-4)
+        core.step(H, 2)
+        assert last_step(core) == (50, (42, 42), Solver.QUICKSTEP)
+    finally:
+        core.close()
+
+
+def sphere_chain(core, n, radius=0.05, gap=0.12):
+    """``n`` spheres resting in a row on the ground, the first held to the world and each to
+    the next by a ball joint (3 rows each), one contact each (3 rows): one island of 6 n rows,
+    3 n of them articulated."""
+    core.build_object(ObjectSpec("ground", [40, 40, 1], position=(0, 0, -0.5),
+                                 geometry_only=True))
+    parent = ""
+    for i in range(n):
+        core.build_object(ObjectSpec(f"c{i}", [radius], position=(i * gap, 0.0,
+                                                                    radius - 0.0001)))
+        core.create_joint(JointType.BALL, f"c{i}", parent,
+                          anchor=((i - 0.5) * gap, 0.0, radius - 0.0001))
+        parent = f"c{i}"
+
+
+@pytest.mark.parametrize("links", [AUTO_SOLVER_MAX_ISLAND_ROWS // 6,
+                                   AUTO_SOLVER_MAX_ISLAND_ROWS // 6 + 1])
+def test_an_articulated_island_with_contacts_takes_the_exact_solver_up_to_the_bound(links):
+    assert 3 * links > AUTO_SOLVER_MAX_ROWS      # a large articulation: past the small system
+    core = Core()
+    try:
+        sphere_chain(core, links)
+        core.step(H, 2)
+        assert core.last_step_contacts == links
+        assert core.last_step_island_rows == (6 * links, 3 * links)
+        exact = 6 * links <= AUTO_SOLVER_MAX_ISLAND_ROWS
+        assert core.last_step_solver == (Solver.WORLDSTEP if exact else Solver.QUICKSTEP)
+    finally:
+        core.close()
+
+
+def test_a_choice_that_changes_mid_run_is_bit_identical_run_after_run_and_from_a_snapshot(
+        monkeypatch):
+    """A pile with one sphere held to the world (articulated): while the spheres fall apart the
+    islands are small (dWorldStep); piled up, the largest island passes a bound of 60 rows
+    (QuickStep). The same calls give the same bytes, and a snapshot taken while falling replays
+    them."""
+    monkeypatch.setattr(virtual_world.ode.world, "AUTO_SOLVER_MAX_ROWS", 0)
+    monkeypatch.setattr(virtual_world.ode.world, "AUTO_SOLVER_MAX_ISLAND_ROWS", 60)
+
+    def held_pile(core):
         pile(core)
+        core.create_joint(JointType.BALL, "s0", "", anchor=(-0.21, -0.21, 0.12))
+
+    first = _run(Solver.AUTO, held_pile, 1200)[0]
+    assert _run(Solver.AUTO, held_pile, 1200)[0] == first
+    core = Core()
+    try:
+        held_pile(core)
         core.step(H, 100)
         assert core.last_step_solver == Solver.WORLDSTEP   # still in the air
         core.save_state("falling")
         core.step(H, 1100)
         assert core.last_step_solver == Solver.QUICKSTEP
+        assert core.last_step_island_rows[0] > 60
         assert state_bytes(core) == first
         core.restore_state("falling")
         core.step(H, 1100)
@@ -123,22 +240,20 @@ def test_explicit_solvers_keep_their_meaning():
 
 
 @pytest.mark.parametrize("ground_first", [True, False])
-def test_contacts_with_the_static_ground_count(ground_first):
-    """50 spheres resting apart on the ground, one contact each (3 rows): 150 rows, over the
-    bound, whichever geometry the contact names first."""
+def test_bodies_at_rest_on_the_static_ground_take_quickstep(ground_first):
+    """50 spheres resting apart on the ground (the rest scenes): 150 rows, past the
+    small-system clause, and 50 islands of one contact whichever geometry the contact names
+    first, nothing articulated: QuickStep, without searching the islands (the measure reads
+    0, 0)."""
     assert 50 * 3 > AUTO_SOLVER_MAX_ROWS
     core = Core()
     try:
-        ground = ObjectSpec("ground", [20, 20, 1], position=(0, 0, -0.5), geometry_only=True)
         if ground_first:
-            core.build_object(ground)
-        for i in range(50):
-            core.build_object(ObjectSpec(f"s{i}", [0.1], position=(i % 10 - 4.5, i // 10 - 2,
-                                                                   0.0999)))
+            core.build_object(GROUND)
+        resting_spheres(core, 50)
         if not ground_first:
-            core.build_object(ground)
+            core.build_object(GROUND)
         core.step(H, 5)
-        assert core.last_step_contacts == 50
-        assert core.last_step_solver == Solver.QUICKSTEP
+        assert last_step(core) == (50, (0, 0), Solver.QUICKSTEP)
     finally:
         core.close()

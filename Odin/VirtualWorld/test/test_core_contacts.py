@@ -16,9 +16,9 @@ import pytest
 from virtual_world.core import Core, FORCE, ObjectSpec, WorldParameters
 
 G = 9.81
-# Coulomb's law within 0.2 %: the default auto solver takes a box on the ground (a dozen
-# constraint rows) to dWorldStep, whose friction at mu = 1 reads 0.12 % weaker than mu m g
-# (QuickStep's within 0.1 %)
+# Coulomb's law within 0.2 %: the default auto solver takes a box on the ground (contacts
+# only) to QuickStep, whose friction at mu = 1 reads within 0.1 % of mu m g (dWorldStep's,
+# which the auto solver took before issue 28, 0.12 % weaker)
 FRICTION_REL = 2e-3
 
 

@@ -111,6 +111,33 @@ def test_a_servo_on_a_hinge2s_second_axis_pulls_the_right_way():
     core.close()
 
 
+def test_a_servo_holds_its_joint_where_set_position_put_it():
+    """Under gravity, a rod held at 0 by its servo is turned to 0.5 rad by Set Position: the
+    servo now holds 0.5 rad (it does not pull the rod back to 0)."""
+    core, joint, motor = rotor(gravity=(0.0, 0.0, -9.81))
+    core.set_servos({motor: {"targets": [0.0]}})
+    core.step(H, 100)
+    half = (math.cos(0.25), 0.0, math.sin(0.25), 0.0)      # 0.5 rad about +y
+    core.set_poses([("rod", (0.25 * math.cos(0.5), 0.0, -0.25 * math.sin(0.5)), half)],
+                   reset_velocity=True)
+    (state,) = core.servo_states()
+    assert state.targets[0] == pytest.approx(angle(core, joint), abs=1e-9)
+    assert angle(core, joint) == pytest.approx(0.5, abs=1e-6)
+    core.step(H, 1000)
+    assert angle(core, joint) == pytest.approx(0.5, abs=1e-3)
+    core.close()
+
+
+def test_a_goal_speed_takes_a_motor_out_of_servo_mode():
+    core, joint, motor = rotor()
+    core.set_servos({motor: {"targets": [0.0]}})
+    core.set_motor_velocities({motor: [1.0]})
+    assert core.servo_states() == []
+    core.step(H, 200)
+    assert angle(core, joint) == pytest.approx(0.2, rel=1e-3)
+    core.close()
+
+
 def test_a_released_servo_holds_still_and_a_snapshot_brings_the_servo_back():
     core, joint, motor = rotor(gravity=(0, 0, -9.81))
     core.set_servos({motor: {"targets": [0.5]}})

@@ -1,6 +1,6 @@
 """The peers' scenes (scenes.py) in Odin's Core, with its defaults (the auto solver: dWorldStep
-on the arm's and the grasp's few constraint rows, QuickStep of 20 iterations on the spheres'
-many; sweep and prune, 3 contacts a pair, mu 1): the plane a static PLANE geometry, the spheres
+on the arm's and the grasp's articulated islands, QuickStep of 20 iterations on the spheres'
+contacts; sweep and prune, 3 contacts a pair, mu 1): the plane a static PLANE geometry, the spheres
 objects, the arm's links capsules on hinges held by servos (Set Servo: position targets,
 motors of MOTOR_MAX_TORQUE), the fingers boxes on sliders squeezing with FINGER_FORCE."""
 from __future__ import annotations

@@ -88,16 +88,14 @@ def describe(plan) -> dict:
         description = step.describe()
         bodies.extend(description["bodies"])
         joints.extend(description["joints"])
-    world = None
-    if plan.world is not None:
-        world = dict(parameters={k: list(v) if isinstance(v, tuple) else v
-                                 for k, v in plan.world.parameters.items()},
-                     step=plan.world.step, steps_per_cycle=plan.world.steps_per_cycle,
-                     rate=plan.world.rate)
+    world = dict(parameters={k: list(v) if isinstance(v, tuple) else v
+                             for k, v in plan.world.parameters.items()},
+                 step=plan.world.step, steps_per_cycle=plan.world.steps_per_cycle,
+                 rate=plan.world.rate, own=list(plan.world.own))
     problem = plan.problem
     return dict(problem=problem.source, format=problem.format,
                 planner=problem.planner.name if problem.planner else None,
-                physics=plan.world is not None,
+                physics=plan.physics,
                 units=dict(length="m", angle="rad", mass="kg", quaternion="w,x,y,z"),
                 world=world, bodies=bodies, joints=joints,
                 robots=[_robot(h) for h in plan.robots if h.instance.role == "robot"],
@@ -113,7 +111,7 @@ def _build_options(parser: argparse.ArgumentParser) -> None:
                         help="Kautham's ODE physics (world settings, a ground plane) for any "
                         "problem [default: for problems with an ODE planner]")
     ground.add_argument("--no-physics", dest="ground", action="store_const", const=False,
-                        help="no ground plane, the world as it is")
+                        help="no ground plane, Odin's default world settings")
     start = parser.add_mutually_exclusive_group()
     start.add_argument("--at-home", dest="start_at_query", action="store_const", const=False,
                        help="build robots at Home [default for 2012 problems]")
@@ -218,8 +216,9 @@ def run_path_main(argv: Optional[Sequence[str]] = None) -> int:
     parser.add_argument("--plot", metavar="OUT.png", help="tracked: plot target against "
                         "actual per joint")
     parser.add_argument("--solver", choices=["auto", "quickstep", "worldstep"],
-                        help="tracked: set the world's solver first (Set World; it stays set). "
-                        "The summary and the last line name the solver in force: AUTO (the "
+                        help="tracked: set the world's solver first (Set World; it stays set "
+                        "until the next problem load, which sets every world parameter). The "
+                        "summary and the last line name the solver in force: AUTO (the "
                         "world's default) steps small articulated scenes exactly (dWorldStep) "
                         "and large ones with QuickStep, which alone can let a chain shake near "
                         "its goal where WORLDSTEP, the exact solver, reaches it")

@@ -26,6 +26,7 @@ import numpy as np
 from gui.core.kautham import environment
 from gui.core.model import CAR, FREE_BODY, MOBILE
 from gui.core.paths import read_rows
+from gui.core.plan import ServoCommand
 from gui.errors import PathFileError
 from odin_common.interface import SERVO_MAX_SPEED, ForceKind
 from odin_common.rotations import quaternion_to_matrix
@@ -89,23 +90,6 @@ class ControlRow:
     """One control step: ``controls`` (k values in [0, 1]) for ``duration`` s."""
     controls: Tuple[float, ...]
     duration: float
-
-
-@dataclass(frozen=True)
-class ServoCommand:
-    """Set Servo's lists, one value per motor axis (motors in order)."""
-    motors: Tuple[str, ...]
-    targets: Tuple[float, ...]
-    rates: Tuple[float, ...] = ()
-    gains: Tuple[float, ...] = ()
-    max_speeds: Tuple[float, ...] = ()
-    max_forces: Tuple[float, ...] = ()
-
-    def request_fields(self) -> dict:
-        """The Set Servo request's fields (lists)."""
-        return dict(motors=list(self.motors), targets=list(self.targets),
-                    rates=list(self.rates), gains=list(self.gains),
-                    max_speeds=list(self.max_speeds), max_forces=list(self.max_forces))
 
 
 @dataclass(frozen=True)

@@ -93,27 +93,52 @@ def _short_value(value) -> str:
     return f"{value:g}" if isinstance(value, float) else str(value)
 
 
+@dataclass(frozen=True)
+class ServoCommand:
+    """Set Servo's lists, one value per motor axis (motors in order)."""
+    motors: Tuple[str, ...]
+    targets: Tuple[float, ...]
+    rates: Tuple[float, ...] = ()
+    gains: Tuple[float, ...] = ()
+    max_speeds: Tuple[float, ...] = ()
+    max_forces: Tuple[float, ...] = ()
+
+    def request_fields(self) -> dict:
+        """The Set Servo request's fields (lists)."""
+        return dict(motors=list(self.motors), targets=list(self.targets),
+                    rates=list(self.rates), gains=list(self.gains),
+                    max_speeds=list(self.max_speeds), max_forces=list(self.max_forces))
+
+
 # ---------------------------------------------------------------------------------- steps
 
 @dataclass(frozen=True, eq=False)
 class WorldStep:
-    """Set World with ``parameters`` {name: value} (odin_common.world_parameters names, SI)."""
+    """Set World with ``parameters`` {name: value} (odin_common.world_parameters names, SI);
+    ``own``: the names the problem sets itself (the others are defaults)."""
     parameters: dict
+    own: Tuple[str, ...] = ()
     owner: ClassVar[Optional[str]] = None
     bodies: ClassVar[Tuple[BodySpec, ...]] = ()
 
     def label(self) -> str:
-        """"world name=value, ..."."""
-        return "world " + ", ".join(f"{k}={_short_value(v)}" for k, v in self.parameters.items())
+        """"world name=value, ... (n more at their defaults)": the problem's own values."""
+        own = [k for k in self.parameters if k in self.own]
+        rest = len(self.parameters) - len(own)
+        if not own:
+            return f"world: all {rest} parameters at their defaults"
+        shown = ", ".join(f"{k}={_short_value(self.parameters[k])}" for k in own)
+        return f"world {shown}" + (f" ({rest} more at their defaults)" if rest else "")
 
     def describe(self) -> dict:
         """No bodies, no joints."""
         return {"bodies": [], "joints": []}
 
     def entries(self, answer) -> List[StepEntry]:
-        """One "World" line per parameter, with its value."""
+        """One "World" line per parameter the problem sets, with its value (the defaults
+        are not listed)."""
         return [StepEntry("World", name, _short_value(value))
-                for name, value in self.parameters.items()]
+                for name, value in self.parameters.items() if name in self.own]
 
     def send(self, client, ids: BuiltIds) -> str:
         """Sets the parameters; answers "set"."""
@@ -123,10 +148,12 @@ class WorldStep:
 
 @dataclass(frozen=True, eq=False)
 class StepSizeStep:
-    """Set Step: ``step`` s, ``steps_per_cycle``, ``rate`` Hz."""
+    """Set Step: ``step`` s, ``steps_per_cycle``, ``rate`` Hz; ``own``: the problem's values
+    (False: the defaults)."""
     step: float
     steps_per_cycle: int
     rate: float
+    own: bool = True
     owner: ClassVar[Optional[str]] = None
     bodies: ClassVar[Tuple[BodySpec, ...]] = ()
 
@@ -140,8 +167,8 @@ class StepSizeStep:
         return {"bodies": [], "joints": []}
 
     def entries(self, answer) -> List[StepEntry]:
-        """One "World" line: the step."""
-        return [StepEntry("World", "step", f"{self.step:g} s")]
+        """One "World" line: the step, when it is the problem's."""
+        return [StepEntry("World", "step", f"{self.step:g} s")] if self.own else []
 
     def send(self, client, ids: BuiltIds) -> str:
         """Sets the step; answers the step the world took ("h s")."""
@@ -343,8 +370,41 @@ class MotorStep:
         return world_id
 
 
+@dataclass(frozen=True, eq=False)
+class HoldStep:
+    """Set Servo that holds robot ``owner`` where it was built: each joint's driving motor
+    (the MotorSteps of ``joint_keys``) a servo toward 0, the value the world reads at the
+    built pose, at no feed-forward rate, ``max_speeds`` rad/s or m/s. A motor at zero speed
+    alone lets an arm creep (its position error is never corrected: 3.3 mm in 10 s for the
+    KUKA LWR); a servo holds it. A Set Velocity of a motor, or a Set Position of the robot,
+    then takes over (docs/INTERFACE.md)."""
+    owner: str
+    joint_keys: Tuple[str, ...]
+    max_speeds: Tuple[float, ...]
+    bodies: ClassVar[Tuple[BodySpec, ...]] = ()
+
+    def label(self) -> str:
+        """"hold robot: n servos at the built pose"."""
+        return f"hold {self.owner}: {len(self.joint_keys)} servos at the built pose"
+
+    def describe(self) -> dict:
+        """No bodies, no joints."""
+        return {"bodies": [], "joints": []}
+
+    def entries(self, answer) -> List[StepEntry]:
+        """Nothing new to list (the motors are listed)."""
+        return []
+
+    def send(self, client, ids: BuiltIds) -> str:
+        """Sets the servos on the world's motor IDs; answers "held"."""
+        zeros = (0.0,) * len(self.joint_keys)
+        client.set_servo(ServoCommand(tuple(ids.motors[k] for k in self.joint_keys), zeros,
+                                      rates=zeros, max_speeds=self.max_speeds))
+        return "held"
+
+
 PlanStep = Union[WorldStep, StepSizeStep, EntityStep, ObjectStep, CompositeStep, JointStep,
-                 MotorStep]
+                 MotorStep, HoldStep]
 
 
 def body_step(spec: BodySpec) -> PlanStep:
@@ -423,14 +483,24 @@ class RobotHandle:
 @dataclass
 class BuildPlan:
     """Steps in the order they must be sent (WorldStep, StepSizeStep, EntityStep, ObjectStep,
-    CompositeStep, JointStep, MotorStep). ``world``: the world settings the plan sets (None:
-    it leaves the world as it is); ``ignored``: the problem's, and what the plan set aside
+    CompositeStep, JointStep, MotorStep). ``world``: the world settings the plan sets (every
+    world parameter and step value); ``physics``: whether they and a ground plane are
+    Kautham's physics; ``ignored``: the problem's, and what the plan set aside
     (``gui.core.model.Ignored``)."""
     problem: Problem
     steps: list
     robots: list                     # RobotHandle per robot (and per movable multi-link obstacle)
-    world: Optional[WorldSettings] = None
+    world: "WorldSettings"
+    physics: bool = False
     ignored: list = field(default_factory=list)
+
+    def set_world(self, world: "WorldSettings") -> None:
+        """The plan sets ``world`` instead (its Set World and Set Step steps replaced)."""
+        self.world = world
+        replaced = {WorldStep: WorldStep(world.parameters, world.own_parameters),
+                    StepSizeStep: StepSizeStep(world.step, world.steps_per_cycle, world.rate,
+                                               "step" in world.own)}
+        self.steps = [replaced.get(type(s), s) for s in self.steps]
 
     def counts(self) -> dict:
         """{step class name: how many}."""

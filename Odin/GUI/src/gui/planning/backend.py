@@ -92,6 +92,17 @@ class CoreWorld:
     def set_joint_parameters(self, joint_id, parameters) -> None:
         self.core.set_joint_parameters(joint_id, parameters)
 
+    def set_servo(self, command: ServoCommand) -> None:
+        """Set Servo's lists split per motor, as the world node splits them."""
+        servos = {m: {} for m in command.motors}
+        for name in ("targets", "rates", "gains", "max_speeds", "max_forces"):
+            values = getattr(command, name)
+            if name == "targets" or len(values):
+                for motor, split in self.core.split_per_axis(list(command.motors),
+                                                             list(values), name).items():
+                    servos[motor][name] = split
+        self.core.set_servos(servos)
+
     def execute(self, plan: BuildPlan) -> dict:
         return send_plan(self, plan)
 
@@ -126,15 +137,7 @@ class CorePort:
         return np.asarray(position), np.asarray(quaternion), np.asarray(linear)
 
     def set_servo(self, command: ServoCommand) -> None:
-        core = self.world.core
-        servos = {m: {} for m in command.motors}
-        for name in ("targets", "rates", "gains", "max_speeds", "max_forces"):
-            values = getattr(command, name)
-            if name == "targets" or len(values):
-                for motor, split in core.split_per_axis(list(command.motors), list(values),
-                                                        name).items():
-                    servos[motor][name] = split
-        core.set_servos(servos)
+        self.world.set_servo(command)
 
     def advance(self, duration: float, forces):
         # a control path reads the world through body_state: the answer's states go unread

@@ -204,7 +204,7 @@ def planning_problem(plan: BuildPlan, robot: Optional[str] = None,
         handle = plan.robot(robot)
     except KeyError as error:
         raise PlanningError(str(error.args[0] if error.args else error)) from None
-    if plan.world is None:
+    if not plan.physics:
         raise PlanningError("the problem has no physics (not one of Kautham's ODE planners): "
                             "nothing to propagate")
     if handle.goal is None or handle.start is None:

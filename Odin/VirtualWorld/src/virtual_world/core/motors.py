@@ -7,7 +7,7 @@ robot held by its motors keeps its pose. Goal speeds: rad/s (angular) or m/s (li
 from __future__ import annotations
 
 import math
-from typing import List, Mapping, Sequence
+from typing import List, Mapping, Sequence, Set
 
 import numpy as np
 
@@ -129,7 +129,8 @@ def axis_counts(scene: Scene, motor_ids: Sequence[str]) -> List[int]:
 
 
 def set_velocities(scene: Scene, velocities: Mapping[str, Sequence[float]]) -> None:
-    """Goal speeds (rad/s or m/s) per motor axis; all checked before any is set."""
+    """Goal speeds (rad/s or m/s) per motor axis; all checked before any is set. A servo
+    given a speed leaves servo mode (the speed is what was asked for)."""
     checked = []
     for motor_id, values in dict(velocities).items():
         motor = scene.motor(motor_id)
@@ -143,7 +144,11 @@ def set_velocities(scene: Scene, velocities: Mapping[str, Sequence[float]]) -> N
         checked.append((motor, vector.tolist()))
     for motor, values in checked:
         motor.velocity = values
-        scene.c.update_motor_goal(scene.motor_slots[motor.id], values)
+        slot = scene.motor_slots[motor.id]
+        if motor.servo is not None:     # a goal speed given: the motor leaves servo mode
+            motor.servo = None
+            scene.c.update_servo(slot, None)
+        scene.c.update_motor_goal(slot, values)
 
 
 def split_per_axis(scene: Scene, motor_ids: Sequence[str], values: Sequence[float],
@@ -237,6 +242,21 @@ def set_servos(scene: Scene, servos: Mapping[str, Mapping]) -> None:
         for axis, force in enumerate(max_forces or (), start=1):
             ode_joints.set_motor_parameter(motor.owner.ptr, motor.kind,
                                            JointParameter.MAX_FORCE, axis, force)
+        scene.c.update_servo(scene.motor_slots[motor.id], _servo_arguments(scene, motor))
+
+
+def retarget_servos(scene: Scene, moved: Set[str]) -> None:
+    """Each servo whose joint joins one of the ``moved`` objects targets the joint's present
+    values (rates kept): a robot put somewhere by Set Position holds where it was put, not
+    where its servos held it before."""
+    for motor in scene.motors.values():
+        if motor.servo is None or not moved.intersection(motor.bodies):
+            continue
+        joint = scene.joints[motor.joint]
+        positions, _ = ode_joints.joint_state(joint.owner.ptr, joint.type)
+        components = ode_joints.SERVO_COMPONENTS[motor.kind][joint.type]
+        motor.servo = motor.servo._replace(
+            targets=tuple(float(positions[c]) for c in components))
         scene.c.update_servo(scene.motor_slots[motor.id], _servo_arguments(scene, motor))
 
 

@@ -174,8 +174,10 @@ class Core:
     def set_poses(self, poses: Sequence[Tuple[str, Sequence[float], Sequence[float]]],
                   reset_velocity: bool = False) -> None:
         """Moves objects: (object id, position m world, orientation wxyz) each, all or
-        nothing. reset_velocity zeroes the bodies' linear and angular velocities."""
+        nothing. reset_velocity zeroes the bodies' linear and angular velocities. Servos on
+        joints of moved objects then hold the joints where they were put."""
         objects.set_poses(self._scene, poses, reset_velocity)
+        motors.retarget_servos(self._scene, {object_id for object_id, *_ in poses})
 
     @disturbs
     def set_velocity(self, object_id: str, linear=None, angular=None) -> None:
@@ -595,6 +597,14 @@ class Core:
     def last_step_solver(self) -> Solver:
         """The solver the last step used: QUICKSTEP or WORLDSTEP (the auto solver's choice)."""
         return Solver(self._scene.c.last_solver)
+
+    @property
+    def last_step_island_rows(self) -> Tuple[int, int]:
+        """What the auto solver measured before the last step: the largest island's
+        constraint rows and the most rows of non-contact joints (motors and limits included)
+        in one island; 0, 0 under an explicit solver, when the small-system clause held and when
+        no awake body has a joint other than a contact (the islands are not searched)."""
+        return self._scene.c.last_island_rows
 
     @locked
     def poses(self) -> Tuple[List[str], np.ndarray, np.ndarray]:

@@ -101,6 +101,12 @@ void odin_world_free_buffers(OdinWorld *w) {
     w->feedback_record = w->feedback_point = w->feedback_sign = NULL;
     w->n_feedback = w->cap_feedback = 0;
     w->n_diverged = w->cap_diverged = 0;
+    free(w->island_keys);
+    free(w->island_index);
+    free(w->island_stack);
+    w->island_keys = NULL;
+    w->island_index = w->island_stack = NULL;
+    w->island_cap = 0;
     free(w->pairs);
     free(w->pairs_sorted);
     free(w->contacts);
@@ -541,9 +547,60 @@ static void clear_sleepers_forces(const OdinWorld *w) {
 
 /* ---------------------------------------------------------------- step (thesis 5.5) */
 
-/* The rows a joint adds to ODE's constraint system at most (its getInfo1's m with a limit or
- * motor active): the auto solver's measure of the work a step asks for. */
+/* ---------------------------------------------------------------- the auto solver's measure */
+
+/* ODE's testRotationalLimit: a limit [lo, hi] (lo <= hi) is active at `value` on or past it. */
+static int limit_active(double lo, double hi, double value) {
+    return lo <= hi && (value <= lo || value >= hi);
+}
+
+/* 1 when axis `axis` (0..2) of a motor or of a joint's own motor/limit adds a row: powered
+ * (FMax > 0) or at an active limit. */
+static int axis_row(dReal (*get)(dJointID, int), dJointID j, int axis, double value) {
+    int g = dParamGroup * axis;
+    return get(j, dParamFMax + g) > 0 ||
+           limit_active(get(j, dParamLoStop + g), get(j, dParamHiStop + g), value);
+}
+
+/* The rows a joint adds to ODE's constraint system this step (its getInfo1's m, ODE 0.16):
+ * the fixed rows of its type, plus one per axis that is powered or at an active limit. A
+ * contact is counted at 3 (friction on; its surface is not readable through ODE's API). */
 static int joint_rows(dJointID j) {
+    int m = 0;
+    switch (dJointGetType(j)) {
+    case dJointTypeContact: case dJointTypeBall:
+        return 3;
+    case dJointTypeFixed:
+        return 6;
+    case dJointTypeDBall: case dJointTypeTransmission:
+        return 1;
+    case dJointTypeHinge:
+        return 5 + axis_row(dJointGetHingeParam, j, 0, dJointGetHingeAngle(j));
+    case dJointTypeSlider:
+        return 5 + axis_row(dJointGetSliderParam, j, 0, dJointGetSliderPosition(j));
+    case dJointTypeUniversal:
+        return 4 + axis_row(dJointGetUniversalParam, j, 0, dJointGetUniversalAngle1(j))
+                 + axis_row(dJointGetUniversalParam, j, 1, dJointGetUniversalAngle2(j));
+    case dJointTypeHinge2:
+        return 4 + axis_row(dJointGetHinge2Param, j, 0, dJointGetHinge2Angle1(j))
+                 + (dJointGetHinge2Param(j, dParamFMax2) > 0);
+    case dJointTypeAMotor:
+        for (int i = 0; i < dJointGetAMotorNumAxes(j); ++i)
+            m += axis_row(dJointGetAMotorParam, j, i, dJointGetAMotorAngle(j, i));
+        return m;
+    case dJointTypeLMotor:
+        for (int i = 0; i < dJointGetLMotorNumAxes(j); ++i)
+            m += dJointGetLMotorParam(j, dParamFMax + dParamGroup * i) > 0;
+        return m;
+    default:                  /* PR, PU, piston, plane-2D, double hinge: their most */
+        return 6;
+    }
+}
+
+/* The rows a joint adds at most (its getInfo1's m with every limit and motor active): the
+ * small-system clause's measure, kept as it was when the pinned planning experiments were
+ * recorded (their plans replay only if auto chooses the same solver at every step). */
+static int joint_rows_at_most(dJointID j) {
     switch (dJointGetType(j)) {
     case dJointTypeContact: case dJointTypeBall: case dJointTypePlane2D:
     case dJointTypeAMotor: case dJointTypeLMotor:
@@ -555,10 +612,10 @@ static int joint_rows(dJointID j) {
     }
 }
 
-/* The constraint rows of the step about to be taken, counting stops above `bound`. Each joint
- * is counted at its first dynamic body (a parked body is kinematic, hence fixed); a sleeping
+/* The whole step's rows by joint_rows_at_most, counting stops above `bound`. Each joint is
+ * counted at its first dynamic body (a parked body is kinematic, hence fixed); a sleeping
  * body's joints are not stepped. */
-static int constraint_rows(const OdinWorld *w, int bound) {
+static int step_rows_at_most(const OdinWorld *w, int bound) {
     int rows = 0;
     for (int i = 0; i < w->n_guarded; ++i) {
         dBodyID b = w->guarded[i];
@@ -569,19 +626,124 @@ static int constraint_rows(const OdinWorld *w, int bound) {
             dBodyID first = dJointGetBody(j, 0);
             if (!first || dBodyIsKinematic(first)) first = dJointGetBody(j, 1);
             if (first != b || !dJointIsEnabled(j)) continue;
-            if ((rows += joint_rows(j)) > bound) return rows;
+            if ((rows += joint_rows_at_most(j)) > bound) return rows;
         }
     }
     return rows;
 }
 
-/* 0 QuickStep or 1 dWorldStep for this step. Auto chooses by the rows to solve: on a small
- * system (an arm held by its motors) the exact solver is both exact and faster than
- * QuickStep's iterations, which let such an arm sag; on a large one (piles, thousands of
- * contacts) its cubic cost loses. The choice depends on the state only: deterministic. */
-static int step_solver(const OdinWorld *w) {
+static int dynamic(dBodyID b) { return b && !dBodyIsKinematic(b); }
+
+/* The guarded body's index, or -1 (a hash of the guarded bodies' addresses, built per step). */
+static int guarded_index(const OdinWorld *w, dBodyID b) {
+    size_t mask = (size_t)(w->island_cap - 1);
+    for (size_t h = pair_hash(b, b) & mask; w->island_keys[h]; h = (h + 1) & mask)
+        if (w->island_keys[h] == b) return w->island_index[h];
+    return -1;
+}
+
+/* 1 when an awake dynamic body has an enabled joint other than a contact: without one every
+ * island is contacts only (a pile, bodies at rest) and auto takes QuickStep without searching
+ * the islands (a walk over the bodies' joints, no hash: cheap on 10,000 bodies at rest). */
+static int articulated(const OdinWorld *w) {
+    for (int i = 0; i < w->n_guarded; ++i) {
+        dBodyID b = w->guarded[i];
+        if (!dBodyIsEnabled(b) || dBodyIsKinematic(b)) continue;
+        int nj = dBodyGetNumJoints(b);
+        for (int k = 0; k < nj; ++k) {
+            dJointID j = dBodyGetJoint(b, k);
+            if (dJointGetType(j) != dJointTypeContact && dJointIsEnabled(j)) return 1;
+        }
+    }
+    return 0;
+}
+
+/* Finds ODE's islands this step (the awake dynamic bodies joined by enabled joints; static
+ * and kinematic bodies join nothing, as in ODE's dxProcessIslands) and sets island_rows (the
+ * largest island's rows) and articulated_rows (the most rows of non-contact joints, motors and
+ * limits included, in one island); both 0 when nothing is articulated. Each joint is counted
+ * once, at its first dynamic body. 0 when memory ran out (auto then takes QuickStep). */
+static int measure_islands(OdinWorld *w) {
+    int n = w->n_guarded;
+    w->island_rows = w->articulated_rows = 0;
+    if (!articulated(w)) return 1;
+    if (w->island_cap < 2 * n) {
+        int cap = 16;
+        while (cap < 2 * n) cap *= 2;
+        dBodyID *keys = realloc(w->island_keys, (size_t)cap * sizeof(dBodyID));
+        if (keys) w->island_keys = keys;
+        int *index = realloc(w->island_index, (size_t)cap * sizeof(int));
+        if (index) w->island_index = index;
+        int *stack = realloc(w->island_stack, (size_t)cap * sizeof(int));
+        if (stack) w->island_stack = stack;
+        if (!keys || !index || !stack) return 0;
+        w->island_cap = cap;
+    }
+    size_t mask = (size_t)(w->island_cap - 1);
+    memset(w->island_keys, 0, (size_t)w->island_cap * sizeof(dBodyID));
+    for (int i = 0; i < n; ++i) {
+        size_t h = pair_hash(w->guarded[i], w->guarded[i]) & mask;
+        while (w->island_keys[h]) h = (h + 1) & mask;
+        w->island_keys[h] = w->guarded[i];
+        w->island_index[h] = i;
+    }
+    /* island_stack's upper half marks the bodies already in an island */
+    int *seen = w->island_stack + w->island_cap / 2;
+    memset(seen, 0, (size_t)n * sizeof(int));
+    for (int i = 0; i < n; ++i) {
+        dBodyID start = w->guarded[i];
+        if (seen[i] || !dBodyIsEnabled(start) || dBodyIsKinematic(start)) continue;
+        int top = 0, rows = 0, articulated = 0;
+        seen[i] = 1;
+        w->island_stack[top++] = i;
+        while (top) {
+            dBodyID b = w->guarded[w->island_stack[--top]];
+            int nj = dBodyGetNumJoints(b);
+            for (int k = 0; k < nj; ++k) {
+                dJointID j = dBodyGetJoint(b, k);
+                if (!dJointIsEnabled(j)) continue;
+                dBodyID first = dJointGetBody(j, 0), second = dJointGetBody(j, 1);
+                if (!dynamic(first)) first = second;
+                if (first == b) {
+                    int r = joint_rows(j);
+                    rows += r;
+                    if (dJointGetType(j) != dJointTypeContact) articulated += r;
+                }
+                dBodyID other = dJointGetBody(j, 0) == b ? second : dJointGetBody(j, 0);
+                if (!dynamic(other)) continue;
+                int o = guarded_index(w, other);
+                if (o < 0 || seen[o]) continue;
+                seen[o] = 1;
+                w->island_stack[top++] = o;
+            }
+        }
+        if (rows > w->island_rows) w->island_rows = rows;
+        if (articulated > w->articulated_rows) w->articulated_rows = articulated;
+    }
+    return 1;
+}
+
+/* 0 QuickStep or 1 dWorldStep for this step. Auto takes the exact solver when either
+ * clause holds:
+ *  - a small system: the whole step has at most auto_step_rows rows by joint_rows_at_most
+ *    (a few bodies, a short arm, a car on the ground: exact and faster than QuickStep's
+ *    iterations; the pinned planning experiments were recorded under this clause alone);
+ *  - a large articulation: an island whose joints and motors alone (contacts aside) have
+ *    more than auto_step_rows rows, so that it can never pass the first clause (the TX90 with
+ *    its hand: 24 joints, about 170 rows), while the largest island has at most auto_rows
+ *    rows. QuickStep's iterations let such a chain held by its motors fold; ODE steps each
+ *    island on its own and dWorldStep's cost is cubic in an island's rows, so the largest
+ *    island bounds its cost (the TX90 + hand grasping a can: about 300).
+ * Anything else (piles, many bodies at rest, a small robot among many contacts, a larger
+ * island) takes QuickStep, linear in the rows, as it did before the second clause existed.
+ * docs/PERFORMANCE.md has the measurements behind both bounds. The choice depends on the
+ * state only: deterministic. */
+static int step_solver(OdinWorld *w) {
     if (w->solver != 2) return w->solver;
-    return constraint_rows(w, w->auto_rows) <= w->auto_rows;
+    w->island_rows = w->articulated_rows = 0;
+    if (step_rows_at_most(w, w->auto_step_rows) <= w->auto_step_rows) return 1;
+    if (!measure_islands(w)) return 0;
+    return w->articulated_rows > w->auto_step_rows && w->island_rows <= w->auto_rows;
 }
 
 int odin_world_step(OdinWorld *w, double h, int count) {

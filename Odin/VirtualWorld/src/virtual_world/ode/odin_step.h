@@ -118,10 +118,17 @@ typedef struct OdinWorld {
     double bounce;           /* 0 = no dContactBounce */
     double bounce_vel;
     int contact_less;        /* 1: record pairs only, never create contacts */
-    int solver;              /* 0 QuickStep, 1 dWorldStep, 2 auto: dWorldStep while a step's
-                                constraint rows are at most auto_rows, QuickStep above */
-    int auto_rows;           /* auto's bound (rows; joint_rows() counts them) */
+    int solver;              /* 0 QuickStep, 1 dWorldStep, 2 auto: dWorldStep while the whole
+                                step has at most auto_step_rows rows (joint_rows_at_most) or an
+                                island's joints alone have more (joint_rows) and the largest
+                                island has at most auto_rows rows, QuickStep otherwise */
+    int auto_step_rows;      /* auto's small-system bound (rows of the whole step) */
+    int auto_rows;           /* auto's island bound (rows of one island) */
     int last_solver;         /* output: the solver the last step used (0 or 1) */
+    int island_rows;         /* output (auto): the last step's largest island's rows (0 when
+                                not searched: the small-system clause held, or no awake body
+                                has a non-contact joint) */
+    int articulated_rows;    /* output (auto): the most rows of non-contact joints in an island */
     unsigned long rand_seed; /* the world's own state of ODE's random generator, which QuickStep
                                 uses to reorder constraints: set before each QuickStep and read
                                 back after, so no other world (or process history) changes it */
@@ -156,6 +163,8 @@ typedef struct OdinWorld {
     /* internal: joint feedback of the recorded contacts of the last step of a call */
     dJointFeedback *feedback; int n_feedback; int cap_feedback;
     int *feedback_record, *feedback_point, *feedback_sign;
+    /* internal: the auto solver's island search (a hash of the guarded bodies, a stack) */
+    dBodyID *island_keys; int *island_index; int *island_stack; int island_cap;
 } OdinWorld;
 
 

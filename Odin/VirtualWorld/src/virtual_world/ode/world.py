@@ -12,7 +12,7 @@ from typing import List, Sequence, Tuple
 
 import numpy as np
 
-from odin_common.interface import AUTO_SOLVER_MAX_ROWS, DivergencePolicy
+from odin_common.interface import AUTO_SOLVER_MAX_ISLAND_ROWS, AUTO_SOLVER_MAX_ROWS, DivergencePolicy
 from odin_common.world_parameters import WorldParameters
 from virtual_world.ode import handles
 from virtual_world.ode.bindings import ffi, lib
@@ -62,7 +62,8 @@ class CWorld:
         s.bounce_vel = p.bounce_velocity
         s.contact_less = int(p.contact_less)
         s.solver = int(p.solver)
-        s.auto_rows = AUTO_SOLVER_MAX_ROWS
+        s.auto_step_rows = AUTO_SOLVER_MAX_ROWS
+        s.auto_rows = AUTO_SOLVER_MAX_ISLAND_ROWS
         s.max_speed = p.divergence_speed
         s.max_spin = p.divergence_angular_speed
         s.extent = p.world_extent
@@ -90,6 +91,13 @@ class CWorld:
     def last_solver(self) -> int:
         """The solver the last step used: 0 QuickStep, 1 dWorldStep."""
         return int(self.struct.last_solver)
+
+    @property
+    def last_island_rows(self) -> tuple:
+        """The auto solver's measure of the last step (0, 0 under an explicit solver, when the
+        small-system clause held or with nothing articulated): the largest island's constraint rows and the most rows of
+        non-contact joints in one island (odin_step.c measure_islands)."""
+        return int(self.struct.island_rows), int(self.struct.articulated_rows)
 
     @drains_ode_messages
     def wake(self) -> None:

@@ -15,6 +15,7 @@ Published by the world node, every publication (``~rate``), from the WorldMirror
                           too, so a late one also gets the last change);
   ``<ns>/joint_states``   sensor_msgs/JointState per robot declared with Set Robot: its own
                           joint names, positions (rad or m) and rates (rad/s or m/s);
+                          advertised while the robot is declared, no longer once it leaves;
   ``<ns>/robot_description`` (a parameter, not a topic): the robot's URDF, set while the
                           robot is declared, deleted when it goes.
 """
@@ -155,8 +156,10 @@ class StandardTopics:
         """Each robot set or removed since the last call: its joint_states publisher and its
         robot_description parameter (the Portal calls this after every service that changed
         the world, so the parameter is there when Set Robot answers, and at publications).
-        A namespace's publisher stays once made (it is silent while no robot uses it): a
-        subscriber stays connected across New Scene and a reload of the same robot."""
+        A robot that leaves (New Scene, Remove Object of one of its links, Set Robot remove, a
+        new problem's load) takes both with it: its topic is no longer advertised (rostopic
+        list, the master), and a subscriber left on it reconnects when a robot of that
+        namespace comes back (the master tells it of the new publisher)."""
         for change, robot in self.mirror.take_robot_changes():
             namespace = f"/{robot.namespace}"
             try:
@@ -165,12 +168,19 @@ class StandardTopics:
                         self._joint_states[robot.namespace] = rospy.Publisher(
                             f"{namespace}/joint_states", JointState, queue_size=10)
                     rospy.set_param(f"{namespace}/robot_description", robot.description)
-                elif rospy.has_param(f"{namespace}/robot_description"):
+                    continue
+                publisher = self._joint_states.pop(robot.namespace, None)
+                if publisher is not None:
+                    publisher.unregister()
+                if rospy.has_param(f"{namespace}/robot_description"):
                     rospy.delete_param(f"{namespace}/robot_description")
             except Exception as error:   # the master gone: the node goes on
-                _log.warning("virtual_world: robot %s: parameter server: %s", robot.name, error)
+                _log.warning("virtual_world: robot %s: master: %s", robot.name, error)
 
     def close(self) -> None:
+        for publisher in self._joint_states.values():
+            publisher.unregister()
+        self._joint_states.clear()
         for robot in list(self.mirror.robots):
             try:
                 rospy.delete_param(f"/{robot.namespace}/robot_description")

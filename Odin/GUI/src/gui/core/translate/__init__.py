@@ -7,9 +7,14 @@ friction of Kautham's car planner ``car``'s; a fixed-base robot's base and the d
 Kautham's chain planner ``chain``'s; a shape's body ``gui.core.bodies``'.
 
 How a problem maps to the world:
-- Kautham's physics (``Problem.physics``: one of its ODE planners; ``BuildDefaults.ground``
-  asks for it in any problem): first Set World and Set Step with what Kautham's ODE
-  environment uses (``gui.core.world_settings``), then an infinite ground plane at z = 0
+- The world first (``gui.core.world_settings``): one Set World with every world parameter and
+  one Set Step with every step value, the problem's own where it has them, else the documented
+  defaults (docs/parameters.md, Set Step's 0.001 s x 40 at 25 Hz), never what the world held
+  before: loading a problem (load_problem, the window's Open, plan, the experiments) gives the
+  same world in a node that ran anything before as in a fresh one. A problem has values of its
+  own under Kautham's physics (``Problem.physics``: one of its ODE planners;
+  ``BuildDefaults.ground`` asks for it in any problem): what Kautham's ODE environment uses
+  (gravity, ERP, CFM, contacts per pair, the step), then an infinite ground plane at z = 0
   (``GROUND``, static).
 - A robot with joints -> one Build Entity (one object or composite per link, internal
   collisions off), then per link one Set Joint: revolute -> HINGE, prismatic -> SLIDER (anchor
@@ -23,14 +28,18 @@ How a problem maps to the world:
   (steering about the base's up, opposite for the wheels ahead of its centre and the others;
   both reversed like a hinge's, so that a positive steering turns left and a positive wheel
   speed rolls the car along its +x). Then one Set Motor per movable joint
-  (angular for hinges and hinge-2s, linear for sliders; zero speed, so the robot holds its
-  pose; the joint's effort limit as its force limit, infinite without one; the chain of
+  (angular for hinges and hinge-2s, linear for sliders; zero speed; the joint's effort limit as its force limit, infinite without one; the chain of
   Kautham's chain planner gets PlanarChainEnvironment's 7 N m and 1 rad/s for every joint
   instead, whatever its URDF says), id "motor:" + joint id; a joint with friction gets a second
   motor at zero speed whose force limit is the friction ("friction:" + joint id), a joint
   with damping a third at zero speed, unlimited force and CFM 1 / damping, which makes ODE
   apply exactly -damping x the joint's rate ("damping:" + joint id); under Kautham's own
-  physics (one of its ODE planners) no joint has either, as in its ODE environment.
+  physics (one of its ODE planners) no joint has either, as in its ODE environment. Last, a
+  robot (not a car, whose wheels' motors at zero speed hold it) gets one Set Servo that holds
+  every joint at the value it is built at (``gui.core.plan.HoldStep``): motors at zero speed
+  alone let an arm creep (3.3 mm in 10 s for the KUKA LWR), servos hold it within 0.1 mm; a
+  Set Velocity of a motor takes it out of servo mode, a Set Position of the robot moves the
+  servos' targets with it.
 - The base by the robot's kind (``gui.core.model``): FIXED_BASE -> in a 2012 problem a fixed
   (kinematic) body that never moves; in a current one a dynamic body held by a FIXED joint to
   the world (Kautham's chain); FREE_BODY, MOBILE, CAR -> a dynamic body, free.

@@ -16,16 +16,16 @@ from gui.core.bodies import shape_to_body, with_surface
 from gui.core.kautham import environment
 from gui.core.kautham.problem import PHYSICS_PLANNERS
 from gui.core.model import CAR, FIXED_BASE, Instance, LinkModel, Problem, warn_once
-from gui.core.plan import (BodySpec, BuildPlan, EntityStep, JointStep, LinkBody, ObjectStep,
-                           RobotHandle, StepSizeStep, WorldStep, body_step)
+from gui.core.plan import (BodySpec, BuildPlan, EntityStep, HoldStep, JointStep, LinkBody,
+                           ObjectStep, RobotHandle, StepSizeStep, WorldStep, body_step)
 from gui.core.translate import car, chain
 from gui.core.translate.joints import (fixed_joint, joint_motors, link_drive, link_joint,
                                        motor_kind)
-from gui.core.world_settings import kautham_world
-from odin_common.interface import MotorKind, Shape as ShapeKind, default_motor_id
+from gui.core.world_settings import default_world, kautham_world
+from odin_common.interface import (SERVO_MAX_SPEED, MotorKind, Shape as ShapeKind,
+                                   default_motor_id)
 from odin_common.specs import (CompositeSpec, EntitySpec, JointSpec, ObjectSpec, Surface,
                                WORLD_SURFACE)
-from odin_common.step_values import StepValues
 
 GROUND = "ground"
 """The ground plane's object ID (another name is taken if an instance has it)."""
@@ -33,10 +33,14 @@ GROUND = "ground"
 
 @dataclass(frozen=True)
 class BuildDefaults:
-    """How a problem is built. ``ground``: Kautham's physics (Set World, Set Step, a ground
-    plane) for every problem (True), none (False), or where Kautham simulates the problem
-    (None: ``Problem.physics``). ``start_at_query``: robots built at the query's start (True),
-    at Home (False), or the start in current problems and Home in 2012 ones (None).
+    """How a problem is built. ``ground``: Kautham's physics (its world settings, a ground
+    plane) for every problem (True), none (False: Odin's default world settings, no ground
+    plane), or where Kautham simulates the problem (None: ``Problem.physics``); every plan
+    sets every world parameter and step value either way (``gui.core.world_settings``).
+    ``start_at_query``: robots built at the query's start (True), at Home (False), or the
+    start in current problems and Home in 2012 ones (None).
+    ``hold_start``: robots' joints held by servos where they are built (``HoldStep``), or
+    left to their motors at zero speed (False: as the thesis's experiments were run).
     ``inertia``: "auto", "file" or "shape" (``gui.core.inertia``). ``max_contact_sink``: m,
     the deepest a body may rest in a contact the planner's CFM softens
     (``gui.core.world_settings``)."""
@@ -44,6 +48,7 @@ class BuildDefaults:
     internal_collisions: bool = False
     ground: Optional[bool] = None
     start_at_query: Optional[bool] = None
+    hold_start: bool = True
     inertia: str = inertia_rule.AUTO
     placeholder_factor: float = 10.0
     max_contact_sink: float = 0.01
@@ -84,18 +89,21 @@ class _Planner:
         for inst in self.problem.instances:
             self._instance(inst)
         self._attachments()
-        world, front = None, []
+        self._holds()
+        # every world parameter and step value, whatever the world held before (issue 28)
+        world = default_world()
         if self.physics:
-            world, ignored = kautham_world(self.problem, self.masses, StepValues().step,
+            world, ignored = kautham_world(self.problem, self.masses,
                                            self.defaults.max_contact_sink)
             self.ignored.extend(ignored)
-            front.append(WorldStep(world.parameters))
-            if world.step is not None:
-                front.append(StepSizeStep(world.step, world.steps_per_cycle, world.rate))
+        front = [WorldStep(world.parameters, world.own_parameters),
+                 StepSizeStep(world.step, world.steps_per_cycle, world.rate,
+                              "step" in world.own)]
+        if self.physics:
             front.append(ObjectStep(self._ground()))
         warn_once(self.ignored[len(self.problem.ignored):], "gui.core.translate")
         return BuildPlan(problem=self.problem, steps=front + self.steps, robots=self.handles,
-                         world=world, ignored=self.ignored)
+                         world=world, physics=self.physics, ignored=self.ignored)
 
     def _ground(self) -> ObjectSpec:
         taken = {i.name for i in self.problem.instances}
@@ -226,6 +234,18 @@ class _Planner:
         handle.max_forces.append(drive.effort)
         handle.max_speeds.append(drive.speed)
         return joint_motors(key, inst.name, joint, drive, kind)
+
+    def _holds(self) -> None:
+        """A HoldStep per robot whose joints all have a driving motor: its servos hold it
+        where it is built (a car's wheels are left to their motors at zero speed)."""
+        if not self.defaults.hold_start:
+            return
+        for handle in self.handles:
+            if (handle.instance.role != "robot" or handle.kind == CAR or not handle.joint_keys
+                    or len(handle.motor_ids) != len(handle.joint_keys)):
+                continue
+            speeds = tuple(float(v) if v else SERVO_MAX_SPEED for v in handle.max_speeds)
+            self.steps.append(HoldStep(handle.name, tuple(handle.joint_keys), speeds))
 
     # -- attachments ---------------------------------------------------------------------------
     def _attachments(self) -> None:
