@@ -216,7 +216,8 @@ def test_ctrl_c_stops_the_workers_runs_and_keeps_the_finished_ones(kautham_dir, 
     tool = subprocess.Popen([sys.executable, "-c", "from gui.planning.benchmark_cli import "
                              "benchmark_main; import sys; sys.exit(benchmark_main())",
                              *options, "--workers", "2"], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, start_new_session=True)     # its own group, as a terminal's job
+                            stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)     # its own group, as a terminal's job
     try:
         for line in tool.stderr:                        # the first finished run
             if "runs done" in line:
