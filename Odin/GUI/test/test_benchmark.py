@@ -159,6 +159,8 @@ def _free_port() -> int:
     (["--planners", "SST"], "cannot construct"),
     (["--scheduler", "tcp://127.0.0.1:{port}"], "no Dask scheduler answers"),
     (["--runs", "0"], "--runs 0"),
+    (["--max-control-steps", "0"], "--max-control-steps 0: at least 1"),
+    (["--min-control-steps", "9", "--max-control-steps", "3"], "is above"),
 ])
 def test_bad_input_is_one_line_before_any_run(kautham_dir, tmp_path, args, what):
     args = [a.format(port=_free_port()) for a in args]
@@ -197,7 +199,7 @@ def test_resuming_another_benchmark_s_results_is_refused(kautham_dir, tmp_path):
 
 def test_an_experiment_with_two_planners_of_one_name_is_refused(kautham_dir):
     sphere = str(kautham_dir.joinpath(*SPHERE))
-    experiment = Experiment("e", (Row(sphere, "RRT", "a"), Row(sphere, None, "a")), Request())
+    experiment = Experiment("e", (Row(sphere, None, "a"), Row(sphere, None, "a")), Request())
     with pytest.raises(PlanningError, match="already has a planner named 'a'"):
         prepare([experiment])
 

@@ -54,7 +54,33 @@ def _parser() -> argparse.ArgumentParser:
                        help="local Dask worker processes [one per core]; 0: no Dask, one run "
                        "after another in this process")
     parser.add_argument("--no-plots", action="store_true", help="no PNG figures")
+    search = parser.add_argument_group(
+        "search settings", "change every problem's own (as rosrun GUI plan's options do)")
+    search.add_argument("--min-control-steps", type=int, metavar="N",
+                        help="a control is held at least N propagation steps")
+    search.add_argument("--max-control-steps", type=int, metavar="N", help="and at most N")
+    search.add_argument("--goal-bias", type=float, metavar="F",
+                        help="KPIECE1's and RRT's fraction of expansions aimed at the goal")
+    search.add_argument("--goal-tolerance", type=float, metavar="M",
+                        help="goal region radius in the plane, m [0.25]")
     return parser
+
+
+def _overrides(args) -> dict:
+    """The search settings the command line changes (SearchSettings field: value)."""
+    given = {name: getattr(args, name) for name in
+             ("min_control_steps", "max_control_steps", "goal_bias", "goal_tolerance")
+             if getattr(args, name) is not None}
+    for name in ("min_control_steps", "max_control_steps"):
+        if name in given and given[name] < 1:
+            raise GuiError(f"--{name.replace('_', '-')} {given[name]}: at least 1")
+    if given.get("min_control_steps", 1) > given.get("max_control_steps", 10 ** 9):
+        raise GuiError("--min-control-steps is above --max-control-steps")
+    if "goal_bias" in given and not 0.0 <= given["goal_bias"] <= 1.0:
+        raise GuiError(f"--goal-bias {given['goal_bias']:g}: between 0 and 1")
+    if "goal_tolerance" in given and not given["goal_tolerance"] > 0:
+        raise GuiError(f"--goal-tolerance {given['goal_tolerance']:g}: must be positive")
+    return given
 
 
 def benchmark_main(argv: Optional[Sequence[str]] = None) -> int:
@@ -104,7 +130,7 @@ def _prepare(args):
         raise GuiError(f"--workers {args.workers}: 0 or more")
     if not args.no_plots:
         check_plotting()
-    return prepare(experiments, args.seed), out
+    return prepare(experiments, args.seed, _overrides(args)), out
 
 
 def _run(args, prepared, out: str) -> int:
@@ -167,6 +193,8 @@ def _write_outputs(args, prepared, store, out, started, total_s, hosts) -> None:
     from gui.planning.benchmark import summary
     from gui.planning.benchmark_log import write_log
     data = summary(prepared, store.results)
+    changed = {name.replace("_", " "): repr(value)
+               for name, value in (prepared.tasks[0].overrides if prepared.tasks else ())}
     for experiment, entries in prepared.experiments:
         by_entry = {e.name: sorted((r for r in store.results.values()
                                     if r.experiment == experiment.name and r.entry == e.name),
@@ -180,7 +208,7 @@ def _write_outputs(args, prepared, store, out, started, total_s, hosts) -> None:
             + ([f"workers on: {', '.join(hosts)}"] if hosts else []))
         write_log(os.path.join(out, experiment.log_name), experiment.name,
                   [(e.name, {"planner": e.planner, "problem": e.problem,
-                             "time limit": repr(e.time_limit)}) for e in entries],
+                             "time limit": repr(e.time_limit), **changed}) for e in entries],
                   by_entry, seed=prepared.seed,
                   max_time=max(e.time_limit for e in entries),
                   max_mem=experiment.request.max_mem,
