@@ -17,7 +17,8 @@ Sphere demos live in the Kautham corpus ($ODIN_KAUTHAM_DIR), the car and the cha
 tools/kautham/ode_demos, so their ``File`` attributes are absolute paths. The logs and runs land in
 physics/ and car/ there, the summary of both and the plots (success_rate.png,
 time_to_solution.png, propagations_per_s.png) in ode_demos/; docs/PLANNING.md shows them. ``ODIN_BENCH_DEMO_RUNS`` and ``ODIN_BENCH_DEMO_TIME`` (s) shorten
-the benchmark for development (the figures then measure that shorter benchmark).
+the benchmark for development (the figures then measure that shorter benchmark), and
+``ODIN_BENCH_DEMO_WORKERS`` sets the local Dask workers (default: one per core).
 """
 import json
 import os
@@ -30,6 +31,7 @@ HERE = pathlib.Path(__file__).resolve().parent
 ROOT = HERE.parent.parent
 PLANNERS = ("KPIECE1", "RRT", "EST")
 RUNS = int(os.environ.get("ODIN_BENCH_DEMO_RUNS", 10))
+WORKERS = os.environ.get("ODIN_BENCH_DEMO_WORKERS")
 
 
 def demos(kautham: pathlib.Path) -> tuple:
@@ -83,7 +85,8 @@ def run(out_dir: pathlib.Path) -> dict:
         file = where / f"{part}.xml"
         benchmark_file(file, chosen)
         subprocess.run([sys.executable, str(ROOT / "Odin" / "GUI" / "scripts" / "benchmark"),
-                        str(file), "--planners", ",".join(PLANNERS), *settings, "--out",
+                        str(file), "--planners", ",".join(PLANNERS), *settings,
+                        *(("--workers", WORKERS) if WORKERS else ()), "--out",
                         str(where), "--no-plots"], check=True, stdout=subprocess.DEVNULL)
         summaries.append(json.loads((where / "summary.json").read_text()))
         for line in (where / "runs.jsonl").read_text().splitlines()[1:]:

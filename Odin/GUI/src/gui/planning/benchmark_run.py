@@ -148,12 +148,16 @@ def problem_bundle(load: Callable[[], object], problem: str
     if not _hook_installed:
         sys.addaudithook(_record_open)
         _hook_installed = True
+    from gui.core import shapes
+    cached = shapes._CACHE
+    shapes._CACHE = {}      # this process's shapes read again: their files opened, and seen
     _recording = set()
     try:
         load()
         opened = {p for p in _recording if os.path.isfile(p)}
     finally:
         _recording = None
+        shapes._CACHE = {**cached, **shapes._CACHE}
     problem = os.path.abspath(problem)
     opened.add(problem)
     root = os.path.commonpath([os.path.dirname(p) for p in opened])
