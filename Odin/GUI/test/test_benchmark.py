@@ -245,3 +245,14 @@ def test_ctrl_c_stops_the_workers_runs_and_keeps_the_finished_ones(kautham_dir, 
     assert f"{6 - len(kept)} runs to do of 6" in resumed.stdout
     results = (out / "runs.jsonl").read_text().splitlines()[1:]
     assert sorted(json.loads(r)["run"] for r in results) == list(range(6))
+
+
+def test_a_scheduler_without_workers_is_refused_before_any_run(kautham_dir, tmp_path):
+    from distributed import LocalCluster
+    with LocalCluster(n_workers=0, processes=False, protocol="tcp", host="127.0.0.1",
+                      dashboard_address=None) as cluster:
+        run = _tool("--problem", str(kautham_dir.joinpath(*SPHERE)), "--scheduler",
+                    cluster.scheduler_address, "--out", str(tmp_path / "out"))
+    assert run.returncode == 2 and "has no worker" in run.stderr, run.stderr
+    assert run.stderr.count("\n") == 1
+    assert not (tmp_path / "out" / "runs.jsonl").exists()

@@ -237,6 +237,13 @@ class DaskRunner:
                 raise PlanningError(f"--scheduler {scheduler}: no Dask scheduler answers "
                                     f"({' '.join(str(error).split()) or type(error).__name__})"
                                     ) from None
+            try:
+                self.client.wait_for_workers(1, timeout=SCHEDULER_TIMEOUT_S)
+            except (OSError, TimeoutError):
+                self.close()
+                raise PlanningError(f"--scheduler {scheduler}: the scheduler has no worker "
+                                    f"after {SCHEDULER_TIMEOUT_S:g} s (start dask worker "
+                                    f"{scheduler} on the machines that run)") from None
         else:
             self.cluster = LocalCluster(n_workers=workers, threads_per_worker=1,
                                         processes=True, dashboard_address=None,
