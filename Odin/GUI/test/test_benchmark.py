@@ -97,6 +97,7 @@ def test_a_malformed_benchmark_file_is_refused_with_its_line(tmp_path, text, whe
     assert error.value.line == where and what in str(error.value)
 
 
+@pytest.mark.slow
 def test_the_log_reads_into_ompl_s_database_with_ompl_s_own_script(kautham_dir, tmp_path):
     script = shutil.which("ompl_benchmark_statistics")
     assert script, "the OMPL wheel (tools/requirements.txt) installs ompl_benchmark_statistics"
@@ -157,7 +158,8 @@ def _free_port() -> int:
     (["--problem", "/nonexistent/p.xml"], "/nonexistent/p.xml: no such file"),
     (["--planners", "KPIECE1,PRM"], "planner 'PRM': unknown planner"),
     (["--planners", "SST"], "cannot construct"),
-    (["--scheduler", "tcp://127.0.0.1:{port}"], "no Dask scheduler answers"),
+    pytest.param(["--scheduler", "tcp://127.0.0.1:{port}"], "no Dask scheduler answers",
+                 marks=pytest.mark.slow),
     (["--runs", "0"], "--runs 0"),
     (["--max-control-steps", "0"], "--max-control-steps 0: at least 1"),
     (["--min-control-steps", "9", "--max-control-steps", "3"], "is above"),
@@ -247,6 +249,7 @@ def test_ctrl_c_stops_the_workers_runs_and_keeps_the_finished_ones(kautham_dir, 
     assert sorted(json.loads(r)["run"] for r in results) == list(range(6))
 
 
+@pytest.mark.slow
 def test_a_scheduler_without_workers_is_refused_before_any_run(kautham_dir, tmp_path):
     from distributed import LocalCluster
     with LocalCluster(n_workers=0, processes=False, protocol="tcp", host="127.0.0.1",
