@@ -13,11 +13,14 @@ the runs still missing.
 """
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import logging
 import os
+import signal
 import sys
+import threading
 import time
 import uuid
 from dataclasses import dataclass
@@ -219,6 +222,21 @@ def _run_on_worker(task: RunTask, stop_event: str) -> RunResult:
     return run_task(task, should_stop)
 
 
+@contextlib.contextmanager
+def _sigint_ignored():
+    """SIGINT ignored while local workers start: they inherit it, so that a terminal's Ctrl-C,
+    which reaches the whole process group, is the benchmark's to handle (it stops the runs and
+    closes the cluster) and no worker dies printing a traceback."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 class DaskRunner:
     """Runs tasks on Dask: ``scheduler`` (an address, ``tcp://host:8786``) or a local cluster
     of ``workers`` worker processes, one thread each (a run keeps one core busy)."""
@@ -245,9 +263,10 @@ class DaskRunner:
                                     f"after {SCHEDULER_TIMEOUT_S:g} s (start dask worker "
                                     f"{scheduler} on the machines that run)") from None
         else:
-            self.cluster = LocalCluster(n_workers=workers, threads_per_worker=1,
-                                        processes=True, dashboard_address=None,
-                                        silence_logs=logging.ERROR)
+            with _sigint_ignored():
+                self.cluster = LocalCluster(n_workers=workers, threads_per_worker=1,
+                                            processes=True, dashboard_address=None,
+                                            silence_logs=logging.ERROR)
             self.client = Client(self.cluster)
 
     def run(self, tasks: Sequence[RunTask], on_result: Callable[[RunResult], None],
@@ -329,15 +348,21 @@ class Progress:
         self.stream = stream
         self.enabled = enabled
         self.tty = hasattr(stream, "isatty") and stream.isatty()
+        self.width = 0
 
     def add(self, result: RunResult) -> None:
         self.done += 1
         self.solved += result.solved
         if self.enabled:
-            end = "" if self.tty and self.done < self.total else "\n"
-            prefix = "\r" if self.tty else ""
-            self.stream.write(f"{prefix}benchmark: {self.done}/{self.total} runs done, "
-                              f"{self.solved} solved, {self.eta()}{end}")
+            line = f"benchmark: {self.done}/{self.total} runs done, {self.solved} solved, " \
+                f"{self.eta()}"
+            if self.tty:      # over the line before, to its end (a shorter one leaves none)
+                end = "" if self.done < self.total else "\n"
+                line = "\r" + line.ljust(self.width) + end
+                self.width = len(line) - 1 - len(end)
+            else:
+                line += "\n"
+            self.stream.write(line)
             self.stream.flush()
 
     def eta(self) -> str:
