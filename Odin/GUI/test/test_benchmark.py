@@ -259,3 +259,26 @@ def test_a_scheduler_without_workers_is_refused_before_any_run(kautham_dir, tmp_
     assert run.returncode == 2 and "has no worker" in run.stderr, run.stderr
     assert run.stderr.count("\n") == 1
     assert not (tmp_path / "out" / "runs.jsonl").exists()
+
+
+def test_a_problem_s_bundle_holds_the_files_it_reads_and_no_cache(kautham_dir, tmp_path,
+                                                                  monkeypatch):
+    from gui.planning.benchmark_run import problem_bundle
+    cache = tmp_path / "cache"
+    cache.mkdir()
+    (cache / "entry.npz").write_bytes(b"derived")
+    monkeypatch.setenv("ODIN_CACHE_DIR", str(cache))
+    sphere = kautham_dir.joinpath(*SPHERE)
+
+    def load():
+        (cache / "entry.npz").read_bytes()              # what a shape cache would read
+        from gui.core.kautham.problem import load_problem
+        load_problem(str(sphere))
+
+    relative, files = problem_bundle(load, str(sphere))
+    names = dict(files)
+    assert relative == "OMPL_ode_demos/Sphere/Sphere.xml"
+    assert names[relative] == sphere.read_bytes()
+    assert "models/robots/OpenDERobots/SphereDE.urdf" in names
+    assert "OMPL_ode_demos/Sphere/controls/sp3.cntr" in names
+    assert not any("npz" in name for name in names)

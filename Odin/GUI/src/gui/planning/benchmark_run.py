@@ -133,9 +133,18 @@ def _record_open(event: str, args) -> None:
         return
     path = os.path.abspath(os.fsdecode(path))
     if path.endswith(_NOT_PROBLEM_FILES) or "-packages" in path or \
-            path.startswith(("/proc/", "/sys/", "/dev/", sys.prefix, sys.base_prefix)):
+            path.startswith(("/proc/", "/sys/", "/dev/", sys.prefix, sys.base_prefix)) or \
+            path.startswith(_cache_folders()):
         return
     _recording.add(path)
+
+
+def _cache_folders() -> tuple:
+    """Folders of what readers derived and kept (a shape cache), never a problem's files:
+    shipping them would make a benchmark's bundle depend on what this machine cached."""
+    folders = [os.environ.get("ODIN_CACHE_DIR"), os.environ.get("XDG_CACHE_HOME"),
+               os.path.join(os.path.expanduser("~"), ".cache")]
+    return tuple(os.path.join(os.path.abspath(f), "") for f in folders if f)
 
 
 def problem_bundle(load: Callable[[], object], problem: str
