@@ -1,0 +1,225 @@
+"""``rosrun GUI benchmark``: Kautham benchmark files (or the same from the command line) run
+as seeded searches through Odin's physics, here or on a Dask cluster; OMPL's logs, a JSON
+summary and plots (docs/PLANNING.md). Exit status: 0 done, 2 with one line on bad input or a
+failure, 130 on Ctrl-C (the finished runs kept: ``--resume`` goes on from them)."""
+from __future__ import annotations
+
+import argparse
+import datetime
+import json
+import logging
+import os
+import sys
+import time
+from typing import Optional, Sequence
+
+from gui.errors import GuiError
+from odin_common.errors import OdinError
+from odin_common.tool import stop_on_ctrl_c
+
+TOOL = "benchmark"
+
+
+def _fail(error: Exception) -> int:
+    print(f"{TOOL}: error: {' '.join(str(error).split())}", file=sys.stderr)
+    return 2
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog=TOOL, description="Benchmark OMPL control planners on Kautham physics problems "
+        "through Odin's world: a Kautham <Benchmark> file, or --problem ... --planners ...; "
+        "OMPL benchmark logs, summary.json and plots in --out.")
+    parser.add_argument("file", nargs="?", help="Kautham benchmark file (<Benchmark> rows)")
+    parser.add_argument("--problem", action="append", default=[], metavar="P",
+                        help="a problem file instead of a benchmark file (repeatable)")
+    parser.add_argument("--planners", metavar="A,B", help="OMPL control planners for every "
+                        "problem (KPIECE1, RRT, EST) [each problem's own <Planner>]")
+    parser.add_argument("--runs", type=int, metavar="N", help="runs per planner [the file's "
+                        "runCount; 10 with --problem]")
+    parser.add_argument("--time", type=float, metavar="S", help="wall-clock seconds per run "
+                        "[the file's maxTime; with --problem each problem's "
+                        "\"_Max Planning Time\", else 10]")
+    parser.add_argument("--seed", type=int, default=1, help="run k of every planner has seed "
+                        "SEED+k [1]")
+    parser.add_argument("--out", default="benchmark", metavar="DIR",
+                        help="folder for the logs, runs.jsonl, summary.json and plots "
+                        "[./benchmark]")
+    parser.add_argument("--resume", action="store_true",
+                        help="go on with the runs DIR/runs.jsonl does not hold yet")
+    where = parser.add_mutually_exclusive_group()
+    where.add_argument("--scheduler", metavar="tcp://HOST:8786",
+                       help="run on this Dask cluster [a local one]")
+    where.add_argument("--workers", type=int, metavar="N",
+                       help="local Dask worker processes [one per core]; 0: no Dask, one run "
+                       "after another in this process")
+    parser.add_argument("--no-plots", action="store_true", help="no PNG figures")
+    search = parser.add_argument_group(
+        "search settings", "change every problem's own (as rosrun GUI plan's options do)")
+    search.add_argument("--min-control-steps", type=int, metavar="N",
+                        help="a control is held at least N propagation steps")
+    search.add_argument("--max-control-steps", type=int, metavar="N", help="and at most N")
+    search.add_argument("--goal-bias", type=float, metavar="F",
+                        help="KPIECE1's and RRT's fraction of expansions aimed at the goal")
+    search.add_argument("--goal-tolerance", type=float, metavar="M",
+                        help="goal region radius in the plane, m [0.25]")
+    return parser
+
+
+def _overrides(args) -> dict:
+    """The search settings the command line changes (SearchSettings field: value)."""
+    given = {name: getattr(args, name) for name in
+             ("min_control_steps", "max_control_steps", "goal_bias", "goal_tolerance")
+             if getattr(args, name) is not None}
+    for name in ("min_control_steps", "max_control_steps"):
+        if name in given and given[name] < 1:
+            raise GuiError(f"--{name.replace('_', '-')} {given[name]}: at least 1")
+    if given.get("min_control_steps", 1) > given.get("max_control_steps", 10 ** 9):
+        raise GuiError("--min-control-steps is above --max-control-steps")
+    if "goal_bias" in given and not 0.0 <= given["goal_bias"] <= 1.0:
+        raise GuiError(f"--goal-bias {given['goal_bias']:g}: between 0 and 1")
+    if "goal_tolerance" in given and not given["goal_tolerance"] > 0:
+        raise GuiError(f"--goal-tolerance {given['goal_tolerance']:g}: must be positive")
+    return given
+
+
+def benchmark_main(argv: Optional[Sequence[str]] = None) -> int:
+    args = _parser().parse_args(argv)
+    logging.getLogger("gui.core").setLevel(logging.ERROR)   # problem_info lists what is unused
+    try:
+        prepared, out = _prepare(args)
+        return _run(args, prepared, out)
+    except (OdinError, OSError) as error:
+        return _fail(error)
+
+
+def _experiments(args):
+    from dataclasses import replace
+    from gui.planning import benchmark_spec as spec
+    if bool(args.file) == bool(args.problem):
+        raise GuiError("give a benchmark file or --problem (one or more), not both or neither")
+    if args.runs is not None and args.runs < 1:
+        raise GuiError(f"--runs {args.runs}: at least 1")
+    if args.time is not None and not args.time > 0:
+        raise GuiError(f"--time {args.time:g}: must be positive")
+    planners = [p.strip() for p in args.planners.split(",") if p.strip()] \
+        if args.planners else None
+    if args.planners is not None and not planners:
+        raise GuiError(f"--planners {args.planners!r}: no planner named")
+    if args.problem:
+        return spec.command_line_experiments(args.problem, planners, args.runs or 10, args.time)
+    experiments = spec.read_benchmark_file(args.file)
+    if planners:
+        experiments = spec.with_planners(experiments, planners)
+    return tuple(replace(e, request=replace(
+        e.request, run_count=args.runs or e.request.run_count,
+        max_time=args.time or e.request.max_time)) for e in experiments)
+
+
+def _prepare(args):
+    from gui.planning.benchmark import prepare
+    from gui.planning.benchmark_plots import check_plotting
+    experiments = _experiments(args)
+    out = os.path.abspath(args.out)
+    if os.path.exists(out) and not os.path.isdir(out):
+        raise GuiError(f"--out {args.out}: a file, not a folder")
+    parent = os.path.dirname(out)
+    if not os.path.isdir(parent) or not os.access(parent, os.W_OK | os.X_OK):
+        raise GuiError(f"--out {args.out}: cannot make it in {parent}")
+    if args.workers is not None and args.workers < 0:
+        raise GuiError(f"--workers {args.workers}: 0 or more")
+    if not args.no_plots:
+        check_plotting()
+    return prepare(experiments, args.seed, _overrides(args)), out
+
+
+def _run(args, prepared, out: str) -> int:
+    from gui.planning.benchmark import DaskRunner, Progress, ResultStore, run_serially
+    # a scheduler that does not answer is bad input: refused before anything is written
+    runner = DaskRunner(args.scheduler) if args.scheduler else None
+    try:
+        os.makedirs(out, exist_ok=True)
+        store = ResultStore(out, prepared, args.resume)
+        todo = store.missing(prepared.tasks)
+        if runner is None and todo and args.workers != 0:
+            runner = DaskRunner(None, args.workers or os.cpu_count() or 1)
+    except BaseException:
+        if runner is not None:
+            runner.close()
+        raise
+    if runner is None:
+        where = "in this process"
+    else:
+        workers = len(runner.client.scheduler_info().get("workers", {}))
+        where = f"on Dask: {args.scheduler or 'a local cluster'}, {workers} workers"
+    print(f"{TOOL}: {len(todo)} runs to do of {len(prepared.tasks)} ({where}); results in "
+          f"{out}", flush=True)
+    show = any(e.request.display_progress for e, _ in prepared.experiments)
+    progress = Progress(len(prepared.tasks), len(store.results),
+                        sum(r.solved for r in store.results.values()), enabled=show)
+    started = datetime.datetime.now()
+    clock = time.monotonic()
+    interrupted = False
+
+    def on_result(result) -> None:
+        store.add(result)
+        progress.add(result)
+
+    hosts = []
+    try:
+        with stop_on_ctrl_c() as stop:
+            try:
+                if runner is None:
+                    run_serially(todo, on_result, stop)
+                else:
+                    hosts = runner.hosts()
+                    runner.run(todo, on_result, stop)
+            except KeyboardInterrupt:
+                stop.requested = True
+            interrupted = bool(stop)
+    finally:
+        progress.finish()
+        if runner is not None:
+            runner.close()
+    _write_outputs(args, prepared, store, out, started, time.monotonic() - clock, hosts)
+    if interrupted:
+        print(f"{TOOL}: stopped: {len(store.results)} of {len(prepared.tasks)} runs kept in "
+              f"{store.path} (--resume goes on)", file=sys.stderr)
+        return 130
+    return 0
+
+
+def _write_outputs(args, prepared, store, out, started, total_s, hosts) -> None:
+    from gui.planning.benchmark import summary
+    from gui.planning.benchmark_log import write_log
+    data = summary(prepared, store.results)
+    changed = {name.replace("_", " "): repr(value)
+               for name, value in (prepared.tasks[0].overrides if prepared.tasks else ())}
+    for experiment, entries in prepared.experiments:
+        by_entry = {e.name: sorted((r for r in store.results.values()
+                                    if r.experiment == experiment.name and r.entry == e.name),
+                                   key=lambda r: r.run) for e in entries}
+        setup = "\n".join(
+            [f"Odin: OMPL control planners searching through Odin's ODE world (rosrun GUI "
+             f"benchmark); run k has seed {prepared.seed}+k; rosrun GUI plan PROBLEM "
+             "--planner P --seed S --time T repeats a run"]
+            + [f"{e.name}: {e.planner} on {e.problem} (its planner: {e.problem_planner})"
+               for e in entries]
+            + ([f"workers on: {', '.join(hosts)}"] if hosts else []))
+        write_log(os.path.join(out, experiment.log_name), experiment.name,
+                  [(e.name, {"planner": e.planner, "problem": e.problem,
+                             "time limit": repr(e.time_limit), **changed}) for e in entries],
+                  by_entry, seed=prepared.seed,
+                  max_time=max(e.time_limit for e in entries),
+                  max_mem=experiment.request.max_mem,
+                  run_count=experiment.request.run_count, total_s=total_s, setup=setup,
+                  started=started)
+    if not args.no_plots and store.results:
+        from gui.planning.benchmark_plots import write_plots
+        data["plots"] = [os.path.basename(p) for p in write_plots(out, data, store.results)]
+    with open(os.path.join(out, "summary.json"), "w") as f:
+        json.dump(data, f, indent=1)
+    print(json.dumps(data, indent=1), flush=True)
+
+
+__all__ = ["benchmark_main"]
