@@ -109,6 +109,15 @@ def test_kpiece_solves_the_sphere_and_its_plan_replays_in_a_fresh_world(
     assert np.hypot(*(end[:2] - [-0.74, 0.78])) < 0.25
 
 
+def test_est_grows_from_valid_samples_and_solves_the_sphere(sphere_backend):
+    """EST extends only from valid sampled states: the forbidden-contact flag was sampled in
+    +-1e10, so no sample was ever valid and EST never propagated (its benchmark figures
+    measured nothing)."""
+    result = plan(sphere_backend, "EST", time_limit=60.0, seed=7)
+    assert result.propagations > 0
+    assert result.solved, result.statistics()
+
+
 def test_an_impossible_time_leaves_the_search_unsolved(sphere_backend):
     result = plan(sphere_backend, "RRT", time_limit=0.05, seed=3)
     assert not result.solved

@@ -173,6 +173,12 @@ class _Setup:
         wide = ob.RealVectorBounds(self.world_size)
         wide.setLow(-WORLD_BOUND)
         wide.setHigh(WORLD_BOUND)
+        # the forbidden-contact flag of a valid state is 0: a state sampled anywhere else is
+        # never valid, and EST, which grows only from valid samples, never propagated. The
+        # world subspace weighs 0 in distances and a sample draws one number per value
+        # whatever its bounds, so the other planners' searches are unchanged.
+        wide.setLow(self.world_size - 1, 0.0)
+        wide.setHigh(self.world_size - 1, 0.0)
         self.world_space.setBounds(wide)
         self.space = ob.CompoundStateSpace([self.robot_space, self.world_space], [1.0, 0.0])
         self.space.registerDefaultProjection(ob.SubspaceProjectionEvaluator(self.space, 0))
