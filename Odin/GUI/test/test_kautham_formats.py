@@ -264,19 +264,6 @@ def test_a_primitive_cannot_be_scaled_unevenly_but_can_be_mirrored(tmp_path):
             geometry='<mesh filename="cube.iv" scale="1 2 1"/>')))
 
 
-def test_a_mesh_wound_inward_is_turned_outward(tmp_path):
-    """The 2012 TX90's tcp_pawn.wrl encloses a negative volume as written (the world refuses
-    its negative inertia): its triangles are reversed, a mesh wound outward is left as is."""
-    from gui.core.shapes import signed_volume
-    outward = read_shape(_write(tmp_path, "out.dae", COLLADA))
-    inward = read_shape(_write(tmp_path, "in.dae", COLLADA.replace(
-        "<p>0 2 1 0 1 3 0 3 2 1 2 3</p>", "<p>0 1 2 0 3 1 0 2 3 1 3 2</p>")))
-    assert signed_volume(outward.mesh.vertices, outward.mesh.triangles) == pytest.approx(1.0)
-    assert signed_volume(inward.mesh.vertices, inward.mesh.triangles) == pytest.approx(1.0)
-    first = outward.mesh.vertices[outward.mesh.triangles[0]]       # as the file winds it
-    np.testing.assert_allclose(first, [[10, 0, 0], [10, 2, 0], [11, 0, 0]])
-
-
 def test_pycollada_is_pinned_in_the_requirements_at_the_version_installed():
     import collada
     from importlib.metadata import version

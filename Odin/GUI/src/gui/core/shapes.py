@@ -66,9 +66,7 @@ DEFAULTS = ShapeDefaults()
 @dataclass(frozen=True, eq=False)
 class Mesh:
     """A triangle mesh: ``vertices`` (N, 3) float64, m; ``triangles`` (M, 3) uint32,
-    counter-clockwise seen from outside: as the file gives them, unless they enclose a
-    negative volume (wound inward, as the 2012 TX90's ``tcp_pawn.wrl`` is: its mass properties
-    would be negative), then every triangle reversed."""
+    counter-clockwise seen from outside as the file gives them."""
     vertices: np.ndarray
     triangles: np.ndarray
     color: tuple = DEFAULTS.default_color
@@ -159,15 +157,6 @@ def _mirrored(primitive: Primitive, signs: np.ndarray, size: float) -> Primitive
                    parameters=tuple(float(v) * size for v in primitive.parameters))
 
 
-def signed_volume(vertices: np.ndarray, triangles: np.ndarray) -> float:
-    """m^3: the volume the triangles enclose, positive when they are wound counter-clockwise
-    seen from outside (the divergence theorem over the triangles' tetrahedra with the
-    origin; exact for a closed mesh, a sign of the winding for an open one)."""
-    corners = vertices[triangles]
-    return float(np.einsum("ij,ij->i", corners[:, 0],
-                           np.cross(corners[:, 1], corners[:, 2])).sum() / 6.0)
-
-
 def merge_vertices(corners: np.ndarray, tolerance: float = DEFAULTS.merge_tolerance
                    ) -> tuple[np.ndarray, np.ndarray]:
     """Merges duplicate vertices of a triangle soup.
@@ -237,8 +226,6 @@ def _finish(raw: _Raw, scale: float, defaults: ShapeDefaults, source: str) -> Sh
     mesh = None
     if len(raw.corners):
         vertices, triangles = merge_vertices(raw.corners * scale, defaults.merge_tolerance)
-        if len(triangles) and signed_volume(vertices, triangles) < 0.0:
-            triangles = np.ascontiguousarray(triangles[:, ::-1])
         if len(triangles):
             color = max(raw.tri_colors, key=lambda c: c[0])[1] if raw.tri_colors else \
                 defaults.default_color
