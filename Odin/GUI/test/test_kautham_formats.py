@@ -295,6 +295,19 @@ def test_a_2012_query_for_two_robots_is_split_between_them_in_robot_order(tmp_pa
     assert any("2 values, the controls are 3 (y, j, j)" in i.why for i in short.ignored)
 
 
+def test_kautham_reads_the_first_controls_element_only(tmp_path):
+    _write(tmp_path, "r.urdf", _urdf())
+    for name, joint in (("first.cntr", "arm"), ("second.cntr", "nope")):
+        _write(tmp_path, name, f'<ControlSet><Control name="c"><DOF name="r/{joint}" '
+               'value="1"/></Control></ControlSet>')
+    problem = _write(tmp_path, "p.xml", '<?xml version="1.0"?>\n<Problem>\n'
+                     '<Robot robot="r.urdf"/>\n<Controls robot="first.cntr"/>\n'
+                     '<Controls robot="second.cntr"/>\n</Problem>\n')
+    loaded = load_problem(problem)
+    assert loaded.instances[0].controls.names == ("c",)
+    assert any(i.what == "a second <Controls>" and i.line == 5 for i in loaded.ignored)
+
+
 # -- files that are not problems ---------------------------------------------------------------
 
 @pytest.mark.parametrize("root,says", [

@@ -154,6 +154,7 @@ class _Loader:
         self.instances: List[Instance] = []
         self.ignored: List[Ignored] = []
         self.cntr: Optional[ControlSet] = None
+        self.controls_node: Optional[Node] = None
         self.planner: Optional[Planner] = None
         self.planner_node: Optional[Node] = None
         self.attachment_nodes: List[Node] = []
@@ -264,6 +265,13 @@ class _Loader:
                         collision=collision, source=str(self.path), line=node.line)
 
     def _controls(self, node: Node) -> None:
+        """The first <Controls>, as Kautham reads it (``child("Controls")``); a later one is
+        listed as ignored."""
+        if self.controls_node is not None:
+            self.ignore(node, "a second <Controls>", f"Kautham reads the first only (line "
+                        f"{self.controls_node.line})")
+            return
+        self.controls_node = node
         if node.get("obstacle"):
             self.ignore(node, f"<Controls obstacle=\"{node.get('obstacle')}\">",
                         "obstacle controls: Odin does not move obstacles by controls")
