@@ -85,6 +85,19 @@ def configurations(model, mimics: dict, rng: np.random.Generator) -> list:
     return out
 
 
+def _with_limits(path: pathlib.Path) -> str:
+    """The URDF's text, a ``<limit>`` added to each revolute or prismatic joint without one:
+    urdfdom (robot_state_publisher's parser) refuses those, Kautham and Odin read them (as
+    continuous); limits do not move a link."""
+    import xml.etree.ElementTree as ElementTree
+    root = ElementTree.fromstring(path.read_bytes())
+    for joint in root.iter("joint"):
+        if joint.get("type") in ("revolute", "prismatic") and joint.find("limit") is None:
+            ElementTree.SubElement(joint, "limit", lower="-10", upper="10", effort="0",
+                                   velocity="0")
+    return ElementTree.tostring(root, encoding="unicode")
+
+
 def _angle(rotation: np.ndarray) -> float:
     return float(np.arccos(np.clip((np.trace(rotation) - 1.0) / 2.0, -1.0, 1.0)))
 
@@ -94,7 +107,7 @@ def check_robot(path: pathlib.Path, model, master, namespace: str, seed: int) ->
     ``path``'s robot at Home and CONFIGURATIONS random configurations."""
     import rospy
     from sensor_msgs.msg import JointState
-    rospy.set_param(f"/{namespace}/robot_description", path.read_text(errors="replace"))
+    rospy.set_param(f"/{namespace}/robot_description", _with_limits(path))
     transforms = _StampedTransforms(f"/{namespace}/tf", f"/{namespace}/tf_static")
     states = rospy.Publisher(f"/{namespace}/joint_states", JointState, queue_size=10,
                              latch=True)
