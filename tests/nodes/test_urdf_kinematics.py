@@ -201,6 +201,7 @@ def test_odin_s_urdf_link_poses_equal_robot_state_publisher_s(ros_master, kautha
     assert _check_folder(tmp_path, ros_master) == 1
 
 
+@pytest.mark.timeout(3600)
 @pytest.mark.skipif(os.environ.get(WHOLE_CORPUS_TESTS) != "1",
                     reason=f"the whole Kautham corpus: `make corpus` runs it "
                     f"({WHOLE_CORPUS_TESTS}=1)")

@@ -258,6 +258,7 @@ def test_mutated_and_truncated_corpus_files_get_one_clear_error_or_a_plan(kautha
 
 
 @pytest.mark.forked
+@pytest.mark.timeout(3 * 3600)     # thousands of problem_info runs on the whole corpus
 @pytest.mark.skipif(os.environ.get(WHOLE_CORPUS_TESTS) != "1",
                     reason=f"the whole Kautham corpus: `make corpus` runs it "
                     f"({WHOLE_CORPUS_TESTS}=1)")
