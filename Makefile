@@ -3,7 +3,7 @@ SHELL := /bin/bash
 ROOT  := $(CURDIR)
 ENV   := set -eo pipefail; source $(ROOT)/setup.bash;
 
-.PHONY: setup bench-setup build demo test test-stress bench experiments lint mutants soak clean
+.PHONY: setup bench-setup build demo test test-stress bench experiments lint mutants soak corpus clean
 
 setup:
 	@tools/install.sh
@@ -50,6 +50,12 @@ mutants: setup
 # a recorder subscribed; not part of `make test`; figures in out/soak/results.json
 soak: setup
 	@$(ENV) python tools/soak/run.py
+
+# every problem file of Kautham's whole public corpus (tools/get_kautham.sh --all) through
+# problem_info, then built into a world with the Viewer and simulated 2 s; not part of `make
+# test`; writes out/corpus/report.md and .json and the README's corpus figures
+corpus: setup
+	@$(ENV) python tools/corpus/run.py
 
 clean:
 	rm -rf build out .pytest_cache

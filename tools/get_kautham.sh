@@ -4,31 +4,51 @@
 # each taken byte for byte at the commit tools/kautham/MANIFEST.md pins for it, in the layout
 # ODIN_KAUTHAM_DIR expects (the MANIFEST's "local path" column).
 #
-#   tools/get_kautham.sh [--repo URL_OR_PATH] [--dest DIR] [--manifest FILE]
+#   tools/get_kautham.sh [--all] [--repo URL_OR_PATH] [--dest DIR] [--manifest FILE]
 #
-#   --repo      a clone or mirror of iocroblab/kautham, or its URL
+#   --all       the whole corpus instead: every file of the repository at each commit the
+#               MANIFEST pins a tree for (legacy_2012/ and current_2025/, the repository's
+#               whole tree under each), for `make corpus` (tools/corpus/run.py). A file whose
+#               content the repository does not hold (absent from a mirror, or a Git LFS
+#               pointer) is listed in SKIPPED.md there and not laid out.
+#   --repo      a clone or mirror of iocroblab/kautham (bare or not), or its URL
 #               (default: https://github.com/iocroblab/kautham.git)
 #   --dest      where the corpus goes (default: $ODIN_KAUTHAM_DIR, else ../shared/kautham
-#               beside this clone, which is where setup.bash looks)
+#               beside this clone, which is where setup.bash looks; with --all:
+#               $ODIN_KAUTHAM_ALL_DIR, else ../shared/kautham_all beside it)
 #   --manifest  the table of files (default: tools/kautham/MANIFEST.md)
 #
-# Every file's size is checked against the MANIFEST; the corpus is assembled in a temporary
-# folder and moved into place only when complete, so a failure leaves nothing half-done.
+# Every file's size is checked against the MANIFEST (--all: against the repository's tree); the
+# corpus is assembled in a temporary folder and moved into place only when complete, so a
+# failure leaves nothing half-done.
 set -eo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 manifest="$root/tools/kautham/MANIFEST.md"
 repo="https://github.com/iocroblab/kautham.git"
-dest="${ODIN_KAUTHAM_DIR:-$(cd "$root/.." && pwd)/shared/kautham}"
+dest=""
+all=0
 
 while [ $# -gt 0 ]; do
   case "$1" in
     --repo) repo="$2"; shift 2 ;;
     --dest) dest="$2"; shift 2 ;;
     --manifest) manifest="$2"; shift 2 ;;
-    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
+    --all) all=1; shift ;;
+    -h|--help) sed -n '2,24p' "$0"; exit 0 ;;
     *) echo "get_kautham.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
+
+if [ -z "$dest" ]; then
+  if [ "$all" = 1 ]; then
+    dest="${ODIN_KAUTHAM_ALL_DIR:-$(cd "$root/.." && pwd)/shared/kautham_all}"
+  else
+    dest="${ODIN_KAUTHAM_DIR:-$(cd "$root/.." && pwd)/shared/kautham}"
+  fi
+fi
+if [ "$all" = 1 ]; then
+  exec "$root/tools/corpus/lay_out_all.sh" "$repo" "$dest" "$manifest"
+fi
 
 if [ -f "$dest/MANIFEST.md" ] && cmp -s "$dest/MANIFEST.md" "$manifest"; then
   echo "get_kautham.sh: the corpus is already at $dest"

@@ -8,6 +8,7 @@ from __future__ import annotations
 import contextlib
 import io
 import json
+import os
 import random
 import shutil
 import signal
@@ -17,6 +18,8 @@ import pytest
 
 from gui.cli import problem_info_main
 from gui.core import shapes
+from gui.core.kautham.corpus import (WHOLE_CORPUS_TESTS, whole_corpus_dir,
+                                     whole_missing_message)
 from gui.core.kautham.urdf import read_urdf
 from gui.core.kautham.xmlfile import read_xml
 from gui.core.shapes import ShapeDefaults, read_shape
@@ -154,8 +157,15 @@ def time_limit(seconds):
 
 
 def mutate(data: bytes, rng: random.Random) -> bytes:
-    """One of: cut short, bytes flipped, a line dropped or doubled, a number made absurd."""
-    kind = rng.randrange(5)
+    """One of: cut short, bytes flipped, a line dropped or doubled, a number made absurd, a
+    wrong encoding (declared or applied)."""
+    kind = rng.randrange(6)
+    if kind == 5:
+        return rng.choice([
+            data.decode("latin-1").encode("utf-16"),                  # UTF-16, no declaration
+            b'<?xml version="1.0" encoding="klingon"?>\n' + data,       # an unknown encoding
+            data.replace(b"?>", b' encoding="UTF-16"?>', 1),          # declared, not applied
+            data.decode("latin-1").encode("utf-8").replace(b"e", b"\xe9", 3)])  # stray latin-1
     if kind == 0:
         return data[:rng.randrange(len(data))]
     if kind == 1:
@@ -195,40 +205,73 @@ def opened_files(problem, root):
     return status, [type(problem)(p) for p in sorted(set(opened) - {str(problem)})]
 
 
-@pytest.mark.forked
-def test_mutated_and_truncated_corpus_files_get_one_clear_error_or_a_plan(kautham_dir,
-                                                                          tmp_path):
-    copy = tmp_path / "kautham"
-    shutil.copytree(kautham_dir, copy)
+def fuzz(copy, mutations: int, rng: random.Random, each_file_once: bool) -> int:
+    """Mutates every file each problem under ``copy`` that problem_info accepts opens (the
+    problem and what it references, STL meshes aside: binary), ``mutations`` times each, and
+    checks problem_info's answer: JSON, or one clear error line; never a traceback or a hang.
+    ``each_file_once``: a file several problems share is fuzzed with the first only. Returns
+    the number of runs."""
     problems = sorted(p for p in copy.rglob("*.xml") if b"<Problem" in p.read_bytes()[:4000])
     assert len(problems) >= 5
-    rng = random.Random(20261123)
-    runs = 0
+    runs, done = 0, set()
     for problem in problems:
         status, dependencies = opened_files(problem, copy)
         if status != 0:
             continue                       # a problem Odin refuses as it is: nothing to fuzz
         for target in [problem] + [p for p in dependencies if p.suffix.lower() != ".stl"]:
+            if each_file_once and target in done:
+                continue
+            done.add(target)
             original = target.read_bytes()
-            for _ in range(MUTATIONS_PER_FILE):
+            for _ in range(mutations):
                 target.write_bytes(mutate(original, rng))
-                shapes._CACHE.clear()
-                try:
-                    with time_limit(60):
-                        status, out, err = problem_info(problem)
-                except Hang:
-                    pytest.fail(f"problem_info hung on {problem} with {target} mutated")
-                except Exception as error:     # what the test is for: nothing escapes
-                    pytest.fail(f"{type(error).__name__} escaped problem_info on {problem} "
-                                f"with {target} mutated: {error}")
                 runs += 1
-                if status == 0:
-                    json.loads(out)
-                else:
-                    assert status == 2, err
-                    one_error_line(err)
+                check_problem_info(problem, target)
             target.write_bytes(original)
+    return runs
+
+
+def check_problem_info(problem, target) -> None:
+    shapes._CACHE.clear()
+    try:
+        with time_limit(60):
+            status, out, err = problem_info(problem)
+    except Hang:
+        pytest.fail(f"problem_info hung on {problem} with {target} mutated")
+    except Exception as error:     # what the test is for: nothing escapes
+        pytest.fail(f"{type(error).__name__} escaped problem_info on {problem} "
+                    f"with {target} mutated: {error}")
+    if status == 0:
+        json.loads(out)
+    else:
+        assert status == 2, err
+        one_error_line(err)
+
+
+@pytest.mark.forked
+def test_mutated_and_truncated_corpus_files_get_one_clear_error_or_a_plan(kautham_dir,
+                                                                          tmp_path):
+    copy = tmp_path / "kautham"
+    shutil.copytree(kautham_dir, copy)
+    runs = fuzz(copy, MUTATIONS_PER_FILE, random.Random(20261123), each_file_once=False)
     assert runs >= 50
+
+
+@pytest.mark.forked
+@pytest.mark.timeout(3 * 3600)     # thousands of problem_info runs on the whole corpus
+@pytest.mark.skipif(os.environ.get(WHOLE_CORPUS_TESTS) != "1",
+                    reason=f"the whole Kautham corpus: `make corpus` runs it "
+                    f"({WHOLE_CORPUS_TESTS}=1)")
+def test_mutated_files_of_kautham_s_whole_corpus_get_one_clear_error_or_a_plan(tmp_path):
+    """The same over every problem of Kautham's public repository at the pinned commits
+    (tools/get_kautham.sh --all), each file once: about 1,500 runs."""
+    whole = whole_corpus_dir()
+    if whole is None:
+        pytest.fail(whole_missing_message())
+    copy = tmp_path / "kautham_all"
+    shutil.copytree(whole, copy, symlinks=True)
+    runs = fuzz(copy, 1, random.Random(20261125), each_file_once=True)
+    assert runs >= 500
 
 
 def test_an_unknown_encoding_is_one_clear_error(tmp_path):

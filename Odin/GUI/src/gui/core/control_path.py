@@ -36,8 +36,8 @@ A control path is a list of rows, each k control values c in [0, 1] and a durati
 seconds (`rosrun GUI run_path PROBLEM --controls FILE`, the Motion tab's "Control path...").
 Each row maps to the robot as Kautham maps a control sample (`Robot::control2Parameters`,
 `parameter2Pose`): normalised DOF values p = offset + sum_k eigValue_k map_k (c_k - 0.5) from
-the control file (`.cntr`, or the `.rob`'s `<ControlSet>`; a DOF it does not list has offset 0.5
-and no map), each clamped to [0, 1], then through the robot's limits: a joint's value
+the control file (`.cntr`, or the `.rob`'s `<ControlSet>`; a DOF it does not list has offset 0.5,
+0 in a 2012 `.rob`'s own set, and no map), each clamped to [0, 1], then through the robot's limits: a joint's value
 q = low + p (high - low) (a continuous joint's range is [-2 pi, 2 pi]); the base's position
 low + p (high - low) per axis of the problem's `<Limits>` box taken into the Home frame, and
 its orientation from X1, X2, X3 by Kuffner's uniform quaternion (w = sqrt(1 - p1) cos(pi p3),

@@ -8,7 +8,8 @@ Readers:
   model matrix, taken in a pre-callback, is applied afterwards with numpy, one shape at a time. Spheres, cylinders and cubes are *not* triangulated: Coin tessellates them as open
   meshes, so they stay ODE primitives (a pre-callback records them with their model matrix and
   prunes them).
-- STL, OBJ, PLY, OFF, GLB... through trimesh (imported only when such a file is read).
+- STL, OBJ, PLY, OFF, GLB... through trimesh (imported only when such a file is read); Collada
+  (.dae) through trimesh and pycollada, as Kautham reads it (``_read_trimesh``).
 
 Mapping a file to Odin (``Shape``):
 - Triangles of every non-primitive node, in the file's frame, become one ``Mesh``; duplicate
@@ -27,6 +28,7 @@ Mapping a file to Odin (``Shape``):
 from __future__ import annotations
 
 import contextlib
+import io
 import os
 import pathlib
 import re
@@ -105,6 +107,25 @@ class Shape:
         prims = tuple(replace(p, pose=T @ p.pose) for p in self.primitives)
         return replace(self, mesh=mesh, primitives=prims)
 
+    def scaled(self, factors) -> "Shape":
+        """The shape with x, y, z multiplied by ``factors`` (3,), which may differ and be
+        negative (a URDF ``<mesh scale="1 -1 -1">``): a mirrored mesh keeps its triangles
+        counter-clockwise seen from outside. A sphere, cylinder or box cannot stretch unevenly:
+        factors of different sizes are a ``ShapeError`` when the shape has one."""
+        f = np.asarray(factors, dtype=float)
+        if not np.all(np.isfinite(f)) or np.any(f == 0.0):
+            raise ShapeError(f"scale {tuple(f)} must be finite and non-zero", self.source)
+        mesh = self.mesh
+        if mesh is not None:
+            triangles = mesh.triangles if np.prod(f) > 0 else mesh.triangles[:, ::-1].copy()
+            mesh = replace(mesh, vertices=mesh.vertices * f, triangles=triangles)
+        size = float(abs(f[0]))
+        if self.primitives and not np.allclose(np.abs(f), size, rtol=1e-9, atol=0.0):
+            raise ShapeError(f"a sphere, cylinder or box cannot be scaled by {tuple(f)} "
+                             "(factors of different sizes)", self.source)
+        return replace(self, mesh=mesh,
+                       primitives=tuple(_mirrored(p, np.sign(f), size) for p in self.primitives))
+
     def with_color(self, color: tuple) -> "Shape":
         mesh = None if self.mesh is None else replace(self.mesh, color=tuple(color))
         prims = tuple(replace(p, color=tuple(color)) for p in self.primitives)
@@ -121,6 +142,20 @@ class Shape:
                 mesh = Mesh(np.vstack([mesh.vertices, other.mesh.vertices]),
                             tri.astype(np.uint32), mesh.color)
         return Shape(self.source, mesh, self.primitives + other.primitives)
+
+
+def _mirrored(primitive: Primitive, signs: np.ndarray, size: float) -> Primitive:
+    """``primitive`` scaled by ``size`` and mirrored by the axis signs (+-1, 3). A mirror is
+    improper, a pose cannot be: the primitive is symmetric about its own x = 0 plane (a
+    sphere, a box, a cylinder along z), so mirroring it there too keeps its shape and makes
+    the rotation proper."""
+    pose = primitive.pose.copy()
+    pose[:3, :3] = np.diag(signs) @ pose[:3, :3]
+    if np.prod(signs) < 0:
+        pose[:3, :3] = pose[:3, :3] @ np.diag([-1.0, 1.0, 1.0])
+    pose[:3, 3] = signs * pose[:3, 3] * size
+    return replace(primitive, pose=pose,
+                   parameters=tuple(float(v) * size for v in primitive.parameters))
 
 
 def merge_vertices(corners: np.ndarray, tolerance: float = DEFAULTS.merge_tolerance
@@ -241,10 +276,32 @@ def _check_stl_count(p: pathlib.Path, max_triangles: int) -> None:
                          f"mesh", p)
 
 
+def _collada_surfaces(p: pathlib.Path) -> io.BytesIO:
+    """A Collada file without its ``<lines>`` and ``<linestrips>``: they hold no surface
+    (nothing collides with a line, and Kautham draws only faces), and pycollada refuses some
+    that assimp, Kautham's reader, reads (an ``<input>`` without ``offset``, in the IOC lab's
+    steel cupboard). The XML is read without entities or network access."""
+    from lxml import etree
+    parser = etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False)
+    root = etree.fromstring(p.read_bytes(), parser)
+    for element in list(root.iter("{*}lines", "{*}linestrips", "lines", "linestrips")):
+        element.getparent().remove(element)
+    return io.BytesIO(etree.tostring(root))
+
+
 def _read_trimesh(p: pathlib.Path) -> _Raw:
+    """Triangles and the main colour of a mesh file read by trimesh (Collada through
+    pycollada). A Collada file's ``<unit>`` and ``<up_axis>`` are not applied, as in Kautham:
+    assimp puts them in the scene's root transform, which Kautham's import
+    (``Assimp2Inventor``, src/problem/assimpImport.cpp) skips; URDFs scale such meshes
+    themselves (``<mesh scale="0.0254 0.0254 0.0254">`` for an inch file)."""
     import trimesh  # slow to import: only when such a file is read
     try:
-        loaded = trimesh.load(str(p), force="mesh", process=False)
+        if p.suffix.lower() == ".dae":
+            loaded = trimesh.load(_collada_surfaces(p), file_type="dae", force="mesh",
+                                  process=False)
+        else:
+            loaded = trimesh.load(str(p), force="mesh", process=False)
     except Exception as error:  # trimesh raises many kinds; all mean "does not parse"
         raise ShapeError(f"does not parse as a mesh: {error}", p) from None
     corners = np.asarray(loaded.triangles, dtype=np.float64) if len(loaded.faces) else \

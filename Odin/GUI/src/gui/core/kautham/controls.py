@@ -13,7 +13,9 @@ The mapping (Kautham's ``Robot::control2Parameters``, ``Robot::parameter2Pose``,
 
     p_dof = offset_dof + sum_k eigValue_k value_{dof,k} (c_k - 0.5)
 
-with offset 0.5 for every DOF the file does not list; each p is then clamped to [0, 1] (the
+with offset 0.5 for every DOF the file does not list (current Kautham's
+``Problem::setRobotControls``), 0 in a 2012 robot's own ``<ControlSet>`` (Kautham 2012's
+``Robot::Robot`` zeroes its offset matrix before reading ``<Offset>``); each p is then clamped to [0, 1] (the
 controls are within bounds when no clamp was needed). Then, through the robot's limits:
 
 - a joint: q = low + p (high - low) (continuous joints: [-2 pi, 2 pi], Kautham's);
@@ -44,6 +46,8 @@ BASE_DOFS = ("X", "Y", "Z", "X1", "X2", "X3")
 """The base's DOFs in Kautham's order: position in the Home frame, then Kuffner's three."""
 OFFSET_DEFAULT = 0.5
 """Kautham's offset of a DOF the control set does not list."""
+LEGACY_OFFSET_DEFAULT = 0.0
+"""Kautham 2012's offset of a DOF a .rob's own control set does not list."""
 CONTINUOUS_LIMITS = (-2.0 * math.pi, 2.0 * math.pi)
 """rad: the range Kautham gives a URDF continuous joint."""
 
@@ -61,6 +65,15 @@ def parse_control_set(node: Node) -> ControlSet:
         controls.append(Control(control.get("name", ""), control.number("eigValue", 1.0),
                                 values, control.line))
     return ControlSet(offset=offset, controls=controls, source=node.path, line=node.line)
+
+
+def free_flyer_control_set() -> ControlSet:
+    """The controls Kautham 2012 gives a robot that is a bare geometry file (``Robot::Robot``,
+    libproblem/robot.cpp, the FREEFLY branch): one control per base DOF X, Y, Z, X1, X2, X3,
+    in that order, each moving its DOF by 1 from the offset 0.5."""
+    return ControlSet(offset={dof: 0.5 for dof in BASE_DOFS},
+                      controls=[Control(dof, 1.0, {dof: 1.0}) for dof in BASE_DOFS],
+                      source="(Kautham's free-flying robot controls)")
 
 
 def read_cntr(path: pathlib.Path) -> ControlSet:
@@ -160,8 +173,10 @@ def base_pose(home: np.ndarray, limits: dict, p: Sequence[float]) -> np.ndarray:
 
 
 def control_map(instance: Instance, control_set: ControlSet, prefixed: bool,
-                names_of_robots: Optional[Sequence[str]] = None) -> Optional[ControlMap]:
+                names_of_robots: Optional[Sequence[str]] = None,
+                offset_default: float = OFFSET_DEFAULT) -> Optional[ControlMap]:
     """``instance``'s share of ``control_set`` (None when no DOF of the set is the robot's).
+    ``offset_default``: the offset of a DOF the set does not list (module docstring).
 
     ``prefixed``: DOF names are "robot/dof" (a .cntr file; a name whose robot is not among
     ``names_of_robots`` is an error, as in Kautham), else bare (a .rob's own set). A DOF name
@@ -170,7 +185,7 @@ def control_map(instance: Instance, control_set: ControlSet, prefixed: bool,
     links = [link.name for link in model.links[1:]]
     dofs = BASE_DOFS + tuple(links)
     index = {name: i for i, name in enumerate(dofs)}
-    offset = np.full(len(dofs), OFFSET_DEFAULT)
+    offset = np.full(len(dofs), offset_default)
     matrix = np.zeros((len(dofs), len(control_set.controls)))
     mine = False
     se3 = False
@@ -213,6 +228,6 @@ def control_map(instance: Instance, control_set: ControlSet, prefixed: bool,
                       offset, matrix, se3, control_set.source)
 
 
-__all__ = ["BASE_DOFS", "OFFSET_DEFAULT", "CONTINUOUS_LIMITS", "parse_control_set",
-           "read_cntr", "ControlMap", "joint_limits", "home_frame_limits",
-           "kuffner_quaternion", "base_pose", "control_map"]
+__all__ = ["BASE_DOFS", "OFFSET_DEFAULT", "LEGACY_OFFSET_DEFAULT", "CONTINUOUS_LIMITS",
+           "parse_control_set", "free_flyer_control_set", "read_cntr", "ControlMap",
+           "joint_limits", "home_frame_limits", "kuffner_quaternion", "base_pose", "control_map"]

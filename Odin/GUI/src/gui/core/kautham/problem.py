@@ -48,7 +48,8 @@ from typing import List, Optional
 
 import numpy as np
 
-from gui.core.kautham.controls import BASE_DOFS, control_map, read_cntr
+from gui.core.kautham.controls import (BASE_DOFS, LEGACY_OFFSET_DEFAULT, control_map,
+                                       free_flyer_control_set, read_cntr)
 from gui.core.kautham.robot_rob import read_dh_robot, read_shape_robot
 from gui.core.kautham.units import LEGACY, SI, Units
 from gui.core.kautham.urdf import read_urdf
@@ -99,6 +100,15 @@ _OBSTACLE_CHILDREN = {"home": None, "location": None, "collision": None, "kautha
                                 "used)"}
 _CAR_WHEELS = 3      # a car has at least this many wheels
 
+_NOT_PROBLEMS = {
+    "benchmark": "is a Kautham benchmark file (<Benchmark>: problems and planners to compare), "
+                 "not a problem: `rosrun GUI benchmark` reads it",
+    "config": "is a Kautham configuration file (<Config>: the files of a task-planning demo), "
+              "not a problem",
+}
+"""Kautham's other XML files that mention <Problem>, by root element: the refusal says what
+the file is."""
+
 
 def load_problem(path: os.PathLike | str) -> Problem:
     """Reads a problem with every robot, obstacle and shape it references.
@@ -108,7 +118,8 @@ def load_problem(path: os.PathLike | str) -> Problem:
     path = pathlib.Path(path)
     root = read_xml(path, "problem file")
     if root.tag != "Problem":
-        raise root.error(f"expected a <Problem> element, found <{root.tag}>")
+        raise root.error(_NOT_PROBLEMS.get(root.tag.lower(),
+                                           f"expected a <Problem> element, found <{root.tag}>"))
     current = any(True for _ in root.findall("Obstacle")) or root.find("Controls") is not None \
         or any(pathlib.PurePath(r.get("robot") or "").suffix.lower() in (".urdf", ".dh")
                for r in root.findall("Robot"))
@@ -143,6 +154,7 @@ class _Loader:
         self.instances: List[Instance] = []
         self.ignored: List[Ignored] = []
         self.cntr: Optional[ControlSet] = None
+        self.controls_node: Optional[Node] = None
         self.planner: Optional[Planner] = None
         self.planner_node: Optional[Node] = None
         self.attachment_nodes: List[Node] = []
@@ -194,7 +206,8 @@ class _Loader:
             model.name = renamed.require("name").strip() or model.name
         self._ignore_children(node, _ROBOT_CHILDREN)
         return Instance(name=self.names.take(model.name), role="robot", model=model,
-                        base_pose=_pose(node.find("Home"), self.units), movable=True,
+                        base_pose=_pose(node.find("Home"), self.units, self.ignored),
+                        movable=True,
                         source=str(self.path), line=node.line, limits=self._limits(node))
 
     def _limits(self, node: Node) -> dict:
@@ -248,10 +261,17 @@ class _Loader:
             pose_node = node.find("Home")       # a 2012 .rob scene is placed by its <Home>
         self._ignore_children(node, _OBSTACLE_CHILDREN)
         return Instance(name=self.names.take(file.stem), role="obstacle", model=model,
-                        base_pose=_pose(pose_node, self.units), movable=movable,
+                        base_pose=_pose(pose_node, self.units, self.ignored), movable=movable,
                         collision=collision, source=str(self.path), line=node.line)
 
     def _controls(self, node: Node) -> None:
+        """The first <Controls>, as Kautham reads it (``child("Controls")``); a later one is
+        listed as ignored."""
+        if self.controls_node is not None:
+            self.ignore(node, "a second <Controls>", f"Kautham reads the first only (line "
+                        f"{self.controls_node.line})")
+            return
+        self.controls_node = node
         if node.get("obstacle"):
             self.ignore(node, f"<Controls obstacle=\"{node.get('obstacle')}\">",
                         "obstacle controls: Odin does not move obstacles by controls")
@@ -275,9 +295,12 @@ class _Loader:
             return
         for robot in robots:                 # 2012: each .rob's own set, over its controls
             own = robot.model.controls
+            if own is None and robot.model.kind == "shape":
+                own = free_flyer_control_set()
             if own is not None:
                 try:
-                    robot.controls = control_map(robot, own, prefixed=False)
+                    robot.controls = control_map(robot, own, prefixed=False,
+                                                 offset_default=LEGACY_OFFSET_DEFAULT)
                 except ProblemError as error:
                     self.ignored.append(Ignored(error.path or "", error.line,
                                                 "<ControlSet>", error.reason))
@@ -352,12 +375,23 @@ class _Loader:
                                         f"cannot be used: {error.reason}"))
 
     def _first_query(self, query: Node, robots: List[Instance]) -> None:
+        """Each robot's start and goal from the query's control vectors. A current problem
+        has one control set for all its robots (a .cntr file, or Kautham's default one), so
+        every robot maps the whole vector; in a 2012 problem each robot has its own set and the
+        vector is theirs end to end, in robot order (Kautham 2012's
+        ``WorkSpace::moveRobotsTo``: robot i takes the next ``getNumControls()`` values)."""
         mapped = [r for r in robots if r.controls is not None]
         if not mapped:
             self.ignore(query, "<Query>", "no robot has controls to map it through")
             return
-        size = mapped[0].controls.size
-        names = mapped[0].controls.names
+        if self.current:
+            names = mapped[0].controls.names
+            parts = [slice(None)] * len(mapped)
+        else:
+            names = tuple(n for r in mapped for n in r.controls.names)
+            ends = np.cumsum([r.controls.size for r in mapped])
+            parts = [slice(end - r.controls.size, end) for r, end in zip(mapped, ends)]
+        size = len(names)
         init = goal = None
         for child in query.children:
             tag = child.tag.lower()
@@ -375,13 +409,11 @@ class _Loader:
             else:
                 self.ignore(child, f"<Query> <{child.tag}>", "obstacle controls: Odin does "
                             "not move obstacles by controls")
-        if not self.current and len({r.controls.size for r in mapped}) > 1:
-            raise query.error("the robots' control sets differ in size")
-        for robot in mapped:
+        for robot, part in zip(mapped, parts):
             if init is not None:
-                robot.start = robot.controls.configuration(robot, _fill(init))
+                robot.start = robot.controls.configuration(robot, _fill(init)[part])
             if goal is not None:
-                robot.goal = robot.controls.configuration(robot, _fill(goal))
+                robot.goal = robot.controls.configuration(robot, _fill(goal)[part])
 
     def _robot_control(self, node: Node, names, init, goal):
         name = node.require("name").strip()
@@ -487,14 +519,24 @@ def _resolve(rel: str, node: Node, problem: pathlib.Path, current: bool) -> path
                      + (", ..." if len(candidates) > 3 else "") + ")")
 
 
-def _pose(node: Optional[Node], units: Units) -> np.ndarray:
+def _pose(node: Optional[Node], units: Units, ignored: List[Ignored]) -> np.ndarray:
+    """The world pose (4, 4; m) of a ``<Home>`` or ``<Location>``: X Y Z, then the rotation
+    TH about WX WY WZ.
+
+    An angle about a zero axis is no rotation, as in Kautham: its
+    ``SE3Conf::fromAxisToQuaternion`` (src/sampling/se3conf.cpp) multiplies the axis by
+    sin(TH/2), which leaves the quaternion's vector part zero. Such a TH is listed in
+    ``ignored`` (it says nothing)."""
     if node is None:
         return np.eye(4)
     position = [node.number(c, 0.0) * units.length for c in ("X", "Y", "Z")]
     axis = [node.number(c, 0.0) for c in ("WX", "WY", "WZ")]
     angle = node.number("TH", 0.0) * units.angle
     if angle != 0.0 and not any(axis):
-        raise node.error("TH is not zero but the axis WX WY WZ is")
+        ignored.append(Ignored(node.path, node.line, f"<{node.tag} TH=\"{node.get('TH')}\">",
+                               "a rotation about the zero axis WX WY WZ: no rotation, as "
+                               "in Kautham (its quaternion has a zero vector part)"))
+        angle = 0.0
     return pose_from_axis_angle(position, axis if any(axis) else (0, 0, 1), angle)
 
 

@@ -8,6 +8,16 @@
       <ControlSet>...</ControlSet>        (optional; see gui.core.kautham.controls)
     </Robot>
 
+The first joint is the robot's base, never a joint, whatever its ``<Description movable>``
+says: Kautham's reader (``Robot::Robot``, libproblem/robot.cpp) gives a robot of n joints n - 1
+joint coordinates and skips the first ("First link is ommited because it is the base"); the 2012
+free-flying robots (``table.rob``, ``minicube.rob``: one ``Base`` joint marked movable) move by
+their base's controls only. The 2009 files of the IROS09 hand problems
+(``3DOFCy_RHand*.rob``) list their ``<Joint>`` elements directly under ``<Robot>``, without the
+``<Joints>`` wrapper that the 2010-2012 reader (pugixml's ``child("Joints")``) requires and that
+later files all have; they are read as the joint list they are, and a file holding both is
+refused as ambiguous.
+
 Lengths (a, d, PreTrans X/Y/Z, prismatic limits) and the link geometry are multiplied by the
 problem's ``scale`` and the file's length unit; angles are converted to radians. A missing
 ``<Parent>`` means the previous joint (a chain); ``<Parent name="">`` the robot's base.
@@ -51,10 +61,7 @@ def read_dh_robot(path: pathlib.Path, scale: float = 1.0) -> RobotModel:
     if not matches:
         raise root.error(f"unknown DHType=\"{dh_raw}\" (expected Standard or Modified)")
     dh_type = matches[0]
-    joints_node = root.find("Joints")
-    joints = list(joints_node.findall("Joint")) if joints_node is not None else []
-    if not joints:
-        raise root.error("has no <Joints> with <Joint> elements")
+    joints = _joint_nodes(root)
     length = units.length * scale
     links: list[LinkModel] = []
     index: dict[str, int] = {}
@@ -71,6 +78,21 @@ def read_dh_robot(path: pathlib.Path, scale: float = 1.0) -> RobotModel:
     return RobotModel(name=name, links=links, source=str(path), kind="rob", dh_type=dh_type,
                       controls=controls, ignored=_planner_weights(root, joints, path),
                       free_base=root.get("robType", "").strip().lower() == "freeflying")
+
+
+def _joint_nodes(root: Node) -> list:
+    """The robot's ``<Joint>`` elements: those of its ``<Joints>``, or (the 2009 files) those
+    directly under ``<Robot>``."""
+    joints_node = root.find("Joints")
+    wrapped = list(joints_node.findall("Joint")) if joints_node is not None else []
+    bare = list(root.findall("Joint"))
+    if wrapped and bare:
+        raise bare[0].error("<Joint> elements both inside <Joints> and directly under <Robot>: "
+                            "which are the robot's is ambiguous")
+    if not (wrapped or bare):
+        raise root.error("has no <Joints> with <Joint> elements (nor <Joint> elements "
+                         "directly under <Robot>)")
+    return wrapped or bare
 
 
 def _planner_weights(root: Node, joints: list, path: pathlib.Path) -> list:
@@ -94,7 +116,8 @@ def _read_link(joint: Node, k: int, links: list, index: dict, dh_type: str, unit
     desc = joint.find("Description")
     rotational = desc.flag("rotational", True) if desc is not None else True
     movable = desc.flag("movable", True) if desc is not None else True
-    kind = FIXED if not movable else (REVOLUTE if rotational else PRISMATIC)
+    base = k == 0            # the base: never a joint (module docstring)
+    kind = FIXED if base or not movable else (REVOLUTE if rotational else PRISMATIC)
     dh = joint.find("DHPars")
     if dh is not None:
         alpha = dh.number("alpha", 0.0) * units.angle

@@ -16,6 +16,10 @@ limits, as in Kautham (its soft limits). Joint types: revolute, continuous (no l
 prismatic, fixed; floating and planar joints are refused. What Odin does not use
 (transmissions, mimic joints, calibration, other Gazebo settings, Kautham's joint
 ``<weight>``) is listed in ``RobotModel.ignored``.
+
+Numbers are read as Kautham reads them (``gui.core.kautham.xmlfile``: ``ixx="0.46 5"``, in the
+TIAGo base's URDF, is 0.46), each such reading listed in ``RobotModel.ignored`` and so warned
+about.
 """
 from __future__ import annotations
 
@@ -24,10 +28,11 @@ from typing import List, Optional
 
 import numpy as np
 
-from gui.core.kautham.xmlfile import Node, parse_number, read_xml
+from gui.core.kautham.xmlfile import LenientNumber, Node, parse_number, read_xml
 from gui.core.kinematics import rpy_matrix
 from gui.core.model import FIXED, PRISMATIC, REVOLUTE, Ignored, Inertial, LinkModel, RobotModel
 from gui.core.shapes import Primitive, Shape, read_shape
+from gui.errors import ShapeError
 from odin_common.specs import WORLD_SURFACE, Surface
 
 _JOINT_KINDS = {"revolute": REVOLUTE, "continuous": REVOLUTE, "prismatic": PRISMATIC,
@@ -76,9 +81,13 @@ def _geometry(owner: Node, scale: float, urdf: pathlib.Path) -> Optional[Shape]:
             elif filename.startswith("file://"):
                 filename = filename[len("file://"):]
             factors = child.numbers("scale", 3, (1.0, 1.0, 1.0))
-            if max(factors) - min(factors) > 1e-9 * max(abs(f) for f in factors):
-                raise child.error("a non-uniform mesh scale is not supported")
-            return read_shape(urdf.parent / filename, factors[0] * scale).transformed(pose)
+            if factors[0] > 0 and max(factors) - min(factors) <= 1e-9 * factors[0]:
+                return read_shape(urdf.parent / filename, factors[0] * scale).transformed(pose)
+            mesh = read_shape(urdf.parent / filename, scale)
+            try:       # uneven or mirroring factors (TIAGo's arm meshes: "1 -1 -1")
+                return mesh.scaled(factors).transformed(pose)
+            except ShapeError as error:
+                raise child.error(f"{filename}: {error.reason}") from None
         if tag == "box":
             dims = tuple(v * scale for v in child.numbers("size", 3))
             return Shape(str(urdf), None, (Primitive("box", dims, pose),))
@@ -228,7 +237,18 @@ def _joint_ignored(joint: Node, path: pathlib.Path, ignored: List[Ignored]) -> N
 
 
 def read_urdf(path: pathlib.Path, scale: float = 1.0) -> RobotModel:
-    root = read_xml(path, "URDF file")
+    """Reads a URDF file with its meshes (module docstring); numbers are read as Kautham reads
+    them (a malformed one by its leading number, listed in ``RobotModel.ignored``)."""
+    lenient: List[LenientNumber] = []
+    model = _read_urdf(path, scale, lenient)
+    model.ignored.extend(Ignored(n.path, n.line, n.what, f"not a number: read as {n.value!r}, "
+                                 "its leading number, as Kautham reads it")
+                         for n in lenient)
+    return model
+
+
+def _read_urdf(path: pathlib.Path, scale: float, lenient: list) -> RobotModel:
+    root = read_xml(path, "URDF file", lenient)
     if root.tag != "robot":
         raise root.error(f"expected a <robot> element, found <{root.tag}>")
     name = root.get("name") or path.stem

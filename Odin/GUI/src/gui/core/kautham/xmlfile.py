@@ -10,12 +10,20 @@ hardens expat: a DTD may not declare entities (a "billion laughs" file expands a
 into gigabytes; Kautham's files declare none), external entities and parameter entities are
 never resolved (an external entity would read another file, or a URL, into the problem), and
 a file larger than odin_common.limits.MAX_INPUT_FILE_MB is refused before it is read.
+
+Numbers: a malformed number is an error naming the file and line, except in a tree read with
+``lenient`` (URDF files): there a value that starts with a number ("0.46 5") is read as that
+leading number, as Kautham reads it (pugixml's ``as_double`` and ``atof`` are C's ``strtod``:
+they stop at the first character that cannot continue the number), and each such reading is
+recorded in the ``lenient`` list as a ``LenientNumber`` for the caller to warn about. A value
+that does not start with a number is an error there too (C would read it as 0, silently).
 """
 from __future__ import annotations
 
 import math
 import os
 import pathlib
+import re
 import xml.parsers.expat
 from dataclasses import dataclass, field
 from typing import Iterator, Optional
@@ -24,15 +32,30 @@ from gui.core.sizes import check_file_size
 from gui.errors import ProblemError
 
 
+_LEADING_NUMBER = re.compile(r"\s*[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
+"""The longest prefix C's strtod reads as a decimal number."""
+
+
+@dataclass(frozen=True)
+class LenientNumber:
+    """A malformed number read as its leading number (module docstring)."""
+    path: str
+    line: int
+    what: str          # the attribute as written: <inertia ixx="0.46 5">
+    value: float       # what was read
+
+
 @dataclass
 class Node:
-    """One XML element: tag, attributes, children, text, and its 1-based line."""
+    """One XML element: tag, attributes, children, text, and its 1-based line. ``lenient``:
+    the list that records lenient readings of the tree's numbers (None: numbers are strict)."""
     tag: str
     attrib: dict
     line: int
     path: str
     children: list = field(default_factory=list)
     text: str = ""
+    lenient: Optional[list] = field(default=None, repr=False)
 
     def find(self, tag: str) -> Optional["Node"]:
         """The first child called ``tag`` (case-insensitive, as Kautham's readers are)."""
@@ -72,7 +95,16 @@ class Node:
             if default is None:
                 raise self.error(f"<{self.tag}> has no attribute {name}=")
             return default
-        return parse_number(raw, f"<{self.tag} {name}=\"{raw}\">", self.path, self.line)
+        what = f"<{self.tag} {name}=\"{raw}\">"
+        try:
+            return parse_number(raw, what, self.path, self.line)
+        except ProblemError:
+            leading = _LEADING_NUMBER.match(raw) if self.lenient is not None else None
+            if leading is None or not math.isfinite(float(leading.group())):
+                raise
+        value = float(leading.group())
+        self.lenient.append(LenientNumber(self.path, self.line, what, value))
+        return value
 
     def flag(self, name: str, default: bool) -> bool:
         raw = self.get(name)
@@ -109,9 +141,11 @@ def parse_number(raw: str, what: str, path: Optional[str], line: Optional[int]) 
     return value
 
 
-def read_xml(path: os.PathLike | str, what: str = "file") -> Node:
+def read_xml(path: os.PathLike | str, what: str = "file",
+             lenient: Optional[list] = None) -> Node:
     """Parses ``path`` into a ``Node`` tree; a missing or malformed file is a ``ProblemError``
-    naming the file and (for malformed XML) the line."""
+    naming the file and (for malformed XML) the line. ``lenient``: a list to record
+    ``LenientNumber`` readings in (module docstring); None: numbers are strict."""
     p = pathlib.Path(path)
     check_file_size(p, what, ProblemError)
     try:
@@ -120,7 +154,7 @@ def read_xml(path: os.PathLike | str, what: str = "file") -> Node:
         raise ProblemError(f"{what} not found", p) from None
     except OSError as error:
         raise ProblemError(f"{what} cannot be read: {error.strerror}", p) from None
-    return parse_xml_bytes(data, str(p))
+    return parse_xml_bytes(data, str(p), lenient)
 
 
 class _Refused(Exception):
@@ -152,14 +186,14 @@ def _harden(parser) -> None:
     parser.ExternalEntityRefHandler = external_reference
 
 
-def parse_xml_bytes(data: bytes, path: str) -> Node:
+def parse_xml_bytes(data: bytes, path: str, lenient: Optional[list] = None) -> Node:
     parser = xml.parsers.expat.ParserCreate()
     _harden(parser)
     stack: list[Node] = []
     root: list[Node] = []
 
     def start(tag, attrib):
-        node = Node(tag, dict(attrib), parser.CurrentLineNumber, path)
+        node = Node(tag, dict(attrib), parser.CurrentLineNumber, path, lenient=lenient)
         if stack:
             stack[-1].children.append(node)
         else:

@@ -1,0 +1,93 @@
+"""The report of `make corpus` (tools/corpus/run.py): counts, out/corpus/report.md, and the
+counts between the README's corpus markers, generated as the bench table is."""
+from __future__ import annotations
+
+import datetime
+import pathlib
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent.parent
+README_PATH = ROOT / "README.md"
+BEGIN = ("<!-- corpus figures begin: written by tools/corpus/report.py from "
+         "out/corpus/report.json; do not edit -->")
+END = "<!-- corpus figures end -->"
+
+
+def outcome(result: dict) -> str:
+    """ok | refused | failed for one file, both passes together."""
+    if result["status"] != "ok":
+        return result["status"]
+    return "failed" if result.get("world") == "failed" else "ok"
+
+
+def counts(results: dict) -> dict:
+    out = dict(files=len(results), ok=0, refused=0, failed=0, tracebacks=0,
+               refused_not_problem=0, refused_missing=0, refused_unexpected=0, simulated=0,
+               world_failed=0)
+    for result in results.values():
+        out[outcome(result)] += 1
+        out["tracebacks"] += bool(result.get("traceback"))
+        if result["status"] == "refused":
+            key = {"not a problem": "refused_not_problem",
+                   "missing file": "refused_missing"}.get(result["refusal"],
+                                                          "refused_unexpected")
+            out[key] += 1
+        out["simulated"] += result.get("world") == "ok"
+        out["world_failed"] += result.get("world") == "failed"
+    return out
+
+
+def summary_line(c: dict) -> str:
+    return (f"corpus: {c['files']} problem files: {c['ok']} ok, {c['refused']} refused "
+            f"({c['refused_not_problem']} not problems, {c['refused_missing']} naming a file "
+            f"the repository lacks, {c['refused_unexpected']} unexpected), {c['failed']} "
+            f"failed, {c['tracebacks']} tracebacks")
+
+
+def _when(run: dict) -> str:
+    return datetime.datetime.fromtimestamp(run["started"], datetime.timezone.utc) \
+        .strftime("%Y-%m-%d %H:%M UTC")
+
+
+def readme_block(run: dict, c: dict) -> str:
+    return (f"Last run: {_when(run)}; `make corpus` took {run['minutes']:.0f} min, "
+            f"{run['seconds']:g} s simulated per problem.\n\n"
+            "| problem files | ok (loads, builds, stands) | refused: not a problem | refused: "
+            "names a file the repository lacks | refused: other | failed | tracebacks |\n"
+            "|---|---|---|---|---|---|---|\n"
+            f"| {c['files']} | {c['ok']} | {c['refused_not_problem']} | {c['refused_missing']} "
+            f"| {c['refused_unexpected']} | {c['failed']} | {c['tracebacks']} |\n\n"
+            "Tests over the whole corpus (fuzz of every file problem_info opens; URDF "
+            "kinematics against robot_state_publisher): "
+            + (run["tests"]["summary"] if run.get("tests") else "not run") + ".\n")
+
+
+def rewrite_readme(block: str, path: pathlib.Path = README_PATH) -> None:
+    text = path.read_text()
+    start, end = text.find(BEGIN), text.find(END)
+    if start < 0 or end < start:
+        raise ValueError(f"{path} has no {BEGIN!r} ... {END!r} markers")
+    path.write_text(text[:start + len(BEGIN)] + "\n" + block + text[end:])
+
+
+def markdown(run: dict, results: dict, c: dict) -> str:
+    lines = [f"# Kautham's whole corpus through Odin ({_when(run)})", "",
+             summary_line(c) + ".", "",
+             f"Corpus: `{run['corpus']}`; {run['seconds']:g} s simulated per problem"
+             + ("" if run["simulated"] else " (no simulation: problem_info only)")
+             + (f"; only files holding `{run['only']}`" if run["only"] else "") + ".", "",
+             "Tests over the whole corpus (fuzz; URDF kinematics against KDL): "
+             + (run["tests"]["summary"] if run.get("tests") else "not run") + ".", "",
+             "| file | outcome | reason | load s | bodies | diverged | fell | ground | "
+             "largest drop m | robots (kind: largest link move mm) |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    for name, result in sorted(results.items()):
+        reason = result.get("world_reason") or result.get("reason") or ""
+        if result["status"] == "refused":
+            reason = f"{result['refusal']}: {reason}"
+        robots = ", ".join(f"{r['name']} ({r['kind']}: {r['moved_m'] * 1000:.2f})"
+                           for r in result.get("robots", []))
+        lines.append(f"| {name} | {outcome(result)} | {reason.replace('|', '/')} | "
+                     f"{result.get('load_s', '')} | {result.get('bodies', '')} | "
+                     f"{result.get('diverged', '')} | {len(result.get('fell', []))} | "
+                     f"{result.get('ground', '')} | {result.get('drop_m', '')} | {robots} |")
+    return "\n".join(lines) + "\n"
