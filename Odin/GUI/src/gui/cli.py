@@ -187,7 +187,9 @@ def load_problem_main(argv: Optional[Sequence[str]] = None) -> int:
         client.execute(plan, progress=progress)
     except OdinError as error:
         return _fail("load_problem", error)
-    print(f"built {args.problem} in {time.monotonic() - started:.2f} s", flush=True)
+    print(f"built {args.problem} in {time.monotonic() - started:.2f} s; the world is paused "
+          f"at its start (rosservice call {client.namespace}/start \"simulate: true\" runs "
+          f"it)", flush=True)
     return 0
 
 

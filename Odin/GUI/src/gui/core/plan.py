@@ -141,7 +141,12 @@ class WorldStep:
                 for name, value in self.parameters.items() if name in self.own]
 
     def send(self, client, ids: BuiltIds) -> str:
-        """Sets the parameters; answers "set"."""
+        """Pauses the world, then sets the parameters; answers "set". A problem is built,
+        and left, at its start: a running world would let links fall while the requests that
+        join them are still on their way, and a plan replays from the state it started from
+        (the Sphere's, landed after the seconds between the load and the replay, ended 0.69 m
+        from a goal its plan reached within 0.25 m)."""
+        client.pause()
         client.set_world(**self.parameters)
         return "set"
 

@@ -67,6 +67,10 @@ class CoreWorld:
     def close(self) -> None:
         self.core.close()
 
+    def pause(self) -> bool:
+        """A Core steps only when asked: it is always paused."""
+        return False
+
     def set_world(self, **changes):
         return self.core.set_world_parameters(**changes)
 
