@@ -22,7 +22,7 @@ import plan_sphere
 
 PROBLEM = common.KAUTHAM_DIR / "current_2025" / "demos" / "OMPL_ode_demos" / "Sphere" / \
     "k-PMPSphere.xml"
-PARAMETERS = dict(plan_sphere.PARAMETERS, seed=1, time_limit_s=60.0)
+PARAMETERS = dict(plan_sphere.PARAMETERS, seed=1, time_limit_s=300.0)
 #: the whole arena: the route crosses it corner to corner
 CAMERA = common.Camera(eye=(0.0, -9.0, 9.5), target=(0.0, 0.4, 0.0))
 
