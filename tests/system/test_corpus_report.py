@@ -9,8 +9,8 @@ import pytest
 TOOLS = pathlib.Path(__file__).resolve().parents[2] / "tools" / "corpus"
 sys.path.insert(0, str(TOOLS))
 
-import checks  # noqa: E402
-import report  # noqa: E402
+import corpus_checks as checks  # noqa: E402
+import corpus_report as report  # noqa: E402
 
 
 @pytest.mark.parametrize("reason,kind", [

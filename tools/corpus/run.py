@@ -50,8 +50,8 @@ import time
 HERE = pathlib.Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-import checks  # noqa: E402
-import report  # noqa: E402
+import corpus_checks as checks  # noqa: E402
+import corpus_report as report  # noqa: E402
 
 from gui.core.kautham.corpus import (WHOLE_CORPUS_TESTS, WHOLE_ENVIRONMENT,  # noqa: E402
                                      whole_corpus_dir, whole_missing_message)

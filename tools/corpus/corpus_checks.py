@@ -14,6 +14,7 @@ import tempfile
 import time
 import traceback
 
+import odin_common  # noqa: F401  (before numpy: the reference BLAS, odin_common.blas)
 import numpy as np
 
 PROBLEM_INFO_TIMEOUT = 300.0

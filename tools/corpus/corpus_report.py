@@ -7,7 +7,7 @@ import pathlib
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent.parent
 README_PATH = ROOT / "README.md"
-BEGIN = ("<!-- corpus figures begin: written by tools/corpus/report.py from "
+BEGIN = ("<!-- corpus figures begin: written by tools/corpus/corpus_report.py from "
          "out/corpus/report.json; do not edit -->")
 END = "<!-- corpus figures end -->"
 
