@@ -18,9 +18,7 @@ demo: setup
 
 # the whole suite on every core (pytest-xdist: each node test owns its roscore and ROS_HOME),
 # the 15 slowest listed at the end
-# worksteal: a worker that runs out of tests takes some of the other's (the default hands out
-# fixed chunks, and one worker ran the last 90 s of the suite alone)
-PYTEST := python -m pytest -p no:cacheprovider -n auto --dist worksteal --durations=15
+PYTEST := python -m pytest -p no:cacheprovider -n auto --durations=15
 
 test: setup
 	@$(ENV) $(PYTEST)
