@@ -23,7 +23,7 @@ print((a @ numpy.linalg.inv(a)).tobytes().hex())
 
 def _probe(first: str) -> list:
     run = subprocess.run([sys.executable, "-c", PROBE.format(first=first)], capture_output=True,
-                         text=True, timeout=60, env=None)
+                         text=True, timeout=60)
     assert run.returncode == 0, run.stderr
     return run.stdout.split()
 

@@ -110,7 +110,7 @@ class RosMaster:
         while time.monotonic() < deadline:
             # before asking: whatever squats a port may accept and never answer (each question
             # would then wait out its timeout), and roscore waits on it silently for minutes
-            if _held_by_others(self.port, {roscore.pid} | _descendants(roscore.pid)):
+            if _held_by_others(self.port, roscore.pid):
                 return "port already in use by another process"
             if self._master_answers():
                 return None
@@ -270,12 +270,13 @@ def _descendants(pid: int) -> set[int]:
     return found
 
 
-def _held_by_others(port: int, ours: set[int]) -> bool:
-    """Some process outside ``ours`` listens on TCP ``port`` (any address; from /proc)."""
+def _held_by_others(port: int, root_pid: int) -> bool:
+    """Some process outside ``root_pid``'s tree listens on TCP ``port`` (any address; from
+    /proc). The tree is read only when something listens: most polls find nobody yet."""
     listening = _listening_socket_inodes(port)
     if not listening:
         return False
-    for pid in ours:
+    for pid in {root_pid} | _descendants(root_pid):
         try:
             links = {os.readlink(fd) for fd in pathlib.Path(f"/proc/{pid}/fd").iterdir()}
         except OSError:
