@@ -198,7 +198,7 @@ def _simulate_batch(corpus: pathlib.Path, files: list, seconds: float,
             dead = [p for p in (world, viewer) if p.poll() is not None]
             if dead:
                 result = dict(world="failed", world_reason=(
-                    f"{dead[0].args[2]} exited with {dead[0].returncode}: "
+                    f"{dead[0].log_name} exited with {dead[0].returncode}: "
                     + master.log_text(dead[0])[-400:]))
             _write(progress, dict(file=relative, result=result))
             if dead:

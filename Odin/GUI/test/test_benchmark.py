@@ -158,8 +158,9 @@ def _free_port() -> int:
     (["--problem", "/nonexistent/p.xml"], "/nonexistent/p.xml: no such file"),
     (["--planners", "KPIECE1,PRM"], "planner 'PRM': unknown planner"),
     (["--planners", "SST"], "cannot construct"),
-    pytest.param(["--scheduler", "tcp://127.0.0.1:{port}"], "no Dask scheduler answers",
-                 marks=pytest.mark.slow),
+    (["--scheduler", "tcp://127.0.0.1:{port}", "--scheduler-timeout", "1"],
+     "no Dask scheduler answers"),
+    (["--scheduler-timeout", "1"], "only with --scheduler"),
     (["--runs", "0"], "--runs 0"),
     (["--max-control-steps", "0"], "--max-control-steps 0: at least 1"),
     (["--min-control-steps", "9", "--max-control-steps", "3"], "is above"),
@@ -255,8 +256,9 @@ def test_a_scheduler_without_workers_is_refused_before_any_run(kautham_dir, tmp_
     with LocalCluster(n_workers=0, processes=False, protocol="tcp", host="127.0.0.1",
                       dashboard_address=None) as cluster:
         run = _tool("--problem", str(kautham_dir.joinpath(*SPHERE)), "--scheduler",
-                    cluster.scheduler_address, "--out", str(tmp_path / "out"))
-    assert run.returncode == 2 and "has no worker" in run.stderr, run.stderr
+                    cluster.scheduler_address, "--scheduler-timeout", "1.5",
+                    "--out", str(tmp_path / "out"))
+    assert run.returncode == 2 and "has no worker after 1.5 s" in run.stderr, run.stderr
     assert run.stderr.count("\n") == 1
     assert not (tmp_path / "out" / "runs.jsonl").exists()
 

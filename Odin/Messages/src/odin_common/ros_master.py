@@ -3,8 +3,9 @@ experiments and benchmarks run on (and what a user's own test suite may use).
 
 Every test that needs ROS gets its own roscore on a free loopback port and its own ROS_HOME,
 so tests never see each other's nodes, and every process started here is stopped (process
-group and all) when the test ends, pass or fail. Needs the ROS command-line tools (roscore,
-rosrun), not rospy: the master is asked over its XML-RPC API from this process (a test waits
+group and all) when the test ends, pass or fail. The core is what ``roscore`` starts
+(rosmaster, roscore.xml's parameters, the rosout node), started directly rather than through
+roslaunch. Needs the ROS command-line tools (rosmaster, rosrun), not rospy: the master is asked over its XML-RPC API from this process (a test waits
 for many services, and a ``rosservice`` process a poll cost 0.4 s of a core each).
 
     with RosMaster() as master:
@@ -18,6 +19,7 @@ before rospy is used in that process).
 """
 from __future__ import annotations
 
+import functools
 import os
 import pathlib
 import random
@@ -27,6 +29,7 @@ import subprocess
 import tempfile
 import time
 import urllib.parse
+import uuid
 import xmlrpc.client
 from typing import Any, Sequence
 
@@ -36,6 +39,10 @@ from typing import Any, Sequence
 # server or outgoing connection before roscore binds it, and rosmaster then hangs for good
 # with its server thread dead ("port ... is already in use").
 _MASTER_PORTS = range(20000, 32768)
+
+
+_CORE_LOGS = ("rosmaster", "rosout")
+"""The log names of the core's processes: what restart_master kills and starts again."""
 
 
 def free_port() -> int:
@@ -77,12 +84,12 @@ class RosMaster:
         self.stop()
 
     def start(self, attempts: int = 3) -> None:
-        """Starts roscore; on a port taken meanwhile (or a roscore that died) tries a new port."""
+        """Starts the core (see ``_start_core``); on a port taken meanwhile (or a master that
+        died) tries a new port."""
         failures = []
         for _ in range(attempts):
-            roscore = self.popen(["roscore", "-p", str(self.port)], log_name="roscore")
             try:
-                failure = self._wait_for_master(roscore)
+                failure = self._start_core()
             except BaseException:
                 self.stop()
                 raise
@@ -94,37 +101,53 @@ class RosMaster:
         raise RuntimeError("roscore did not come up: " + "; ".join(failures))
 
     def restart_master(self) -> None:
-        """Kills roscore (SIGKILL, as a crash would) and starts a new one on the same port:
+        """Kills the core (SIGKILL, as a crash would) and starts a new one on the same port:
         the new master knows no node, no parameter (a fault drill, tests/nodes)."""
-        old = next(p for p in self._processes if p.args[:1] == ["roscore"])
-        _stop_group(old, signal_first=signal.SIGKILL)
-        self._processes.remove(old)
-        roscore = self.popen(["roscore", "-p", str(self.port)], log_name="roscore")
-        failure = self._wait_for_master(roscore)
+        core = [p for p in self._processes if p.log_name in _CORE_LOGS]
+        _stop_groups(core, signal_first=signal.SIGKILL)
+        self._processes = [p for p in self._processes if p not in core]
+        failure = self._start_core()
         if failure is not None:
             raise RuntimeError(f"roscore did not come back on port {self.port}: {failure}")
 
-    def _wait_for_master(self, roscore: subprocess.Popen) -> str | None:
+    def _start_core(self) -> str | None:
+        """What ``roscore -p PORT`` starts, without roslaunch in between: rosmaster, the
+        parameters roscore.xml sets (/run_id, /rosversion, /rosdistro) and the rosout node.
+        roslaunch's own start and orderly stop took 2.6 s (1.8 s of CPU) of every node
+        test. None once the master answers, else why it will not."""
+        rosmaster = self.popen(["rosmaster", "--core", "-p", str(self.port), "-w", "3"],
+                               log_name="rosmaster")
+        failure = self._wait_for_master(rosmaster)
+        if failure is not None:
+            return failure
+        version, distro = _ros_versions()
+        for name, value in (("/run_id", str(uuid.uuid1())), ("/rosversion", version),
+                            ("/rosdistro", distro)):
+            if self.master_call("setParam", name, value) is None:
+                return f"the master refused parameter {name}"
+        self.rosrun("rosout", "rosout", "__name:=rosout")
+        return None
+
+    def _wait_for_master(self, rosmaster: subprocess.Popen) -> str | None:
         """None once the master answers, else why it will not."""
         deadline = time.monotonic() + self._startup_timeout
         while time.monotonic() < deadline:
             # before asking: whatever squats a port may accept and never answer (each question
-            # would then wait out its timeout), and roscore waits on it silently for minutes
-            if _held_by_others(self.port, roscore.pid):
+            # would then wait out its timeout), and rosmaster waits on it silently for minutes
+            if _held_by_others(self.port, rosmaster.pid):
                 return "port already in use by another process"
             if self._master_answers():
                 return None
-            log = self.log_text(roscore)
+            log = self.log_text(rosmaster)
             if "already in use" in log:
                 return "port already in use"
-            if roscore.poll() is not None:
-                return f"roscore exited with {roscore.returncode}: {log[-500:]}"
-            time.sleep(0.2)
+            if rosmaster.poll() is not None:
+                return f"rosmaster exited with {rosmaster.returncode}: {log[-500:]}"
+            time.sleep(0.05)
         return f"no answer after {self._startup_timeout} s"
 
     def _master_answers(self) -> bool:
-        # roslaunch sets /rosdistro once the master is up: the same sign rosparam waited for
-        return self.master_call("getParam", "/rosdistro") is not None
+        return self.master_call("getPid") is not None
 
     def master_call(self, method: str, *args: Any, timeout: float = 5.0) -> Any:
         """The value of one ROS Master API call (``lookupService``, ``getParam``, ...) made as
@@ -143,9 +166,11 @@ class RosMaster:
         self.env["ROS_MASTER_URI"] = self.uri
 
     def stop(self) -> None:
-        """Stops every process started here, newest first: SIGINT, then SIGKILL."""
-        for process in reversed(self._processes):
-            _stop_group(process)
+        """Stops every process started here, the nodes first (so they unregister from a
+        master still there), then the core: SIGINT, then SIGKILL."""
+        nodes = [p for p in self._processes if p.log_name not in _CORE_LOGS]
+        _stop_groups(nodes)
+        _stop_groups([p for p in self._processes if p not in nodes])
         self._processes.clear()
         for log in self._logs:
             log.close()
@@ -167,11 +192,17 @@ class RosMaster:
                                    stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
                                    start_new_session=True)
         process.log_path = log.name  # type: ignore[attr-defined]
+        process.log_name = name  # type: ignore[attr-defined]
         self._processes.append(process)
         return process
 
     def rosrun(self, package: str, executable: str, *args: str) -> subprocess.Popen:
-        return self.popen(["rosrun", package, executable, *args], log_name=executable)
+        """``rosrun PACKAGE EXECUTABLE ARGS...``: the program rosrun would run, started
+        directly (``find_executable``); through rosrun itself where it finds none, so that the
+        error is rosrun's."""
+        program = find_executable(package, executable, self.env)
+        command = [program] if program else ["rosrun", package, executable]
+        return self.popen([*command, *args], log_name=executable)
 
     def run(self, args: Sequence[str], check: bool = True, timeout: float = 60,
             input: str | None = None) -> subprocess.CompletedProcess:
@@ -219,6 +250,84 @@ class RosMaster:
                                    + self.log_text(process)[-3000:])
 
 
+@functools.lru_cache(maxsize=None)
+def _ros_versions() -> tuple[str, str]:
+    """(/rosversion, /rosdistro) as roscore.xml computes them (``rosversion roslaunch``,
+    ``rosversion -d``), with rosversion's own functions in this process."""
+    from rospkg.rosversion import get_distro_name_from_roscore, get_version_from_package_name
+    distro = os.environ.get("ROS_DISTRO") or get_distro_name_from_roscore() or "Debian"
+    return get_version_from_package_name("roslaunch") or "<unversioned>", distro
+
+
+def find_executable(package: str, executable: str, env: dict) -> str | None:
+    """The program ``rosrun PACKAGE EXECUTABLE`` runs in ``env`` (its ROS_PACKAGE_PATH and
+    CMAKE_PREFIX_PATH), or None where rosrun would find none or ask which of several.
+
+    rosrun's own search, done in this process: the package's catkin libexec and share
+    folders (``catkin_find --without-underlays --libexec --share``) and its ``rospack find``
+    folder, walked for an executable file of that name (not under the package's ``build/``);
+    of two, the one outside the share folders (a devel space's relay script). Debian's rosrun
+    runs catkin_find up to four times, 0.8 s of CPU for every node a test started.
+    tests/nodes/test_ros_master.py checks the answers against ``rosrun --prefix echo``."""
+    return _rosrun_choice(package, executable, env.get("ROS_PACKAGE_PATH", ""),
+                          env.get("CMAKE_PREFIX_PATH", ""))
+
+
+@functools.lru_cache(maxsize=None)
+def _rosrun_choice(package: str, executable: str, package_path: str,
+                   prefix_path: str) -> str | None:
+    from catkin.find_in_workspaces import find_in_workspaces
+    workspaces = _catkin_workspaces(prefix_path)
+    folders = find_in_workspaces(["libexec", "share"], package, _workspaces=workspaces,
+                                 first_matching_workspace_only=True)
+    rospack = subprocess.run(["rospack", "find", package], capture_output=True, text=True,
+                             env=dict(os.environ, ROS_PACKAGE_PATH=package_path,
+                                      CMAKE_PREFIX_PATH=prefix_path))
+    package_folder = rospack.stdout.strip() if rospack.returncode == 0 else ""
+    found = _unique_in_order(_executables_named(
+        executable, [*folders, *([package_folder] if package_folder else [])],
+        package_folder))
+    if len(found) == 2:
+        shares = find_in_workspaces(["share"], package, _workspaces=workspaces,
+                                    first_matching_workspace_only=True)
+        outside = [f for f in found if not any(f.startswith(s) for s in shares)]
+        found = outside if len(outside) == 1 else found
+    return found[0] if len(found) == 1 else None
+
+
+def _catkin_workspaces(prefix_path: str) -> list:
+    """catkin's workspaces for this CMAKE_PREFIX_PATH (catkin reads it from os.environ only;
+    Debian's catkin adds /usr to them)."""
+    from catkin.workspace import get_workspaces
+    saved = os.environ.get("CMAKE_PREFIX_PATH")
+    os.environ["CMAKE_PREFIX_PATH"] = prefix_path
+    try:
+        return get_workspaces()
+    finally:
+        if saved is None:
+            os.environ.pop("CMAKE_PREFIX_PATH")
+        else:
+            os.environ["CMAKE_PREFIX_PATH"] = saved
+
+
+def _executables_named(name: str, folders: list, package_folder: str) -> list:
+    """``find -L FOLDERS -name NAME -type f -perm /111 ! -regex '.*PKG/build/.*'``."""
+    skipped = os.path.join(package_folder, "build") + os.sep if package_folder else None
+    found = []
+    for folder in folders:
+        for where, _, files in os.walk(folder, followlinks=True):
+            path = os.path.join(where, name)
+            if name in files and os.path.isfile(path) and os.stat(path).st_mode & 0o111 \
+                    and not (skipped and path.startswith(skipped)):
+                found.append(path)
+    return found
+
+
+def _unique_in_order(paths: list) -> list:
+    """``uniq``: adjacent repeats once."""
+    return [p for k, p in enumerate(paths) if k == 0 or paths[k - 1] != p]
+
+
 class _TimeoutTransport(xmlrpc.client.Transport):
     """XML-RPC over HTTP that gives up after ``timeout`` s (the standard one waits forever)."""
 
@@ -232,28 +341,61 @@ class _TimeoutTransport(xmlrpc.client.Transport):
         return connection
 
 
-def _stop_group(process: subprocess.Popen, signal_first: int = signal.SIGINT) -> None:
-    """``signal_first`` to the process's group, then SIGKILL to the group and to every
-    descendant: roslaunch starts its nodes (rosmaster, rosout, rostest's nodes) in sessions of
-    their own, and a hung rosmaster outlives a killed roscore."""
-    tree = _descendants(process.pid)
-    if process.poll() is None:
+def _stop_groups(processes: Sequence[subprocess.Popen],
+                 signal_first: int = signal.SIGINT) -> None:
+    """``signal_first`` to each process's group at once, up to 8 s for all of them to exit,
+    then SIGKILL to the groups and to every descendant: roslaunch starts its nodes (rostest's
+    nodes, a user's launch file) in sessions of their own, and a hung rosmaster outlives a
+    killed parent. Stopped side by side: a test's nodes each take a second or two to shut
+    down cleanly, and one after the other that was a tenth of the suite."""
+    if not processes:
+        return
+    tree = _descendants({p.pid for p in processes})
+    running = [p for p in processes if p.poll() is None]
+    for process in running:
         try:
             os.killpg(process.pid, signal_first)
-            process.wait(timeout=8)
-        except (ProcessLookupError, subprocess.TimeoutExpired):
+        except ProcessLookupError:
             pass
-    tree |= _descendants(process.pid)
-    for kill, target in [(os.killpg, process.pid), *((os.kill, pid) for pid in tree)]:
+    deadline = time.monotonic() + 8
+    for process in running:
+        try:
+            process.wait(timeout=max(0.0, deadline - time.monotonic()))
+        except subprocess.TimeoutExpired:
+            pass
+    tree |= _descendants({p.pid for p in processes})
+    targets = [(os.killpg, p.pid) for p in processes] + [(os.kill, pid) for pid in tree]
+    for kill, target in targets:
         try:
             kill(target, signal.SIGKILL)
         except ProcessLookupError:
             pass
-    process.wait()
+    for process in processes:
+        process.wait()
+    _wait_until_gone(tree)
 
 
-def _descendants(pid: int) -> set[int]:
-    """Process ids of pid's children, their children, and so on (from /proc)."""
+def _wait_until_gone(pids: set[int], timeout: float = 5.0) -> None:
+    """Until none of ``pids`` runs any more (exited, or a zombie: its sockets are closed).
+    SIGKILL is delivered asynchronously: a master started on the port of a rosmaster killed a
+    moment ago would otherwise find it still listening there."""
+    deadline = time.monotonic() + timeout
+    while pids and time.monotonic() < deadline:
+        pids = {pid for pid in pids if _running(pid)}
+        if pids:
+            time.sleep(0.01)
+
+
+def _running(pid: int) -> bool:
+    try:
+        state = pathlib.Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except (OSError, IndexError):
+        return False
+    return state not in ("Z", "X")
+
+
+def _descendants(roots: set[int]) -> set[int]:
+    """Process ids of the roots' children, their children, and so on (from /proc)."""
     children: dict[int, list[int]] = {}
     for stat in pathlib.Path("/proc").glob("[0-9]*/stat"):
         try:
@@ -261,7 +403,7 @@ def _descendants(pid: int) -> set[int]:
         except OSError:
             continue  # exited meanwhile
         children.setdefault(int(fields[1]), []).append(int(stat.parent.name))
-    found, frontier = set(), [pid]
+    found, frontier = set(), list(roots)
     while frontier:
         for child in children.get(frontier.pop(), []):
             if child not in found:
@@ -276,7 +418,7 @@ def _held_by_others(port: int, root_pid: int) -> bool:
     listening = _listening_socket_inodes(port)
     if not listening:
         return False
-    for pid in {root_pid} | _descendants(root_pid):
+    for pid in {root_pid} | _descendants({root_pid}):
         try:
             links = {os.readlink(fd) for fd in pathlib.Path(f"/proc/{pid}/fd").iterdir()}
         except OSError:

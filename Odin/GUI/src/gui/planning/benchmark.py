@@ -35,7 +35,8 @@ DEFAULT_TIME_S = 10.0
 """s per run when neither the benchmark nor the problem (``_Max Planning Time``) gives one."""
 RESULTS_FILE = "runs.jsonl"
 SCHEDULER_TIMEOUT_S = 10.0
-"""s: how long to wait for ``--scheduler`` to answer before giving up."""
+"""s: how long to wait for ``--scheduler`` to answer, and then for its first worker, before
+giving up (``--scheduler-timeout``)."""
 
 
 @dataclass(frozen=True)
@@ -241,7 +242,8 @@ class DaskRunner:
     """Runs tasks on Dask: ``scheduler`` (an address, ``tcp://host:8786``) or a local cluster
     of ``workers`` worker processes, one thread each (a run keeps one core busy)."""
 
-    def __init__(self, scheduler: Optional[str] = None, workers: int = 0):
+    def __init__(self, scheduler: Optional[str] = None, workers: int = 0,
+                 timeout_s: float = SCHEDULER_TIMEOUT_S):
         try:
             from distributed import Client, LocalCluster
         except ImportError as error:
@@ -250,17 +252,17 @@ class DaskRunner:
         self.cluster = None
         if scheduler:
             try:
-                self.client = Client(scheduler, timeout=SCHEDULER_TIMEOUT_S)
+                self.client = Client(scheduler, timeout=timeout_s)
             except (OSError, TimeoutError, ValueError) as error:
                 raise PlanningError(f"--scheduler {scheduler}: no Dask scheduler answers "
                                     f"({' '.join(str(error).split()) or type(error).__name__})"
                                     ) from None
             try:
-                self.client.wait_for_workers(1, timeout=SCHEDULER_TIMEOUT_S)
+                self.client.wait_for_workers(1, timeout=timeout_s)
             except (OSError, TimeoutError):
                 self.close()
                 raise PlanningError(f"--scheduler {scheduler}: the scheduler has no worker "
-                                    f"after {SCHEDULER_TIMEOUT_S:g} s (start dask worker "
+                                    f"after {timeout_s:g} s (start dask worker "
                                     f"{scheduler} on the machines that run)") from None
         else:
             with _sigint_ignored():

@@ -14,6 +14,7 @@ import time
 from typing import Optional, Sequence
 
 from gui.errors import GuiError
+from gui.planning.benchmark import SCHEDULER_TIMEOUT_S
 from odin_common.errors import OdinError
 from odin_common.tool import stop_on_ctrl_c
 
@@ -53,6 +54,9 @@ def _parser() -> argparse.ArgumentParser:
     where.add_argument("--workers", type=int, metavar="N",
                        help="local Dask worker processes [one per core]; 0: no Dask, one run "
                        "after another in this process")
+    parser.add_argument("--scheduler-timeout", type=float, metavar="S",
+                        help="s to wait for --scheduler to answer, then for its first worker "
+                        f"[{SCHEDULER_TIMEOUT_S:g}]")
     parser.add_argument("--no-plots", action="store_true", help="no PNG figures")
     search = parser.add_argument_group(
         "search settings", "change every problem's own (as rosrun GUI plan's options do)")
@@ -126,6 +130,11 @@ def _prepare(args):
     parent = os.path.dirname(out)
     if not os.path.isdir(parent) or not os.access(parent, os.W_OK | os.X_OK):
         raise GuiError(f"--out {args.out}: cannot make it in {parent}")
+    if args.scheduler_timeout is not None and not args.scheduler_timeout > 0:
+        raise GuiError(f"--scheduler-timeout {args.scheduler_timeout:g}: must be positive")
+    if args.scheduler_timeout is not None and not args.scheduler:
+        raise GuiError("--scheduler-timeout: only with --scheduler")
+    args.scheduler_timeout = args.scheduler_timeout or SCHEDULER_TIMEOUT_S
     if args.workers is not None and args.workers < 0:
         raise GuiError(f"--workers {args.workers}: 0 or more")
     if not args.no_plots:
@@ -136,7 +145,8 @@ def _prepare(args):
 def _run(args, prepared, out: str) -> int:
     from gui.planning.benchmark import DaskRunner, Progress, ResultStore, run_serially
     # a scheduler that does not answer is bad input: refused before anything is written
-    runner = DaskRunner(args.scheduler) if args.scheduler else None
+    runner = DaskRunner(args.scheduler, timeout_s=args.scheduler_timeout) \
+        if args.scheduler else None
     try:
         os.makedirs(out, exist_ok=True)
         store = ResultStore(out, prepared, args.resume)

@@ -15,15 +15,17 @@ The result is expressed in the mesh's own frame.
 """
 from __future__ import annotations
 
-from typing import Dict, NamedTuple, Tuple
+from typing import TYPE_CHECKING, Dict, NamedTuple, Tuple
 
 import numpy as np
-import trimesh
 
 from virtual_world.core.shapes import Shape
 from virtual_world.errors import InvalidArgument
 from virtual_world.ode import bodies
 from virtual_world.ode.runtime import log
+
+if TYPE_CHECKING:
+    import trimesh
 
 
 class MeshMass(NamedTuple):
@@ -47,6 +49,9 @@ def _solid(mesh: trimesh.Trimesh, mass: float):
 
 def mesh_mass(vertices: np.ndarray, triangles: np.ndarray, mass: float) -> MeshMass:
     """Mass properties of a mesh: vertices (n,3) m, triangles (m,3) indices, mass kg > 0."""
+    # imported on the first mesh: trimesh (with scipy) was a third of every world node's
+    # start-up, and most worlds never build a mesh
+    import trimesh
     mesh = trimesh.Trimesh(np.asarray(vertices, float), np.asarray(triangles, np.int64),
                            process=True, validate=False)
     if mesh.is_watertight:

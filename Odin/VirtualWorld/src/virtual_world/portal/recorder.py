@@ -15,7 +15,6 @@ from __future__ import annotations
 import pathlib
 import time
 
-import rosbag
 import rospy
 
 from Messages.msg import Advance, RecordStart, Situation
@@ -34,6 +33,7 @@ class Recorder:
     def __init__(self, path: str, parameters: WorldParameters, values: StepValues):
         self.path = pathlib.Path(path).expanduser().resolve()
         self.path.parent.mkdir(parents=True, exist_ok=True)
+        import rosbag    # on the first recording: its crypto imports were 0.14 s of every node's start
         self._bag = rosbag.Bag(str(self.path), "w")
         self._last = 0
         self._write(START, RecordStart(messages.world_parameters_message(parameters),
