@@ -18,6 +18,10 @@ sys.path.insert(0, str(ROOT / "tests" / "nodes"))
 
 from odin_common.ros_master import RosMaster  # noqa: E402
 
+# imported here, once per worker, so that every forked test inherits them: rospy, the
+# messages and the services took a node test's child 1.3 s of CPU to import again
+import world_client  # noqa: E402,F401
+
 
 def pytest_configure(config):
     """A suite started in the background (a non-interactive shell's ``&``, nohup, some CI
