@@ -162,6 +162,7 @@ def _free_port() -> int:
      "no Dask scheduler answers"),
     (["--scheduler-timeout", "1"], "only with --scheduler"),
     (["--runs", "0"], "--runs 0"),
+    (["--max-mem", "-1"], "--max-mem -1: must be positive"),
     (["--max-control-steps", "0"], "--max-control-steps 0: at least 1"),
     (["--min-control-steps", "9", "--max-control-steps", "3"], "is above"),
 ])
@@ -284,3 +285,30 @@ def test_a_problem_s_bundle_holds_the_files_it_reads_and_no_cache(kautham_dir, t
     assert "models/robots/OpenDERobots/SphereDE.urdf" in names
     assert "OMPL_ode_demos/Sphere/controls/sp3.cntr" in names
     assert not any("npz" in name for name in names)
+
+
+def test_max_mem_ends_a_search_as_its_time_limit_would(kautham_dir):
+    """maxMem as OMPL's Benchmark applies it: the search ends once the run's process has grown
+    by more than maxMem MB of resident memory, and the run is recorded like one the clock
+    ended (the walls demo with EST keeps searching for its whole minute without it)."""
+    from gui.planning.benchmark_run import run_task
+    walls = str(kautham_dir.joinpath(*SPHERE[:-1], "k-PMPSphere.xml"))
+    experiments = command_line_experiments([walls], ["EST"], 1, 60.0, max_mem=0.25)
+    task = prepare(experiments, seed=1).tasks[0]
+    assert task.memory_limit_mb == 0.25
+    result = run_task(task)
+    assert result.error == "" and result.status != "Crash", result
+    assert result.time_s < 20 and result.propagations > 0 and not result.solved
+
+
+def test_the_memory_watch_fires_once_the_process_grew_by_the_limit():
+    from gui.planning.bridge import MEMORY_CHECK_S, _memory_watch
+    over = _memory_watch(8.0)
+    assert not over()
+    grown = bytearray(32 * 2 ** 20)         # resident once written
+    grown[::4096] = b"x" * len(grown[::4096])
+    time.sleep(MEMORY_CHECK_S * 1.5)
+    assert over()
+    assert not _memory_watch(None)()
+    with pytest.raises(PlanningError, match="must be positive"):
+        _memory_watch(0.0)

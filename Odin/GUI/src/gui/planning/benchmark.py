@@ -58,11 +58,11 @@ class Prepared:
     seed: int
 
     def fingerprint(self) -> str:
-        """Changes when any run would differ (its problem's bytes, planner, seed, limit)."""
+        """Changes when any run would differ (its problem's bytes, planner, seed, limits)."""
         digest = hashlib.sha256()
         for task in self.tasks:
             digest.update(repr((task.key, task.planner, task.seed, task.time_limit,
-                                task.problem, task.overrides)).encode())
+                                task.problem, task.overrides, task.memory_limit_mb)).encode())
             for relative, data in task.files:
                 digest.update(relative.encode() + hashlib.sha256(data).digest())
         return digest.hexdigest()
@@ -129,7 +129,8 @@ def prepare(experiments: Sequence[Experiment], seed: int = 1,
                                     f"a planner named {entry.name!r} (PlannerAlias)")
             entries.append(entry)
             tasks += [RunTask(experiment.name, entry.name, k, planner, seed + k, entry.time_limit,
-                              relative, files, tuple(sorted(overrides.items())))
+                              relative, files, tuple(sorted(overrides.items())),
+                              experiment.request.max_mem)
                       for k in range(experiment.request.run_count)]
         planned.append((experiment, tuple(entries)))
     names = [e.name for e in experiments]

@@ -41,6 +41,9 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--time", type=float, metavar="S", help="wall-clock seconds per run "
                         "[the file's maxTime; with --problem each problem's "
                         "\"_Max Planning Time\", else 10]")
+    parser.add_argument("--max-mem", type=float, metavar="MB", help="MB a run's process may "
+                        "grow by during its search; the search ends there, as at its time "
+                        "limit (OMPL's maxMem) [the file's maxMem, else 4096]")
     parser.add_argument("--seed", type=int, default=1, help="run k of every planner has seed "
                         "SEED+k [1]")
     parser.add_argument("--out", default="benchmark", metavar="DIR",
@@ -106,18 +109,22 @@ def _experiments(args):
         raise GuiError(f"--runs {args.runs}: at least 1")
     if args.time is not None and not args.time > 0:
         raise GuiError(f"--time {args.time:g}: must be positive")
+    if args.max_mem is not None and not args.max_mem > 0:
+        raise GuiError(f"--max-mem {args.max_mem:g}: must be positive")
     planners = [p.strip() for p in args.planners.split(",") if p.strip()] \
         if args.planners else None
     if args.planners is not None and not planners:
         raise GuiError(f"--planners {args.planners!r}: no planner named")
     if args.problem:
-        return spec.command_line_experiments(args.problem, planners, args.runs or 10, args.time)
+        return spec.command_line_experiments(args.problem, planners, args.runs or 10, args.time,
+                                             args.max_mem)
     experiments = spec.read_benchmark_file(args.file)
     if planners:
         experiments = spec.with_planners(experiments, planners)
     return tuple(replace(e, request=replace(
         e.request, run_count=args.runs or e.request.run_count,
-        max_time=args.time or e.request.max_time)) for e in experiments)
+        max_time=args.time or e.request.max_time,
+        max_mem=args.max_mem or e.request.max_mem)) for e in experiments)
 
 
 def _prepare(args):

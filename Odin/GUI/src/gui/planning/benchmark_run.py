@@ -51,7 +51,8 @@ class RunTask:
     """One run: ``experiment`` and ``entry`` (the planner's name in the log) name it with
     ``run`` (0-based); ``planner``: OMPL's; ``seed``: OMPL's; ``time_limit``: s of wall clock;
     ``problem``: the problem file's path within ``files`` ((relative path, bytes) pairs);
-    ``overrides``: SearchSettings fields to change ((name, value) pairs)."""
+    ``overrides``: SearchSettings fields to change ((name, value) pairs); ``memory_limit_mb``:
+    MB the run's process may grow by during its search (the benchmark's maxMem)."""
     experiment: str
     entry: str
     run: int
@@ -61,6 +62,7 @@ class RunTask:
     problem: str
     files: Tuple[Tuple[str, bytes], ...]
     overrides: Tuple[Tuple[str, object], ...] = ()
+    memory_limit_mb: float = 4096.0
 
     @property
     def key(self) -> Tuple[str, str, int]:
@@ -191,6 +193,7 @@ def run_task(task: RunTask, should_stop: Callable[[], bool] = lambda: False) -> 
                 f.write(data)
         order = dict(problem=os.path.join(folder, task.problem), planner=task.planner,
                      seed=task.seed, time_limit=task.time_limit,
+                     memory_limit_mb=task.memory_limit_mb,
                      overrides=dict(task.overrides), parent=os.getpid())
         child = subprocess.Popen(
             [sys.executable, "-m", "gui.planning.benchmark_run"], stdin=subprocess.PIPE,
@@ -258,10 +261,10 @@ def _end(child: subprocess.Popen, talker: threading.Thread) -> None:
 # -------------------------------------------------------------------------- the run's process
 
 def search(problem: str, planner: str, seed: int, time_limit: float, overrides: dict,
-           stop: Callable[[], bool]) -> dict:
+           stop: Callable[[], bool], memory_limit_mb: Optional[float] = None) -> dict:
     """The search ``rosrun GUI plan problem --planner P --seed S --time T`` makes (the Core
-    back end, the problem's own settings changed by ``overrides``); the RunResult fields it
-    measures."""
+    back end, the problem's own settings changed by ``overrides``), ended also by
+    ``memory_limit_mb`` (``bridge.plan``); the RunResult fields it measures."""
     from gui.core.kautham.problem import load_problem
     from gui.core.translate import BuildDefaults, plan_problem
     from gui.planning.backend import CoreBackend
@@ -271,7 +274,7 @@ def search(problem: str, planner: str, seed: int, time_limit: float, overrides: 
     settings = SearchSettings.of_problem(build, **overrides)
     backend = CoreBackend(build, planning_problem(build, None, settings))
     try:
-        result = plan(backend, planner, time_limit, seed, stop)
+        result = plan(backend, planner, time_limit, seed, stop, memory_limit_mb)
     finally:
         backend.close()
     digest = hashlib.sha256()
@@ -309,7 +312,8 @@ def main() -> int:
     try:
         with stop_on_ctrl_c() as stop:
             answer = search(order["problem"], order["planner"], order["seed"],
-                            order["time_limit"], order["overrides"], stop)
+                            order["time_limit"], order["overrides"], stop,
+                            order["memory_limit_mb"])
     except KeyboardInterrupt:
         return 130
     except (OdinError, OSError) as error:

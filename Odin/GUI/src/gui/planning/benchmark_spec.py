@@ -44,8 +44,8 @@ ones add Kautham's own sampling, which Odin does not have: plain KPIECE1 or RRT 
 class Request:
     """OMPL's Benchmark::Request as Kautham's ``<Parameter>`` rows set it. ``max_time``: s of
     wall clock per run (None: each problem's own ``_Max Planning Time``, else 10 s: the
-    command-line form's default); ``max_mem``: MB per run (written to the log, as OMPL does;
-    not enforced); ``run_count``: runs per planner; ``time_between_updates``: s (Odin's runs
+    command-line form's default); ``max_mem``: MB a run's process may grow by during its
+    search (OMPL's rule: the search ends there, as the clock would end it); ``run_count``: runs per planner; ``time_between_updates``: s (Odin's runs
     report no progress series: kept for the log); ``display_progress``: the progress line;
     ``filename``: the log's file name ("" : ``<experiment>.log``)."""
     max_time: Optional[float] = 5.0
@@ -156,15 +156,18 @@ def _parameter(node: Node, request: Request) -> Request:
 
 
 def command_line_experiments(problems: Sequence[str], planners: Optional[Sequence[str]],
-                             runs: int, time_limit: Optional[float]) -> Tuple[Experiment, ...]:
-    """``--problem P ... --planners A,B --runs N --time S``: one experiment per problem,
-    named after its file, with every planner (None: the problem's own)."""
+                             runs: int, time_limit: Optional[float],
+                             max_mem: Optional[float] = None) -> Tuple[Experiment, ...]:
+    """``--problem P ... --planners A,B --runs N --time S --max-mem MB``: one experiment per
+    problem, named after its file, with every planner (None: the problem's own)."""
     experiments = []
     for problem in problems:
         rows = tuple(Row(os.path.abspath(problem), p, "", "--problem")
                      for p in (planners or [None]))
         name = os.path.splitext(os.path.basename(problem))[0]
-        experiments.append(Experiment(name, rows, Request(max_time=time_limit, run_count=runs)))
+        request = Request(max_time=time_limit, run_count=runs,
+                          max_mem=max_mem or Request.max_mem)
+        experiments.append(Experiment(name, rows, request))
     names = [e.name for e in experiments]
     twice = sorted({n for n in names if names.count(n) > 1})
     if twice:

@@ -24,6 +24,7 @@ PDST (``UNCONSTRUCTIBLE``).
 from __future__ import annotations
 
 import math
+import os
 import time
 from dataclasses import dataclass
 from typing import Callable, List, Optional, Tuple
@@ -243,9 +244,13 @@ def seed_ompl(seed: int) -> None:
 
 
 def plan(backend, planner: str = "KPIECE1", time_limit: float = 10.0,
-         seed: Optional[int] = None, stop: Optional[Callable[[], bool]] = None) -> PlanResult:
+         seed: Optional[int] = None, stop: Optional[Callable[[], bool]] = None,
+         memory_limit_mb: Optional[float] = None) -> PlanResult:
     """Searches ``backend.problem`` with ``planner`` for at most ``time_limit`` s of wall
-    clock (``seed``: OMPL's seed, see ``seed_ompl``). ``stop()`` true ends the search at the
+    clock (``seed``: OMPL's seed, see ``seed_ompl``) and, with ``memory_limit_mb``, until this
+    process has grown by more than that many MB of resident memory since the search began
+    (OMPL Benchmark's maxMem rule; the search ends as the clock would end it, its status
+    what the planner answers). ``stop()`` true ends the search at the
     planner's next iteration (one propagation at most) and raises KeyboardInterrupt: what
     Ctrl-C does under ``odin_common.tool.stop_on_ctrl_c`` (OMPL's solve runs in C++, where
     no Python signal handler can raise; a propagation cut by an exception would be lost)."""
@@ -258,11 +263,12 @@ def plan(backend, planner: str = "KPIECE1", time_limit: float = 10.0,
     started = time.perf_counter()
     deadline = time.monotonic() + time_limit
     callbacks = setup.callbacks
+    memory_over = _memory_watch(memory_limit_mb)
 
     def over() -> bool:
         """OMPL's termination condition, asked once per planner iteration."""
         return time.monotonic() >= deadline or callbacks.error is not None or \
-            (stop is not None and bool(stop()))
+            (stop is not None and bool(stop())) or memory_over()
 
     ob, _, _ = _ompl()
     status = setup.setup.solve(ob.PlannerTerminationCondition(over))
@@ -281,6 +287,39 @@ def plan(backend, planner: str = "KPIECE1", time_limit: float = 10.0,
     return PlanResult(planner, seed, bool(setup.setup.haveExactSolutionPath()
                                           and backend.problem.in_goal(final)),
                       str(status), tuple(rows), final, distance, propagations, elapsed)
+
+
+MEMORY_CHECK_S = 0.1
+"""s between two readings of the process's resident memory during a search with a limit (a
+reading costs about as much as 2 % of a propagation)."""
+
+
+def _memory_watch(limit_mb: Optional[float]) -> Callable[[], bool]:
+    """A function true once this process's resident memory is more than ``limit_mb`` MB above
+    what it was now (always false without a limit); it reads /proc at most every
+    MEMORY_CHECK_S."""
+    if limit_mb is None:
+        return lambda: False
+    if not (math.isfinite(limit_mb) and limit_mb > 0):
+        raise PlanningError(f"memory limit {limit_mb!r} MB must be positive")
+    ceiling = resident_bytes() + limit_mb * 2 ** 20
+    state = dict(next_check=0.0, over=False)
+
+    def over() -> bool:
+        now = time.monotonic()
+        if not state["over"] and now >= state["next_check"]:
+            state["next_check"] = now + MEMORY_CHECK_S
+            state["over"] = resident_bytes() > ceiling
+        return state["over"]
+    return over
+
+
+def resident_bytes() -> int:
+    """This process's resident memory, bytes (/proc/self/statm, as OMPL's
+    getProcessMemoryUsage reads it)."""
+    with open("/proc/self/statm") as f:
+        pages = int(f.read().split()[1])
+    return pages * os.sysconf("SC_PAGE_SIZE")
 
 
 def _rows(path, problem) -> List[ControlRow]:
