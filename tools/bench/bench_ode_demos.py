@@ -18,12 +18,12 @@ tools/kautham/ode_demos, so their ``File`` attributes are absolute paths. The lo
 physics/ and car/ there, the summary of both and the plots (success_rate.png,
 time_to_solution.png, propagations_per_s.png) in ode_demos/; docs/PLANNING.md shows them. ``ODIN_BENCH_DEMO_RUNS`` and ``ODIN_BENCH_DEMO_TIME`` (s) shorten
 the benchmark for development (the figures then measure that shorter benchmark), and
-``ODIN_BENCH_DEMO_WORKERS`` sets the local Dask workers (default: one per core).
+``ODIN_BENCH_DEMO_WORKERS`` sets the local Dask workers (default: one per core). A ``make
+bench`` stopped in the middle of it goes on from the runs it finished (``_benchmark``).
 """
 import json
 import os
 import pathlib
-import shutil
 import subprocess
 import sys
 
@@ -68,6 +68,24 @@ def benchmark_file(path: pathlib.Path, demos_run: tuple) -> None:
     path.write_text("".join(parts))
 
 
+def _benchmark(file: pathlib.Path, where: pathlib.Path, settings: tuple) -> None:
+    """``rosrun GUI benchmark FILE`` into ``where``; it goes on with the runs a stopped
+    ``make bench`` left there (``--resume``) when they are of the same benchmark (problems'
+    bytes, planners, seeds, limits), and starts again when they are not."""
+    command = [sys.executable, str(ROOT / "Odin" / "GUI" / "scripts" / "benchmark"), str(file),
+               "--planners", ",".join(PLANNERS), *settings,
+               *(("--workers", WORKERS) if WORKERS else ()), "--out", str(where), "--no-plots"]
+    if (where / "runs.jsonl").exists():
+        resumed = subprocess.run(command + ["--resume"], stdout=subprocess.DEVNULL,
+                                 stderr=subprocess.PIPE, text=True)
+        if resumed.returncode == 0:
+            return
+        if "written for another benchmark" not in resumed.stderr:
+            raise RuntimeError(f"benchmark --resume failed: {resumed.stderr.strip()}")
+        (where / "runs.jsonl").unlink()
+    subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
+
+
 def run(out_dir: pathlib.Path) -> dict:
     from gui.core.kautham.corpus import corpus_dir, missing_message
     from gui.planning.benchmark_plots import write_plots
@@ -76,19 +94,14 @@ def run(out_dir: pathlib.Path) -> dict:
     if kautham is None:
         raise RuntimeError(missing_message())
     folder = out_dir / "ode_demos"
-    if folder.exists():
-        shutil.rmtree(folder)
     every = demos(kautham)
     summaries, results = [], {}
     for part, chosen, settings in (("physics", every[:3], ()), ("car", every[3:], CAR_SETTINGS)):
         where = folder / part
-        where.mkdir(parents=True)
+        where.mkdir(parents=True, exist_ok=True)
         file = where / f"{part}.xml"
         benchmark_file(file, chosen)
-        subprocess.run([sys.executable, str(ROOT / "Odin" / "GUI" / "scripts" / "benchmark"),
-                        str(file), "--planners", ",".join(PLANNERS), *settings,
-                        *(("--workers", WORKERS) if WORKERS else ()), "--out",
-                        str(where), "--no-plots"], check=True, stdout=subprocess.DEVNULL)
+        _benchmark(file, where, settings)
         summaries.append(json.loads((where / "summary.json").read_text()))
         for line in (where / "runs.jsonl").read_text().splitlines()[1:]:
             result = RunResult.from_json(json.loads(line))
