@@ -60,7 +60,10 @@ How a problem maps to the world:
   weight, not a mass); a composite's mass is shared among its parts in proportion to their
   volumes. Inertia (``gui.core.inertia``): the URDF's tensor about its centre of mass where it
   is a rigid body's and plausible for the link's shape, the shape's at uniform density
-  otherwise. Contact surfaces: the link's (URDF contact coefficients) on its object or parts.
+  otherwise. The world refuses a given inertia far too light in rotation for the body's
+  geometry (a principal radius of gyration under ``odin_common.limits.MIN_GYRATION_FRACTION``
+  of the geometry's reach from that axis: ODE's solver would abort the process), so such a
+  tensor is set aside for the shape's too. Contact surfaces: the link's (URDF contact coefficients) on its object or parts.
 - Names (thesis 8.3): links are "robot/link" (Kautham's own .cntr naming), one-link instances
   keep the instance name; instance names come from the robot's name or the obstacle's file
   name, numbered "_2", "_3"... on collision; composite parts are "name#k".
