@@ -620,6 +620,46 @@ def test_a_mobile_robot_has_a_free_base_its_controls_drive_with_its_arm(tmp_path
     assert pan + handle.built_at[0] == pytest.approx(1.2, abs=0.02)
 
 
+CRATE = """<?xml version="1.0"?><robot name="crate"><link name="base"><inertial><mass
+ value="0.05"/><inertia ixx="0.000683" iyy="0.000683" izz="0.000683" ixy="0" ixz="0" iyz="0"/>
+ </inertial><collision><geometry><box size="0.3 0.3 0.3"/></geometry></collision></link>
+</robot>"""
+
+SHELF = """<?xml version="1.0"?><robot name="shelf"><link name="base"><collision><geometry>
+ <box size="1 0.4 0.02"/></geometry></collision></link></robot>"""
+
+
+def test_without_kautham_physics_only_the_controls_and_attachments_move_anything(tmp_path,
+                                                                                world):
+    """A geometric planner's problem (Kautham simulates nothing): the mobile robot's base is
+    held where its controls put it (kinematic: Set Velocity and Set Position move it, gravity
+    and contacts do not), its joint by its servo; an obstacle whose URDF gives a mass (an object
+    a task may carry) is a body held to the world where the problem puts it, in mid-air too; one
+    without a mass is static geometry. No ground: in Kautham nothing falls."""
+    (tmp_path / "crate.urdf").write_text(CRATE)
+    (tmp_path / "shelf.urdf").write_text(SHELF)
+    problem_file = _rover(tmp_path)
+    problem_file.write_text(problem_file.read_text().replace("<Controls", (
+        '<Obstacle obstacle="crate.urdf"><Home X="1" Y="0" Z="1.2" WX="0" WY="0" WZ="1" '
+        'TH="0"/></Obstacle><Obstacle obstacle="shelf.urdf"><Home X="-1" Y="0" Z="0.8" WX="0" '
+        'WY="0" WZ="1" TH="0"/></Obstacle><Controls')))
+    plan = plan_problem(load_problem(problem_file))
+    assert not plan.physics
+    entity = _steps(plan, EntityStep)[0].spec
+    assert [o.fixed for o in entity.objects] == [True, False]       # the base, the mast
+    bodies = {b.id: b for b in plan.bodies()}
+    assert bodies["shelf"].geometry_only and not bodies["crate"].geometry_only
+    assert list(plan.holds()) == ["crate"]
+    world.execute(plan)
+    before = {i: world.position(i) for i in ("rover/base", "rover/mast", "crate")}
+    world.run(2.0)
+    for body, position in before.items():
+        assert np.linalg.norm(world.position(body) - position) < 1e-4, body
+    world.core.set_velocity("rover/base", linear=(0.5, 0.0, 0.0))   # a control moves it
+    world.run(1.0)
+    assert world.position("rover/base")[0] == pytest.approx(0.5, abs=1e-6)
+
+
 # -- a problem's world is the problem's (issue 28) ------------------------------------------------
 @pytest.mark.usefixtures("kautham_dir")
 def test_an_experiments_own_world_replaces_the_defaults_and_keeps_the_problems_other_values():

@@ -485,6 +485,11 @@ class RobotHandle:
         return out
 
 
+HOLD = "<hold>"
+"""The last part of the key of a JointStep that holds an obstacle's body to the world where the
+problem puts it (``BuildPlan.holds``)."""
+
+
 @dataclass
 class BuildPlan:
     """Steps in the order they must be sent (WorldStep, StepSizeStep, EntityStep, ObjectStep,
@@ -517,6 +522,12 @@ class BuildPlan:
     def bodies(self) -> List[BodySpec]:
         """Every object and composite the plan builds (entities' members included), in order."""
         return [body for step in self.steps for body in step.bodies]
+
+    def holds(self) -> Dict[str, str]:
+        """{obstacle body ID: world ID of the FIXED joint that holds it where the problem puts
+        it} (``HOLD``: a geometric problem's obstacle body, which only an attachment moves)."""
+        return {s.spec.body1: s.spec.default_id for s in self.steps
+                if isinstance(s, JointStep) and s.key.endswith("/" + HOLD)}
 
     def robot(self, name: Optional[str] = None) -> RobotHandle:
         """The robot called ``name`` (the first robot when None); KeyError naming the robots

@@ -42,7 +42,11 @@ How a problem maps to the world:
   servos' targets with it.
 - The base by the robot's kind (``gui.core.model``): FIXED_BASE -> in a 2012 problem a fixed
   (kinematic) body that never moves; in a current one a dynamic body held by a FIXED joint to
-  the world (Kautham's chain); FREE_BODY, MOBILE, CAR -> a dynamic body, free.
+  the world (Kautham's chain); FREE_BODY, MOBILE, CAR -> under Kautham's physics a dynamic
+  body, free; FREE_BODY and MOBILE otherwise (a geometric planner's problem, where Kautham
+  simulates nothing and only the controls place the base) a fixed (kinematic) body held at
+  the pose it is built at, as a fixed-base robot's joints are held: gravity and contacts never
+  move it, a Set Velocity or Set Position does (``run_path --tracked`` drives it so).
 - A robot is built at its start (the query's ``<Init>``) in current problems, at Home in 2012
   ones (``BuildDefaults.start_at_query``); ``RobotHandle.built_at`` keeps the joint values the
   world's joint readings are relative to.
@@ -51,8 +55,13 @@ How a problem maps to the world:
 - A static obstacle -> Build Object/Composite with ``geometry_only``. A movable obstacle (a .rob
   scene, a URDF with masses, ``<Scene movable="true">``, any obstacle under Kautham's physics,
   an attached obstacle) -> bodies with masses; a multi-link one is built like a robot but its
-  base is left free. ``<InitialAttachedObstacle>`` -> a FIXED joint between the link and the
-  obstacle's (base) body, as they are placed.
+  base is left free (without Kautham's physics, held kinematic where it is put, like a mobile
+  robot's). In a current problem without Kautham's physics a one-link obstacle body not
+  attached at the start is held where the problem puts it by a FIXED joint to the world
+  (key "name/<hold>", ``BuildPlan.holds``): only an attachment moves an obstacle there; a
+  tracked path's Transfer lets it go when it attaches it and holds it again where it leaves
+  it. ``<InitialAttachedObstacle>`` -> a FIXED joint between the link and the obstacle's
+  (base) body, as they are placed.
 - Shapes: a mesh -> mesh object (vertices in the link frame); one primitive -> primitive
   object whose body sits at the primitive's pose in the link; anything else -> a composite
   whose frame is the link frame (one part per primitive, one for the mesh), id ">p1>p2...".

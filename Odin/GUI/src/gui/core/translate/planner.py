@@ -15,8 +15,9 @@ from gui.core import inertia as inertia_rule
 from gui.core.bodies import shape_to_body, with_surface
 from gui.core.kautham import environment
 from gui.core.kautham.problem import PHYSICS_PLANNERS
-from gui.core.model import CAR, FIXED_BASE, Instance, LinkModel, Problem, warn_once
-from gui.core.plan import (BodySpec, BuildPlan, EntityStep, HoldStep, JointStep, LinkBody,
+from gui.core.model import (CAR, FIXED_BASE, FREE_BODY, MOBILE, Instance, LinkModel, Problem,
+                             warn_once)
+from gui.core.plan import (HOLD, BodySpec, BuildPlan, EntityStep, HoldStep, JointStep, LinkBody,
                            ObjectStep, RobotHandle, StepSizeStep, WorldStep, body_step)
 from gui.core.translate import car, chain
 from gui.core.translate.joints import (fixed_joint, joint_motors, link_drive, link_joint,
@@ -68,11 +69,22 @@ class _Planner:
         start = defaults.start_at_query
         self.start_at_query = problem.format == "current" if start is None else start
         attached = {a.obstacle for a in problem.attachments}
-        # bodies: movable obstacles, attached ones, and every current obstacle under
-        # Kautham's physics (its ODE environment makes them all dynamic)
+        # bodies: movable obstacles (2012 .rob scenes), attached ones, and every current
+        # obstacle under Kautham's physics (its ODE environment makes them all dynamic); in a
+        # geometric problem Kautham never moves the others
         self.dynamic = {i.name for i in problem.obstacles
                         if i.movable or i.name in attached
                         or (self.physics and problem.format == "current")}
+        # Kautham's controls place a free-flying or mobile robot's base (and a robot standing
+        # as an obstacle, a 2012 .rob scene with joints, stays where it is put): without
+        # Kautham's physics nothing else moves them, so their base is held (kinematic)
+        self.hold_free_bases = not self.physics
+        # a current problem's obstacle body (its URDF gives a mass: an object a task may
+        # carry) stays where the problem puts it until a task attaches it: without Kautham's
+        # physics only an attachment moves an obstacle (the thesis's 2012 movable scenes fall
+        # and are pushed, as Odin always built them)
+        self.hold_obstacles = not self.physics and problem.format == "current"
+        self.attached = attached
         # Kautham's chain planner drives its chain's joints as PlanarChainEnvironment does,
         # its car planner sets its car's wheel axes as CarEnvironment does
         planned = PHYSICS_PLANNERS.get(problem.planner.name) if problem.physics else None
@@ -129,11 +141,16 @@ class _Planner:
         single = len(inst.model.links) == 1
         if static or (single and inst.role == "obstacle"):
             self.steps.extend(body_step(s) for s in specs)
+            if not static and self.hold_obstacles and inst.name not in self.attached:
+                self.steps.append(JointStep(f"{inst.name}/{HOLD}", inst.name,
+                                            fixed_joint(specs[0].id, "")))
             return
         robot = inst.role == "robot"
         holding: List[JointStep] = []
         if robot and inst.kind == FIXED_BASE and not single:
             specs, holding = chain.hold_base(inst.name, specs, self.problem.format)
+        elif self.hold_free_bases and (inst.kind in (FREE_BODY, MOBILE) or not robot):
+            specs = [dataclasses.replace(specs[0], fixed=True)] + specs[1:]
         self.steps.append(EntityStep(EntitySpec(
             name=inst.name,
             objects=tuple(s for s in specs if isinstance(s, ObjectSpec)),
