@@ -65,8 +65,11 @@ How a problem maps to the world:
 - Shapes: a mesh -> mesh object (vertices in the link frame); one primitive -> primitive
   object whose body sits at the primitive's pose in the link; anything else -> a composite
   whose frame is the link frame (one part per primitive, one for the mesh), id ">p1>p2...".
-- Masses: the file's mass, else ``BuildDefaults.link_mass`` (a .rob ``<Weight>`` is a planner
-  weight, not a mass); a composite's mass is shared among its parts in proportion to their
+- Masses: the file's mass; a URDF robot's link without ``<inertial>`` (massless to URDF and to
+  Kautham, which no body can be) its shape's volume at ``BuildDefaults.massless_density``
+  (water's, at least ``LIGHTEST_LINK``: 1 kg fingertips sagged the Allegro hands' 1 N m
+  joints); else ``BuildDefaults.link_mass`` (1 kg, what Kautham's ODE environment gives an
+  obstacle without a mass; a .rob ``<Weight>`` is a planner weight, not a mass); a composite's mass is shared among its parts in proportion to their
   volumes. Inertia (``gui.core.inertia``): the URDF's tensor about its centre of mass where it
   is a rigid body's and plausible for the link's shape, the shape's at uniform density
   otherwise. The world refuses a given inertia far too light in rotation for the body's

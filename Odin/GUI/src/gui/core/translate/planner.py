@@ -12,7 +12,7 @@ from typing import Dict, List, Optional, Tuple
 import numpy as np
 
 from gui.core import inertia as inertia_rule
-from gui.core.bodies import shape_to_body, with_surface
+from gui.core.bodies import shape_to_body, shape_volume, with_surface
 from gui.core.kautham import environment
 from gui.core.kautham.problem import PHYSICS_PLANNERS
 from gui.core.model import (CAR, FIXED_BASE, FREE_BODY, MOBILE, Instance, LinkModel, Problem,
@@ -32,6 +32,12 @@ GROUND = "ground"
 """The ground plane's object ID (another name is taken if an instance has it)."""
 
 
+LIGHTEST_LINK = 0.001
+"""kg: the least a URDF robot link without ``<inertial>`` weighs (a tiny shape's volume at
+``BuildDefaults.massless_density`` would make it thousands of times lighter than its
+neighbours, which ODE's solvers handle badly)."""
+
+
 @dataclass(frozen=True)
 class BuildDefaults:
     """How a problem is built. ``ground``: Kautham's physics (its world settings, a ground
@@ -42,10 +48,13 @@ class BuildDefaults:
     start in current problems and Home in 2012 ones (None).
     ``hold_start``: robots' joints held by servos where they are built (``HoldStep``), or
     left to their motors at zero speed (False: as the thesis's experiments were run).
+    ``link_mass``, ``massless_density``: what a link whose file gives no mass weighs
+    (``_Planner._default_mass``).
     ``inertia``: "auto", "file" or "shape" (``gui.core.inertia``). ``max_contact_sink``: m,
     the deepest a body may rest in a contact the planner's CFM softens
     (``gui.core.world_settings``)."""
     link_mass: float = 1.0          # kg, a link or movable obstacle without a mass
+    massless_density: float = 1000.0    # kg/m^3, a URDF robot link without <inertial>
     internal_collisions: bool = False
     ground: Optional[bool] = None
     start_at_query: Optional[bool] = None
@@ -173,7 +182,7 @@ class _Planner:
         specs, bodies = [], []
         for link, pose in zip(model.links, model.link_poses(base_pose, built_at)):
             name = inst.name if single else f"{inst.name}/{link.name}"
-            mass = link.mass if link.mass is not None else self.defaults.link_mass
+            mass = link.mass if link.mass is not None else self._default_mass(inst, link)
             spec, offset = shape_to_body(name, link.shape, pose, mass, static)
             if not static:
                 spec = self._mass_properties(spec, link, name, mass, offset)
@@ -185,6 +194,19 @@ class _Planner:
         if not inst.collision:   # <Collision enabled="false">: the world never pairs it
             specs = [dataclasses.replace(s, no_collisions=True) for s in specs]
         return specs, bodies
+
+    def _default_mass(self, inst: Instance, link: LinkModel) -> float:
+        """kg, a link whose file gives no mass: a URDF robot's link without ``<inertial>``
+        (massless to URDF and to Kautham, which no body can be) weighs its shape's volume at
+        ``BuildDefaults.massless_density``; any other (a .rob link, an obstacle, a link
+        without a shape) ``BuildDefaults.link_mass``, as Kautham's ODE environment gives an
+        obstacle without a mass 1 kg."""
+        if inst.role != "robot" or inst.model.kind != "urdf" or link.shape is None:
+            return self.defaults.link_mass
+        volume = shape_volume(link.shape)
+        if volume <= 0:
+            return self.defaults.link_mass
+        return max(self.defaults.massless_density * volume, LIGHTEST_LINK)
 
     def _surface(self, inst: Instance, link: LinkModel, name: str) -> Surface:
         """The contact surface of ``inst``'s ``link`` (body ``name``): its URDF's, but for
