@@ -655,9 +655,14 @@ def test_without_kautham_physics_only_the_controls_and_attachments_move_anything
     world.run(2.0)
     for body, position in before.items():
         assert np.linalg.norm(world.position(body) - position) < 1e-4, body
-    world.core.set_velocity("rover/base", linear=(0.5, 0.0, 0.0))   # a control moves it
+    # a control row moves the held base (its velocity) and servos the joint; it then stops
+    handle = plan.robot()
+    assert handle.base_held
+    results = run_control_path(CorePort(world), handle,
+                               [ControlRow(handle.goal.controls, 0.5)] * 2)
+    np.testing.assert_allclose(results[0].base_position[:2], (1.0, -1.0), atol=1e-6)
     world.run(1.0)
-    assert world.position("rover/base")[0] == pytest.approx(0.5, abs=1e-6)
+    np.testing.assert_allclose(world.position("rover/base")[:2], (1.0, -1.0), atol=1e-6)
 
 
 FINGER = """<?xml version="1.0"?><robot name="hand">

@@ -437,7 +437,9 @@ class RobotHandle:
     ``max_forces`` / ``max_speeds``: per movable joint, its effort (N m or N) and speed
     (rad/s or m/s) limits (None: none given). ``joint_axes``: per movable joint, which of its
     world joint's values is the joint's (0; a car's wheel is its hinge-2's spin, 1).
-    ``base_mass``: kg, the base body's mass."""
+    ``base_mass``: kg, the base body's mass. ``base_held``: the base is built kinematic where
+    it stands (a free-flying or mobile robot without Kautham's physics): its velocity moves
+    it, forces do not."""
     instance: Instance
     bodies: list                     # LinkBody per link, model order
     joint_keys: list                 # per movable joint (model.movable_links() order)
@@ -451,6 +453,7 @@ class RobotHandle:
     max_speeds: list = field(default_factory=list)
     joint_axes: list = field(default_factory=list)
     base_mass: float = 0.0
+    base_held: bool = False
 
     def __post_init__(self):
         if self.built_at is None:

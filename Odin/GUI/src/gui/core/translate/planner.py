@@ -158,7 +158,8 @@ class _Planner:
         holding: List[JointStep] = []
         if robot and inst.kind == FIXED_BASE and not single:
             specs, holding = chain.hold_base(inst.name, specs, self.problem.format)
-        elif self.hold_free_bases and (inst.kind in (FREE_BODY, MOBILE) or not robot):
+        held = self.hold_free_bases and (not robot or inst.kind in (FREE_BODY, MOBILE))
+        if held:
             specs = [dataclasses.replace(specs[0], fixed=True)] + specs[1:]
         self.steps.append(EntityStep(EntitySpec(
             name=inst.name,
@@ -166,7 +167,8 @@ class _Planner:
             composites=tuple(s for s in specs if isinstance(s, CompositeSpec)),
             internal_collisions=self.defaults.internal_collisions)))
         handle = RobotHandle(inst, bodies, [], home=inst.model.home(), built_at=built_at,
-                             base_pose=base_pose, kind=inst.kind, base_mass=specs[0].mass)
+                             base_pose=base_pose, kind=inst.kind, base_mass=specs[0].mass,
+                             base_held=held)
         if not single:
             self.steps.extend(holding)
             self._joints(inst, handle, base_pose, built_at)
