@@ -49,6 +49,49 @@ def test_a_diverging_body_is_parked_reported_and_the_world_runs_on(ros_master):
     assert node.poll() is None, ros_master.log_text(node)[-2000:]
 
 
+def room_mesh():
+    """(vertices, triangles) flat lists: a 12 m x 6 m floor and two 3 m walls, closed boxes
+    (outward counter-clockwise) in one mesh."""
+    corners = [(x, y, z) for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]
+    box = [0, 1, 3, 0, 3, 2, 4, 6, 7, 4, 7, 5, 0, 4, 5, 0, 5, 1, 2, 3, 7, 2, 7, 6, 0, 2, 6,
+           0, 6, 4, 1, 5, 7, 1, 7, 3]
+    vertices, triangles = [], []
+    for k, (sides, centre) in enumerate((((12, 6, 0.1), (0, 0, -0.05)),
+                                         ((12, 0.1, 3), (0, 3, 1.5)), ((0.1, 6, 3), (6, 0, 1.5)))):
+        vertices += [c * s / 2 + o for corner in corners for c, s, o in zip(corner, sides, centre)]
+        triangles += [8 * k + i for i in box]
+    return vertices, triangles
+
+
+def test_a_body_too_light_in_rotation_for_its_size_is_refused_and_the_node_lives(ros_master):
+    """Kautham's IOC lab layout (a 12 m room of 0.05 kg whose URDF inertia, scaled with its
+    mesh, is 7e-8 kg m^2) under ODE's dense solver, loaded pieces resting on its floor: ODE
+    aborted the node inside the step (issue 31's TIAGo warehouse). The room is refused, naming
+    the limit; the rest is built and steps, and the node answers."""
+    import rospy
+    from world_client import WorldClient, box
+    from Messages.msg import Object
+
+    node = ros_master.rosrun("VirtualWorld", "virtualWorld")
+    ros_master.wait_for_service("/virtual_world/step_once")
+    rospy.init_node("odin_test_client", anonymous=True, disable_signals=True)
+    world = WorldClient()
+    world.ok("set_world", set_solver=True, solver=1, quickstep_iterations=20)
+    vertices, triangles = room_mesh()
+    refused = world("build_object", object=Object(
+        name="room", parameters=vertices, indices=triangles, mass=0.05,
+        inertia=[6.8e-8] * 3 + [0] * 3, center_of_mass=[0, 0, 0], position=[0, 0, 0],
+        orientation=[1, 0, 0, 0]))
+    assert not refused.success and "MIN_GYRATION_FRACTION" in refused.message
+    for i in range(16):
+        world.ok("build_object", object=box(f"b{i}", (1.0, 0.8, 0.7), (
+            -5 + (i % 8) * 1.4, -2 + (i // 8) * 1.5, 0.349), mass=0.05))
+    world.ok("step_once", cycles=10)
+    assert world.ok("get_world").objects == [f"b{i}" for i in range(16)]
+    world.close()
+    assert node.poll() is None, ros_master.log_text(node)[-2000:]
+
+
 def test_resource_limits_refuse_what_would_exhaust_memory_and_the_node_goes_on(ros_master):
     """~max_request_mb: a 2 MB mesh request against a 1 MB cap fails the call before the node
     reads its body; ~max_objects and ~max_snapshots refuse with a message; a bad limit stops

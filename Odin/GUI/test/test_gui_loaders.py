@@ -334,6 +334,7 @@ def test_problem_with_relative_parent_paths_and_free_flying_robot(corpus):
     built = plan.steps[2]                  # after the world's Set World and Set Step
     entity = built.spec
     assert isinstance(built, EntityStep) and len(entity.objects) == 1
+    assert entity.objects[0].fixed     # a free flyer without Kautham's physics: held
     assert entity.objects[0].position == pytest.approx((0.1, 0, 0))
     assert plan.robots[0].joint_keys == []
     # the .rob scene: a movable obstacle with joints but no fixed base joint

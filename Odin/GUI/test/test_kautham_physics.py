@@ -620,6 +620,92 @@ def test_a_mobile_robot_has_a_free_base_its_controls_drive_with_its_arm(tmp_path
     assert pan + handle.built_at[0] == pytest.approx(1.2, abs=0.02)
 
 
+CRATE = """<?xml version="1.0"?><robot name="crate"><link name="base"><inertial><mass
+ value="0.05"/><inertia ixx="0.000683" iyy="0.000683" izz="0.000683" ixy="0" ixz="0" iyz="0"/>
+ </inertial><collision><geometry><box size="0.3 0.3 0.3"/></geometry></collision></link>
+</robot>"""
+
+SHELF = """<?xml version="1.0"?><robot name="shelf"><link name="base"><collision><geometry>
+ <box size="1 0.4 0.02"/></geometry></collision></link></robot>"""
+
+
+def test_without_kautham_physics_only_the_controls_and_attachments_move_anything(tmp_path,
+                                                                                world):
+    """A geometric planner's problem (Kautham simulates nothing): the mobile robot's base is
+    held where its controls put it (kinematic: Set Velocity and Set Position move it, gravity
+    and contacts do not), its joint by its servo; an obstacle whose URDF gives a mass (an object
+    a task may carry) is a body held to the world where the problem puts it, in mid-air too; one
+    without a mass is static geometry. No ground: in Kautham nothing falls."""
+    (tmp_path / "crate.urdf").write_text(CRATE)
+    (tmp_path / "shelf.urdf").write_text(SHELF)
+    problem_file = _rover(tmp_path)
+    problem_file.write_text(problem_file.read_text().replace("<Controls", (
+        '<Obstacle obstacle="crate.urdf"><Home X="1" Y="0" Z="1.2" WX="0" WY="0" WZ="1" '
+        'TH="0"/></Obstacle><Obstacle obstacle="shelf.urdf"><Home X="-1" Y="0" Z="0.8" WX="0" '
+        'WY="0" WZ="1" TH="0"/></Obstacle><Controls')))
+    plan = plan_problem(load_problem(problem_file))
+    assert not plan.physics
+    entity = _steps(plan, EntityStep)[0].spec
+    assert [o.fixed for o in entity.objects] == [True, False]       # the base, the mast
+    bodies = {b.id: b for b in plan.bodies()}
+    assert bodies["shelf"].geometry_only and not bodies["crate"].geometry_only
+    assert list(plan.holds()) == ["crate"]
+    world.execute(plan)
+    before = {i: world.position(i) for i in ("rover/base", "rover/mast", "crate")}
+    world.run(2.0)
+    for body, position in before.items():
+        assert np.linalg.norm(world.position(body) - position) < 1e-4, body
+    # a control row moves the held base (its velocity) and servos the joint; it then stops
+    handle = plan.robot()
+    assert handle.base_held
+    results = run_control_path(CorePort(world), handle,
+                               [ControlRow(handle.goal.controls, 0.5)] * 2)
+    np.testing.assert_allclose(results[0].base_position[:2], (1.0, -1.0), atol=1e-6)
+    world.run(1.0)
+    np.testing.assert_allclose(world.position("rover/base")[:2], (1.0, -1.0), atol=1e-6)
+
+
+FINGER = """<?xml version="1.0"?><robot name="hand">
+ <link name="palm"><inertial><mass value="0.5"/><inertia ixx="0.001" iyy="0.001" izz="0.001"
+  ixy="0" ixz="0" iyz="0"/></inertial><collision><geometry><box size="0.1 0.1 0.02"/>
+  </geometry></collision></link>
+ <link name="finger"><collision><origin xyz="0.05 0 0"/><geometry><box size="0.1 0.02 0.02"/>
+  </geometry></collision></link>
+ <joint name="knuckle" type="revolute"><parent link="palm"/><child link="finger"/><origin
+  xyz="0.05 0 0"/><axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="0.05"
+  velocity="1"/></joint>
+</robot>"""
+
+FINGER_CNTR = """<?xml version="1.0"?><ControlSet>
+ <Control name="hand/knuckle" eigValue="1"><DOF name="hand/finger" value="1"/></Control>
+</ControlSet>"""
+
+
+def test_a_urdf_link_without_inertial_weighs_its_shape_at_waters_density(tmp_path, world):
+    """A finger without ``<inertial>`` (massless to URDF and to Kautham) on a 0.05 N m knuckle:
+    4e-5 m^3 at 1000 kg/m^3 is 0.04 kg, 0.02 N m of gravity at its centre, which the held
+    knuckle carries; at the 1 kg a link without a mass gets otherwise (0.49 N m) it sagged to
+    its stop. An obstacle without a mass still gets 1 kg (Kautham's ODE environment's)."""
+    (tmp_path / "hand.urdf").write_text(FINGER)
+    (tmp_path / "hand.cntr").write_text(FINGER_CNTR)
+    (tmp_path / "shelf.urdf").write_text(SHELF)
+    problem = tmp_path / "hand.xml"
+    problem.write_text(
+        '<?xml version="1.0"?><Problem><Robot robot="hand.urdf"><Home X="0" Y="0" Z="1" WX="0" '
+        'WY="0" WZ="1" TH="0"/></Robot><Obstacle obstacle="shelf.urdf" movable="true"><Home '
+        'X="0" Y="1" Z="0" WX="0" WY="0" WZ="1" TH="0"/></Obstacle><Controls robot="hand.cntr"/>'
+        '<Planner><Parameters><Name>omplRRTConnect</Name></Parameters><Queries><Query><Init>'
+        '0.5</Init><Goal>0.6</Goal></Query></Queries></Planner></Problem>')
+    plan = plan_problem(load_problem(problem))
+    bodies = {b.id: b for b in plan.bodies()}
+    assert bodies["hand/finger"].mass == pytest.approx(1000 * 0.1 * 0.02 * 0.02)
+    assert bodies["hand/palm"].mass == 0.5 and bodies["shelf"].mass == 1.0
+    world.execute(plan)
+    tip = world.position("hand/finger")
+    world.run(2.0)
+    assert np.linalg.norm(world.position("hand/finger") - tip) < 1e-3
+
+
 # -- a problem's world is the problem's (issue 28) ------------------------------------------------
 @pytest.mark.usefixtures("kautham_dir")
 def test_an_experiments_own_world_replaces_the_defaults_and_keeps_the_problems_other_values():

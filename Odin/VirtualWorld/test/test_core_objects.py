@@ -52,6 +52,26 @@ def test_a_closed_tetrahedron_has_its_exact_centre_and_inertia(core, winding):
     np.testing.assert_allclose(inertia, expected, atol=1e-12)
 
 
+def test_a_closed_mesh_whose_surface_integrals_give_no_rigid_body_gets_its_bounding_box(core):
+    """A 1 m cube and, 3 m away in the same mesh, a 0.5 m cube whose faces wind inward: closed
+    and of positive volume, but its surface integrals give principal moments (-1.28, -1.28,
+    0.18) kg m^2 per kg (the 2012 TX90's Tcp mesh was refused so, and its whole robot with
+    it). The mesh gets the bounding box rule: a solid 3.75 x 1 x 1 m box centred on the box."""
+    cube = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float)
+    outward = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
+                        [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
+    vertices = np.concatenate([cube * 0.5, cube * 0.25 + (3.0, 0.0, 0.0)])
+    faces = np.concatenate([outward, outward[:, ::-1] + 8])
+    m = 2.0
+    core.build_object(ObjectSpec("odd", vertices.reshape(-1).tolist(),
+                                 faces.reshape(-1).tolist(), mass=m))
+    mass, com, inertia = core.mass_properties("odd")
+    x, y, z = 3.75, 1.0, 1.0
+    np.testing.assert_allclose(com, ((-0.5 + 3.25) / 2, 0.0, 0.0), atol=1e-12)
+    np.testing.assert_allclose(inertia, m / 12 * np.diag([y * y + z * z, x * x + z * z,
+                                                          x * x + y * y]), atol=1e-12)
+
+
 def test_set_poses_keeps_the_velocities_unless_told_to_reset_them(core):
     """A ball moving at (1, 2, 3) m/s and turning at (0.5, 0, -0.5) rad/s is moved: it keeps
     both velocities; moved with reset_velocity it is at rest, and stays where it was put."""

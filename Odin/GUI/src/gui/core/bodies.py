@@ -62,6 +62,12 @@ def _pieces(shape: Shape) -> list:
     return pieces
 
 
+def shape_volume(shape: Shape) -> float:
+    """m^3: the sum of the shape's pieces' volumes (a closed mesh's own, an open or flat
+    mesh's bounding box's, each primitive's)."""
+    return float(sum(piece[5] for piece in _pieces(shape)))
+
+
 def _volume(part_kind: str, parameters: tuple, vertices=None, triangles=None) -> float:
     """m^3: a primitive's, or a closed mesh's; the box around an open or flat mesh's."""
     if part_kind != "mesh":

@@ -60,7 +60,9 @@ kind of robot:
   `ControlDefaults.max_acceleration`; the base's orientation is not driven (Kautham's
   twoDRobotEnvironment samples the force itself, in [-20, 20] N per axis; a row here is a
   configuration, as Kautham's control samples through the `.cntr` are, and the force the one
-  that reaches it);
+  that reaches it); a base the build holds kinematic (a free-flying or mobile robot without
+  Kautham's physics, ``RobotHandle.base_held``) gets instead the velocity (x* - x0) / d along
+  those axes, which puts it there at the row's end, and is stopped after the last row;
 - a car (two controls, CarEnvironment's): steering angle -0.5 + c1 rad, reached by each wheel
   hinge-2's first axis at a rate of 1/s per radian of error under 2 N m (a servo of gain 1),
   and wheel speed -5 + 15 c2 rad/s on its second axis under 50 N m.
@@ -94,11 +96,13 @@ class ControlRow:
 
 @dataclass(frozen=True)
 class Actuation:
-    """What one row asks of the world: a servo command (or None) and forces (body ID, (3,) N,
-    world frame) acting for ``duration`` s."""
+    """What one row asks of the world: a servo command (or None), forces (body ID, (3,) N,
+    world frame) acting for ``duration`` s, and a held base's velocity (body ID, (3,) m/s,
+    world frame; None: none) for that time."""
     duration: float
     servo: Optional[ServoCommand] = None
     forces: Tuple[Tuple[str, Tuple[float, float, float]], ...] = ()
+    base_velocity: Optional[Tuple[str, Tuple[float, float, float]]] = None
 
 
 BodyState = Tuple[np.ndarray, np.ndarray, np.ndarray]
@@ -112,6 +116,8 @@ class ControlPort(Protocol):
     def body_state(self, body_id: str) -> BodyState: ...
 
     def set_servo(self, command: ServoCommand) -> None: ...
+
+    def set_body_velocity(self, body_id: str, linear, angular) -> None: ...
 
     def advance(self, duration: float, forces: Sequence[Tuple[str, Sequence[float]]]) -> None: ...
 
@@ -181,11 +187,15 @@ def actuation(handle, row: ControlRow, state: Optional[BodyState],
     controls = handle.instance.controls
     target = controls.configuration(handle.instance, row.controls)
     servo = _joint_servo(handle, target.joints, defaults) if handle.motor_ids else None
-    forces = ()
+    forces, velocity = (), None
     if handle.kind in (FREE_BODY, MOBILE) and controls.se3 and controls.moved_base_axes():
-        forces = (_base_force(handle, target.base_pose, state, row.duration,
-                              controls.moved_base_axes(), defaults),)
-    return Actuation(row.duration, servo, forces)
+        if handle.base_held:
+            velocity = _base_velocity(handle, target.base_pose, state, row.duration,
+                                      controls.moved_base_axes())
+        else:
+            forces = (_base_force(handle, target.base_pose, state, row.duration,
+                                  controls.moved_base_axes(), defaults),)
+    return Actuation(row.duration, servo, forces, velocity)
 
 
 def _joint_servo(handle, targets: np.ndarray, defaults: ControlDefaults) -> ServoCommand:
@@ -211,16 +221,33 @@ def _car_servo(handle, controls: Sequence[float]) -> ServoCommand:
         max_forces=(environment.STEERING_MAX_TORQUE, environment.WHEEL_MAX_TORQUE) * wheels)
 
 
-def _base_force(handle, target_pose: np.ndarray, state: Optional[BodyState], duration: float,
-                axes: Sequence[int], defaults: ControlDefaults) -> Tuple[str, tuple]:
+def _base_origin(handle, state: Optional[BodyState]) -> np.ndarray:
+    """(3,) m, world: the base link's origin in the base body's ``state``."""
     if state is None:
         raise ValueError(f"{handle.name}: a free base needs its state to be driven")
-    position, quaternion, velocity = state
-    body = handle.bodies[0]
+    position, quaternion, _ = state
     pose = np.eye(4)
     pose[:3, :3] = quaternion_to_matrix(quaternion)
     pose[:3, 3] = position
-    base = (pose @ np.linalg.inv(body.offset))[:3, 3]        # the base link's origin
+    return (pose @ np.linalg.inv(handle.bodies[0].offset))[:3, 3]
+
+
+def _base_velocity(handle, target_pose: np.ndarray, state: Optional[BodyState],
+                   duration: float, axes: Sequence[int]) -> Tuple[str, tuple]:
+    """A held (kinematic) base's velocity that puts it at the row's position along ``axes``
+    when the row ends (nothing else moves it)."""
+    base = _base_origin(handle, state)
+    velocity = np.zeros(3)
+    for i in axes:
+        velocity[i] = (target_pose[i, 3] - base[i]) / duration
+    return handle.bodies[0].body_id, tuple(float(v) for v in velocity)
+
+
+def _base_force(handle, target_pose: np.ndarray, state: Optional[BodyState], duration: float,
+                axes: Sequence[int], defaults: ControlDefaults) -> Tuple[str, tuple]:
+    base = _base_origin(handle, state)
+    velocity = state[2]
+    body = handle.bodies[0]
     mass = handle.base_mass
     force = np.zeros(3)
     limit = mass * defaults.max_acceleration
@@ -264,12 +291,16 @@ def run_control_path(port: ControlPort, handle, rows: Sequence[ControlRow],
         act = actuation(handle, row, state, defaults)
         if act.servo is not None:
             port.set_servo(act.servo)
+        if act.base_velocity is not None:
+            port.set_body_velocity(*act.base_velocity, (0.0, 0.0, 0.0))
         port.advance(row.duration, act.forces)
         result = RowResult(k, port.body_state(base_id)[0], act,
                            None if watch is None else port.body_state(watch))
         results.append(result)
         if progress is not None:
             progress(result)
+    if handle.base_held:                # a kinematic base keeps its velocity: it stops here
+        port.set_body_velocity(base_id, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
     return results
 
 
@@ -290,6 +321,10 @@ class ClientPort:
 
     def set_servo(self, command: ServoCommand) -> None:
         self.client.set_servo(command)
+
+    def set_body_velocity(self, body_id: str, linear, angular) -> None:
+        self.client.set_body_velocity(body_id, linear=list(linear), angular=list(angular))
+        self._states.pop(body_id, None)
 
     def advance(self, duration: float, forces) -> None:
         started = time.monotonic()

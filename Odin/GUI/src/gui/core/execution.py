@@ -7,10 +7,13 @@ each robot's servos get the trajectory's target at the middle of the coming peri
 feed-forward, its mean rate over the period (Set Servo; the servo's speed is
 clamp(rate + gain (target - q), +-limit) each step, under the joint's effort limit); a
 free-flying base gets the velocity rate + ``base_gain`` error (linear and angular, world frame)
-and a force cancelling gravity on the robot's mass, as a velocity servo of its own; then the
+and a force cancelling gravity on the robot's mass, as a velocity servo of its own (a base the
+build holds kinematic, outside Kautham's physics, moves at that velocity exactly); then the
 world runs the period with contacts on (one kept Propagate), and the joints are read.
 Attach/detach events become a FIXED joint between the link's body and the obstacle's, made and
-removed at their waypoint's time (the robot is at rest there). The path starts where the robot
+removed at their waypoint's time (the robot is at rest there); an obstacle the build holds
+where the problem puts it (``BuildPlan.holds``) is let go as it is attached and held again
+where it is left. The path starts where the robot
 is: its present configuration is the first waypoint, the path's first sample (a ``.kps``
 query's ``Init``) the second. A robot farther from that sample than ``start_tolerance`` (rad
 or m: the largest difference of a joint, of a base's coordinate or of its rotation) is refused
@@ -331,6 +334,7 @@ def execute_tracked(port: TrackingPort, plan, solution: Solution,
     weights = _base_weights(port, robots)
     gravity = port.gravity()
     made: Dict[Tuple[str, str], str] = {}
+    holds = plan.holds()
     collisions: Dict[Tuple[str, str], List[float]] = {}
     times, targets, actuals = [], [], []
     pending = sorted(events, key=lambda e: e.time)
@@ -342,7 +346,7 @@ def execute_tracked(port: TrackingPort, plan, solution: Solution,
         done = k + 1
         t = k * period
         while pending and pending[0].time <= t + 1e-9:
-            _apply(port, pending.pop(0), made)
+            _apply(port, pending.pop(0), made, holds)
         middle, end = trajectory.sample(t + 0.5 * period), trajectory.sample(t + period)
         rates = (end.joints - trajectory.sample(t).joints) / period
         forces = []
@@ -435,13 +439,23 @@ def _compare(port: TrackingPort, robots: Sequence[_Robot], sample) -> Tuple[np.n
     return np.concatenate(target), np.concatenate(actual)
 
 
-def _apply(port: TrackingPort, event: _Event, made: Dict[Tuple[str, str], str]) -> None:
+def _apply(port: TrackingPort, event: _Event, made: Dict[Tuple[str, str], str],
+           holds: Dict[str, str]) -> None:
+    """Makes or removes the event's attachment. An obstacle held where the problem put it
+    (``holds``: ``BuildPlan.holds``, "" while attached) is let go when attached and held again
+    where it is left."""
     key = (event.link_body, event.obstacle_body)
     if event.action == ATTACH:
         if key not in made:
+            if holds.get(event.obstacle_body):
+                port.detach(holds[event.obstacle_body])
+                holds[event.obstacle_body] = ""
             made[key] = port.attach(*key)
     elif key in made:
         port.detach(made.pop(key))
+        if event.obstacle_body in holds and not any(
+                obstacle == event.obstacle_body for _, obstacle in made):
+            holds[event.obstacle_body] = port.attach(event.obstacle_body, "")
 
 
 # -- the world through gui.ros.client.WorldClient ---------------------------------------------

@@ -7,7 +7,9 @@ moment is within ``placeholder_factor`` of the shape's at the same mass: a tenso
 is a placeholder (the corpus's ODE demos carry 0.000036 kg m^2 for a 25 kg sphere of 0.25 m)
 and the shape's inertia at uniform density is used instead, which is also what Kautham's ODE
 environment does with every link (``dMassSet*Total`` of its shape). A link with a mesh keeps its
-file's tensor (real robots' CAD inertias). ``mode`` "file" always uses a rigid body's tensor,
+file's tensor (real robots' CAD inertias), unless the world would refuse it as far too light in
+rotation for the link's geometry (``odin_common.limits.thin_inertia``: a placeholder scaled
+down with its mesh, as the IOC lab layout's). ``mode`` "file" always uses a rigid body's tensor,
 "shape" never. Every tensor set aside is listed (``gui.core.model.Ignored``).
 """
 from __future__ import annotations
@@ -19,6 +21,7 @@ import numpy as np
 
 from gui.core.model import Ignored, LinkModel
 from gui.core.shapes import Shape
+from odin_common.limits import primitive_corners, thin_inertia
 
 AUTO, FILE, SHAPE = "auto", "file", "shape"
 INERTIA_MODES = (AUTO, FILE, SHAPE)
@@ -89,6 +92,18 @@ def rigid_body_problem(tensor: np.ndarray) -> Optional[str]:
     return None
 
 
+def shape_points(shape: Shape) -> np.ndarray:
+    """(n, 3) m in the shape's frame: its mesh's vertices and its primitives' box corners
+    (the points the world's check of a given inertia reads, odin_common.limits)."""
+    points = [np.zeros((0, 3))]
+    if shape is not None and shape.mesh is not None:
+        points.append(np.asarray(shape.mesh.vertices, dtype=float))
+    for prim in (shape.primitives if shape is not None else ()):
+        corners = primitive_corners(prim.kind, prim.parameters)
+        points.append(corners @ prim.pose[:3, :3].T + prim.pose[:3, 3])
+    return np.concatenate(points)
+
+
 def choose(link: LinkModel, owner: str, mass: float, offset: np.ndarray, mode: str = AUTO,
            placeholder_factor: float = 10.0) -> Tuple[Optional[BodyInertia], Optional[Ignored]]:
     """The inertia the body of ``link`` (named ``owner``, of ``mass`` kg) gets, in the body's
@@ -101,7 +116,7 @@ def choose(link: LinkModel, owner: str, mass: float, offset: np.ndarray, mode: s
         return None, None
     tensor = inertial.tensor * (mass / inertial.mass)
     what = f"<inertial> of link \"{link.name}\" ({owner})"
-    problem = rigid_body_problem(tensor)
+    problem = rigid_body_problem(tensor) or _thin(link, tensor, mass)
     if problem is not None:
         return None, Ignored(link.source, link.line, what, f"{problem}: the shape's inertia "
                              "is used")
@@ -127,5 +142,13 @@ def choose(link: LinkModel, owner: str, mass: float, offset: np.ndarray, mode: s
                        tuple(float(v) for v in frame[:3, 3])), None
 
 
-__all__ = ["AUTO", "FILE", "SHAPE", "INERTIA_MODES", "BodyInertia", "primitive_inertia",
+def _thin(link: LinkModel, tensor: np.ndarray, mass: float) -> Optional[str]:
+    """Why the world would refuse ``tensor`` as too light in rotation for the link's shape
+    (odin_common.limits.thin_inertia), in the inertial frame; None when it would not."""
+    to_inertial = np.linalg.inv(link.inertial.origin)
+    points = shape_points(link.shape) @ to_inertial[:3, :3].T + to_inertial[:3, 3]
+    return thin_inertia(tensor, mass, points)
+
+
+__all__ = ["shape_points", "AUTO", "FILE", "SHAPE", "INERTIA_MODES", "BodyInertia", "primitive_inertia",
            "primitive_volume", "shape_inertia", "rigid_body_problem", "choose"]

@@ -437,7 +437,9 @@ class RobotHandle:
     ``max_forces`` / ``max_speeds``: per movable joint, its effort (N m or N) and speed
     (rad/s or m/s) limits (None: none given). ``joint_axes``: per movable joint, which of its
     world joint's values is the joint's (0; a car's wheel is its hinge-2's spin, 1).
-    ``base_mass``: kg, the base body's mass."""
+    ``base_mass``: kg, the base body's mass. ``base_held``: the base is built kinematic where
+    it stands (a free-flying or mobile robot without Kautham's physics): its velocity moves
+    it, forces do not."""
     instance: Instance
     bodies: list                     # LinkBody per link, model order
     joint_keys: list                 # per movable joint (model.movable_links() order)
@@ -451,6 +453,7 @@ class RobotHandle:
     max_speeds: list = field(default_factory=list)
     joint_axes: list = field(default_factory=list)
     base_mass: float = 0.0
+    base_held: bool = False
 
     def __post_init__(self):
         if self.built_at is None:
@@ -485,6 +488,11 @@ class RobotHandle:
         return out
 
 
+HOLD = "<hold>"
+"""The last part of the key of a JointStep that holds an obstacle's body to the world where the
+problem puts it (``BuildPlan.holds``)."""
+
+
 @dataclass
 class BuildPlan:
     """Steps in the order they must be sent (WorldStep, StepSizeStep, EntityStep, ObjectStep,
@@ -517,6 +525,12 @@ class BuildPlan:
     def bodies(self) -> List[BodySpec]:
         """Every object and composite the plan builds (entities' members included), in order."""
         return [body for step in self.steps for body in step.bodies]
+
+    def holds(self) -> Dict[str, str]:
+        """{obstacle body ID: world ID of the FIXED joint that holds it where the problem puts
+        it} (``HOLD``: a geometric problem's obstacle body, which only an attachment moves)."""
+        return {s.spec.body1: s.spec.default_id for s in self.steps
+                if isinstance(s, JointStep) and s.key.endswith("/" + HOLD)}
 
     def robot(self, name: Optional[str] = None) -> RobotHandle:
         """The robot called ``name`` (the first robot when None); KeyError naming the robots

@@ -143,6 +143,9 @@ class CorePort:
     def set_servo(self, command: ServoCommand) -> None:
         self.world.set_servo(command)
 
+    def set_body_velocity(self, body_id: str, linear, angular) -> None:
+        self.world.core.set_velocity(body_id, linear=tuple(linear), angular=tuple(angular))
+
     def advance(self, duration: float, forces):
         # a control path reads the world through body_state: the answer's states go unread
         return self.world.core.propagate(duration, self.world.step_values.step,

@@ -6,8 +6,10 @@ Meshes:
   * closed mesh (``is_watertight``): normals repaired (``trimesh.repair.fix_normals``), an
     inverted mesh turned outside-out, density = mass / |volume|; the exact centre of mass and
     inertia about it follow (trimesh's surface-integral formulas);
-  * open mesh (or one that stays non-volumetric after the repair; a third of Kautham's link
-    meshes are open or hold several bodies): the mesh's axis-aligned bounding box as a solid
+  * open mesh (or one that stays non-volumetric after the repair, or whose surface integrals
+    give no rigid body's inertia, as a closed but self-intersecting mesh's do: the 2012 TX90's
+    Tcp; a third of Kautham's link meshes are open or hold several bodies): the mesh's
+    axis-aligned bounding box as a solid
     box of the given mass, centred on the box. (The convex hull would be tighter but needs
     scipy, which Odin does not depend on.) A mesh flat in one direction gets a flat box's
     inertia; one flat in two directions is an error.
@@ -44,7 +46,19 @@ def _solid(mesh: trimesh.Trimesh, mass: float):
     if not np.isfinite(volume) or volume <= 1e-15 * max(mesh.scale, 1e-12) ** 3:
         return None
     mesh.density = mass / volume
-    return np.asarray(mesh.center_mass, float), np.asarray(mesh.moment_inertia, float)
+    center, inertia = np.asarray(mesh.center_mass, float), np.asarray(mesh.moment_inertia, float)
+    if not (np.all(np.isfinite(center)) and _rigid(inertia)):
+        return None     # a closed but self-intersecting mesh: no solid's figures
+    return center, inertia
+
+
+def _rigid(inertia: np.ndarray) -> bool:
+    """Whether ``inertia`` (3, 3) is a rigid body's: finite, positive definite, principal
+    moments meeting the triangle inequality."""
+    if not np.all(np.isfinite(inertia)):
+        return False
+    principal = np.linalg.eigvalsh(inertia)
+    return principal[0] > 0 and principal[0] + principal[1] >= principal[2] * (1 - 1e-9)
 
 
 def mesh_mass(vertices: np.ndarray, triangles: np.ndarray, mass: float) -> MeshMass:

@@ -99,6 +99,26 @@ def _centred(what: str, dmass) -> np.ndarray:
     return com
 
 
+def _part_points(part: _Part) -> np.ndarray:
+    """(n, 3) m, object frame: a mesh part's vertices, a primitive's bounding box corners."""
+    if part.shape.kind == "mesh":
+        local = part.shape.vertices
+    else:
+        local = limits.primitive_corners(part.shape.kind, part.shape.dims)
+    return local @ quaternion_to_matrix(part.orientation).T + part.position
+
+
+def _check_given_inertia(what: str, dmass, com: np.ndarray, parts: Sequence[_Part],
+                         mass: float) -> None:
+    """InvalidArgument when a given inertia (centred ``dmass``) is too light in rotation for
+    the parts' geometry (odin_common.limits.thin_inertia): ODE's solver would then return
+    non-finite velocities, and ODE aborts the process on those."""
+    points = np.concatenate([_part_points(part) for part in parts]) - com
+    problem = limits.thin_inertia(bodies.inertia_matrix(dmass), mass, points)
+    if problem is not None:
+        raise InvalidArgument(f"{what}: inertia: {problem}")
+
+
 def prepare_object(spec: ObjectSpec) -> _Prepared:
     if not isinstance(spec, ObjectSpec):
         raise InvalidArgument(f"{spec!r} is not an ObjectSpec")
@@ -120,6 +140,8 @@ def prepare_object(spec: ObjectSpec) -> _Prepared:
     if not geometry_only:
         dmass = given if given is not None else shape_mass(what, part.shape, mass)
         com = _centred(what, dmass)
+        if given is not None:
+            _check_given_inertia(what, dmass, com, [part], mass)
     return _Prepared(spec, name, [part], position, orientation, fixed, geometry_only,
                      no_collisions, dmass, com)
 
@@ -159,6 +181,9 @@ def prepare_composite(spec: CompositeSpec) -> _Prepared:
                                                   part.mass),
                                 part.position.tolist(), part.orientation.tolist())
         com = _centred(f"object {object_id!r}", dmass)
+        if given is not None:
+            _check_given_inertia(f"object {object_id!r}", dmass, com, parts,
+                                 sum(part.mass for part in parts))
     return _Prepared(spec, object_id, parts, position, orientation, fixed, geometry_only,
                      no_collisions, dmass, com)
 

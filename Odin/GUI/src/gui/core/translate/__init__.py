@@ -42,7 +42,11 @@ How a problem maps to the world:
   servos' targets with it.
 - The base by the robot's kind (``gui.core.model``): FIXED_BASE -> in a 2012 problem a fixed
   (kinematic) body that never moves; in a current one a dynamic body held by a FIXED joint to
-  the world (Kautham's chain); FREE_BODY, MOBILE, CAR -> a dynamic body, free.
+  the world (Kautham's chain); FREE_BODY, MOBILE, CAR -> under Kautham's physics a dynamic
+  body, free; FREE_BODY and MOBILE otherwise (a geometric planner's problem, where Kautham
+  simulates nothing and only the controls place the base) a fixed (kinematic) body held at
+  the pose it is built at, as a fixed-base robot's joints are held: gravity and contacts never
+  move it, a Set Velocity or Set Position does (``run_path --tracked`` drives it so).
 - A robot is built at its start (the query's ``<Init>``) in current problems, at Home in 2012
   ones (``BuildDefaults.start_at_query``); ``RobotHandle.built_at`` keeps the joint values the
   world's joint readings are relative to.
@@ -51,16 +55,27 @@ How a problem maps to the world:
 - A static obstacle -> Build Object/Composite with ``geometry_only``. A movable obstacle (a .rob
   scene, a URDF with masses, ``<Scene movable="true">``, any obstacle under Kautham's physics,
   an attached obstacle) -> bodies with masses; a multi-link one is built like a robot but its
-  base is left free. ``<InitialAttachedObstacle>`` -> a FIXED joint between the link and the
-  obstacle's (base) body, as they are placed.
+  base is left free (without Kautham's physics, held kinematic where it is put, like a mobile
+  robot's). In a current problem without Kautham's physics a one-link obstacle body not
+  attached at the start is held where the problem puts it by a FIXED joint to the world
+  (key "name/<hold>", ``BuildPlan.holds``): only an attachment moves an obstacle there; a
+  tracked path's Transfer lets it go when it attaches it and holds it again where it leaves
+  it. ``<InitialAttachedObstacle>`` -> a FIXED joint between the link and the obstacle's
+  (base) body, as they are placed.
 - Shapes: a mesh -> mesh object (vertices in the link frame); one primitive -> primitive
   object whose body sits at the primitive's pose in the link; anything else -> a composite
   whose frame is the link frame (one part per primitive, one for the mesh), id ">p1>p2...".
-- Masses: the file's mass, else ``BuildDefaults.link_mass`` (a .rob ``<Weight>`` is a planner
-  weight, not a mass); a composite's mass is shared among its parts in proportion to their
+- Masses: the file's mass; a URDF robot's link without ``<inertial>`` (massless to URDF and to
+  Kautham, which no body can be) its shape's volume at ``BuildDefaults.massless_density``
+  (water's, at least ``LIGHTEST_LINK``: 1 kg fingertips sagged the Allegro hands' 1 N m
+  joints); else ``BuildDefaults.link_mass`` (1 kg, what Kautham's ODE environment gives an
+  obstacle without a mass; a .rob ``<Weight>`` is a planner weight, not a mass); a composite's mass is shared among its parts in proportion to their
   volumes. Inertia (``gui.core.inertia``): the URDF's tensor about its centre of mass where it
   is a rigid body's and plausible for the link's shape, the shape's at uniform density
-  otherwise. Contact surfaces: the link's (URDF contact coefficients) on its object or parts.
+  otherwise. The world refuses a given inertia far too light in rotation for the body's
+  geometry (a principal radius of gyration under ``odin_common.limits.MIN_GYRATION_FRACTION``
+  of the geometry's reach from that axis: ODE's solver would abort the process), so such a
+  tensor is set aside for the shape's too. Contact surfaces: the link's (URDF contact coefficients) on its object or parts.
 - Names (thesis 8.3): links are "robot/link" (Kautham's own .cntr naming), one-link instances
   keep the instance name; instance names come from the robot's name or the obstacle's file
   name, numbered "_2", "_3"... on collision; composite parts are "name#k".

@@ -12,11 +12,12 @@ from typing import Dict, List, Optional, Tuple
 import numpy as np
 
 from gui.core import inertia as inertia_rule
-from gui.core.bodies import shape_to_body, with_surface
+from gui.core.bodies import shape_to_body, shape_volume, with_surface
 from gui.core.kautham import environment
 from gui.core.kautham.problem import PHYSICS_PLANNERS
-from gui.core.model import CAR, FIXED_BASE, Instance, LinkModel, Problem, warn_once
-from gui.core.plan import (BodySpec, BuildPlan, EntityStep, HoldStep, JointStep, LinkBody,
+from gui.core.model import (CAR, FIXED_BASE, FREE_BODY, MOBILE, Instance, LinkModel, Problem,
+                             warn_once)
+from gui.core.plan import (HOLD, BodySpec, BuildPlan, EntityStep, HoldStep, JointStep, LinkBody,
                            ObjectStep, RobotHandle, StepSizeStep, WorldStep, body_step)
 from gui.core.translate import car, chain
 from gui.core.translate.joints import (fixed_joint, joint_motors, link_drive, link_joint,
@@ -31,6 +32,12 @@ GROUND = "ground"
 """The ground plane's object ID (another name is taken if an instance has it)."""
 
 
+LIGHTEST_LINK = 0.001
+"""kg: the least a URDF robot link without ``<inertial>`` weighs (a tiny shape's volume at
+``BuildDefaults.massless_density`` would make it thousands of times lighter than its
+neighbours, which ODE's solvers handle badly)."""
+
+
 @dataclass(frozen=True)
 class BuildDefaults:
     """How a problem is built. ``ground``: Kautham's physics (its world settings, a ground
@@ -41,10 +48,13 @@ class BuildDefaults:
     start in current problems and Home in 2012 ones (None).
     ``hold_start``: robots' joints held by servos where they are built (``HoldStep``), or
     left to their motors at zero speed (False: as the thesis's experiments were run).
+    ``link_mass``, ``massless_density``: what a link whose file gives no mass weighs
+    (``_Planner._default_mass``).
     ``inertia``: "auto", "file" or "shape" (``gui.core.inertia``). ``max_contact_sink``: m,
     the deepest a body may rest in a contact the planner's CFM softens
     (``gui.core.world_settings``)."""
     link_mass: float = 1.0          # kg, a link or movable obstacle without a mass
+    massless_density: float = 1000.0    # kg/m^3, a URDF robot link without <inertial>
     internal_collisions: bool = False
     ground: Optional[bool] = None
     start_at_query: Optional[bool] = None
@@ -68,11 +78,22 @@ class _Planner:
         start = defaults.start_at_query
         self.start_at_query = problem.format == "current" if start is None else start
         attached = {a.obstacle for a in problem.attachments}
-        # bodies: movable obstacles, attached ones, and every current obstacle under
-        # Kautham's physics (its ODE environment makes them all dynamic)
+        # bodies: movable obstacles (2012 .rob scenes), attached ones, and every current
+        # obstacle under Kautham's physics (its ODE environment makes them all dynamic); in a
+        # geometric problem Kautham never moves the others
         self.dynamic = {i.name for i in problem.obstacles
                         if i.movable or i.name in attached
                         or (self.physics and problem.format == "current")}
+        # Kautham's controls place a free-flying or mobile robot's base (and a robot standing
+        # as an obstacle, a 2012 .rob scene with joints, stays where it is put): without
+        # Kautham's physics nothing else moves them, so their base is held (kinematic)
+        self.hold_free_bases = not self.physics
+        # a current problem's obstacle body (its URDF gives a mass: an object a task may
+        # carry) stays where the problem puts it until a task attaches it: without Kautham's
+        # physics only an attachment moves an obstacle (the thesis's 2012 movable scenes fall
+        # and are pushed, as Odin always built them)
+        self.hold_obstacles = not self.physics and problem.format == "current"
+        self.attached = attached
         # Kautham's chain planner drives its chain's joints as PlanarChainEnvironment does,
         # its car planner sets its car's wheel axes as CarEnvironment does
         planned = PHYSICS_PLANNERS.get(problem.planner.name) if problem.physics else None
@@ -129,18 +150,25 @@ class _Planner:
         single = len(inst.model.links) == 1
         if static or (single and inst.role == "obstacle"):
             self.steps.extend(body_step(s) for s in specs)
+            if not static and self.hold_obstacles and inst.name not in self.attached:
+                self.steps.append(JointStep(f"{inst.name}/{HOLD}", inst.name,
+                                            fixed_joint(specs[0].id, "")))
             return
         robot = inst.role == "robot"
         holding: List[JointStep] = []
         if robot and inst.kind == FIXED_BASE and not single:
             specs, holding = chain.hold_base(inst.name, specs, self.problem.format)
+        held = self.hold_free_bases and (not robot or inst.kind in (FREE_BODY, MOBILE))
+        if held:
+            specs = [dataclasses.replace(specs[0], fixed=True)] + specs[1:]
         self.steps.append(EntityStep(EntitySpec(
             name=inst.name,
             objects=tuple(s for s in specs if isinstance(s, ObjectSpec)),
             composites=tuple(s for s in specs if isinstance(s, CompositeSpec)),
             internal_collisions=self.defaults.internal_collisions)))
         handle = RobotHandle(inst, bodies, [], home=inst.model.home(), built_at=built_at,
-                             base_pose=base_pose, kind=inst.kind, base_mass=specs[0].mass)
+                             base_pose=base_pose, kind=inst.kind, base_mass=specs[0].mass,
+                             base_held=held)
         if not single:
             self.steps.extend(holding)
             self._joints(inst, handle, base_pose, built_at)
@@ -156,7 +184,7 @@ class _Planner:
         specs, bodies = [], []
         for link, pose in zip(model.links, model.link_poses(base_pose, built_at)):
             name = inst.name if single else f"{inst.name}/{link.name}"
-            mass = link.mass if link.mass is not None else self.defaults.link_mass
+            mass = link.mass if link.mass is not None else self._default_mass(inst, link)
             spec, offset = shape_to_body(name, link.shape, pose, mass, static)
             if not static:
                 spec = self._mass_properties(spec, link, name, mass, offset)
@@ -168,6 +196,19 @@ class _Planner:
         if not inst.collision:   # <Collision enabled="false">: the world never pairs it
             specs = [dataclasses.replace(s, no_collisions=True) for s in specs]
         return specs, bodies
+
+    def _default_mass(self, inst: Instance, link: LinkModel) -> float:
+        """kg, a link whose file gives no mass: a URDF robot's link without ``<inertial>``
+        (massless to URDF and to Kautham, which no body can be) weighs its shape's volume at
+        ``BuildDefaults.massless_density``; any other (a .rob link, an obstacle, a link
+        without a shape) ``BuildDefaults.link_mass``, as Kautham's ODE environment gives an
+        obstacle without a mass 1 kg."""
+        if inst.role != "robot" or inst.model.kind != "urdf" or link.shape is None:
+            return self.defaults.link_mass
+        volume = shape_volume(link.shape)
+        if volume <= 0:
+            return self.defaults.link_mass
+        return max(self.defaults.massless_density * volume, LIGHTEST_LINK)
 
     def _surface(self, inst: Instance, link: LinkModel, name: str) -> Surface:
         """The contact surface of ``inst``'s ``link`` (body ``name``): its URDF's, but for
