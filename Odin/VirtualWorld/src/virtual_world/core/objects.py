@@ -227,7 +227,7 @@ def _build_geometry(scene: Scene, p: _Prepared, part: _Part, body, tag: int) -> 
     if shape.kind == "mesh":
         vertices, triangles = collision_mesh(shape, scene.parameters.collision_mesh_tolerance)
         geom = handles.new_trimesh(scene.c.space, vertices, triangles, scene.take_serial(),
-                                   body)
+                                   body, meshes=scene.meshes)
     elif shape.kind == "plane":
         geom = handles.new_primitive(scene.c.space, "plane", _plane(p.position, p.orientation),
                                      scene.take_serial())
