@@ -216,8 +216,9 @@ def new_trimesh(space: Owner, vertices: np.ndarray, triangles: np.ndarray, seria
 
 
 #: triangles of trimesh data no geom uses that a TriMeshDataCache keeps for later geoms by
-#: default: the TX90 + hand + cans of Kautham's flagship problem collide with ~120,000
-#: (building them took ~0.5 s of every load); ODE's data costs ~100 bytes a triangle
+#: default: the TX90 + hand + cans of Kautham's flagship problem collide with ~77,000 (14
+#: data for 28 meshes; building them took ~0.45 s of every load); with its arrays a data
+#: holds ~60 bytes a triangle, so at most ~60 MB stay idle
 IDLE_TRIANGLES = 1_000_000
 
 
