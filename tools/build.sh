@@ -23,4 +23,8 @@ if ! make_workspace "${force[@]}"; then
   then :; else tail -40 "$root/build/catkin_make.log" >&2; exit 1; fi
 fi
 touch "$ws/build/.odin-configured"
+# byte-compile the stack and the generated messages now: a process that cannot write them
+# (PYTHONDONTWRITEBYTECODE, a read-only tree) would compile ~100 modules on every start
+# (~0.45 s of each load_problem)
+"$python" -m compileall -q "$root/Odin" "$ws/devel/lib" > /dev/null
 echo "build.sh: catkin workspace built in $ws"

@@ -5,6 +5,7 @@ import json
 import math
 import os
 import pathlib
+import time
 
 import numpy as np
 import pytest
@@ -44,6 +45,33 @@ def test_load_problem_error_builds_nothing(world, tmp_path):
     result = world.run(["rosrun", "GUI", "load_problem", str(bad)], check=False, timeout=60)
     assert result.returncode != 0
     assert result.stderr.strip().count("\n") == 0 and f"{bad}:3:" in result.stderr
+
+
+def test_load_problem_names_a_bad_file_at_once_while_it_still_looks_for_the_world(
+        ros_master, tmp_path):
+    """The world is looked for while the problem is read (the two overlap): a bad file is
+    still the one error, at once, not after the 30 s the world would be waited for."""
+    bad = tmp_path / "bad.xml"
+    bad.write_text('<?xml version="1.0"?>\n<Problem>\n <Robot robot="nope.rob"/>\n</Problem>\n')
+    started = time.monotonic()
+    result = ros_master.run(["rosrun", "GUI", "load_problem", str(bad), "--timeout", "30"],
+                            check=False, timeout=60)
+    assert result.returncode == 2
+    assert result.stderr.strip().count("\n") == 0 and f"{bad}:3:" in result.stderr
+    assert time.monotonic() - started < 20
+
+
+def test_load_problem_without_a_world_says_so_in_one_line_after_its_timeout(ros_master,
+                                                                            legacy):
+    started = time.monotonic()
+    result = ros_master.run(["rosrun", "GUI", "load_problem", "--timeout", "2",
+                             str(legacy / "TX90_RHand_ICRA10_5PMD_TwoCan.xml")],
+                            check=False, timeout=60)
+    assert result.returncode == 2
+    errors = [line for line in result.stderr.splitlines() if ": warning: " not in line]
+    assert errors == ["load_problem: error: /virtual_world: no VirtualWorld answering after "
+                      "2 s (is `rosrun VirtualWorld virtualWorld` running?)"]
+    assert 2.0 <= time.monotonic() - started < 20
 
 
 def test_initial_position_and_paths_move_the_links(world, tmp_path, legacy):

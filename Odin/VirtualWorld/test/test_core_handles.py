@@ -33,6 +33,14 @@ def kinds(freed):
     return collections.Counter(kind for kind, _ in freed)
 
 
+def frees(freed):
+    """Destroy calls per kind (addresses may be reused)."""
+    counts = collections.Counter()
+    for (kind, _), count in freed.items():
+        counts[kind] += count
+    return counts
+
+
 def build_scene(core):
     core.build_object(ObjectSpec("ground", [4, 4, 1], position=(0, 0, -0.5), geometry_only=True))
     core.build_object(ObjectSpec("s", [0.1], position=(0, 0, 1)))
@@ -100,7 +108,7 @@ def test_remove_object_frees_its_handles_and_reports_ids(spy):
     removed = core.remove_object("mesh")
     assert removed == vc.Removed(("1:s&mesh",), ("motor:1:s&mesh",),
                                  ("jointforce:1:s&mesh:0",), ("mesh",))
-    assert kinds(spy) == {"joint": 2, "geom": 1, "trimeshdata": 1, "body": 1}
+    assert kinds(spy) == {"joint": 2, "geom": 1, "body": 1}   # its trimesh data kept idle
     spy.clear()
     removed = core.remove_object(">p1>p2")
     assert removed.geometries == ("p1", "p2") and removed.joints == ("0:>p1>p2&",)
@@ -113,9 +121,9 @@ def test_remove_object_frees_its_handles_and_reports_ids(spy):
 def test_new_scene_and_close_free_everything_once(spy):
     core = Core()
     build_scene(core)
-    core.new_scene()
+    core.new_scene()  # the mesh's trimesh data is kept for the next scene
     assert kinds(spy) == {"world": 1, "space": 1, "jointgroup": 1, "body": 3, "geom": 5,
-                          "trimeshdata": 1, "joint": 3}
+                          "joint": 3}
     assert all(count == 1 for count in spy.values())
     assert core.poses()[0] == [] and core.object_ids() == [] and core.sim_time == 0.0
     assert core.joint_ids() == [] and core.motor_ids() == [] and core.body_force_ids() == []
@@ -126,6 +134,75 @@ def test_new_scene_and_close_free_everything_once(spy):
     assert kinds(spy) == {"world": 1, "space": 1, "jointgroup": 1, "body": 3, "geom": 5,
                           "trimeshdata": 1, "joint": 3}
     assert all(count == 1 for count in spy.values())
+
+
+def box_mesh():
+    return (np.array(BOX_V, dtype=float).reshape(-1, 3),
+            np.array(BOX_I, dtype=np.uint32).reshape(-1, 3))
+
+
+def test_geoms_over_the_same_mesh_share_one_trimesh_data(spy):
+    space, cache = handles.new_space(), handles.TriMeshDataCache()
+    vertices, triangles = box_mesh()
+    first = handles.new_trimesh(space, vertices, triangles, serial=1, meshes=cache)
+    second = handles.new_trimesh(space, vertices.copy(), triangles.copy(), serial=2,
+                                 meshes=cache)
+    other = handles.new_trimesh(space, vertices * 2, triangles, serial=3, meshes=cache)
+    assert cache.builds == 2 and cache.sizes == (2, 0)
+    def data(geom):
+        return geom._handle.keep[0].data.address      # the lease the geom holds
+
+    assert data(first) == data(second) != data(other)
+    first.close()
+    assert kinds(spy) == {"geom": 1} and cache.sizes == (2, 0)   # the second still uses it
+    second.close()
+    other.close()
+    assert kinds(spy) == {"geom": 3} and cache.sizes == (2, 2)   # idle, kept
+    cache.close()
+    assert kinds(spy) == {"geom": 3, "trimeshdata": 2} and cache.sizes == (0, 0)
+    assert all(count == 1 for count in spy.values())
+    space.close()
+
+
+def test_trimesh_data_no_geom_uses_is_freed_beyond_the_idle_budget(spy):
+    space, cache = handles.new_space(), handles.TriMeshDataCache(idle_triangles=12)
+    vertices, triangles = box_mesh()                                # 12 triangles each
+    geoms = [handles.new_trimesh(space, vertices * (k + 1), triangles, serial=k + 1,
+                                 meshes=cache) for k in range(3)]
+    geoms[0].close()
+    assert kinds(spy) == {"geom": 1} and cache.sizes == (3, 1)
+    geoms[1].close()                               # 24 idle triangles: the oldest goes
+    assert frees(spy) == {"geom": 2, "trimeshdata": 1} and cache.sizes == (2, 1)
+    again = handles.new_trimesh(space, vertices * 2, triangles, serial=4, meshes=cache)
+    assert cache.builds == 3 and cache.sizes == (2, 0)             # the idle one, reused
+    cache.close()                                  # still leased: freed after its last geom
+    assert frees(spy) == {"geom": 2, "trimeshdata": 1}
+    again.close()
+    geoms[2].close()
+    assert frees(spy) == {"geom": 4, "trimeshdata": 3} and cache.sizes == (0, 0)
+    space.close()
+
+
+def test_new_scene_reuses_the_trimesh_data_and_collides_as_a_fresh_world():
+    def drop_on_mesh(core):
+        core.build_object(ObjectSpec("mesh", BOX_V, BOX_I, position=(0, 0, 0),
+                                     geometry_only=True))
+        core.build_object(ObjectSpec("ball", [0.05], position=(0.02, 0.01, 0.3)))
+        core.step(0.001, 600)
+        return core.body_state("ball")
+
+    fresh = Core()
+    expected = drop_on_mesh(fresh)
+    fresh.close()
+    core = Core()
+    drop_on_mesh(core)
+    core.new_scene()
+    again = drop_on_mesh(core)
+    assert core._meshes.builds == 1
+    assert again[0][2] == pytest.approx(0.15, abs=2e-3)             # resting on the box
+    for got, want in zip(again, expected):
+        np.testing.assert_array_equal(got, want)                   # bit for bit
+    core.close()
 
 
 def test_new_scene_keeps_world_parameters():

@@ -90,3 +90,20 @@ def test_set_poses_keeps_the_velocities_unless_told_to_reset_them(core):
     core.step(H, 10)
     np.testing.assert_allclose(core.body_state("ball")[0], (0.0, 0.0, 2.0), atol=1e-15)
     np.testing.assert_allclose(core.body_state("other")[2], (1.0, 2.0, 3.0))   # untouched
+
+
+def test_a_built_geometry_keeps_a_messages_arrays_and_flattens_any_other_sequence(core):
+    """A message's float64[] and uint32[] arrive as tuples of floats and ints: given back as
+    they are (no copy of a large mesh); lists, arrays and ints become flat float and int
+    tuples."""
+    corners = (0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
+    faces = (0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3)
+    built = core.build_object(ObjectSpec("tetra", corners, faces)).geometries[0]
+    assert built.parameters is corners and built.indices is faces
+    box = core.build_object(ObjectSpec("box", [1, 2, 3], position=(3, 0, 0))).geometries[0]
+    assert box.parameters == (1.0, 2.0, 3.0) and type(box.parameters[0]) is float
+    mesh = core.build_object(ObjectSpec("mesh", np.array(corners).reshape(4, 3),
+                                        np.array(faces, np.uint32).reshape(4, 3),
+                                        position=(6, 0, 0))).geometries[0]
+    assert mesh.parameters == corners and mesh.indices == faces
+    assert {type(v) for v in mesh.parameters + mesh.indices} == {float, int}

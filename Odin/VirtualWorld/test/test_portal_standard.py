@@ -236,6 +236,15 @@ def test_a_large_mesh_marker_is_simplified_as_the_viewer_draws_it():
     assert shape.point_count < len(indices) / 2
 
 
+def test_a_mesh_marker_is_made_once_per_mesh_content():
+    vertices = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
+    indices = [0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3]
+    first = marker_shape(vertices.ravel(), indices, 0)
+    assert marker_shape(tuple(vertices.ravel()), np.array(indices), 0) is first
+    moved = marker_shape((vertices + 1).ravel(), indices, 0)
+    assert moved is not first and moved.points != first.points
+
+
 # -- robots and the mirror with a real Core ----------------------------------------------------
 
 def _pendulum(core: Core, mirror: WorldMirror) -> str:

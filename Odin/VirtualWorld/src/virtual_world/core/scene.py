@@ -13,15 +13,20 @@ from odin_common.world_parameters import WorldParameters
 from virtual_world.core.records import (BodyForceRecord, Collision, GeometryRecord,
                                         JointForceRecord, JointRecord, MotorRecord, ObjectRecord)
 from virtual_world.errors import Unsupported, UnknownName
+from virtual_world.ode.handles import TriMeshDataCache
 from virtual_world.ode.world import CWorld, PoseReader
 
 
 class Scene:
     """The ODE world (``c``) and every record of what it holds."""
 
-    def __init__(self, parameters: WorldParameters, resources: ResourceLimits):
+    def __init__(self, parameters: WorldParameters, resources: ResourceLimits,
+                 meshes: Optional[TriMeshDataCache] = None):
+        """``meshes``: the trimesh data this scene's mesh geoms share (the Core's, kept across
+        New Scenes); None: each geom builds its own."""
         self.parameters = parameters
         self.resources = resources
+        self.meshes = meshes
         self.c = CWorld(parameters)
         self.objects: Dict[str, ObjectRecord] = {}
         self.geometries: Dict[str, GeometryRecord] = {}

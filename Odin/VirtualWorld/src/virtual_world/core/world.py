@@ -33,6 +33,7 @@ from virtual_world.core.records import (BodyState, Built, BuiltEntity, Collision
 from virtual_world.core.scene import Scene
 from virtual_world.errors import Closed, InvalidArgument, UnknownName
 from virtual_world.ode import bodies
+from virtual_world.ode.handles import TriMeshDataCache
 from virtual_world.ode.runtime import init_ode
 
 
@@ -52,7 +53,9 @@ class Core:
         check.shared(parameters.validate)
         self._lock = threading.RLock()
         self.resources = resources
-        self._scene: Optional[Scene] = Scene(parameters, resources)
+        # built trimesh data outlives the scene: the same meshes come back after New Scene
+        self._meshes = TriMeshDataCache()
+        self._scene: Optional[Scene] = Scene(parameters, resources, self._meshes)
 
     # ------------------------------------------------------------------ lifetime
 
@@ -62,7 +65,7 @@ class Core:
         same world parameters; sim_time restarts at 0."""
         parameters = self._scene.parameters
         self._scene.close()
-        self._scene = Scene(parameters, self.resources)
+        self._scene = Scene(parameters, self.resources, self._meshes)
 
     def close(self) -> None:
         """Frees everything; idempotent. Any later call but close() raises Closed."""
@@ -70,6 +73,7 @@ class Core:
             if self._scene is not None:
                 self._scene.close()
                 self._scene = None
+                self._meshes.close()
 
     def __enter__(self) -> "Core":
         return self

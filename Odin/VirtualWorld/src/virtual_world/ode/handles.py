@@ -10,14 +10,17 @@ Rules (dm_control / pymunk style):
     joints behind their owners' backs, and dBodyDestroy would turn attached geoms into static
     ones): the order is kept in handle records (_Handle) that hold no owner; spaces are
     created with cleanup off, so geoms are only ever destroyed by their owners;
-  * a trimesh geom keeps its vertex and index arrays (ODE does not copy them) and its trimesh
-    data owner alive, and frees that data after the geom.
+  * a trimesh geom holds a lease on its trimesh data (``TriMeshDataCache``: one built data per
+    mesh content, shared by every geom over that mesh, with the vertex and index arrays ODE
+    does not copy) and returns it after the geom is freed; the data is freed once no geom
+    holds it and the cache keeps it no longer.
 
 Arguments are the Core's, already checked: ODE ends the process on bad input.
 The destroy functions are looked up in ``DESTROYERS`` at call time so tests can spy on them.
 """
 from __future__ import annotations
 
+import collections
 import weakref
 from typing import Any, Callable, Dict, Iterable, Optional, Sequence, Tuple
 
@@ -68,8 +71,8 @@ class _Handle:
         DESTROYERS[self.kind](ptr)
         for parent in self.parents:
             parent.children.pop(id(self), None)
-        for item in self.keep:  # owners kept by this handle (a trimesh's data) go right after it
-            if isinstance(item, Owner):
+        for item in self.keep:  # what this handle kept (a trimesh's data) goes right after it
+            if isinstance(item, (Owner, TriMeshLease)):
                 item.close()
         self.keep = ()
 
@@ -197,23 +200,126 @@ def new_primitive(space: Owner, kind: str, dims: Sequence[float], serial: int,
 
 @drains_ode_messages
 def new_trimesh(space: Owner, vertices: np.ndarray, triangles: np.ndarray, serial: int,
-                body: Optional[Owner] = None) -> Owner:
+                body: Optional[Owner] = None,
+                meshes: Optional["TriMeshDataCache"] = None) -> Owner:
     """A trimesh geom over ``vertices`` (n, 3) m and ``triangles`` (m, 3) indices.
 
-    ODE keeps pointers to the arrays without copying them: they are copied into cffi arrays
-    that the geom's owner keeps alive with the trimesh data owner; the data is freed right
-    after the geom."""
-    vertices = ffi.new("double[]", np.asarray(vertices, dtype=float).reshape(-1).tolist())
-    indices = ffi.new("dTriIndex[]", np.asarray(triangles).reshape(-1).tolist())
+    Its trimesh data is leased from ``meshes`` (shared with every geom over the same mesh and
+    kept for later ones), or built for this geom alone without a cache; the geom's owner
+    returns the lease right after freeing the geom."""
+    lease = (meshes or TriMeshDataCache(idle_triangles=0)).lease(vertices, triangles)
+    ptr = lib.dCreateTriMesh(space.ptr, lease.data.ptr, ffi.NULL, ffi.NULL, ffi.NULL)
+    if ptr == ffi.NULL:
+        lease.close()
+        raise MemoryError("ODE returned NULL for a new trimesh")
+    return new_geom(ptr, space, serial, body, keep=(lease,))  # the lease goes after the geom
+
+
+#: triangles of trimesh data no geom uses that a TriMeshDataCache keeps for later geoms by
+#: default: the TX90 + hand + cans of Kautham's flagship problem collide with ~77,000 (14
+#: data for 28 meshes; building them took ~0.45 s of every load); with its arrays a data
+#: holds ~60 bytes a triangle, so at most ~60 MB stay idle
+IDLE_TRIANGLES = 1_000_000
+
+
+class _MeshEntry:
+    """One built trimesh data (its owner keeps the arrays ODE points into) and its users."""
+
+    __slots__ = ("data", "triangles", "users")
+
+    def __init__(self, data: Owner, triangles: int):
+        self.data = data
+        self.triangles = triangles
+        self.users = 0
+
+
+class TriMeshLease:
+    """A geom's hold on shared trimesh ``data`` (an Owner); ``close()`` (idempotent) gives
+    it back to its cache."""
+
+    __slots__ = ("data", "_cache", "_key")
+
+    def __init__(self, cache: "TriMeshDataCache", key: Tuple[bytes, bytes], data: Owner):
+        self.data = data
+        self._cache = cache
+        self._key = key
+
+    def close(self) -> None:
+        if self._cache is not None:
+            cache, self._cache = self._cache, None
+            cache._release(self._key)
+
+
+class TriMeshDataCache:
+    """Built trimesh data (dGeomTriMeshDataBuildDouble) per mesh content: the vertices
+    (float64, m) and triangles (uint32) exactly as given, so a geom over shared data collides
+    bit for bit as over its own. Data in use is shared; data no geom uses is kept, most
+    recently released last, up to ``idle_triangles`` triangles (the same robot comes back
+    after every New Scene), and freed when it falls out or on ``close()``. The only owner of
+    each data: a geom holds a TriMeshLease, never the data itself."""
+
+    def __init__(self, idle_triangles: int = IDLE_TRIANGLES):
+        self.idle_triangles = idle_triangles
+        self._entries: Dict[Tuple[bytes, bytes], _MeshEntry] = {}
+        self._idle: "collections.OrderedDict[Tuple[bytes, bytes], None]" = \
+            collections.OrderedDict()
+        self._closed = False
+        self.builds = 0  # data built so far (the others were shared or kept)
+
+    def lease(self, vertices: np.ndarray, triangles: np.ndarray) -> TriMeshLease:
+        """A lease on the data of ``vertices`` (n, 3) m and ``triangles`` (m, 3) indices,
+        built now unless data of the very same arrays exists."""
+        vertex_bytes = np.ascontiguousarray(vertices, dtype=np.float64).tobytes()
+        index_bytes = np.ascontiguousarray(triangles, dtype=np.uint32).tobytes()
+        key = (vertex_bytes, index_bytes)
+        entry = self._entries.get(key)
+        if entry is None:
+            entry = self._entries[key] = _MeshEntry(_build_data(vertex_bytes, index_bytes),
+                                                    len(index_bytes) // 12)
+            self.builds += 1
+        self._idle.pop(key, None)
+        entry.users += 1
+        return TriMeshLease(self, key, entry.data)
+
+    def _release(self, key: Tuple[bytes, bytes]) -> None:
+        entry = self._entries[key]
+        entry.users -= 1
+        if entry.users == 0:
+            self._idle[key] = None
+            self._trim(0 if self._closed else self.idle_triangles)
+
+    def _trim(self, budget: int) -> None:
+        """Frees the least recently released idle data until at most ``budget`` triangles
+        of idle data are left."""
+        idle = sum(self._entries[key].triangles for key in self._idle)
+        while self._idle and idle > budget:
+            key, _ = self._idle.popitem(last=False)
+            entry = self._entries.pop(key)
+            idle -= entry.triangles
+            entry.data.close()
+
+    @property
+    def sizes(self) -> Tuple[int, int]:
+        """(data held, of which idle)."""
+        return len(self._entries), len(self._idle)
+
+    def close(self) -> None:
+        """Frees the idle data now, and any data still leased when its last geom goes."""
+        self._closed = True
+        self._trim(0)
+
+
+def _build_data(vertex_bytes: bytes, index_bytes: bytes) -> Owner:
+    """Trimesh data over read-only copies of the arrays: ODE keeps pointers to them without
+    copying, so the data's owner keeps them alive (cffi buffers over the bytes: no per-value
+    conversion)."""
+    vertices = ffi.from_buffer("double[]", vertex_bytes)
+    indices = ffi.from_buffer("dTriIndex[]", index_bytes)
     data = Owner("trimeshdata", lib.dGeomTriMeshDataCreate(), keep=(vertices, indices))
     lib.dGeomTriMeshDataBuildDouble(data.ptr, vertices, 3 * ffi.sizeof("double"),
                                     len(vertices) // 3, indices, len(indices),
                                     3 * ffi.sizeof("dTriIndex"))
-    ptr = lib.dCreateTriMesh(space.ptr, data.ptr, ffi.NULL, ffi.NULL, ffi.NULL)
-    if ptr == ffi.NULL:
-        data.close()
-        raise MemoryError("ODE returned NULL for a new trimesh")
-    return new_geom(ptr, space, serial, body, keep=(vertices, indices, data))  # data after geom
+    return data
 
 
 # ---------------------------------------------------------------------------------- joints

@@ -50,7 +50,10 @@ def display_color(color: Sequence[float]) -> Tuple[float, float, float, float]:
     return DEFAULT_COLOR if not any(values) else values
 
 
-@dataclass
+_IDENTITY = ((0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0))   # (position, quaternion (w, x, y, z))
+
+
+@dataclass(frozen=True)
 class _Shape:
     """What a geometry looks like as a marker, in the geometry's own frame."""
     type: int
@@ -65,26 +68,49 @@ def marker_shape(parameters: Sequence[float], indices: Sequence[int], shape: int
     Core)."""
     params = np.asarray(parameters, dtype=float).reshape(-1)
     kind = shape_of(params.size, shape)
-    identity = ((0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0))
     if kind == Shape.SPHERE:
         d = 2 * params[0]
-        return _Shape(Marker.SPHERE, (d, d, d), identity, b"", 0)
+        return _Shape(Marker.SPHERE, (d, d, d), _IDENTITY, b"", 0)
     if kind == Shape.CYLINDER:
         d = 2 * params[0]
-        return _Shape(Marker.CYLINDER, (d, d, params[1]), identity, b"", 0)
+        return _Shape(Marker.CYLINDER, (d, d, params[1]), _IDENTITY, b"", 0)
     if kind == Shape.BOX:
-        return _Shape(Marker.CUBE, tuple(params[:3]), identity, b"", 0)
+        return _Shape(Marker.CUBE, tuple(params[:3]), _IDENTITY, b"", 0)
     if kind == Shape.PLANE:
         return _Shape(Marker.CUBE, (PLANE_DRAWN_SIZE, PLANE_DRAWN_SIZE, PLANE_DRAWN_THICKNESS),
                       ((0.0, 0.0, -PLANE_DRAWN_THICKNESS / 2), (1.0, 0.0, 0.0, 0.0)), b"", 0)
     if kind == Shape.CAPSULE:
-        vertices, triangles = capsule_mesh(params[0], params[1])
-    else:
+        return _triangle_list(*capsule_mesh(params[0], params[1]))
+    key = (params.tobytes(), np.asarray(indices, np.int64).tobytes())
+    marker = _MESH_MARKERS.pop(key, None)
+    if marker is None:
         vertices, triangles = display_mesh(params.reshape(-1, 3), indices)
-        triangles = facing_outwards(vertices, triangles)   # RViz lights the front side only
+        # RViz lights the front side only
+        marker = _triangle_list(vertices, facing_outwards(vertices, triangles))
+    _MESH_MARKERS[key] = marker   # most recently used last
+    _trim_mesh_markers()
+    return marker
+
+
+def _triangle_list(vertices: np.ndarray, triangles: np.ndarray) -> _Shape:
     corners = np.ascontiguousarray(vertices[triangles], dtype="<f8")
-    return _Shape(Marker.TRIANGLE_LIST, (1.0, 1.0, 1.0), identity, corners.tobytes(),
+    return _Shape(Marker.TRIANGLE_LIST, (1.0, 1.0, 1.0), _IDENTITY, corners.tobytes(),
                   len(corners))
+
+
+_MESH_MARKERS: "collections.OrderedDict[Tuple[bytes, bytes], _Shape]" = \
+    collections.OrderedDict()
+"""Markers of the meshes built lately, by their exact parameters and indices: simplifying a
+mesh for display is most of a build's marker cost (~0.3 s for the TX90 + hand), and the same
+robot comes back after every New Scene. Markers are never changed once made."""
+#: bytes of points the cache of mesh markers keeps at most (the TX90 + hand: ~15 MB)
+MESH_MARKER_BYTES = 64 * 2 ** 20
+
+
+def _trim_mesh_markers() -> None:
+    held = sum(len(m.points) for m in _MESH_MARKERS.values())
+    while len(_MESH_MARKERS) > 1 and held > MESH_MARKER_BYTES:
+        held -= len(_MESH_MARKERS.popitem(last=False)[1].points)
 
 
 class _GeometryMarker:
