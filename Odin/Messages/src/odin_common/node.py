@@ -13,11 +13,12 @@ registers everything again the way rospy does at start when it does not.
 """
 from __future__ import annotations
 
+import signal
 import sys
 import threading
 import time
 import xmlrpc.client
-from typing import Optional
+from typing import Callable, Optional
 
 import rosgraph
 import rospy
@@ -48,6 +49,21 @@ def init_ros_node(name: str, disable_signals: bool = False, poll: float = 0.5,
             raise KeyboardInterrupt from None
         raise
     prompt_shutdown()
+
+
+def stop_on_signals(stop: Callable[[], None]) -> None:
+    """SIGINT and SIGTERM call ``stop()`` and nothing else, for a node whose main thread runs
+    its own loop (the world's): it stops the loop, and the node shuts rospy down once the
+    loop has returned (``rospy.signal_shutdown``). ``stop`` must take no lock the main thread
+    may hold: it runs inside whatever that thread was doing.
+
+    rospy's own handler runs its whole shutdown there instead, closing every topic: a signal
+    that came while the loop published (a topic's lock held) waited for that lock forever, and
+    the world ignored Ctrl-C until it was killed."""
+    def handler(signum, frame) -> None:
+        stop()
+    for number in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(number, handler)
 
 
 def prompt_shutdown() -> None:

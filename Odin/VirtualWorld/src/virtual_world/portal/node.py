@@ -64,7 +64,7 @@ from Services import srv
 from odin_common import OdinError, replies
 from odin_common.interface import WORLD_SERVICES, DivergencePolicy
 from odin_common.limits import ResourceLimits
-from odin_common.node import MasterWatch, init_ros_node
+from odin_common.node import MasterWatch, init_ros_node, stop_on_signals
 from odin_common.world_parameters import PARAMETERS
 from virtual_world.core import Core, step_values
 from virtual_world.core.loop import CycleReport, RealTimeFactor, WorldLoop
@@ -274,7 +274,10 @@ class Portal:
         return {name: (positions[i], quaternions[i]) for i, name in enumerate(names)}
 
 def main() -> None:
-    init_ros_node("virtual_world")
+    # the loop runs on this thread: Ctrl-C and SIGTERM only stop it (stop_on_signals)
+    init_ros_node("virtual_world", disable_signals=True)
+    asked = threading.Event()
+    stop_on_signals(asked.set)                  # while the portal is being made
     MasterWatch()
     try:
         portal = Portal()
@@ -285,4 +288,8 @@ def main() -> None:
     rospy.loginfo("virtual_world ready: step %g s x %d per cycle at %g Hz",
                   portal.loop.step_values.step, portal.loop.step_values.steps_per_cycle,
                   portal.loop.step_values.rate)
+    stop_on_signals(portal.loop.stop)
+    if asked.is_set():
+        portal.loop.stop()
     portal.run()
+    rospy.signal_shutdown("the world loop stopped")
