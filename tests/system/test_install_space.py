@@ -83,7 +83,8 @@ print("z", core.body_state("ball")[0][2])
     assert z == pytest.approx(1.0 - 0.5 * 9.81 * 0.1 ** 2, abs=0.01)
 
 
-@pytest.mark.slow
+# not marked slow, unlike the test above: it runs after it (slow tests go first), on the
+# install space that test's worker built, instead of waiting beside it for the build
 def test_a_node_started_from_the_install_space_serves(install_env, ros_master):
     env = dict(install_env)
     env.update({key: ros_master.env[key] for key in ("ROS_MASTER_URI", "ROS_HOME", "ROS_IP",
