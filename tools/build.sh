@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Builds the catkin workspace build/ws (its src/Odin is a link to the stack) with the venv's
-# Python. Called by tools/install.sh; run it again after editing .msg/.srv or the C extension.
+# Python, and the install space build/install_ws (tools/install_space.sh). Called by
+# tools/install.sh; run it again after editing .msg/.srv or the C extension.
 set -eo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 ws="$root/build/ws"
@@ -28,3 +29,6 @@ touch "$ws/build/.odin-configured"
 # (~0.45 s of each load_problem)
 "$python" -m compileall -q "$root/Odin" "$ws/devel/lib" > /dev/null
 echo "build.sh: catkin workspace built in $ws"
+# the install space make test checks (tests/system/test_install_space.py), built now so that a
+# test run recompiles only what changed (held by the test's lock: two at once would collide)
+(flock 9; "$root/tools/install_space.sh") 9> "$root/build/install_ws.lock"
