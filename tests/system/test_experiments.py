@@ -223,22 +223,15 @@ def test_plan_chain_pushes_box2_aside_and_reaches_kautham_s_goal_threshold():
         name for pair in o["chain_touched"] for name in pair)
 
 
-@pytest.mark.forked
-def test_plan_car_drives_kautham_s_car_to_its_goal_pushing_a_cube_aside():
-    """KPIECE1 plans Kautham's car demo (k-PMPCar.xml, vendored), built as Kautham's
-    CarEnvironment builds it (world wheel axes, its contact friction): the car drives from the
-    arena's north-east corner to the south-west one, pushes a cube out of its way, touches no
-    wall, ends on its wheels, and the plan replays bit for bit in a fresh world node, which
-    declares the car with its hinge-2 wheels (tools/experiments/plan_car.py)."""
-    import plan_car
-    o = _planned_and_replayed(plan_car)
-    # seed 6 solves it in 22,006 propagations, 1,301 rows of 0.05 s
-    assert o["planner"]["propagations"] == 22006 and o["rows_run"] == 1301
-    assert o["goal_tolerance_m"] == 0.25
-    assert ["SimpleCar/base_link", "cubeDE2"] in o["car_touched"]
-    assert o["obstacles_moved_in_the_plane_m"]["cubeDE2"] > 1.0
-    # it ends resting on its suspension at its ride height (its chassis 0.16 m up unloaded)
-    assert 0.09 < o["executed_end_m"][2] < 0.14
+# Kautham's car demo planned and driven (tools/experiments/plan_car.py) is not here but in
+# `make experiments`, whose verdict checks the same outcomes (plan_car.checks: seed 6's 22,006
+# propagations and 1,301 rows, the cube pushed aside, no wall touched, the bit-identical
+# replay, the car at rest on its wheels): its 22,006 propagations are 35-40 s of one core
+# alone and took 60 s here while three workers share two cores, and make test holds no test
+# over 60 s (issue 32). The car's pieces stay here: its planning problem and propagations
+# (Odin/GUI/test/test_planning_robots.py), its control paths run in a world node and their
+# distance to the goal (tests/nodes/test_run_path_reports.py), its build
+# (Odin/GUI/test/test_kautham_physics.py).
 
 
 def test_one_command_runs_several_experiments(kautham_dir):

@@ -125,7 +125,8 @@ def _ask_master(uri: str, caller_id: str, timeout: Optional[float]) -> None:
 
 
 class MasterWatch:
-    """A daemon thread that registers this node again with a master that forgot it."""
+    """A daemon thread that registers this node again with a master that forgot it, or any of
+    its topics and services (a master restarted: ``_forgotten``), once a ``period`` (s)."""
 
     def __init__(self, period: float = 1.0):
         self.period = period
@@ -139,11 +140,29 @@ class MasterWatch:
         while not rospy.is_shutdown():
             time.sleep(self.period)
             try:
-                master.lookupNode(name)
-            except rosgraph.MasterError:          # the master answers and does not know us
-                self._register_again(master)
+                forgotten = self._forgotten(master, name)
             except (OSError, xmlrpc.client.Error):  # no master now: wait for one
                 continue
+            if forgotten:
+                self._register_again(master)
+
+    @staticmethod
+    def _forgotten(master: rosgraph.Master, name: str) -> bool:
+        """Whether the master lacks any publication, subscription or service of this node.
+        Not only the node as a whole: a master that restarted while rospy was still
+        registering the node's start-up knew its first topics (rospy retries those) and none
+        of its services, and asking for the node found it."""
+        try:
+            publishers, subscribers, providers = master.getSystemState()
+        except rosgraph.MasterError:
+            return True
+
+        def known(state: list) -> set:
+            return {topic for topic, nodes in state if name in nodes}
+        topics, services = get_topic_manager(), get_service_manager()
+        return bool({t for t, _ in topics.get_publications()} - known(publishers)
+                    or {t for t, _ in topics.get_subscriptions()} - known(subscribers)
+                    or {s for s, _ in services.get_services()} - known(providers))
 
     def _register_again(self, master: rosgraph.Master) -> None:
         """What rospy's RegManager.start does once: every publication, subscription and service
