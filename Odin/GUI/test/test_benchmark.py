@@ -4,6 +4,7 @@ before any run, and Ctrl-C keeping the finished runs for --resume."""
 
 import json
 import os
+import pathlib
 import shutil
 import signal
 import socket
@@ -208,10 +209,20 @@ def test_an_experiment_with_two_planners_of_one_name_is_refused(kautham_dir):
         prepare([experiment])
 
 
-def _runs_of_our_module() -> list:
+def _runs_of_our_module(mark: str) -> list:
+    """Run processes (gui.planning.benchmark_run) whose environment holds ``mark``: those of
+    one benchmark, not those other tests run at the same time on other workers."""
     found = subprocess.run(["pgrep", "-f", "gui.planning.benchmark_run"], capture_output=True,
                            text=True).stdout.split()
-    return [p for p in found if int(p) != os.getpid()]
+    ours = []
+    for pid in found:
+        try:
+            environment = pathlib.Path(f"/proc/{pid}/environ").read_bytes()
+        except OSError:
+            continue                            # ended meanwhile
+        if mark.encode() in environment.split(b"\0"):
+            ours.append(pid)
+    return ours
 
 
 @pytest.mark.slow
@@ -219,15 +230,18 @@ def test_ctrl_c_stops_the_workers_runs_and_keeps_the_finished_ones(kautham_dir, 
     out = tmp_path / "out"
     options = ["--problem", str(kautham_dir.joinpath(*SPHERE)), "--planners", "KPIECE1",
                "--runs", "6", "--time", "120", "--out", str(out), "--no-plots"]
+    mark = f"ODIN_TEST_BENCHMARK={os.getpid()}-{time.monotonic_ns()}"
     tool = subprocess.Popen([sys.executable, "-c", "from gui.planning.benchmark_cli import "
                              "benchmark_main; import sys; sys.exit(benchmark_main())",
                              *options, "--workers", "2"], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True,
+                            env=dict(os.environ, ODIN_TEST_BENCHMARK=mark.split("=", 1)[1]),
                             start_new_session=True)     # its own group, as a terminal's job
     try:
         for line in tool.stderr:                        # the first finished run
             if "runs done" in line:
                 break
+        assert _runs_of_our_module(mark), "no run of this benchmark found running"
         os.killpg(tool.pid, signal.SIGINT)              # what a terminal's Ctrl-C does
         started = time.monotonic()
         _, err = tool.communicate(timeout=60)
@@ -240,10 +254,10 @@ def test_ctrl_c_stops_the_workers_runs_and_keeps_the_finished_ones(kautham_dir, 
     kept = (out / "runs.jsonl").read_text().splitlines()[1:]
     assert 1 <= len(kept) < 6
     for _ in range(50):                                 # no run left behind
-        if not _runs_of_our_module():
+        if not _runs_of_our_module(mark):
             break
         time.sleep(0.1)
-    assert not _runs_of_our_module()
+    assert not _runs_of_our_module(mark)
     resumed = _tool(*options, "--workers", "0", "--resume")
     assert resumed.returncode == 0, resumed.stderr
     assert f"{6 - len(kept)} runs to do of 6" in resumed.stdout
