@@ -95,10 +95,6 @@ PYTHON: Tuple[AcceptedPython, ...] = (
            "return vertices, indices.astype(np.uint32).reshape(-1, 3)"),
           ("virtual_world/core/validation.py", "vector",
            "array = np.array(value, dtype=float).reshape(-1)"),
-          ("virtual_world/ode/handles.py", "new_trimesh",
-           'vertices = ffi.new("double[]", np.asarray(vertices, dtype=float).reshape(-1).tolist())'),
-          ("virtual_world/ode/handles.py", "new_trimesh",
-           'indices = ffi.new("dTriIndex[]", np.asarray(triangles).reshape(-1).tolist())'),
       )),
 )
 
