@@ -5,8 +5,9 @@ Every test that needs ROS gets its own roscore on a free loopback port and its o
 so tests never see each other's nodes, and every process started here is stopped (process
 group and all) when the test ends, pass or fail. The core is what ``roscore`` starts
 (rosmaster, roscore.xml's parameters, the rosout node), started directly rather than through
-roslaunch. Needs the ROS command-line tools (rosmaster, rosrun), not rospy: the master is asked over its XML-RPC API from this process (a test waits
-for many services, and a ``rosservice`` process a poll cost 0.4 s of a core each).
+roslaunch. Needs the ROS command-line tools (rosmaster, rosrun), not rospy: the master is
+asked over its XML-RPC API from this process (a test waits for many services, and a
+``rosservice`` process a poll cost 0.4 s of a core each).
 
     with RosMaster() as master:
         master.rosrun("VirtualWorld", "virtualWorld")
@@ -205,9 +206,9 @@ class RosMaster:
     def rosrun_command(self, args: Sequence[str], env: dict | None = None) -> list:
         """``args``, where they are ``rosrun PACKAGE PROGRAM ...``, as the program rosrun
         would exec with the same arguments in ``env`` (this master's by default;
-        ``find_executable``): the same process without
-        the rosrun script's 0.8 s of CPU. As given where rosrun finds no single program (the
-        error is then rosrun's) or has options of its own."""
+        ``find_executable``): the same process without the rosrun script's 0.8 s of CPU. As
+        given where rosrun finds no single program (the error is then rosrun's) or has
+        options of its own."""
         args = list(args)
         if len(args) >= 3 and args[0] == "rosrun" and not args[1].startswith("-"):
             program = find_executable(args[1], args[2], env or self.env)
@@ -219,8 +220,8 @@ class RosMaster:
             input: str | None = None) -> subprocess.CompletedProcess:
         """Runs a short command against this master and returns its completed process (a
         ``rosrun`` command as ``rosrun_command`` says)."""
-        return subprocess.run(self.rosrun_command(args), env=self.env, capture_output=True, text=True,
-                              check=check, timeout=timeout, input=input,
+        return subprocess.run(self.rosrun_command(args), env=self.env, capture_output=True,
+                              text=True, check=check, timeout=timeout, input=input,
                               stdin=None if input is not None else subprocess.DEVNULL)
 
     def wait_for_service(self, name: str, timeout: float = 30.0) -> None:
@@ -399,20 +400,25 @@ def _wait_until_gone(pids: set[int], timeout: float = 5.0) -> None:
 
 
 def _running(pid: int) -> bool:
+    fields = _stat_fields(pathlib.Path(f"/proc/{pid}/stat"))
+    return fields is not None and fields[0] not in ("Z", "X")
+
+
+def _stat_fields(stat: pathlib.Path) -> list | None:
+    """The fields of a /proc/PID/stat after the command's name (state, parent, ...), or None
+    when the process is gone."""
     try:
-        state = pathlib.Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+        return stat.read_text().rsplit(")", 1)[1].split()
     except (OSError, IndexError):
-        return False
-    return state not in ("Z", "X")
+        return None
 
 
 def _descendants(roots: set[int]) -> set[int]:
     """Process ids of the roots' children, their children, and so on (from /proc)."""
     children: dict[int, list[int]] = {}
     for stat in pathlib.Path("/proc").glob("[0-9]*/stat"):
-        try:
-            fields = stat.read_text().rsplit(")", 1)[1].split()
-        except OSError:
+        fields = _stat_fields(stat)
+        if fields is None:
             continue  # exited meanwhile
         children.setdefault(int(fields[1]), []).append(int(stat.parent.name))
     found, frontier = set(), list(roots)

@@ -150,5 +150,6 @@ def _thin(link: LinkModel, tensor: np.ndarray, mass: float) -> Optional[str]:
     return thin_inertia(tensor, mass, points)
 
 
-__all__ = ["shape_points", "AUTO", "FILE", "SHAPE", "INERTIA_MODES", "BodyInertia", "primitive_inertia",
-           "primitive_volume", "shape_inertia", "rigid_body_problem", "choose"]
+__all__ = ["shape_points", "AUTO", "FILE", "SHAPE", "INERTIA_MODES", "BodyInertia",
+           "primitive_inertia", "primitive_volume", "shape_inertia", "rigid_body_problem",
+           "choose"]

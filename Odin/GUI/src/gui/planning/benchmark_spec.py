@@ -45,8 +45,9 @@ class Request:
     """OMPL's Benchmark::Request as Kautham's ``<Parameter>`` rows set it. ``max_time``: s of
     wall clock per run (None: each problem's own ``_Max Planning Time``, else 10 s: the
     command-line form's default); ``max_mem``: MB a run's process may grow by during its
-    search (OMPL's rule: the search ends there, as the clock would end it); ``run_count``: runs per planner; ``time_between_updates``: s (Odin's runs
-    report no progress series: kept for the log); ``display_progress``: the progress line;
+    search (OMPL's rule: the search ends there, as the clock would end it); ``run_count``:
+    runs per planner; ``time_between_updates``: s (Odin's runs report no progress series:
+    kept for the log); ``display_progress``: the progress line;
     ``filename``: the log's file name ("" : ``<experiment>.log``)."""
     max_time: Optional[float] = 5.0
     max_mem: float = 4096.0

@@ -33,7 +33,8 @@ class Recorder:
     def __init__(self, path: str, parameters: WorldParameters, values: StepValues):
         self.path = pathlib.Path(path).expanduser().resolve()
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        import rosbag    # on the first recording: its crypto imports were 0.14 s of every node's start
+        # imported on the first recording: its crypto imports were 0.14 s of every node's start
+        import rosbag
         self._bag = rosbag.Bag(str(self.path), "w")
         self._last = 0
         self._write(START, RecordStart(messages.world_parameters_message(parameters),
