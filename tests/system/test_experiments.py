@@ -44,10 +44,11 @@ def test_contactless_pair_greys_exactly_while_touching(kautham_dir):
     frames = facts["frames"]
     assert frames["frames_touching"] >= 5 and frames["frames_free"] >= 5, \
         f"{frames['frames_touching']} frames touching, {frames['frames_free']} free"
-    assert frames["can_grey_exactly_while_touching"], \
-        [(r["t_s"], r["touching"], r["can_red_share"]) for r in frames["per_frame"]]
-    assert frames["tip_grey_exactly_while_touching"], \
-        [(r["t_s"], r["touching"], r["tip_brightness_ratio"]) for r in frames["per_frame"]]
+    assert frames["can_grey_exactly_while_touching"], "frames (t s, touching, red share): " + \
+        ", ".join(f"{r['t_s']} {r['touching']} {r['can_red_share']}" for r in frames["per_frame"])
+    assert frames["tip_grey_exactly_while_touching"], "frames (t s, touching, brightness): " + \
+        ", ".join(f"{r['t_s']} {r['touching']} {r['tip_brightness_ratio']}"
+                  for r in frames["per_frame"])
 
 
 @pytest.mark.forked

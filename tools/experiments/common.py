@@ -128,12 +128,12 @@ class Session:
         self.record = Record()
         self.frame_paths: list = []
         self.frame_times: list = []
+        self._viewer_scene_complete = False
         self.sim_time = 0.0
         self.cycles = 0
         self.stepping_wall = 0.0
         self._master: Optional[RosMaster] = None
         self.client = None
-        self.frame_settle = 0.05  # < 2 idle publication periods
         self._started = 0.0
 
     # -- lifecycle ------------------------------------------------------------------------
@@ -271,12 +271,13 @@ class Session:
         raise ExperimentError(f"no {message} stamped {wanted} s after {timeout} s")
 
     def cycle_and_frame(self) -> Optional[pathlib.Path]:
-        """One cycle, then its Viewer frame. The Viewer lags a little behind a burst of
-        cycles (its colouring depends on the order of the last two updates and Collided
-        messages), so it first gets time to drain its queue; the cycle that follows is then
-        the last thing it hears before the snapshot."""
+        """One cycle, then its Viewer frame. The Viewer first catches up with the cycle before
+        (drawn into the frame's file, overwritten after the cycle): after a burst of cycles it
+        may have dropped world updates (it keeps the newest), and a collision stays grey from
+        the update before it (viewer.core.scene), which must be the cycle before."""
         if self.save_frames:
-            time.sleep(self.frame_settle)
+            self._wait_for_viewer_scene_once()
+            self.snapshot_of_now(self._next_frame_name())
         self.cycle(1)
         return self.frame()
 
@@ -284,17 +285,42 @@ class Session:
         """Saves the Viewer's picture of the current state as the next numbered frame."""
         if not self.save_frames:
             return None
-        if not self.frame_paths:
-            self.wait_for_viewer_scene()
-        self.wait_for_update()
-        time.sleep(self.frame_settle)  # the Viewer's own subscription gets the same messages
-        name = f"frame_{len(self.frame_paths) + 1:04d}.png"
-        response = self._snapshot(name=name)
-        if not response.success:
-            raise ExperimentError(f"/viewer/save_snapshot refused: {response.message}")
-        self.frame_paths.append(pathlib.Path(response.path))
+        self._wait_for_viewer_scene_once()
+        self.frame_paths.append(self.snapshot_of_now(self._next_frame_name()))
         self.frame_times.append(self.sim_time)
         return self.frame_paths[-1]
+
+    def snapshot_of_now(self, name: str, timeout: float = 10.0) -> pathlib.Path:
+        """The Viewer's snapshot ``name`` of the current simulated time: asked again until the
+        Viewer answers that it drew this cycle's world update and (contact-less policy, where
+        the world publishes one each cycle) its Collided message. The Viewer hears the world
+        on topics of its own, a little after this process does, and more after a burst of
+        cycles; its colours depend on both messages (viewer.core.scene)."""
+        wanted = round(self.sim_time, 6)
+        contact_less = self.world_parameters.get("contact_less", False)
+        deadline = time.monotonic() + timeout
+        while True:
+            response = self._snapshot(name=name)
+            if not response.success:
+                raise ExperimentError(f"/viewer/save_snapshot refused: {response.message}")
+            drawn = _t(response.world_update_stamp)
+            colours = _t(response.collided_stamp) if contact_less else wanted
+            if drawn == wanted and colours == wanted:
+                return pathlib.Path(response.path)
+            if time.monotonic() > deadline:
+                self.check_nodes()
+                raise ExperimentError(
+                    f"the Viewer still draws the world update of {drawn} s and the Collided "
+                    f"message of {colours} s after {timeout} s, not {wanted} s")
+            time.sleep(0.005)
+
+    def _next_frame_name(self) -> str:
+        return f"frame_{len(self.frame_paths) + 1:04d}.png"
+
+    def _wait_for_viewer_scene_once(self) -> None:
+        if not self._viewer_scene_complete:
+            self.wait_for_viewer_scene()
+            self._viewer_scene_complete = True
 
     def wait_for_viewer_scene(self, timeout: float = 30.0) -> None:
         """Until the Viewer shows the whole scene: the world hands geometries to the Viewer
@@ -322,9 +348,12 @@ class Session:
         self._wait_for_stamp("collided", "Collided", timeout)
 
     def finish(self) -> None:
-        """Waits for the last messages; call before reading ``record``."""
+        """Waits for the last cycle's messages; call before reading ``record``."""
         self.wait_for_update()
-        time.sleep(0.2)
+        if self.world_parameters.get("contact_less", False):
+            self.wait_for_collided()
+        elif self.want_contacts:
+            self.wait_for_contacts()
         self.check_nodes()
 
     # -- measures ---------------------------------------------------------------------------

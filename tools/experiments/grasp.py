@@ -356,7 +356,6 @@ def take_closeup(s: "common.Session", label: str, subject: str):
     import rospy
     from Services.srv import SetCamera
     s.wait_for_update()
-    time.sleep(s.frame_settle)
     with s.record.lock:
         position = np.array(s.record.poses[round(s.sim_time, 6)][subject][0])
     radial = position[:2] - np.array(BASE_AXIS_XY)
@@ -367,13 +366,10 @@ def take_closeup(s: "common.Session", label: str, subject: str):
     set_camera = rospy.ServiceProxy("/viewer/set_camera", SetCamera)
     set_camera(set_pose=True, eye=list(eye), target=list(position), up=[0.0, 0.0, 1.0])
     try:
-        answer = s._snapshot(name=f"closeup_{len(os.listdir(s.frames_dir)):04d}.png")
-        if not answer.success:
-            raise common.ExperimentError(f"/viewer/save_snapshot refused: {answer.message}")
+        return s.snapshot_of_now(f"closeup_{len(os.listdir(s.frames_dir)):04d}.png")
     finally:
         set_camera(set_pose=True, eye=list(CAMERA.eye), target=list(CAMERA.target),
                    up=[0.0, 0.0, 1.0])
-    return pathlib.Path(answer.path)
 
 
 def closeup_sheet(closeups, out: pathlib.Path, columns: int = 3, width: int = 320):

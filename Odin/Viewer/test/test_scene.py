@@ -50,6 +50,61 @@ def test_collision_listed_every_cycle_stays_grey():
     assert scene.color_of("cube") == BLUE
 
 
+def test_a_repeated_stamp_is_the_same_cycle_and_grey_lasts_until_a_new_one():
+    # a paused world republishes its last cycle (same stamp) at its rate: however many repeats
+    # reach the Viewer, the cycle's colouring stays; the next stamp ends it
+    scene = ball_scene()
+    scene.update([], stamp=0.230)
+    scene.collided(["ball"], stamp=0.230)
+    for _ in range(3):
+        scene.update([situation("ball", (0, 0, 0.3))], stamp=0.230)
+        scene.collided([], stamp=0.230)
+        assert scene.color_of("ball") == COLLIDING_COLOR
+    assert (scene.update_stamp, scene.collided_stamp) == (0.230, 0.230)
+    scene.update([], stamp=0.231)        # listed since the previous cycle's update: grey
+    assert scene.color_of("ball") == COLLIDING_COLOR
+    scene.update([], stamp=0.232)
+    assert scene.color_of("ball") == RED
+    scene.new_scene()
+    assert (scene.update_stamp, scene.collided_stamp) == (None, None)
+
+
+def test_with_stamps_the_colours_follow_the_world_s_order_not_the_arrival_order():
+    def cycle_after(arrivals):
+        scene = ball_scene()
+        scene.update([], stamp=0.001)
+        for kind, stamp, names in arrivals:
+            if kind == "update":
+                scene.update([], stamp=stamp)
+            else:
+                scene.collided(names, stamp=stamp)
+        return scene.color_of("ball"), scene.color_of("cube")
+    in_order = [("update", 0.002, ()), ("collided", 0.002, ["ball"]),
+                ("update", 0.003, ()), ("collided", 0.003, ["cube"])]
+    collided_ahead = [("collided", 0.002, ["ball"]), ("collided", 0.003, ["cube"]),
+                      ("update", 0.002, ()), ("update", 0.003, ())]
+    collided_late = [("update", 0.002, ()), ("update", 0.003, ()),
+                     ("collided", 0.002, ["ball"]), ("collided", 0.003, ["cube"])]
+    grey_both = (COLLIDING_COLOR, COLLIDING_COLOR)
+    assert cycle_after(in_order) == cycle_after(collided_ahead) == cycle_after(collided_late) \
+        == grey_both
+    # a cycle later the first one's collision is over, whatever the order
+    assert cycle_after(in_order + [("update", 0.004, ())]) == (RED, COLLIDING_COLOR)
+    assert cycle_after(collided_ahead + [("update", 0.004, ())]) == (RED, COLLIDING_COLOR)
+    # a message older than the previous update's stamp comes too late to colour anything
+    assert cycle_after(in_order[:2] + [("update", 0.003, ()), ("update", 0.004, ()),
+                                       ("collided", 0.002, ["cube"])]) == (RED, BLUE)
+
+
+def test_a_stamp_that_goes_back_starts_the_colouring_afresh():
+    scene = ball_scene()
+    scene.update([], stamp=5.0)
+    scene.collided(["ball"], stamp=5.0)
+    scene.update([], stamp=0.001)              # a bag played in a loop starts again
+    scene.update([], stamp=0.002)
+    assert scene.color_of("ball") == RED
+
+
 def test_update_moves_known_objects_and_skips_unknown_names_and_bad_poses():
     scene = ball_scene()
     applied = scene.update([situation("ball", (1, 2, 3), (0, 0, 0, 1)),

@@ -5,8 +5,16 @@ Each object has a pose (world frame, REP 103), a colour and a shape. Its origina
 remembered: an object that a Collided message lists is drawn in ``COLLIDING_COLOR`` at once, and
 stays so until the second scene update after that message, i.e. after every update an object is
 grey exactly when some Collided message listed it since the previous update (thesis 6.4.2: the
-colliding status is cleared each cycle). New Scene replaces the whole scene. Adding an object
-re-fits the camera to the whole scene unless the user fixed the camera.
+colliding status is cleared each cycle). With stamps (simulated time), "since" is the world's
+order, not the order of arrival: the two topics reach the Viewer on threads of their own, and
+after a burst of cycles one runs ahead of the other. After an update stamped u, following one
+stamped p, an object is grey exactly when a Collided message stamped p or later lists it; a
+message whose stamp is before p comes too late to colour anything. An update with the stamp of
+the one before is the same cycle told again (a paused world repeats its last cycle at its
+rate): it moves objects but starts no new colouring cycle. An update whose stamp goes back (a
+bag played in a loop) starts the colouring afresh. Unstamped updates and messages keep the
+order of arrival. The scene remembers the stamps of the last update and Collided message it
+applied: which simulated time a frame shows. New Scene replaces the whole scene. Adding an object re-fits the camera to the whole scene unless the user fixed the camera.
 
 The scene is not thread-safe: one thread (the Portal's render thread) owns it.
 """
@@ -103,8 +111,9 @@ class Scene:
     def __init__(self, camera: Optional[Camera] = None, camera_fixed: bool = False,
                  background: Sequence[float] = DEFAULT_BACKGROUND) -> None:
         self._objects: dict = {}
-        self._listed_since_update: set = set()   # named by Collided since the last update
         self._grey: set = set()
+        self._forget_collisions()
+        self.collided_stamp: Optional[float] = None   # s, the last Collided message's
         self._camera = camera or Camera()
         self.camera_fixed = camera_fixed
         bg = np.asarray(background, dtype=float).reshape(-1)
@@ -148,19 +157,29 @@ class Scene:
                               f"({len(self._objects)} objects)")
         del self._objects[object_id]
         self._grey.discard(object_id)
-        self._listed_since_update.discard(object_id)
+        for names in self._listed.values():
+            names.discard(object_id)
 
     def new_scene(self) -> None:
         """Replaces the scene by an empty one (the camera stays where it is)."""
         self._objects = {}
         self._grey = set()
-        self._listed_since_update = set()
+        self._forget_collisions()
+        self.collided_stamp = None
+
+    def _forget_collisions(self) -> None:
+        # names listed by Collided messages whose colouring cycles are not over, by stamp (s;
+        # None for unstamped messages): those stamped at or after the current update's
+        self._listed: dict = {}
+        self.update_stamp: Optional[float] = None     # s, the last update's; None: none yet
+        self._previous_stamp: Optional[float] = None  # s, the update's before it
 
     # -- the world's topics ----------------------------------------------------------------
-    def update(self, situations: Iterable) -> int:
+    def update(self, situations: Iterable, stamp: Optional[float] = None) -> int:
         """Applies poses ``(name, position (3,) m, orientation (w, x, y, z))``; names the scene
         does not hold and entries with a non-finite or bad pose are skipped. Ends a colouring
-        cycle (see the module doc). Returns the number of poses applied."""
+        cycle (see the module doc) unless ``stamp`` (s, simulated time) is the last update's.
+        Returns the number of poses applied."""
         applied = 0
         for name, position, orientation in situations:
             obj = self._objects.get(name)
@@ -171,15 +190,27 @@ class Scene:
             except ViewerError:
                 continue
             applied += 1
-        self._grey = self._listed_since_update & self._objects.keys()
-        self._listed_since_update = set()
+        if stamp is not None and self.update_stamp is not None:
+            if stamp == self.update_stamp:
+                return applied                  # the same cycle told again
+            if stamp < self.update_stamp:
+                self._forget_collisions()       # time went back: nothing listed still counts
+        self._grey = set().union(*self._listed.values()) & self._objects.keys()
+        self._listed = {listed_at: names for listed_at, names in self._listed.items()
+                        if None not in (listed_at, stamp) and listed_at >= stamp}
+        self._previous_stamp, self.update_stamp = self.update_stamp, stamp
         return applied
 
-    def collided(self, names: Iterable[str]) -> None:
-        """Objects a Collided message lists: grey now and through the next update."""
+    def collided(self, names: Iterable[str], stamp: Optional[float] = None) -> None:
+        """Objects a Collided message (stamped ``stamp`` s) lists: grey now and through the
+        next update of another stamp."""
+        self.collided_stamp = stamp
         names = set(names) & self._objects.keys()
-        self._listed_since_update |= names
+        if None not in (stamp, self._previous_stamp) and stamp < self._previous_stamp:
+            return                              # its colouring cycles are over
         self._grey |= names
+        if None in (stamp, self.update_stamp) or stamp >= self.update_stamp:
+            self._listed.setdefault(stamp, set()).update(names)
 
     def color_of(self, object_id: str) -> tuple:
         """The colour the object is drawn in now."""
