@@ -77,11 +77,34 @@ class Client:
                          orientation=[1, 0, 0, 0], color=color)
 
     def publish_update(self, situations):
+        """Publishes the poses stamped now; returns the stamp (s)."""
         from Messages.msg import Situation
         msg = self.SpaceDistribution()
         msg.header.stamp = self.rospy.Time.now()
         msg.situations = [Situation(name=n, position=p, orientation=q) for n, p, q in situations]
         self.update_pub.publish(msg)
+        return msg.header.stamp.to_sec()
+
+    def publish_collided(self, names):
+        """Publishes a Collided message stamped now; returns the stamp (s)."""
+        msg = self.Collided(names=names)
+        msg.header.stamp = self.rospy.Time.now()
+        self.collided_pub.publish(msg)
+        return msg.header.stamp.to_sec()
+
+    def drawn(self, update_stamp=None, collided_stamp=None, timeout=10.0):
+        """A frame (from Save Snapshot) of the scene once the Viewer has applied the update
+        and the Collided message of these stamps (s)."""
+        deadline = time.monotonic() + timeout
+        while True:
+            answer = self.snapshot(name="drawn.png")
+            assert answer.success, answer.message
+            if all(wanted is None or abs(got.to_sec() - wanted) < 1e-6 for wanted, got in
+                   ((update_stamp, answer.world_update_stamp),
+                    (collided_stamp, answer.collided_stamp))):
+                return np.asarray(PilImage.open(answer.path).convert("RGB"))
+            assert time.monotonic() < deadline, "the Viewer never drew the messages"
+            time.sleep(0.01)
 
 
 def start_viewer(master, tmp_path, *params):
@@ -107,19 +130,22 @@ def test_node_draws_colours_collisions_and_survives_bad_requests(ros_master, tmp
     assert is_hue(patch(frame, centre), 0)
 
     # colliding: grey now and through the next update, red again after the one after
-    client.collided_pub.publish(client.Collided(names=["ball"]))
-    time.sleep(0.15)
-    grey = client.fresh_frame()
+    first = client.publish_update([("ball", (0, 0, 0.4), (1, 0, 0, 0))])
+    grey = client.drawn(first, client.publish_collided(["ball"]))
     PilImage.fromarray(grey).save(tmp_path / "node_colliding.png")
     assert is_grey(patch(grey, centre), BACKGROUND)
+    second = client.publish_update([("ball", (0, 0, 0.4), (1, 0, 0, 0))])
+    assert is_grey(patch(client.drawn(second), centre), BACKGROUND)
+    third = client.publish_update([("ball", (0, 0, 0.4), (1, 0, 0, 0)),
+                                   ("not_viewed_yet", (0, 0, 0), (1, 0, 0, 0)),
+                                   ("ball", (math.nan, 0, 0), (1, 0, 0, 0))])
+    assert is_hue(patch(client.drawn(third), centre), 0)
+    # a Collided message without a stamp (a user's own tool) colours in the order it arrives
+    client.collided_pub.publish(client.Collided(names=["ball"]))
+    assert is_grey(patch(client.drawn(collided_stamp=0.0), centre), BACKGROUND)
     client.publish_update([("ball", (0, 0, 0.4), (1, 0, 0, 0))])
-    time.sleep(0.15)
-    assert is_grey(patch(client.fresh_frame(), centre), BACKGROUND)
-    client.publish_update([("ball", (0, 0, 0.4), (1, 0, 0, 0)),
-                           ("not_viewed_yet", (0, 0, 0), (1, 0, 0, 0)),
-                           ("ball", (math.nan, 0, 0), (1, 0, 0, 0))])
-    time.sleep(0.15)
-    assert is_hue(patch(client.fresh_frame(), centre), 0)
+    fifth = client.publish_update([("ball", (0, 0, 0.4), (1, 0, 0, 0))])
+    assert is_hue(patch(client.drawn(fifth), centre), 0)
 
     # bad requests: refused with a message, and the node keeps rendering
     bad = [client.remove(id="ghost"),

@@ -88,6 +88,12 @@ def _vector(name: str, value, size: int = 3) -> Optional[tuple]:
     return out
 
 
+def _stamp_seconds(header) -> Optional[float]:
+    """The header's stamp (s), None for a zero stamp: ROS's "no time" (a message a user's tool
+    publishes without one), which the scene orders by arrival."""
+    return header.stamp.to_sec() if not header.stamp.is_zero() else None
+
+
 def default_snapshot_dir() -> pathlib.Path:
     return pathlib.Path(rospkg.get_ros_home()) / "odin_snapshots"
 
@@ -166,7 +172,7 @@ class Portal:
     # -- topics ----------------------------------------------------------------------------
     def _world_update(self, msg: SpaceDistribution) -> None:
         situations = [(s.name, tuple(s.position), tuple(s.orientation)) for s in msg.situations]
-        stamp = msg.header.stamp.to_sec()
+        stamp = _stamp_seconds(msg.header)
         self.loop.post(lambda scene, _: scene.update(situations, stamp))
 
     def _markers(self, msg: MarkerArray) -> None:
@@ -185,7 +191,7 @@ class Portal:
 
     def _collided(self, msg: Collided) -> None:
         names = list(msg.names)
-        stamp = msg.header.stamp.to_sec()
+        stamp = _stamp_seconds(msg.header)
         self.loop.post(lambda scene, _: scene.collided(names, stamp))
 
     # -- services --------------------------------------------------------------------------
