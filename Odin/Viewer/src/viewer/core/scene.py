@@ -14,7 +14,8 @@ the one before is the same cycle told again (a paused world repeats its last cyc
 rate): it moves objects but starts no new colouring cycle. An update whose stamp goes back (a
 bag played in a loop) starts the colouring afresh. Unstamped updates and messages keep the
 order of arrival. The scene remembers the stamps of the last update and Collided message it
-applied: which simulated time a frame shows. New Scene replaces the whole scene. Adding an object re-fits the camera to the whole scene unless the user fixed the camera.
+applied: which simulated time a frame shows. New Scene replaces the whole scene. Adding an
+object re-fits the camera to the whole scene unless the user fixed the camera.
 
 The scene is not thread-safe: one thread (the Portal's render thread) owns it.
 """
