@@ -30,8 +30,7 @@ class ChainTest(unittest.TestCase):
             self.assertTrue(response.success, response.message)
         first_frame = self._frame()
         self.assertTrue(rospy.ServiceProxy("/virtual_world/start", Start)(True).success)
-        time.sleep(1.5)
-        update = rospy.wait_for_message("/virtual_world/world_update", SpaceDistribution, 10)
+        update = self._update_at(1.5)
         height = {s.name: s.position[2] for s in update.situations}["sphere"]
         # resting on the box: box top 0.4 m + radius 0.15 m, within the surface layer
         self.assertAlmostEqual(height, 0.55, delta=0.01)
@@ -39,6 +38,17 @@ class ChainTest(unittest.TestCase):
         self.assertEqual(first_frame.shape, last_frame.shape)
         changed = np.abs(first_frame.astype(int) - last_frame.astype(int)).sum(axis=2) > 60
         self.assertGreater(changed.sum(), 100, "the rendered frame did not change")
+
+    @staticmethod
+    def _update_at(sim_time: float, timeout: float = 60.0) -> SpaceDistribution:
+        """The first world update stamped at or after ``sim_time`` (s, simulated): the world
+        runs in real time only when the machine keeps up."""
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            update = rospy.wait_for_message("/virtual_world/world_update", SpaceDistribution, 10)
+            if update.header.stamp.to_sec() >= sim_time:
+                return update
+        raise AssertionError(f"the world did not reach {sim_time} s in {timeout} s")
 
     @staticmethod
     def _frame():
