@@ -95,6 +95,19 @@ def test_a_box_in_the_way_is_pushed_and_the_link_does_not_give_way():
     core.close()
 
 
+def test_a_link_driven_out_of_the_world_stops_at_its_extent():
+    core = Core(WorldParameters(gravity=(0.0, 0.0, 0.0), world_extent=10.0))
+    core.build_object(ObjectSpec("carriage", [0.1, 0.1, 0.1], mass=1.0))
+    rail = core.create_joint(SLIDER, "carriage", "", axis1=(1, 0, 0))
+    motor = core.create_motor(joint=rail, kind=MotorKind.LINEAR)
+    core.set_drive([motor], ServoDrive.KINEMATIC)
+    core.set_motor_velocities({motor: [100.0]})
+    core.step(0.01, 200)                                   # 200 m asked for
+    x = core.body_state("carriage")[0][0]
+    assert 9.0 < x <= 10.0 and core.take_divergences() == []
+    core.close()
+
+
 def test_switching_back_to_dynamic_gives_the_motors_the_arm_again():
     core, joints, motors = two_link_arm(max_force=0.5)
     core.set_drive(motors, ServoDrive.KINEMATIC)

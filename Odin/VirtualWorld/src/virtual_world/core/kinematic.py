@@ -17,6 +17,7 @@ their own axis:
   the joints to dynamic bodies see the motion and nothing is teleported; each step starts from
   the present poses alone, so a snapshot or a state vector puts a driven robot back bit for bit;
 - a link is infinitely heavy for everything else: what is in its way is pushed, however heavy;
+  a link that would leave the world's extent (world parameter world_extent) stops at its edge;
 - ODE leaves every joint and motor between two kinematic bodies, or a kinematic body and the
   world, out of its LCP: an arm under the drive costs the solver nothing. A joint between a link
   and a dynamic body stays in the LCP, the link's side moving as commanded (a finger on a

@@ -103,6 +103,9 @@ void odin_kinematic_drive(OdinWorld *w, double h) {
             Pose relative = compose(&parent_inv, &moved);
             next = compose(&parent_next, &relative);
         }
+        if (fabs(next.p[0]) > w->extent || fabs(next.p[1]) > w->extent ||
+            fabs(next.p[2]) > w->extent || !isfinite(next.p[0] + next.p[1] + next.p[2]))
+            next = now;     /* a link stops at the world's extent (no body may leave it) */
         double norm = sqrt(next.q[0] * next.q[0] + next.q[1] * next.q[1] +
                            next.q[2] * next.q[2] + next.q[3] * next.q[3]);
         for (int j = 0; j < 4; ++j) k->next_quaternion[j] = next.q[j] / norm;

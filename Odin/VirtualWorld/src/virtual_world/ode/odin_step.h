@@ -66,7 +66,8 @@ typedef struct OdinMotorGoal {
  * the parent's pose at the step's end; the body then gets the linear and angular velocity that
  * carry it there in the step (ODE integrates a kinematic body by its velocities, with finite
  * rotation: exact to rounding). So contacts and the joints to dynamic bodies see the motion and
- * no pose is ever written. Each step starts from the present poses: nothing else is state. */
+ * no pose is ever written. Each step starts from the present poses: nothing else is state. A
+ * link whose pose at the step's end would leave the world's extent stays where it is. */
 typedef struct OdinKinematicLink {
     dBodyID body;
     dBodyID parent;          /* the parent's body; NULL: the static world */
