@@ -63,6 +63,25 @@ def test_the_links_follow_the_commanded_speeds_exactly_against_gravity():
     core.close()
 
 
+def test_a_driven_arm_stays_up_with_its_joints_applying_no_force():
+    """Dynamic, the shoulder holds the arm up against gravity; kinematic, ODE leaves joints
+    between kinematic bodies (or one and the world) out of the step: they apply nothing, and
+    the arm stays up all the same."""
+    core, joints, motors = two_link_arm(max_force=100.0)
+    core.step(H, 1)
+    _, (shoulder,), _ = core.state(joints=[joints[0]])
+    assert shoulder.force1[2] > 5.0                 # about 2 kg x 9.81 up on the upper rod
+    core.close()
+    core, joints, motors = two_link_arm(max_force=100.0)
+    core.set_drive(motors, ServoDrive.KINEMATIC)
+    core.step(H, 100)
+    _, reactions, _ = core.state(joints=list(joints))
+    for reaction in reactions:
+        assert reaction.force1 == reaction.torque1 == (0.0, 0.0, 0.0), reaction
+    assert values(core, joints) == [0.0, 0.0]
+    core.close()
+
+
 def test_a_kinematic_servo_follows_its_law_with_no_force_limit():
     """The servo's law alone moves the joint: e(n) = e0 (1 - gain h)^n, exactly, though its
     motor's force limit (0.5 N m) could not even hold the arm up."""
