@@ -172,6 +172,18 @@ def test_bad_requests_are_refused_and_change_nothing(motor_ids, drive, error):
     core.close()
 
 
+def test_two_motors_on_one_joint_cannot_both_drive_it():
+    core, joints, motors = two_link_arm()
+    second = core.create_motor("second", joint=joints[0])
+    with pytest.raises(InvalidArgument, match="both drive"):
+        core.set_drive([motors[0], second], ServoDrive.KINEMATIC)
+    core.set_drive([motors[0]], ServoDrive.KINEMATIC)
+    with pytest.raises(InvalidArgument, match="both drive"):
+        core.set_drive([second], ServoDrive.KINEMATIC)
+    assert core.kinematic_links() == {motors[0]: "upper"}
+    core.close()
+
+
 def test_a_joint_the_drive_cannot_move_is_refused():
     core = Core(WorldParameters(gravity=GRAVITY))
     core.build_object(ObjectSpec("a", [0.1, 0.1, 0.1], mass=1.0))

@@ -81,6 +81,13 @@ def links_of(scene: Scene, motor_ids: Iterable[str]) -> Dict[str, str]:
     """{motor id: its link}, parents first: each joint's link is its body whose other body is
     held (the world, a fixed object or an earlier link). Refuses a set that is no such forest."""
     pending = list(dict.fromkeys(motor_ids))
+    driver: Dict[str, str] = {}             # joint id -> the motor that drives it
+    for motor_id in pending:
+        joint_id = scene.motors[motor_id].joint
+        if joint_id in driver:
+            raise InvalidArgument(f"motors {driver[joint_id]!r} and {motor_id!r} both drive "
+                                  f"joint {joint_id!r}: one motor drives a joint kinematically")
+        driver[joint_id] = motor_id
     links: Dict[str, str] = {}
     held = {o for o, obj in scene.objects.items() if obj.fixed}
     while pending:
@@ -90,6 +97,9 @@ def links_of(scene: Scene, motor_ids: Iterable[str]) -> Dict[str, str]:
             free = [b for b in joint.bodies if b and b not in held]
             if len(free) != 1:      # both held, or neither (yet)
                 continue
+            if free[0] in scene.parked:
+                raise InvalidArgument(f"motor {motor_id!r}: its link {free[0]!r} is parked by "
+                                      "the divergence guard")
             links[motor_id] = free[0]
             held.add(free[0])
             progress.append(motor_id)
@@ -126,8 +136,9 @@ def refresh(scene: Scene) -> None:
         motor = scene.motors.get(motor_id)
         joint = scene.joints.get(motor.joint) if motor is not None else None
         parent = "" if joint is None else next((b for b in joint.bodies if b != object_id), "")
-        if joint is not None and object_id in scene.objects and (
-                parent == "" or scene.objects[parent].fixed or parent in kept.values()):
+        held = parent == "" or parent in kept.values() or (
+            parent in scene.objects and scene.objects[parent].fixed)
+        if joint is not None and object_id in scene.objects and held:
             kept[motor_id] = object_id
     for object_id in set(scene.kinematic.values()) - set(kept.values()):
         if object_id in scene.objects:
