@@ -100,7 +100,8 @@ def test_a_box_in_the_way_is_pushed_and_the_link_does_not_give_way():
     core.build_object(ObjectSpec("pusher", [0.1, 0.4, 0.4], mass=1.0, position=(0, 0, 0)))
     core.build_object(ObjectSpec("box", [0.2, 0.2, 0.2], mass=50.0, position=(0.3, 0, 0)))
     rail = core.create_joint(SLIDER, "pusher", "", axis1=(1, 0, 0))
-    motor = core.create_motor(joint=rail, kind=MotorKind.LINEAR, max_forces=[1.0])  # 50 kg: too weak
+    # 1 N: far too weak to push 50 kg
+    motor = core.create_motor(joint=rail, kind=MotorKind.LINEAR, max_forces=[1.0])
     core.set_drive([motor], ServoDrive.KINEMATIC)
     core.set_motor_velocities({motor: [0.5]})
     core.step(H, 1000)

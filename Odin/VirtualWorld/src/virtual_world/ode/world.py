@@ -4,7 +4,8 @@ group, the contact settings, and the arrays of persistent actions the C step loo
 ``CWorld`` owns an ``OdinWorld`` struct (memory Python's, allocated with ffi.new) and the three
 scene handles; the arrays of body forces, joint forces, motor goals and kinematic links are
 rebuilt from plain tuples whenever they change, and always before a handle they point at is
-freed (C must never see a freed handle). Collision records come back as geom addresses, which the Core names.
+freed (C must never see a freed handle). Collision records come back as geom addresses,
+which the Core names.
 """
 from __future__ import annotations
 
