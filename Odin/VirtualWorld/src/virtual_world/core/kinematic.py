@@ -117,7 +117,10 @@ def links_of(scene: Scene, motor_ids: Iterable[str]) -> Dict[str, str]:
 
 def install(scene: Scene, links: Dict[str, str]) -> None:
     """Makes exactly ``links`` ({motor id: link}, parents first) kinematic and hands C the
-    array; the rest dynamic again."""
+    array; the rest dynamic again. Nothing to do when they already are (a snapshot put back,
+    every propagation, which planners run by the thousand)."""
+    if dict(links) == scene.kinematic:
+        return
     now = set(links.values())
     for object_id in set(scene.kinematic.values()) - now:
         bodies.set_kinematic_link(scene.objects[object_id].body.ptr, False)

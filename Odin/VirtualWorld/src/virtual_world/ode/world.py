@@ -169,6 +169,8 @@ class CWorld:
     def set_kinematic_links(self, links: Sequence[KinematicLink]) -> None:
         """The kinematic drive's links, parents first (odin_step.h OdinKinematicLink); each
         link's direction is read from the joint (+1 when the link is its ODE body 1)."""
+        if not links and not self.struct.n_kinematic:
+            return      # none before, none now: every propagation of a planner comes here
         array = ffi.new("OdinKinematicLink[]", max(len(links), 1))
         for k, (body, parent, parent_link, slot, joint, joint_type) in zip(array, links):
             k.body, k.parent = body, parent if parent is not None else ffi.NULL
