@@ -76,8 +76,8 @@ SERVICES = {
                       "{joint: '1:ball&', magnitudes: [0.2]}"),
     "GetWorld": ("new (past the thesis): the values in force and what the world holds", None),
     "SetServo": ("new (past the thesis): joint servos (a position target tracked by a motor "
-                 "under its force limit), for run_path --tracked", "{motors: ['motor:1:ball&'], "
-                 "targets: [0.2]}"),
+                 "under its force limit), for run_path --tracked; the kinematic drive (issue "
+                 "30)", "{motors: ['motor:1:ball&'], targets: [0.2]}"),
     "SetSurface": ("new (past the thesis): per-object contact properties, as Kautham's URDF "
                    "<contact_coefficients> and its environments' contact tables give them",
                    "{id: ball, surface: {set_friction: true, friction: 0.4, set_bounce: true, "
@@ -237,7 +237,7 @@ def render_kautham() -> str:
             "with the services above (`gui.core.translate`); `problem_info PROBLEM` shows the "
             "plan as JSON, with what Odin does not use under `ignored`. How a problem maps to "
             f"the world:\n\n{mapping}\n\n### Control paths\n\n{MAPPING.strip()}\n\n"
-            + render_tracked())
+            + render_tracked() + render_kinematic())
 
 
 def render_tracked() -> str:
@@ -247,6 +247,14 @@ def render_tracked() -> str:
     from gui.core.trajectory import TIMING
     return (f"### Tracked paths\n\nTiming: {TIMING.strip()}\n\nExecution: "
             f"{execution.__doc__.split(chr(10), 3)[3].strip()}\n\n")
+
+
+def render_kinematic() -> str:
+    """What Set Servo's kinematic drive does: the docstring of virtual_world.core.kinematic
+    (its one home) but its first line and last paragraph (the Core's own record)."""
+    from virtual_world.core import kinematic
+    body = kinematic.__doc__.split("\n", 2)[2].rsplit("\n\n", 1)[0].strip()
+    return f"### Kinematic drive\n\n{body}\n\n"
 
 
 def _value(value) -> str:

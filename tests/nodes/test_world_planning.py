@@ -161,3 +161,23 @@ def test_a_servo_holds_a_joint_at_its_target_and_reports_it(world):
     world.ok("set_servo", motors=["motor:1:bob&"], release=True)
     got = world.ok("get_state")
     assert list(got.motor_goals) == [0.0]
+
+
+def test_set_servos_kinematic_drive_moves_the_joint_at_exactly_its_speed(world):
+    """The pendulum's hinge under the kinematic drive (Set Servo ``drive`` alone): at 0.5 rad/s
+    for 2 s it is at 1 rad exactly, though its motor (2 N m) could not lift the bob that far;
+    a bad drive is refused; DYNAMIC gives the joint back to the motor."""
+    from Services.srv import SetServoRequest
+    _scene(world)
+    refused = world("set_servo", motors=["motor:1:bob&"], drive=7)
+    assert not refused.success and "drive 7" in refused.message
+    world.ok("set_servo", motors=["motor:1:bob&"], drive=SetServoRequest.KINEMATIC)
+    world.ok("set_velocity", motors=["motor:1:bob&"], velocities=[0.5])
+    world.ok("step_once", cycles=50)                     # 2 s
+    state = world.ok("get_state", joints=["1:bob&"])
+    assert state.joints[0].positions[0] == pytest.approx(1.0, abs=1e-9)
+    world.ok("set_servo", motors=["motor:1:bob&"], drive=SetServoRequest.DYNAMIC)
+    world.ok("set_velocity", motors=["motor:1:bob&"], velocities=[0.0])
+    world.ok("step_once", cycles=25)
+    state = world.ok("get_state", joints=["1:bob&"])
+    assert state.joints[0].positions[0] < 0.99          # the weak motor gives way

@@ -136,20 +136,56 @@ def test_grasp_in_tracked_mode_follows_the_path_files_and_still_holds_the_can(tm
     # the fingers stop on the can short of their targets (0.85 rad short): they hold it
     assert tracking["goal_error_rad"] > 0.3, tracking
     assert any("can" in pair and "Palm" in pair for pair in tracking["collision_pairs"])
-    h = o["can_height_above_table_while_carried_m"]
-    assert h["min"] > 0.1, f"carried as low as {h['min']} m above the table"
-    assert o["can_moved_while_carried_m"] > 0.5, f"carried {o['can_moved_while_carried_m']} m"
     # 19.1 mm from the lift's start (the grip settles as the arm starts lifting), 8.5 mm
-    # while carried, nothing sunk
-    assert o["max_slip_in_hand_before_opening_m"] < 0.025, o
-    assert o["max_slip_in_hand_while_carried_m"] < 0.015, o
-    assert o["can_sank_in_hand_before_opening_m"] < 0.003, o
-    # the release: the can leaves 0.12 s after the opening, free fall allows 0.036 s (one
-    # cycle more slack than the velocity mode: TRACKED_FALL_SLACK_S)
+    # while carried, nothing sunk; the release: the can leaves 0.12 s after the opening, free
+    # fall allows 0.036 s (one cycle more slack than the velocity mode: TRACKED_FALL_SLACK_S)
+    _assert_tracked_grasp_held_carried_and_released(grasp, o)
+
+
+def _assert_tracked_grasp_held_carried_and_released(grasp, o: dict) -> None:
+    _assert_tracked_grasp_held_and_carried(o)
     checks = grasp.release_checks(o, grasp.TRACKED_FALL_SLACK_S)
     failed = [name for name, held in checks.items() if not held]
     assert not failed, (failed, o)
+
+
+def _assert_tracked_grasp_held_and_carried(o: dict) -> None:
+    h = o["can_height_above_table_while_carried_m"]
+    assert h["min"] > 0.1, f"carried as low as {h['min']} m above the table"
+    assert o["can_moved_while_carried_m"] > 0.5, f"carried {o['can_moved_while_carried_m']} m"
+    assert o["max_slip_in_hand_before_opening_m"] < 0.025, o
+    assert o["max_slip_in_hand_while_carried_m"] < 0.015, o
+    assert o["can_sank_in_hand_before_opening_m"] < 0.003, o
     assert o["can_on_floor_at_end"], f"the can ends at {o['can_final_position_m']}"
+
+
+@pytest.mark.forked
+def test_grasp_with_the_kinematic_drive_lifts_carries_and_drops_the_can(tmp_path, kautham_dir):
+    """Tracked mode with the arm, the palm and the hand's placing joints under the kinematic
+    drive (grasp.KINEMATIC_LINKS), the flexing finger joints dynamic (issue 30)."""
+    import grasp
+    facts = grasp.run(frames=False, out_root=tmp_path, mode="tracked", kinematic=True,
+                      viewer=False)
+    o, tracking = facts["outcome"], facts["tracking"]
+    # the arm follows the commanded motion exactly (the servos' law, step by step): what is
+    # left is the law's own lag behind the path's targets (1.4 mrad, as the dynamic arm's)
+    assert tracking["arm_tracking_error_max_rad"] < 0.01, tracking
+    assert tracking["arm_goal_error_rad"] < 1e-9, tracking
+    assert tracking["goal_error_rad"] > 0.3, tracking     # the fingers stop on the can
+    _assert_tracked_grasp_held_and_carried(o)
+    checks = grasp.release_checks(o, grasp.TRACKED_FALL_SLACK_S)
+    # Two of the release's checks, set on the compliant dynamic arm, do not hold on the rigid
+    # one (measured: the can leaves 0.08 s after the opening, not 0.12 s, then rolls down the
+    # palm's face, which does not give way: the palm touches it one cycle after it left, and it
+    # reaches the floor 0.48-0.52 s after the opening where free fall allows 0.46 s). Pinned,
+    # so that a change of either shows: the touch within one cycle, the floor within two.
+    differs = ("the hand still touches it after the opening starts, not after it left",
+               "it reaches the floor no later than free fall allows")
+    failed = [name for name, held in checks.items() if not held and name not in differs]
+    assert not failed, (failed, o)
+    cycle = grasp.WORLD["steps_per_cycle"] * grasp.WORLD["step"]
+    assert o["hand_opens_at_s"] < o["hand_last_touches_can_at_s"] <= o["left_hand_at_s"] + cycle
+    assert o["on_floor_after_opening_s"] <= o["latest_on_floor_after_opening_s"] + 2 * cycle
 
 
 @pytest.mark.forked

@@ -19,6 +19,11 @@ simulated over wall-clock time, median of the runs.
 ``rtf_grasp_exact_meshes`` is one run with the hand's meshes colliding as given
 (collision_mesh_tolerance 0 instead of the experiment's 4 mm), timed in the same bench run,
 and ``rtf_grasp_mesh_tolerance_speedup`` the ratio of the two.
+
+``rtf_grasp_kinematic``: the grasp in tracked mode with the arm, the palm and the hand's placing
+joints under the kinematic drive and the flexing finger joints dynamic (``grasp.run(
+kinematic=True)``), stepping rtf as rtf_grasp's, median of RUNS runs; ``grasp_kinematic_held``
+the fraction of those runs whose outcome checks all held (``grasp.verdict``).
 """
 import json
 import pathlib
@@ -45,6 +50,24 @@ def _grasp_timing(out_dir: pathlib.Path, world_changes: dict, viewer: bool = Fal
     return dict(summary["timing"], propagate_rtf=summary["carry_propagated"]["rtf"])
 
 
+def _kinematic_grasp(out_dir: pathlib.Path) -> dict:
+    """One kinematic grasp run without frames or Viewer (in a child): its stepping rtf and
+    whether its outcome checks held."""
+    import grasp
+    facts = grasp.run(frames=False, out_root=out_dir, mode="tracked", viewer=False,
+                      kinematic=True)
+    summary = json.loads((out_dir / "grasp_kinematic" / "summary.json").read_text())
+    return {"rtf": float(summary["timing"]["rtf_stepping"]), "held": grasp.verdict(facts)[0]}
+
+
+def run_kinematic(out_dir: pathlib.Path) -> dict:
+    """``rtf_grasp_kinematic`` and ``grasp_kinematic_held`` (the module's docstring)."""
+    runs = [in_child(_kinematic_grasp, pathlib.Path(out_dir) / "experiments_kinematic")
+            for _ in range(RUNS)]
+    return {"rtf_grasp_kinematic": statistics.median(r["rtf"] for r in runs),
+            "grasp_kinematic_held": sum(bool(r["held"]) for r in runs) / len(runs)}
+
+
 def run(out_dir: pathlib.Path) -> dict:
     out = pathlib.Path(out_dir) / "experiments"
     timings, with_viewer = [], []
@@ -62,4 +85,5 @@ def run(out_dir: pathlib.Path) -> dict:
             "rtf_grasp_overall": statistics.median(float(t["rtf_overall"]) for t in timings),
             "propagate_rtf_grasp": statistics.median(float(t["propagate_rtf"]) for t in timings),
             "rtf_grasp_exact_meshes": float(exact["rtf_stepping"]),
-            "rtf_grasp_mesh_tolerance_speedup": round(rtf / float(exact["rtf_stepping"]), 3)}
+            "rtf_grasp_mesh_tolerance_speedup": round(rtf / float(exact["rtf_stepping"]), 3),
+            **run_kinematic(out_dir)}

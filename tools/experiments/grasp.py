@@ -104,13 +104,18 @@ def motor_of(handle, link_name: str) -> str:
 MODES = ("tracked", "velocity")
 
 
-def run(frames: bool = True, out_root=None, mode: str = "tracked", viewer: bool = True) -> dict:
+def run(frames: bool = True, out_root=None, mode: str = "tracked", viewer: bool = True,
+        kinematic: bool = False) -> dict:
     """The grasp in ``mode``; with ``frames``, the Viewer's numbered frames and close-ups;
-    ``viewer=False`` (no frames) runs it without a Viewer node (bench_experiments)."""
+    ``viewer=False`` (no frames) runs it without a Viewer node (bench_experiments).
+    ``kinematic`` (tracked mode only): the arm and the palm under the kinematic drive
+    (KINEMATIC_LINKS), the fingers dynamic; the summary goes to ``grasp_kinematic``."""
     if mode not in MODES:
         raise common.ExperimentError(f"grasp mode {mode!r}: choose from {', '.join(MODES)}")
+    if kinematic and mode != "tracked":
+        raise common.ExperimentError("the kinematic grasp runs in tracked mode only")
     from gui.core.paths import RADIANS, load_robot_path
-    p = dict(PARAMETERS, mode=mode)
+    p = dict(PARAMETERS, mode=mode, kinematic=kinematic)
     # the thesis's grasp, as pinned: the arm's motors at zero speed between the commands (the
     # servos that hold a loaded robot let the opening hand release the can 0.16 s late)
     problem, plan = common.load_plan(common.EXAMPLES / PROBLEM, WORLD, hold_start=False)
@@ -118,7 +123,8 @@ def run(frames: bool = True, out_root=None, mode: str = "tracked", viewer: bool 
         CAN, (-0.35, 1.18, 0.6803), p["can_mass_kg"], p["can_color"], p["can_radius_m"],
         p["can_length_m"]))
     kwargs = {} if out_root is None else {"out_root": out_root}
-    with common.Session("grasp", WORLD, CAMERA, track={CAN, PALM}, frames=frames,
+    with common.Session("grasp_kinematic" if kinematic else "grasp", WORLD, CAMERA,
+                        track={CAN, PALM}, frames=frames,
                         contacts=True, viewer=viewer, **kwargs) as s:
         s.client.execute(plan)
         handle = plan.robots[0]
@@ -130,6 +136,10 @@ def run(frames: bool = True, out_root=None, mode: str = "tracked", viewer: bool 
         for motor in flex:  # fingers squeeze with a bounded torque
             s.client.set_joint_parameters(motor, [(JointParameter.MAX_FORCE, 1,
                                                    p["finger_max_torque_N_m"])])
+        if kinematic:
+            from odin_common.interface import ServoDrive
+            s.client.set_drive([motor_of(handle, name) for name in KINEMATIC_LINKS],
+                               ServoDrive.KINEMATIC)
         drive = Drive(s, handle, p, frames)
         drive.phase("start")
         s.cycle_and_frame()
@@ -147,6 +157,8 @@ def run(frames: bool = True, out_root=None, mode: str = "tracked", viewer: bool 
         facts["phases_s"] = phases
         if drive.tracking is not None:
             facts["tracking"] = drive.tracking
+        if kinematic:
+            facts["kinematic_links"] = list(KINEMATIC_LINKS)
         if drive.closeups:
             facts["closeups"] = str(closeup_sheet(drive.closeups, s.out / "closeups.png")
                                     .relative_to(common.ROOT))
@@ -323,6 +335,13 @@ def tracking_facts(report, handle) -> dict:
 
 #: the TX90's arm joints (the rest are the hand's)
 ARM = ("Shoulder", "ForeArm", "Elbow", "Arm", "Wrist", "Tcp")
+#: the kinematic grasp's links under the kinematic drive: the arm, the palm (the joint between
+#: the TX90's flange and the hand) and the hand's joints that only place the fingers (the
+#: thumb's turn, the fingers' spread): every joint but the flexing ones (FLEX). Those stay
+#: dynamic: their servos' targets lie past the can, and kinematic fingers would drive through
+#: it instead of squeezing it under the finger motors' torque limit. On the kinematic links,
+#: each finger's three flexing joints stay in the LCP with the can they hold.
+KINEMATIC_LINKS = ARM + ("Palm", "Thumb", "Thumb-Base", "Index-Base", "Mid-Base", "Ring-Base")
 
 
 def propagate_carry(s: "common.Session", shoulder: str, started: float, ended: float) -> dict:

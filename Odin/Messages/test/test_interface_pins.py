@@ -9,7 +9,7 @@ from Messages import msg
 from Services import srv
 from odin_common import interface, world_parameters
 from odin_common.interface import (AxisFrame, ForceKind, JointParameter, JointType, MotorKind,
-                                   SetJointAction, Shape, Solver)
+                                   ServoDrive, SetJointAction, Shape, Solver)
 
 SRV_DIR = pathlib.Path(__file__).resolve().parents[2] / "Services" / "srv"
 
@@ -23,6 +23,7 @@ PINS = [
     (ForceKind, msg.BodyForce),
     (Shape, msg.Object),
     (Solver, srv.SetWorldRequest),
+    (ServoDrive, srv.SetServoRequest),
 ]
 
 
@@ -34,7 +35,8 @@ def test_every_enum_member_is_the_constant_of_its_message(enum, generated):
 
 def test_the_message_defines_no_constant_the_enum_lacks():
     for enum, generated in [(JointType, msg.Joint), (JointParameter, msg.JointParameter),
-                            (SetJointAction, srv.SetJointRequest)]:
+                            (SetJointAction, srv.SetJointRequest),
+                            (ServoDrive, srv.SetServoRequest)]:
         constants = {name for name in dir(generated) if name.isupper() and
                      isinstance(getattr(generated, name), int)}
         assert constants == {m.name for m in enum}, enum.__name__

@@ -256,6 +256,11 @@ def run_path_main(argv: Optional[Sequence[str]] = None) -> int:
                         "world's default) steps small articulated scenes exactly (dWorldStep) "
                         "and large ones with QuickStep, which alone can let a chain shake near "
                         "its goal where WORLDSTEP, the exact solver, reaches it")
+    parser.add_argument("--kinematic", action="store_true",
+                        help="tracked: the path's robots under the kinematic drive first (Set "
+                        "Servo drive KINEMATIC on every joint's motor; it stays set): the links "
+                        "follow the servos' law exactly and push what they meet, no force "
+                        "limit (docs/INTERFACE.md, \"Kinematic drive\")")
     units = parser.add_mutually_exclusive_group()
     units.add_argument("--degrees", action="store_true",
                        help="values in degrees (mm) [default for 2012 problems]")
@@ -355,6 +360,11 @@ def _run_tracked(args, plan) -> int:
     _check_start(client, plan, solution, args.from_here)       # before --solver changes a thing
     if args.solver:
         client.set_world(solver=Solver[args.solver.upper()])
+    if args.kinematic:
+        from odin_common.interface import ServoDrive
+        for handle in plan.robots:
+            if handle.name in solution.paths:
+                client.set_drive(handle.motor_ids, ServoDrive.KINEMATIC)
     solver = Solver(client.world_parameters().solver).name.lower()
     shown = [0]
 

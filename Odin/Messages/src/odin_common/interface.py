@@ -72,6 +72,13 @@ class AxisFrame(IntEnum):
     SECOND_BODY = 2
 
 
+class ServoDrive(IntEnum):
+    """Services/SetServo ``drive``: how the motors' joints move (docs/SERVOS.md)."""
+    UNCHANGED = 0        # as they do now (a new motor: DYNAMIC)
+    DYNAMIC = 1          # the motors push the joints under their maximum force (the default)
+    KINEMATIC = 2        # the links beyond the joints follow the commanded speed exactly
+
+
 class ForceKind(IntEnum):
     """Services/SetExternalForce ``kind``."""
     FORCE = 0            # N
@@ -433,7 +440,7 @@ class NodeParameter(NamedTuple):
     what: str
 
 
-__all__ = ["NodeParameter", "SERVO_GAIN", "SERVO_MAX_SPEED", "JointType", "JointParameter", "SetJointAction", "MotorKind", "AxisFrame",
+__all__ = ["NodeParameter", "SERVO_GAIN", "SERVO_MAX_SPEED", "JointType", "JointParameter", "SetJointAction", "MotorKind", "AxisFrame", "ServoDrive",
            "ForceKind", "Solver", "DivergencePolicy", "AUTO_SOLVER_MAX_ROWS", "AUTO_SOLVER_MAX_ISLAND_ROWS", "JOINT_AXES_USED", "JOINT_USES_ANCHOR",
            "JOINT_NEEDS_TWO_BODIES", "JOINT_AXIS2_ON_BODY2", "JOINT_FORCE_MAGNITUDES", "JOINT_STATE_AXES", "JOINT_PARAMETERS",
            "JOINT_PARAMETER_AXES", "MOTOR_PARAMETERS", "UNIT_PARAMETERS",

@@ -346,6 +346,11 @@ class WorldClient:
         rates, gains 1/s, speed limits, force limits)."""
         self.call("set_servo", **command.request_fields())
 
+    def set_drive(self, motors: Sequence[str], drive: int) -> None:
+        """Set Servo's drive alone (odin_common.interface.ServoDrive) for the motors' joints:
+        KINEMATIC, the links follow the commanded speeds exactly; DYNAMIC, motors push them."""
+        self.call("set_servo", motors=list(motors), drive=int(drive))
+
     def propagate(self, duration: float, step: float = 0.0,
                   motor_goals: Optional[Dict[str, Sequence[float]]] = None,
                   forces: Sequence[dict] = (), start: str = "", keep: bool = False

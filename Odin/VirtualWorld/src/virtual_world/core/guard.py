@@ -23,9 +23,10 @@ REASONS = {1: "a value is not finite", 2: "faster than divergence_speed",
 
 def guarded(scene: Scene) -> List[str]:
     """The objects C checks (and, under auto_disable, lets sleep): every object with a dynamic
-    body, not parked."""
+    body, not parked and not moved by the kinematic drive."""
+    driven = set(scene.kinematic.values())
     return [i for i, o in scene.objects.items()
-            if o.body is not None and not o.fixed and i not in scene.parked]
+            if o.body is not None and not o.fixed and i not in scene.parked and i not in driven]
 
 
 def refresh(scene: Scene) -> None:

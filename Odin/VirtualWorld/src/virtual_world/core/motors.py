@@ -15,7 +15,7 @@ from odin_common import limits
 from odin_common.interface import (JOINT_AXIS2_ON_BODY2, SERVO_GAIN, SERVO_MAX_SPEED, AxisFrame,
                                    JointParameter, MotorKind)
 from odin_common.specs import MotorSpec
-from virtual_world.core import validation as check
+from virtual_world.core import kinematic, validation as check
 from virtual_world.core.records import MotorRecord, Servo, ServoState
 from virtual_world.core.scene import Scene
 from virtual_world.errors import DuplicateName, InvalidArgument, Unsupported
@@ -182,6 +182,7 @@ def rebuild_goals(scene: Scene) -> None:
     for slot, motor in enumerate(motors):
         if motor.servo is not None:
             scene.c.update_servo(slot, _servo_arguments(scene, motor))
+    kinematic.refresh(scene)    # the links' motors have new slots; a gone motor's link drops
 
 
 def _servo_arguments(scene: Scene, motor: MotorRecord) -> tuple:

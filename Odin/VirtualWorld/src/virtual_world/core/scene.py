@@ -35,6 +35,7 @@ class Scene:
         self.pairs: Dict[FrozenSet[str], str] = {}       # {body1, body2} -> joint id
         self.motors: Dict[str, MotorRecord] = {}
         self.motor_slots: Dict[str, int] = {}           # motor id -> slot in C's goal array
+        self.kinematic: Dict[str, str] = {}             # kinematic drive: motor id -> link
         self.body_forces: Dict[str, BodyForceRecord] = {}
         self.joint_forces: Dict[str, JointForceRecord] = {}
         self.entities: Dict[str, List[str]] = {}

@@ -4,7 +4,8 @@ A snapshot holds everything a step reads that calls can change: every body's pos
 velocities (ODE's own numbers, odin_state.c), static geometries' poses, every joint's and
 motor's parameters, motor goals, persistent body and joint forces, simulated time and the
 step count, the world's state of ODE's random generator (QuickStep's constraint order), the
-collisions recorded but not yet read, and which bodies the divergence guard had parked. Putting one back, then stepping as before, gives
+collisions recorded but not yet read, which bodies the divergence guard had parked and which
+links the kinematic drive moved. Putting one back, then stepping as before, gives
 bit-identical poses and velocities (tests/ compare raw float64 bytes).
 
 A snapshot belongs to the scene's contents when it was taken (its objects, joints and motors):
@@ -19,7 +20,7 @@ from typing import Dict, Tuple
 import numpy as np
 
 from odin_common.interface import JOINT_PARAMETER_AXES, JOINT_PARAMETERS, MOTOR_PARAMETERS
-from virtual_world.core import forces, guard, motors, readout
+from virtual_world.core import forces, guard, kinematic, motors, readout
 from virtual_world.core.records import BodyForceRecord, Collision, JointForceRecord
 from virtual_world.core.scene import Scene
 from virtual_world.errors import InvalidArgument
@@ -48,6 +49,7 @@ class Snapshot:
     step_count: int
     rand_seed: int
     parked: Tuple[str, ...]                     # objects the divergence guard had parked
+    kinematic: Dict[str, str]                   # the kinematic drive's links (motor -> object)
 
 
 def contents(scene: Scene) -> Contents:
@@ -70,7 +72,8 @@ def take(scene: Scene) -> Snapshot:
         servos={i: m.servo for i, m in scene.motors.items()},
         body_forces=dict(scene.body_forces), joint_forces=dict(scene.joint_forces),
         carried=dict(scene.carried), sim_time=scene.sim_time,
-        step_count=scene.c.step_count, rand_seed=scene.c.rand_seed, parked=tuple(scene.parked))
+        step_count=scene.c.step_count, rand_seed=scene.c.rand_seed,
+        parked=tuple(scene.parked), kinematic=dict(scene.kinematic))
 
 
 def _joint_parameters(scene: Scene):
@@ -108,6 +111,7 @@ def check_fits(scene: Scene, snapshot: Snapshot, what: str) -> None:
 def put_back(scene: Scene, snapshot: Snapshot) -> None:
     """Puts the scene's dynamic state back as ``snapshot`` holds it (check_fits first)."""
     guard.set_parked(scene, snapshot.parked)
+    kinematic.install(scene, snapshot.kinematic)
     bodies.write_states([scene.objects[i].body.ptr for i in snapshot.body_ids],
                         snapshot.body_states)
     for name, pose in zip(snapshot.static_names, snapshot.static_poses):

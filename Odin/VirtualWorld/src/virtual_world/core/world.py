@@ -20,12 +20,12 @@ from typing import Dict, List, Mapping, Optional, Sequence, Tuple
 
 import numpy as np
 
-from odin_common.interface import ForceKind, JointType, MotorKind, Solver
+from odin_common.interface import ForceKind, JointType, MotorKind, ServoDrive, Solver
 from odin_common.limits import ResourceLimits
 from odin_common.specs import CompositeSpec, EntitySpec, JointSpec, MotorSpec, ObjectSpec
 from odin_common.world_parameters import WorldParameters
-from virtual_world.core import (forces, guard, joints, motors, objects, readout, snapshots,
-                                validation as check)
+from virtual_world.core import (forces, guard, joints, kinematic, motors, objects, readout,
+                                snapshots, validation as check)
 from virtual_world.core.requests import changes_contents, changes_state, disturbs, locked
 from virtual_world.core.records import (BodyState, Built, BuiltEntity, Collision, Divergence,
                                         JointReaction, JointState, MotorState, ObjectState,
@@ -279,15 +279,42 @@ class Core:
         return motors.split_per_axis(self._scene, motor_ids, values, what)
 
     @disturbs
-    def set_servos(self, servos: Mapping[str, Mapping]) -> None:
+    def set_servos(self, servos: Mapping[str, Mapping],
+                   drive: int = ServoDrive.UNCHANGED) -> None:
         """Servo mode for motors, all checked first (core.motors.set_servos): each tracks a
-        position target on its joint's axes."""
-        motors.set_servos(self._scene, servos)
+        position target on its joint's axes; ``drive`` (ServoDrive) for their joints
+        (core.kinematic: KINEMATIC, the links follow the servos' law exactly)."""
+        scene = self._scene
+        links = kinematic.plan(scene, list(servos), drive)
+        motors.set_servos(scene, servos)
+        if links is not None:
+            kinematic.install(scene, links)
 
     @disturbs
-    def release_servos(self, motor_ids: Sequence[str]) -> None:
-        """Motors back from servo mode to speed goals, at zero."""
-        motors.release_servos(self._scene, motor_ids)
+    def release_servos(self, motor_ids: Sequence[str],
+                       drive: int = ServoDrive.UNCHANGED) -> None:
+        """Motors back from servo mode to speed goals, at zero; ``drive`` as set_servos'."""
+        scene = self._scene
+        for motor_id in motor_ids:
+            scene.motor(motor_id)
+        links = kinematic.plan(scene, motor_ids, drive)
+        motors.release_servos(scene, motor_ids)
+        if links is not None:
+            kinematic.install(scene, links)
+
+    @disturbs
+    def set_drive(self, motor_ids: Sequence[str], drive: int) -> None:
+        """The drive (ServoDrive) of the motors' joints alone, all or nothing: KINEMATIC, the
+        links beyond them follow the motors' commanded speeds exactly (core.kinematic)."""
+        scene = self._scene
+        links = kinematic.plan(scene, motor_ids, drive)
+        if links is not None:
+            kinematic.install(scene, links)
+
+    @locked
+    def kinematic_links(self) -> Dict[str, str]:
+        """{motor id: the object it drives kinematically}, parents first."""
+        return dict(self._scene.kinematic)
 
     @locked
     def servo_states(self) -> List[ServoState]:

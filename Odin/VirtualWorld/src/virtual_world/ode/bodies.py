@@ -273,3 +273,9 @@ def inertia_matrix(m) -> np.ndarray:
 def mass_is_valid(m) -> bool:
     """ODE's own check (dMassCheck); it reports through ODE's message handler when false."""
     return bool(lib.dMassCheck(m))
+
+
+def set_kinematic_link(body, on: bool) -> None:
+    """Makes a body a link of the kinematic drive (kinematic, finite rotation, never
+    auto-disabled, awake) or dynamic again (its mass back; odin_kinematic.c)."""
+    lib.odin_kinematic_set(body, int(bool(on)))

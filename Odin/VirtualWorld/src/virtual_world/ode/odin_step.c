@@ -419,6 +419,7 @@ static void apply_motor_goals(OdinWorld *w) {
                 if (v > g->max_speed[k]) v = g->max_speed[k];
                 if (v < -g->max_speed[k]) v = -g->max_speed[k];
             }
+            g->speed[k] = v;
             if (g->kind == 0) dJointSetAMotorParam(g->motor, dParamVel + k * dParamGroup, v);
             else dJointSetLMotorParam(g->motor, dParamVel + k * dParamGroup, v);
         }
@@ -762,6 +763,7 @@ int odin_world_step(OdinWorld *w, double h, int count) {
         apply_body_forces(w);                         /* 2. forces and torques on bodies */
         apply_joint_forces(w);                        /* 3. joint forces and motor goals */
         apply_motor_goals(w);
+        odin_kinematic_drive(w, h);                   /*    kinematic links' velocities */
         w->last_solver = step_solver(w);
         if (w->last_solver == 0) {                    /* 4. step */
             dRandSetSeed(w->rand_seed);

@@ -54,7 +54,33 @@ typedef struct OdinMotorGoal {
     double gain[3];          /* 1/s */
     double max_speed[3];     /* rad/s or m/s */
     double position[3];      /* out: the joint's value when the last step began */
+    double speed[3];         /* out: the speed commanded for the last step (rad/s or m/s): the
+                                goal, or the servo's clamped law */
 } OdinMotorGoal;
+
+/* A link under the kinematic drive (virtual_world.core.kinematic): a kinematic body whose hinge
+ * or slider to its parent moves at exactly the speed its motor commands (OdinMotorGoal.speed,
+ * the goal or the servo's law), whatever it meets. Before every step, parents first, the link's
+ * pose at the step's end is found by forward kinematics: its pose relative to its parent's,
+ * turned about (hinge) or moved along (slider) the joint's axis by direction x h x speed, on
+ * the parent's pose at the step's end; the body then gets the linear and angular velocity that
+ * carry it there in the step (ODE integrates a kinematic body by its velocities, with finite
+ * rotation: exact to rounding). So contacts and the joints to dynamic bodies see the motion and
+ * no pose is ever written. Each step starts from the present poses: nothing else is state. A
+ * link whose pose at the step's end would leave the world's extent stays where it is. */
+typedef struct OdinKinematicLink {
+    dBodyID body;
+    dBodyID parent;          /* the parent's body; NULL: the static world */
+    int parent_link;         /* the parent's index in the array (before this one); -1: the
+                                parent is not driven (the world or a fixed body: it stays put) */
+    int motor;               /* the slot of the joint's motor in OdinWorld.motors */
+    dJointID joint;          /* the link's joint to its parent */
+    int joint_type;          /* dJointTypeHinge or dJointTypeSlider */
+    double direction;        /* +1: the link is the joint's ODE body 1 (the joint's value grows
+                                as it turns or slides along the axis); -1: its body 2 */
+    double next_position[3]; /* internal: the pose at the step's end (body position, m) */
+    double next_quaternion[4];
+} OdinKinematicLink;
 
 /* What every geom's data (dGeomSetData) points at; Python allocates it with the geom and keeps
  * it alive as long as the geom. serial: the geom's number in its scene, given in creation order,
@@ -136,6 +162,7 @@ typedef struct OdinWorld {
     OdinBodyForce *forces; int n_forces;
     OdinJointForce *joint_forces; int n_joint_forces;
     OdinMotorGoal *motors; int n_motors;
+    OdinKinematicLink *kinematic; int n_kinematic;   /* parents before children */
     /* outputs */
     int last_step_contacts;
     int record_every_step;   /* contact policy: record the pairs of every step, not the last */
@@ -167,6 +194,13 @@ typedef struct OdinWorld {
     dBodyID *island_keys; int *island_index; int *island_stack; int island_cap;
 } OdinWorld;
 
+
+/* Makes a body a kinematic link (on 1: kinematic, finite rotation, never auto-disabled, awake)
+ * or dynamic again (on 0: its mass back, infinitesimal rotation; the guard's auto-disable sync
+ * sets its flag). */
+void odin_kinematic_set(dBodyID body, int on);
+/* Internal (odin_kinematic.c): the kinematic links' velocities for a step of h seconds. */
+void odin_kinematic_drive(OdinWorld *w, double h);
 
 /* Runs `count` steps of `h` seconds; returns the steps taken (fewer when the guard parked a
  * body and stop_on_divergence is set). */

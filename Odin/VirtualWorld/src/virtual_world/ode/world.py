@@ -2,9 +2,10 @@
 group, the contact settings, and the arrays of persistent actions the C step loop applies.
 
 ``CWorld`` owns an ``OdinWorld`` struct (memory Python's, allocated with ffi.new) and the three
-scene handles; the arrays of body forces, joint forces and motor goals are rebuilt from plain
-tuples whenever they change, and always before a handle they point at is freed (C must never
-see a freed handle). Collision records come back as geom addresses, which the Core names.
+scene handles; the arrays of body forces, joint forces, motor goals and kinematic links are
+rebuilt from plain tuples whenever they change, and always before a handle they point at is
+freed (C must never see a freed handle). Collision records come back as geom addresses,
+which the Core names.
 """
 from __future__ import annotations
 
@@ -21,6 +22,8 @@ from virtual_world.ode.runtime import drains_ode_messages
 BodyForce = Tuple  # (body ptr, torque, vector_in_body, at_point, point_in_body, vector, point)
 JointForce = Tuple  # (joint ptr, ODE joint type, magnitudes)
 MotorGoal = Tuple  # (motor ptr, MotorKind, velocities)
+KinematicLink = Tuple  # (body ptr, parent body ptr or None, parent's index or -1, motor slot,
+#                         joint ptr, ODE joint type)
 Divergence = Tuple  # (body address, reason, value, position, velocity, angular, step)
 Record = Tuple  # (geom address 1, geom address 2, depth m, points ((x, y, z), ...) m,
 #                  the step count when first seen, normals (unit, pushing geom 1), forces on
@@ -163,6 +166,18 @@ class CWorld:
                 g.velocity[k] = value
         self._install("motors", array, len(goals))
 
+    def set_kinematic_links(self, links: Sequence[KinematicLink]) -> None:
+        """The kinematic drive's links, parents first (odin_step.h OdinKinematicLink); each
+        link's direction is read from the joint (+1 when the link is its ODE body 1)."""
+        if not links and not self.struct.n_kinematic:
+            return      # none before, none now: every propagation of a planner comes here
+        array = ffi.new("OdinKinematicLink[]", max(len(links), 1))
+        for k, (body, parent, parent_link, slot, joint, joint_type) in zip(array, links):
+            k.body, k.parent = body, parent if parent is not None else ffi.NULL
+            k.parent_link, k.motor, k.joint, k.joint_type = parent_link, slot, joint, joint_type
+            k.direction = 1.0 if lib.dJointGetBody(joint, 0) == body else -1.0
+        self._install("kinematic", array, len(links))
+
     @drains_ode_messages
     def set_guarded(self, bodies: Sequence) -> None:
         """The bodies the divergence guard checks after every step (the dynamic ones)."""
@@ -266,7 +281,7 @@ class CWorld:
         if self.world.closed:
             return
         s = self.struct
-        for field in ("forces", "joint_forces", "motors", "guarded"):
+        for field in ("forces", "joint_forces", "motors", "kinematic", "guarded"):
             setattr(s, field, ffi.NULL)
             setattr(s, "n_" + field, 0)
         self._arrays.clear()

@@ -31,6 +31,10 @@ READ_ONLY = frozenset({"get_world", "get_state", "check_collision"})
 LOOP_CONTROL = frozenset({"start", "step_once"})
 
 
+#: Set Servo's per-axis lists
+SERVO_LISTS = ("targets", "rates", "gains", "max_speeds", "max_forces")
+
+
 class NoViewer:
     """A viewer sink that shows nothing (replay)."""
 
@@ -179,16 +183,19 @@ class WorldServices:
         if not motor_ids:
             raise InvalidArgument("no motor given")
         if request.release:
-            self.core.release_servos(motor_ids)
+            self.core.release_servos(motor_ids, request.drive)
             return {"message": f"released {len(motor_ids)} servo(s)"}
+        if request.drive and not any(len(getattr(request, name)) for name in SERVO_LISTS):
+            self.core.set_drive(motor_ids, request.drive)
+            return {"message": f"drive of {len(motor_ids)} motor(s) set"}
         servos = {motor_id: {} for motor_id in motor_ids}
-        for name in ("targets", "rates", "gains", "max_speeds", "max_forces"):
+        for name in SERVO_LISTS:
             values = list(getattr(request, name))
             if name == "targets" or values:
                 for motor_id, split in self.core.split_per_axis(motor_ids, values,
                                                                 name).items():
                     servos[motor_id][name] = split
-        self.core.set_servos(servos)
+        self.core.set_servos(servos, request.drive)
         return {"message": f"{len(motor_ids)} servo(s) set"}
 
     def set_surface(self, request) -> dict:
