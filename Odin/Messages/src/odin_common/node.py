@@ -124,9 +124,22 @@ def _ask_master(uri: str, caller_id: str, timeout: Optional[float]) -> None:
         raise rosgraph.MasterError(message)
 
 
+#: MasterWatch's mark for a master that answered with an error (it knows nothing of the node)
+MASTER_LOST = ("master", "")
+
+
+def forgotten(missing_before: set, missing_now: set) -> bool:
+    """Whether a registration is forgotten: missing from the master at two looks in a row."""
+    return bool(missing_before & missing_now)
+
+
 class MasterWatch:
     """A daemon thread that registers this node again with a master that forgot it, or any of
-    its topics and services (a master restarted: ``_forgotten``), once a ``period`` (s)."""
+    its topics and services (a master restarted: ``_missing``), looking once a ``period`` (s).
+
+    A registration counts as forgotten when it is missing at two looks in a row: rospy adds a
+    new topic to its own lists a moment before it tells the master, and a look in between
+    (a node that loads a problem makes a topic per robot) took that for a restarted master."""
 
     def __init__(self, period: float = 1.0):
         self.period = period
@@ -137,32 +150,37 @@ class MasterWatch:
     def _run(self) -> None:
         name = rospy.get_name()
         master = rosgraph.Master(name)
+        missing_before: set = set()
         while not rospy.is_shutdown():
             time.sleep(self.period)
             try:
-                forgotten = self._forgotten(master, name)
+                missing = self._missing(master, name)
             except (OSError, xmlrpc.client.Error):  # no master now: wait for one
                 continue
-            if forgotten:
+            if forgotten(missing_before, missing):
                 self._register_again(master)
+                missing = set()
+            missing_before = missing
 
     @staticmethod
-    def _forgotten(master: rosgraph.Master, name: str) -> bool:
-        """Whether the master lacks any publication, subscription or service of this node.
-        Not only the node as a whole: a master that restarted while rospy was still
-        registering the node's start-up knew its first topics (rospy retries those) and none
-        of its services, and asking for the node found it."""
+    def _missing(master: rosgraph.Master, name: str) -> set:
+        """The publications, subscriptions and services of this node the master lacks, as
+        ("publication" | "subscription" | "service", name); {MASTER_LOST} when the master
+        knows nothing of the node. Not only the node as a whole: a master that restarted
+        while rospy was still registering the node's start-up knew its first topics (rospy
+        retries those) and none of its services, and asking for the node found it."""
         try:
             publishers, subscribers, providers = master.getSystemState()
         except rosgraph.MasterError:
-            return True
+            return {MASTER_LOST}
 
-        def known(state: list) -> set:
-            return {topic for topic, nodes in state if name in nodes}
+        def unknown(kind: str, ours: list, state: list) -> set:
+            known = {topic for topic, nodes in state if name in nodes}
+            return {(kind, entry) for entry, _ in ours if entry not in known}
         topics, services = get_topic_manager(), get_service_manager()
-        return bool({t for t, _ in topics.get_publications()} - known(publishers)
-                    or {t for t, _ in topics.get_subscriptions()} - known(subscribers)
-                    or {s for s, _ in services.get_services()} - known(providers))
+        return (unknown("publication", topics.get_publications(), publishers)
+                | unknown("subscription", topics.get_subscriptions(), subscribers)
+                | unknown("service", services.get_services(), providers))
 
     def _register_again(self, master: rosgraph.Master) -> None:
         """What rospy's RegManager.start does once: every publication, subscription and service
