@@ -54,3 +54,17 @@ def test_nodes_are_started_as_rosrun_would_start_them():
         chosen = rosrun.stdout.strip() if rosrun.returncode == 0 else None
         assert find_executable(package, program, env) == chosen, (package, program)
     assert find_executable("GUI", "problem_info", env) is not None
+
+
+def test_waiting_for_a_service_probes_it_as_rospy_does_and_the_node_logs_no_warning():
+    from rosgraph.network import encode_ros_handshake_header
+    from odin_common.ros_master import _tcpros_header
+    fields = {"probe": "1", "md5sum": "*", "callerid": "/odin_ros_master", "service": "/a/b"}
+    assert _tcpros_header(fields) == encode_ros_handshake_header(fields)
+    with RosMaster() as master:
+        world = master.rosrun("VirtualWorld", "virtualWorld")
+        master.wait_for_service("/virtual_world/step_once")
+        master.wait_for_service("/virtual_world/start")
+        assert master.run(["rosservice", "call", "/virtual_world/step_once", "cycles: 1"]
+                          ).returncode == 0           # the log holds the whole start-up
+        assert "Inbound TCP/IP connection failed" not in master.log_text(world)

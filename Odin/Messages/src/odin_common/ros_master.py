@@ -26,6 +26,7 @@ import pathlib
 import random
 import signal
 import socket
+import struct
 import subprocess
 import tempfile
 import time
@@ -248,7 +249,11 @@ class RosMaster:
             return False
         address = urllib.parse.urlsplit(uri)        # rosrpc://host:port
         try:
-            with socket.create_connection((address.hostname, address.port), timeout=5):
+            with socket.create_connection((address.hostname, address.port), timeout=5) as link:
+                # rospy.wait_for_service's probe header: the server closes without a warning
+                # (a bare connection logged "Inbound TCP/IP connection failed" in every node)
+                link.sendall(_tcpros_header({"probe": "1", "md5sum": "*",
+                                             "callerid": "/odin_ros_master", "service": name}))
                 return True
         except OSError:
             return False
@@ -472,3 +477,12 @@ def run_rostest(test_file: str, env: dict | None = None,
     return subprocess.run(["rostest", "--text", test_file], env=run_env,
                           capture_output=True, text=True, timeout=timeout,
                           stdin=subprocess.DEVNULL, start_new_session=True)
+
+
+def _tcpros_header(fields: dict) -> bytes:
+    """A TCPROS connection header (ROS's wiki, "ROS/Connection Header"): each field
+    ``key=value`` after its length, all after their total length, lengths 4-byte little
+    endian (rosgraph.network.encode_ros_handshake_header, which this layer may not import)."""
+    entries = [f"{key}={value}".encode() for key, value in sorted(fields.items())]
+    body = b"".join(struct.pack("<I", len(entry)) + entry for entry in entries)
+    return struct.pack("<I", len(body)) + body
