@@ -14,7 +14,7 @@ from virtual_world.core.records import (BodyForceRecord, Collision, GeometryReco
                                         JointForceRecord, JointRecord, MotorRecord, ObjectRecord)
 from virtual_world.errors import Unsupported, UnknownName
 from virtual_world.ode.handles import TriMeshDataCache
-from virtual_world.ode.world import CWorld, PoseReader
+from virtual_world.ode.world import BodyArray, CWorld, PoseReader
 
 
 class Scene:
@@ -50,11 +50,13 @@ class Scene:
         self.divergences: List[object] = []             # records.Divergence not yet taken
         self._pose_reader: Optional[PoseReader] = None
         self._pose_names: List[str] = []
+        self._bodies: Optional[BodyArray] = None
 
     def close(self) -> None:
         """Frees every ODE handle of the scene; idempotent."""
         self.c.close()
         self._pose_reader = None
+        self._bodies = None
 
     # -- look-ups that refuse unknown names --------------------------------------------------
     def object(self, object_id: str) -> ObjectRecord:
@@ -87,6 +89,23 @@ class Scene:
             return self.geometries[name]
         except (KeyError, TypeError):
             raise UnknownName(f"no geometry named {name!r}") from None
+
+    # -- objects, their bodies in one C array for state vectors ------------------------------
+    def add_object(self, record: ObjectRecord) -> None:
+        self.objects[record.id] = record
+        self._bodies = None
+
+    def drop_object(self, object_id: str) -> None:
+        del self.objects[object_id]
+        self._bodies = None
+
+    def body_array(self) -> BodyArray:
+        """Every object's body, in object order (a body state vector's order), rebuilt after
+        a build or a removal."""
+        if self._bodies is None:
+            self._bodies = BodyArray([o.body.ptr for o in self.objects.values()
+                                      if o.body is not None])
+        return self._bodies
 
     # -- geometries, in one C array for pose read-out ---------------------------------------
     def take_serial(self) -> int:

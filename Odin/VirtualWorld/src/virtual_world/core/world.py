@@ -29,7 +29,8 @@ from virtual_world.core import (forces, guard, joints, motors, objects, readout,
 from virtual_world.core.requests import changes_contents, changes_state, disturbs, locked
 from virtual_world.core.records import (BodyState, Built, BuiltEntity, Collision, Divergence,
                                         JointReaction, JointState, MotorState, ObjectState,
-                                        Propagation, Removed, ServoState)
+                                        Propagation, Removed, ServoState,
+                                        StatePropagation)
 from virtual_world.core.scene import Scene
 from virtual_world.errors import Closed, InvalidArgument, UnknownName
 from virtual_world.ode import bodies
@@ -411,18 +412,27 @@ class Core:
         stepping on from it gives the results stepping on from when it was read gave. Under
         auto_disable the bodies' rest counts start again here (ODE's count is in no vector),
         so a body about to fall asleep may sleep some steps later than it did."""
-        self._put_state_vector(self._checked_state_vector(vector))
+        self._put_state_vector(self.checked_state_vector(vector))
 
-    def _checked_state_vector(self, vector: Sequence[float]) -> np.ndarray:
-        """``vector`` as float64 when it is a body state vector of this world."""
-        count = len(self._body_ptrs())
-        vector = np.asarray(vector, dtype=np.float64)
+    @locked
+    def checked_state_vector(self, vector: Sequence[float]) -> np.ndarray:
+        """``vector`` as float64 when it is a body state vector of this world (its size,
+        finite values, a 32-bit generator state); InvalidArgument otherwise."""
+        count = self._scene.body_array().count
+        try:
+            vector = np.asarray(vector, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise InvalidArgument(f"a body state vector holds numbers; got "
+                                  f"{str(vector)[:60]}") from None
         size = 1 + count * bodies.BODY_STATE_SIZE
-        if vector.shape != (size,) or not np.all(np.isfinite(vector)):
+        # a finite sum means finite values (the usual case, one pass); an infinite one may
+        # be an overflow of finite values, which the element-wise test tells
+        if vector.shape != (size,) or not (math.isfinite(vector.sum())
+                                           or np.isfinite(vector).all()):
             raise InvalidArgument(f"a body state vector of this world has {size} finite "
                                   f"values (1 + {bodies.BODY_STATE_SIZE} per body); got "
                                   f"shape {vector.shape}")
-        seed = vector[0]
+        seed = float(vector[0])
         if seed != int(seed) or not 0 <= seed < 2 ** 32:
             raise InvalidArgument(f"random generator state {seed!r} is not a 32-bit integer")
         return vector
@@ -460,12 +470,7 @@ class Core:
         ``read_states`` False leaves the answer's ``states`` empty (a planner reads the state
         vector alone). Everything is checked before anything changes."""
         scene = self._scene
-        duration = check.number("duration", duration)
-        step_size = check.step_size(step_size)
-        if duration <= 0:
-            raise InvalidArgument(f"duration={duration!r} must be positive")
-        steps = check.step_count(max(1, round(min(duration / step_size, 1e18))),
-                                 f"duration={duration!r} s at step {step_size!r} s")
+        step_size, steps = _steps_of(duration, step_size)
         keep = check.flag("keep", keep)
         start_snapshot = self._snapshot(start) if start else None
         if start_snapshot is not None:
@@ -473,7 +478,7 @@ class Core:
         if start_state is not None and len(start_state):
             if start_snapshot is not None:
                 raise InvalidArgument("give a start snapshot or a start state, not both")
-            start_state = self._checked_state_vector(start_state)
+            start_state = self.checked_state_vector(start_state)
         else:
             start_state = None
         before = snapshots.take(scene)
@@ -495,6 +500,32 @@ class Core:
         if not keep:
             snapshots.put_back(scene, before)
         return result._replace(wall_time=time.perf_counter() - started, kept=keep)
+
+    @changes_state
+    def propagate_state(self, start_state: Sequence[float], duration: float, step_size: float,
+                        forces: Sequence[Tuple[str, Sequence[float]]] = ()) -> StatePropagation:
+        """A planner's propagation, all in one C call: from the body state vector
+        ``start_state`` (``body_state_vector``'s), ``duration`` s in steps of ``step_size``
+        s under ``forces`` ((object id, force N, world frame, at the centre of mass) each, for
+        this call only), recording the pairs that collide on the way; the world stays in the
+        state reached. The states and pairs are bit for bit those of ``propagate`` from
+        ``start_state`` with these forces as body forces and ``keep`` (tests/ compare them);
+        its answer holds only what a planner reads. Everything is checked first."""
+        scene = self._scene
+        step_size, steps = _steps_of(duration, step_size)
+        start_state = np.ascontiguousarray(self.checked_state_vector(start_state))
+        state, steps = scene.c.propagate(scene.body_array(), start_state,
+                                         _checked_pushes(scene, forces), step_size, steps)
+        scene.carried = {}
+        scene.sim_time += step_size * steps
+        guard.collect(scene, step_size)
+        names = scene.geometry_names
+        pairs = []
+        for address1, address2 in scene.c.record_pairs():
+            first, second = names[address1], names[address2]
+            pairs.append((first, second) if first <= second else (second, first))
+        scene.c.clear_records()
+        return StatePropagation(state, tuple(sorted(pairs)), steps)
 
     def _run(self, steps: int, step_size: float, read_states: bool = True) -> Propagation:
         """Steps with every step's collisions recorded; what a propagation answers."""
@@ -652,6 +683,30 @@ class Core:
         Contact-less policy: every pair seen since the last read; reading clears the set.
         Contact policy: the pairs that had contacts in the last step."""
         return readout.read_collisions(self._scene)
+
+
+def _checked_pushes(scene: Scene, pushes: Sequence[Tuple[str, Sequence[float]]]) -> list:
+    """(object id, force N world) pairs as (body ptr, force) for CWorld.propagate, each
+    checked as add_body_force checks a force at the centre of mass."""
+    checked = []
+    for push in pushes:
+        try:
+            object_id, vector = push
+        except (TypeError, ValueError):
+            raise InvalidArgument(f"force {push!r} is not (object id, force vector)") from None
+        checked.append((scene.body_object(object_id, "force").body.ptr,
+                        forces.checked_vector(object_id, ForceKind.FORCE, vector).tolist()))
+    return checked
+
+
+def _steps_of(duration: float, step_size: float) -> Tuple[float, int]:
+    """(step_size, the number of steps) of a propagation of ``duration`` s, both checked."""
+    duration = check.number("duration", duration)
+    step_size = check.step_size(step_size)
+    if duration <= 0:
+        raise InvalidArgument(f"duration={duration!r} must be positive")
+    return step_size, check.step_count(max(1, round(min(duration / step_size, 1e18))),
+                                       f"duration={duration!r} s at step {step_size!r} s")
 
 
 __all__ = ["Core", "ForceKind", "JointType", "MotorKind"]

@@ -328,24 +328,30 @@ static void near_callback(void *data, dGeomID o1, dGeomID o2) {
 
 /* ---------------------------------------------------------------- persistent actions */
 
-static void apply_body_forces(const OdinWorld *w) {
-    for (int i = 0; i < w->n_forces; ++i) {
-        const OdinBodyForce *f = &w->forces[i];
-        const double *v = f->vector, *p = f->point;
-        if (f->torque) {
-            if (f->vector_in_body) dBodyAddRelTorque(f->body, v[0], v[1], v[2]);
-            else dBodyAddTorque(f->body, v[0], v[1], v[2]);
-        } else if (!f->at_point) {
-            if (f->vector_in_body) dBodyAddRelForce(f->body, v[0], v[1], v[2]);
-            else dBodyAddForce(f->body, v[0], v[1], v[2]);
-        } else if (f->vector_in_body) {
-            if (f->point_in_body) dBodyAddRelForceAtRelPos(f->body, v[0], v[1], v[2], p[0], p[1], p[2]);
-            else dBodyAddRelForceAtPos(f->body, v[0], v[1], v[2], p[0], p[1], p[2]);
-        } else {
-            if (f->point_in_body) dBodyAddForceAtRelPos(f->body, v[0], v[1], v[2], p[0], p[1], p[2]);
-            else dBodyAddForceAtPos(f->body, v[0], v[1], v[2], p[0], p[1], p[2]);
-        }
+static void apply_body_force(const OdinBodyForce *f) {
+    const double *v = f->vector, *p = f->point;
+    if (f->torque) {
+        if (f->vector_in_body) dBodyAddRelTorque(f->body, v[0], v[1], v[2]);
+        else dBodyAddTorque(f->body, v[0], v[1], v[2]);
+    } else if (!f->at_point) {
+        if (f->vector_in_body) dBodyAddRelForce(f->body, v[0], v[1], v[2]);
+        else dBodyAddForce(f->body, v[0], v[1], v[2]);
+    } else if (f->vector_in_body) {
+        if (f->point_in_body) dBodyAddRelForceAtRelPos(f->body, v[0], v[1], v[2], p[0], p[1], p[2]);
+        else dBodyAddRelForceAtPos(f->body, v[0], v[1], v[2], p[0], p[1], p[2]);
+    } else {
+        if (f->point_in_body) dBodyAddForceAtRelPos(f->body, v[0], v[1], v[2], p[0], p[1], p[2]);
+        else dBodyAddForceAtPos(f->body, v[0], v[1], v[2], p[0], p[1], p[2]);
     }
+}
+
+/* The persistent forces, then a propagation's own (odin_world_propagate): a propagation's
+ * force comes last, as it did when it was added to the persistent ones for the call, so that
+ * ODE sums a body's forces in the same order either way. */
+static void apply_body_forces(const OdinWorld *w) {
+    for (int i = 0; i < w->n_forces; ++i) apply_body_force(&w->forces[i]);
+    for (int i = 0; i < w->n_propagation_forces; ++i)
+        apply_body_force(&w->propagation_forces[i]);
 }
 
 /* Adds +v to the first body and -v to the second, as torque or force (ODE's own convention). */
@@ -782,6 +788,37 @@ int odin_world_step(OdinWorld *w, double h, int count) {
     }
     w->recording = 0;
     return s;
+}
+
+/* One propagation from a body state vector (see odin_step.h), as Core.propagate runs one from
+ * a start state and keeps it: the state put back, the records forgotten, the generator's state
+ * set, then the step loop recording every step, then the state read. */
+int odin_world_propagate(OdinWorld *w, dBodyID *bodies, int n, const double *state_in,
+                         const OdinBodyForce *forces, int n_forces, double h, int count,
+                         double *state_out) {
+    odin_write_body_states(bodies, n, state_in + 1);
+    odin_world_clear_records(w);
+    w->rand_seed = (unsigned long)state_in[0];
+    w->propagation_forces = forces;
+    w->n_propagation_forces = n_forces;
+    w->record_every_step = 1;
+    int taken = odin_world_step(w, h, count);
+    w->record_every_step = 0;
+    w->propagation_forces = NULL;
+    w->n_propagation_forces = 0;
+    state_out[0] = (double)w->rand_seed;
+    odin_read_body_states(bodies, n, state_out + 1);
+    return taken;
+}
+
+/* The recorded pairs' geoms, two addresses per record, into out (room for 2 * max); returns the
+ * records there are (those beyond max not written). */
+int odin_world_record_pairs(const OdinWorld *w, uintptr_t *out, int max) {
+    for (int i = 0; i < w->n_records && i < max; ++i) {
+        out[2 * i] = (uintptr_t)w->records[i].g1;
+        out[2 * i + 1] = (uintptr_t)w->records[i].g2;
+    }
+    return w->n_records;
 }
 
 /* Collision detection on the present poses, no step. The pairs go into the records like a

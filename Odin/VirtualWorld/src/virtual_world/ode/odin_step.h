@@ -136,6 +136,9 @@ typedef struct OdinWorld {
     OdinBodyForce *forces; int n_forces;
     OdinJointForce *joint_forces; int n_joint_forces;
     OdinMotorGoal *motors; int n_motors;
+    /* one propagation's body forces (odin_world_propagate), applied after the persistent ones;
+       NULL between propagations */
+    const OdinBodyForce *propagation_forces; int n_propagation_forces;
     /* outputs */
     int last_step_contacts;
     int record_every_step;   /* contact policy: record the pairs of every step, not the last */
@@ -185,6 +188,20 @@ void odin_world_restart_rest_counts(OdinWorld *w);
 int odin_world_sleeping(const OdinWorld *w);
 /* Forgets the divergences Python has read. */
 void odin_world_clear_divergences(OdinWorld *w);
+/* One planner's propagation in one call: puts back the body state vector state_in (ODE's
+ * random generator state, then ODIN_BODY_STATE_SIZE values for each of the n bodies, in the
+ * order of `bodies`; odin_write_body_states), forgets the collision records, adds `forces`
+ * (n_forces, after the persistent ones) for this call only, runs odin_world_step(w, h, count)
+ * recording every step's colliding pairs (kept for odin_world_record_pairs), and writes the
+ * state reached into state_out (the same layout). The same ODE calls in the same order as
+ * putting the vector back, adding the forces and stepping one call at a time: bit-identical
+ * states. Returns the steps taken. */
+int odin_world_propagate(OdinWorld *w, dBodyID *bodies, int n, const double *state_in,
+                         const OdinBodyForce *forces, int n_forces, double h, int count,
+                         double *state_out);
+/* The recorded pairs' geoms (g1, g2 addresses of each record) into out, which has room for
+ * 2 * max values; returns how many records there are. */
+int odin_world_record_pairs(const OdinWorld *w, uintptr_t *out, int max);
 /* Records the pairs touching now, without stepping and without contacts: under the contact-less
  * policy always; under the contact policy only when any_policy (a collision query). */
 void odin_world_detect(OdinWorld *w, int any_policy);

@@ -37,7 +37,7 @@ class CWorld:
         self.struct = ffi.new("OdinWorld *")
         s = self.struct
         s.world, s.space, s.contact_group = self.world.ptr, self.space.ptr, self.contacts.ptr
-        self._arrays = {}          # keeps the action arrays alive while C points at them
+        self._arrays = {}          # keeps the arrays C points at alive, and reused buffers
         self.apply(parameters)
 
     @drains_ode_messages
@@ -186,6 +186,8 @@ class CWorld:
         """The bodies the guard parked since the last call (body address, reason, value,
         position, velocity, angular velocity, step count), forgotten once read."""
         s = self.struct
+        if not s.n_diverged:
+            return []
         out = [(int(ffi.cast("uintptr_t", d.body)), int(d.reason), float(d.value),
                 tuple(d.position), tuple(d.velocity), tuple(d.angular), int(d.step))
                for d in (s.diverged[i] for i in range(s.n_diverged))]
@@ -235,6 +237,46 @@ class CWorld:
         return int(lib.odin_world_step(self.struct, step_size, count))
 
     @drains_ode_messages
+    def propagate(self, bodies: "BodyArray", start: np.ndarray,
+                  forces: Sequence[Tuple[object, Sequence[float]]], step_size: float,
+                  count: int) -> Tuple[np.ndarray, int]:
+        """One planner's propagation in one C call (odin_step.h, odin_world_propagate): from
+        the body state vector ``start`` (float64, contiguous, ``bodies``' layout) under
+        ``forces`` ((body ptr, force N world, at the centre of mass) each, this call only),
+        ``count`` steps recording every step's pairs. Returns (the state vector reached, the
+        steps taken); the world stays in that state."""
+        pushes = self._propagation_forces(len(forces))
+        for f, (body, vector) in zip(pushes, forces):
+            f.body = body
+            f.vector = vector
+        out = np.empty_like(start)
+        taken = lib.odin_world_propagate(
+            self.struct, bodies.array, bodies.count, ffi.from_buffer("double[]", start),
+            pushes, len(forces), step_size, count, ffi.from_buffer("double[]", out))
+        return out, int(taken)
+
+    def _propagation_forces(self, count: int):
+        """An array for ``count`` propagation forces (at the centre of mass, world frame:
+        every other field 0), kept from call to call (a planner sends one per step)."""
+        array = self._arrays.get("propagation_forces")
+        if array is None or len(array) < count:
+            array = ffi.new("OdinBodyForce[]", max(count, 4))
+            self._arrays["propagation_forces"] = array
+        return array
+
+    def record_pairs(self) -> List[Tuple[int, int]]:
+        """The geom addresses of every collision record (records() without the contacts)."""
+        count = int(self.struct.n_records)
+        if not count:
+            return []
+        out = self._arrays.get("record_pairs")
+        if out is None or len(out) < 2 * count:
+            out = ffi.new("uintptr_t[]", 2 * max(count, 64))
+            self._arrays["record_pairs"] = out
+        lib.odin_world_record_pairs(self.struct, out, count)
+        return [(out[2 * i], out[2 * i + 1]) for i in range(count)]
+
+    @drains_ode_messages
     def detect(self, any_policy: bool = False) -> None:
         """Records what touches now, without stepping or contacts: under the contact-less
         policy, or under either when ``any_policy`` (a collision query)."""
@@ -276,6 +318,14 @@ class CWorld:
         self.contacts.close()
         self.world.close()        # every body, joint and motor left
         s.world = s.space = s.contact_group = ffi.NULL
+
+
+class BodyArray:
+    """A fixed list of bodies in one C array (a body state vector's bodies, in its order)."""
+
+    def __init__(self, bodies: Sequence):
+        self.count = len(bodies)
+        self.array = ffi.new("dBodyID[]", list(bodies) or 1)
 
 
 class PoseReader:
