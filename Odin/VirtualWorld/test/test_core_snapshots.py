@@ -428,10 +428,12 @@ def test_a_bad_state_propagation_is_refused_and_changes_nothing(core):
     good = core.body_state_vector()
     core.step(H, 20)
     before, time_before = state_bytes(core), core.sim_time
-    seed_broken = good.copy()
+    seed_broken, nan_inside = good.copy(), good.copy()
     seed_broken[0] = 0.5
+    nan_inside[30] = np.nan
     for args, message in (
-            ((good[:-1], 0.01, H), "values"), ((np.full(good.size, np.nan), 0.01, H), "finite"),
+            ((good[:-1], 0.01, H), "values"), ((nan_inside, 0.01, H), "value 30 is nan"),
+            ((np.full(good.size, np.inf), 0.01, H), "32-bit"),
             ((["a"] * good.size, 0.01, H), "numbers"), ((seed_broken, 0.01, H), "32-bit"),
             ((good, -1.0, H), "duration"), ((good, 0.01, 0.0), "step_size"),
             ((good, 1e9, H), "steps"),
@@ -440,7 +442,7 @@ def test_a_bad_state_propagation_is_refused_and_changes_nothing(core):
             ((good, 0.01, H, [("l1", (math.nan, 0, 0))]), "finite"),
             ((good, 0.01, H, [("l1", (0, 0, 2 * FORCE_LIMIT))]), "beyond the limit"),
             ((good, 0.01, H, [("l1",)]), "object id, force vector"),
-            ((good, 0.01, H, [("l1", (1, 0))]), "expected 3")):
+            ((good, 0.01, H, [("l1", (1, 0))]), "vector of 3 numbers")):
         with pytest.raises(OdinError, match=message):
             core.propagate_state(*args)
         assert state_bytes(core) == before and core.sim_time == time_before, message

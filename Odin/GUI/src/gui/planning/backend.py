@@ -167,17 +167,27 @@ class VectorBodies:
     state, bit for bit (the same arithmetic on the same numbers)."""
 
     def __init__(self, slots: Dict[str, Tuple[int, np.ndarray]]):
-        self._slots = {name: (1 + index * BODY_STATE_SIZE, np.asarray(com, dtype=np.float64))
-                       for name, (index, com) in slots.items()}
+        self._slots = {}
+        for name, (index, com) in slots.items():
+            start = 1 + index * BODY_STATE_SIZE
+            com = np.asarray(com, dtype=np.float64)
+            self._slots[name] = (*(slice(start + f.start, start + f.stop)
+                                   for f in (_POSITION, _QUATERNION, _LINEAR)),
+                                 com, not com.any())
 
     def body(self, state: np.ndarray, name: str) -> BodyState:
         """The body ``name``'s (frame origin (3,) m, quaternion (w, x, y, z), linear velocity
-        (3,) m/s of its centre of mass), world frame, in ``state``."""
-        start, com = self._slots[name]
-        record = state[start:start + BODY_STATE_SIZE]
-        quaternion = record[_QUATERNION]
-        return (record[_POSITION] - quaternion_to_matrix(quaternion) @ com, quaternion,
-                record[_LINEAR])
+        (3,) m/s of its centre of mass), world frame, in ``state`` (views of it but the
+        origin)."""
+        position, quaternion, linear, com, centred = self._slots[name]
+        position, quaternion = state[position], state[quaternion]
+        if centred:
+            x, y, z = position.tolist()
+            if x and y and z:
+                # origin = position - R @ 0 = position: subtracting a zero changes no value
+                # but a zero's sign, hence the non-zero position (body_state's very bits)
+                return position.copy(), quaternion, state[linear]
+        return position - quaternion_to_matrix(quaternion) @ com, quaternion, state[linear]
 
 
 def _field(name: str) -> slice:
@@ -230,13 +240,17 @@ class CoreBackend:
 
     def _one(self, state, control) -> Outcome:
         core, problem = self.world.core, self.problem
-        state = core.checked_state_vector(state)     # refused before anything changes
+        state = np.asarray(state, dtype=np.float64)
+        if state.shape != self._start.shape:
+            core.checked_state_vector(state)     # raises: the Core's refusal of its size
         act = step_actuation(problem, control, self.bodies.body(state, problem.base_body))
         if act.servo is not None and act.servo != self._servo_sent:
+            core.checked_state_vector(state)     # a bad state changes no servo either
             # the same settings again change nothing: a control held over several steps
             # is sent once (this world's servos are set by this back end alone)
             self.port.set_servo(act.servo)
             self._servo_sent = act.servo
+        # propagate_state checks the state's values before it changes anything
         result = core.propagate_state(state, problem.step, self.world.step_values.step,
                                       act.forces)
         self.propagations += 1

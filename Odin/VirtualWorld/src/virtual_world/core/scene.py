@@ -17,6 +17,10 @@ from virtual_world.ode.handles import TriMeshDataCache
 from virtual_world.ode.world import BodyArray, CWorld, PoseReader
 
 
+PAIR_NAMES_KEPT = 4096
+"""Sets of colliding pairs Scene.pair_names remembers (then it starts again)."""
+
+
 class Scene:
     """The ODE world (``c``) and every record of what it holds."""
 
@@ -51,6 +55,7 @@ class Scene:
         self._pose_reader: Optional[PoseReader] = None
         self._pose_names: List[str] = []
         self._bodies: Optional[BodyArray] = None
+        self._pair_names: Dict[bytes, Tuple[Tuple[str, str], ...]] = {}
 
     def close(self) -> None:
         """Frees every ODE handle of the scene; idempotent."""
@@ -119,11 +124,31 @@ class Scene:
         self.geometries[record.name] = record
         self.geometry_names[record.owner.address] = record.name
         self._pose_reader = None
+        self._pair_names = {}
 
     def drop_geometry(self, record: GeometryRecord) -> None:
         del self.geometry_names[record.owner.address]
         del self.geometries[record.name]
         self._pose_reader = None
+        self._pair_names = {}       # a new geom may come at a freed one's address
+
+    def pair_names(self, raw: bytes) -> Tuple[Tuple[str, str], ...]:
+        """The geometry pairs of collision records given as raw geom address pairs (C's
+        uintptr_t, CWorld.propagate's): names sorted within a pair and the pairs sorted.
+        Remembered until a geometry comes or goes: a planner meets the same few sets of
+        pairs again and again."""
+        pairs = self._pair_names.get(raw)
+        if pairs is None:
+            names = self.geometry_names
+            found = []
+            for address1, address2 in zip(*[iter(memoryview(raw).cast("N"))] * 2):
+                first, second = names[address1], names[address2]
+                found.append((first, second) if first <= second else (second, first))
+            pairs = tuple(sorted(found))
+            if len(self._pair_names) >= PAIR_NAMES_KEPT:
+                self._pair_names = {}
+            self._pair_names[raw] = pairs
+        return pairs
 
     def pose_reader(self) -> Tuple[List[str], PoseReader]:
         """(geometry names, a reader of their poses), rebuilt after a build or a removal."""

@@ -412,29 +412,28 @@ class Core:
         stepping on from it gives the results stepping on from when it was read gave. Under
         auto_disable the bodies' rest counts start again here (ODE's count is in no vector),
         so a body about to fall asleep may sleep some steps later than it did."""
-        self._put_state_vector(self.checked_state_vector(vector))
+        self._put_state_vector(self._checked_state_vector(vector))
 
     @locked
     def checked_state_vector(self, vector: Sequence[float]) -> np.ndarray:
-        """``vector`` as float64 when it is a body state vector of this world (its size,
-        finite values, a 32-bit generator state); InvalidArgument otherwise."""
-        count = self._scene.body_array().count
+        """``vector`` as contiguous float64 when it is a body state vector of this world (its
+        size, finite values, a 32-bit generator state); InvalidArgument otherwise."""
+        return self._checked_state_vector(vector)
+
+    def _checked_state_vector(self, vector: Sequence[float]) -> np.ndarray:
         try:
-            vector = np.asarray(vector, dtype=np.float64)
+            vector = np.ascontiguousarray(vector, dtype=np.float64)
         except (TypeError, ValueError):
             raise InvalidArgument(f"a body state vector holds numbers; got "
                                   f"{str(vector)[:60]}") from None
-        size = 1 + count * bodies.BODY_STATE_SIZE
-        # a finite sum means finite values (the usual case, one pass); an infinite one may
-        # be an overflow of finite values, which the element-wise test tells
-        if vector.shape != (size,) or not (math.isfinite(vector.sum())
-                                           or np.isfinite(vector).all()):
+        size = 1 + self._scene.body_array().count * bodies.BODY_STATE_SIZE
+        if vector.shape != (size,):
             raise InvalidArgument(f"a body state vector of this world has {size} finite "
                                   f"values (1 + {bodies.BODY_STATE_SIZE} per body); got "
                                   f"shape {vector.shape}")
-        seed = float(vector[0])
-        if seed != int(seed) or not 0 <= seed < 2 ** 32:
-            raise InvalidArgument(f"random generator state {seed!r} is not a 32-bit integer")
+        fault = bodies.state_vector_fault(vector)
+        if fault >= 0:
+            raise _state_vector_fault(vector, fault)
         return vector
 
     def _put_state_vector(self, vector: np.ndarray) -> None:
@@ -478,7 +477,7 @@ class Core:
         if start_state is not None and len(start_state):
             if start_snapshot is not None:
                 raise InvalidArgument("give a start snapshot or a start state, not both")
-            start_state = self.checked_state_vector(start_state)
+            start_state = self._checked_state_vector(start_state)
         else:
             start_state = None
         before = snapshots.take(scene)
@@ -513,19 +512,16 @@ class Core:
         its answer holds only what a planner reads. Everything is checked first."""
         scene = self._scene
         step_size, steps = _steps_of(duration, step_size)
-        start_state = np.ascontiguousarray(self.checked_state_vector(start_state))
-        state, steps = scene.c.propagate(scene.body_array(), start_state,
-                                         _checked_pushes(scene, forces), step_size, steps)
+        start_state = self._checked_state_vector(start_state)
+        state, steps, pairs = scene.c.propagate(scene.body_array(), start_state,
+                                                _checked_pushes(scene, forces), step_size,
+                                                steps)
+        if steps < 0:        # C checks the values again before it changes anything
+            raise _state_vector_fault(start_state, -1 - steps)
         scene.carried = {}
         scene.sim_time += step_size * steps
         guard.collect(scene, step_size)
-        names = scene.geometry_names
-        pairs = []
-        for address1, address2 in scene.c.record_pairs():
-            first, second = names[address1], names[address2]
-            pairs.append((first, second) if first <= second else (second, first))
-        scene.c.clear_records()
-        return StatePropagation(state, tuple(sorted(pairs)), steps)
+        return StatePropagation(state, scene.pair_names(pairs), steps)
 
     def _run(self, steps: int, step_size: float, read_states: bool = True) -> Propagation:
         """Steps with every step's collisions recorded; what a propagation answers."""
@@ -685,6 +681,15 @@ class Core:
         return readout.read_collisions(self._scene)
 
 
+def _state_vector_fault(vector: np.ndarray, index: int) -> InvalidArgument:
+    """The refusal of a body state vector whose value ``index`` cannot be put back."""
+    if index == 0:
+        return InvalidArgument(f"random generator state {float(vector[0])!r} is not a "
+                               "32-bit integer")
+    return InvalidArgument(f"a body state vector's values are finite; value {index} is "
+                           f"{float(vector[index])!r}")
+
+
 def _checked_pushes(scene: Scene, pushes: Sequence[Tuple[str, Sequence[float]]]) -> list:
     """(object id, force N world) pairs as (body ptr, force) for CWorld.propagate, each
     checked as add_body_force checks a force at the centre of mass."""
@@ -695,12 +700,28 @@ def _checked_pushes(scene: Scene, pushes: Sequence[Tuple[str, Sequence[float]]])
         except (TypeError, ValueError):
             raise InvalidArgument(f"force {push!r} is not (object id, force vector)") from None
         checked.append((scene.body_object(object_id, "force").body.ptr,
-                        forces.checked_vector(object_id, ForceKind.FORCE, vector).tolist()))
+                        forces.checked_vector(object_id, ForceKind.FORCE, vector)))
     return checked
+
+
+_STEPS_OF: Dict[Tuple[float, float], Tuple[float, int]] = {}
+"""_steps_of's answers for float arguments: a planner asks the same every step."""
 
 
 def _steps_of(duration: float, step_size: float) -> Tuple[float, int]:
     """(step_size, the number of steps) of a propagation of ``duration`` s, both checked."""
+    floats = type(duration) is float and type(step_size) is float   # noqa: E721 - not bool
+    if floats and (duration, step_size) in _STEPS_OF:
+        return _STEPS_OF[duration, step_size]
+    answer = _checked_steps(duration, step_size)
+    if floats:
+        if len(_STEPS_OF) >= 64:
+            _STEPS_OF.clear()
+        _STEPS_OF[duration, step_size] = answer
+    return answer
+
+
+def _checked_steps(duration: float, step_size: float) -> Tuple[float, int]:
     duration = check.number("duration", duration)
     step_size = check.step_size(step_size)
     if duration <= 0:

@@ -151,12 +151,27 @@ static int keep_pair(OdinWorld *w, dGeomID g1, dGeomID g2, long s1, long s2,
     return 1;
 }
 
-/* Sorts the pass's pairs by key: a least-significant-digit radix sort, a byte at a time,
- * skipping the bytes every key shares (with fewer than 65,536 geoms, four of the eight): a
- * few operations per pair, where qsort's comparisons cost a step 3 % of its instructions. */
+/* Up to this many pairs are sorted by insertion: the radix sort's eight passes over its 256
+ * counters cost more than a few dozen comparisons (a planner's small scenes, every step). */
+#define INSERTION_SORT_PAIRS 24
+
+/* Sorts the pass's pairs by key (keys are unique: each pair of geoms is met once a pass): by
+ * insertion when there are few, otherwise a least-significant-digit radix sort, a byte at a
+ * time, skipping the bytes every key shares (with fewer than 65,536 geoms, four of the
+ * eight): a few operations per pair, where qsort's comparisons cost a step 3 % of its
+ * instructions. */
 static void sort_pairs(OdinWorld *w) {
     int n = w->n_pairs, count[256];
     OdinPair *from = w->pairs, *to = w->pairs_sorted;
+    if (n <= INSERTION_SORT_PAIRS) {
+        for (int i = 1; i < n; ++i) {
+            OdinPair p = from[i];
+            int j = i;
+            for (; j > 0 && from[j - 1].key > p.key; --j) from[j] = from[j - 1];
+            from[j] = p;
+        }
+        return;
+    }
     for (int shift = 0; shift < 64; shift += 8) {
         memset(count, 0, sizeof count);
         for (int i = 0; i < n; ++i) count[(from[i].key >> shift) & 255]++;
@@ -795,7 +810,9 @@ int odin_world_step(OdinWorld *w, double h, int count) {
  * set, then the step loop recording every step, then the state read. */
 int odin_world_propagate(OdinWorld *w, dBodyID *bodies, int n, const double *state_in,
                          const OdinBodyForce *forces, int n_forces, double h, int count,
-                         double *state_out) {
+                         double *state_out, uintptr_t *pairs, int max_pairs, int *n_pairs) {
+    int fault = odin_state_vector_fault(state_in, 1 + n * ODIN_BODY_STATE_SIZE);
+    if (fault >= 0) return -1 - fault;
     odin_write_body_states(bodies, n, state_in + 1);
     odin_world_clear_records(w);
     w->rand_seed = (unsigned long)state_in[0];
@@ -808,6 +825,8 @@ int odin_world_propagate(OdinWorld *w, dBodyID *bodies, int n, const double *sta
     w->n_propagation_forces = 0;
     state_out[0] = (double)w->rand_seed;
     odin_read_body_states(bodies, n, state_out + 1);
+    *n_pairs = odin_world_record_pairs(w, pairs, max_pairs);
+    if (*n_pairs <= max_pairs) odin_world_clear_records(w);
     return taken;
 }
 

@@ -38,6 +38,7 @@ class CWorld:
         s = self.struct
         s.world, s.space, s.contact_group = self.world.ptr, self.space.ptr, self.contacts.ptr
         self._arrays = {}          # keeps the arrays C points at alive, and reused buffers
+        self._pair_count = ffi.new("int *")
         self.apply(parameters)
 
     @drains_ode_messages
@@ -239,42 +240,39 @@ class CWorld:
     @drains_ode_messages
     def propagate(self, bodies: "BodyArray", start: np.ndarray,
                   forces: Sequence[Tuple[object, Sequence[float]]], step_size: float,
-                  count: int) -> Tuple[np.ndarray, int]:
+                  count: int) -> Tuple[np.ndarray, int, bytes]:
         """One planner's propagation in one C call (odin_step.h, odin_world_propagate): from
         the body state vector ``start`` (float64, contiguous, ``bodies``' layout) under
         ``forces`` ((body ptr, force N world, at the centre of mass) each, this call only),
         ``count`` steps recording every step's pairs. Returns (the state vector reached, the
-        steps taken); the world stays in that state."""
-        pushes = self._propagation_forces(len(forces))
+        steps taken or -1 - i when value i of ``start`` cannot be put back, the recorded
+        pairs' geom addresses as raw uintptr_t pairs); the world stays in the state reached,
+        its collision records forgotten."""
+        pushes = self._buffer("propagation_forces", "OdinBodyForce[]", len(forces))
         for f, (body, vector) in zip(pushes, forces):
             f.body = body
             f.vector = vector
+        pairs = self._buffer("record_pairs", "uintptr_t[]", 2 * _PAIRS_KEPT)
         out = np.empty_like(start)
         taken = lib.odin_world_propagate(
             self.struct, bodies.array, bodies.count, ffi.from_buffer("double[]", start),
-            pushes, len(forces), step_size, count, ffi.from_buffer("double[]", out))
-        return out, int(taken)
+            pushes, len(forces), step_size, count, ffi.from_buffer("double[]", out),
+            pairs, _PAIRS_KEPT, self._pair_count)
+        count = self._pair_count[0]
+        if count > _PAIRS_KEPT:        # more than the buffer holds: all of them, then
+            pairs = self._buffer("record_pairs", "uintptr_t[]", 2 * count)
+            lib.odin_world_record_pairs(self.struct, pairs, count)
+            lib.odin_world_clear_records(self.struct)
+        return out, taken, ffi.buffer(pairs, count * _PAIR_BYTES)[:] if count else b""
 
-    def _propagation_forces(self, count: int):
-        """An array for ``count`` propagation forces (at the centre of mass, world frame:
-        every other field 0), kept from call to call (a planner sends one per step)."""
-        array = self._arrays.get("propagation_forces")
+    def _buffer(self, name: str, ctype: str, count: int):
+        """A C array of at least ``count`` items (``ctype``), kept from call to call (a
+        planner propagates thousands of times a second); its contents are the caller's."""
+        array = self._arrays.get(name)
         if array is None or len(array) < count:
-            array = ffi.new("OdinBodyForce[]", max(count, 4))
-            self._arrays["propagation_forces"] = array
+            array = ffi.new(ctype, max(count, 4))
+            self._arrays[name] = array
         return array
-
-    def record_pairs(self) -> List[Tuple[int, int]]:
-        """The geom addresses of every collision record (records() without the contacts)."""
-        count = int(self.struct.n_records)
-        if not count:
-            return []
-        out = self._arrays.get("record_pairs")
-        if out is None or len(out) < 2 * count:
-            out = ffi.new("uintptr_t[]", 2 * max(count, 64))
-            self._arrays["record_pairs"] = out
-        lib.odin_world_record_pairs(self.struct, out, count)
-        return [(out[2 * i], out[2 * i + 1]) for i in range(count)]
 
     @drains_ode_messages
     def detect(self, any_policy: bool = False) -> None:
@@ -318,6 +316,13 @@ class CWorld:
         self.contacts.close()
         self.world.close()        # every body, joint and motor left
         s.world = s.space = s.contact_group = ffi.NULL
+
+
+_PAIRS_KEPT = 256
+"""Collision records a propagation hands back in its buffer at once (more take a second
+call)."""
+_PAIR_BYTES = 2 * ffi.sizeof("uintptr_t")
+"""Bytes of one record's geom pair."""
 
 
 class BodyArray:
