@@ -177,8 +177,7 @@ class VectorBodies:
 
     def body(self, state: np.ndarray, name: str) -> BodyState:
         """The body ``name``'s (frame origin (3,) m, quaternion (w, x, y, z), linear velocity
-        (3,) m/s of its centre of mass), world frame, in ``state`` (views of it but the
-        origin)."""
+        (3,) m/s of its centre of mass), world frame, in ``state``: read-only (views of it)."""
         position, quaternion, linear, com, centred = self._slots[name]
         position, quaternion = state[position], state[quaternion]
         if centred:
@@ -186,7 +185,7 @@ class VectorBodies:
             if x and y and z:
                 # origin = position - R @ 0 = position: subtracting a zero changes no value
                 # but a zero's sign, hence the non-zero position (body_state's very bits)
-                return position.copy(), quaternion, state[linear]
+                return position, quaternion, state[linear]
         return position - quaternion_to_matrix(quaternion) @ com, quaternion, state[linear]
 
 

@@ -32,7 +32,7 @@ from virtual_world.core.records import (BodyState, Built, BuiltEntity, Collision
                                         Propagation, Removed, ServoState,
                                         StatePropagation)
 from virtual_world.core.scene import Scene
-from virtual_world.errors import Closed, InvalidArgument, UnknownName
+from virtual_world.errors import Closed, CoreError, InvalidArgument, UnknownName
 from virtual_world.ode import bodies
 from virtual_world.ode.handles import TriMeshDataCache
 from virtual_world.ode.runtime import init_ode
@@ -421,6 +421,15 @@ class Core:
         return self._checked_state_vector(vector)
 
     def _checked_state_vector(self, vector: Sequence[float]) -> np.ndarray:
+        vector = self._sized_state_vector(vector)
+        fault = bodies.state_vector_fault(vector)
+        if fault >= 0:
+            raise _state_vector_fault(vector, fault)
+        return vector
+
+    def _sized_state_vector(self, vector: Sequence[float]) -> np.ndarray:
+        """``vector`` as contiguous float64 when it has the size of this world's body state
+        vectors; its values are checked by state_vector_fault."""
         try:
             vector = np.ascontiguousarray(vector, dtype=np.float64)
         except (TypeError, ValueError):
@@ -431,9 +440,6 @@ class Core:
             raise InvalidArgument(f"a body state vector of this world has {size} finite "
                                   f"values (1 + {bodies.BODY_STATE_SIZE} per body); got "
                                   f"shape {vector.shape}")
-        fault = bodies.state_vector_fault(vector)
-        if fault >= 0:
-            raise _state_vector_fault(vector, fault)
         return vector
 
     def _put_state_vector(self, vector: np.ndarray) -> None:
@@ -512,11 +518,15 @@ class Core:
         its answer holds only what a planner reads. Everything is checked first."""
         scene = self._scene
         step_size, steps = _steps_of(duration, step_size)
-        start_state = self._checked_state_vector(start_state)
-        state, steps, pairs = scene.c.propagate(scene.body_array(), start_state,
-                                                _checked_pushes(scene, forces), step_size,
-                                                steps)
-        if steps < 0:        # C checks the values again before it changes anything
+        start_state = self._sized_state_vector(start_state)
+        try:
+            pushes = _checked_pushes(scene, forces)
+        except CoreError:
+            self._checked_state_vector(start_state)     # a bad state is said first
+            raise
+        state, steps, pairs = scene.c.propagate(scene.body_array(), start_state, pushes,
+                                                step_size, steps)
+        if steps < 0:        # C checks the state's values before it changes anything
             raise _state_vector_fault(start_state, -1 - steps)
         scene.carried = {}
         scene.sim_time += step_size * steps

@@ -287,7 +287,7 @@ static void read_contact_forces(OdinWorld *w) {
  * recording, the contacts of recorded pairs get joint feedback (read_contact_forces). */
 static void make_contacts(OdinWorld *w, double h) {
     if (!w->unordered && w->n_pairs > 1) sort_pairs(w);
-    int feedback = w->recording && feedback_room(w, w->n_contacts);
+    int feedback = w->recording && !w->pairs_only && feedback_room(w, w->n_contacts);
     w->n_feedback = 0;
     for (int k = 0; k < w->n_pairs; ++k) {
         const OdinPair *p = &w->pairs[k];
@@ -818,9 +818,9 @@ int odin_world_propagate(OdinWorld *w, dBodyID *bodies, int n, const double *sta
     w->rand_seed = (unsigned long)state_in[0];
     w->propagation_forces = forces;
     w->n_propagation_forces = n_forces;
-    w->record_every_step = 1;
+    w->record_every_step = w->pairs_only = 1;
     int taken = odin_world_step(w, h, count);
-    w->record_every_step = 0;
+    w->record_every_step = w->pairs_only = 0;
     w->propagation_forces = NULL;
     w->n_propagation_forces = 0;
     state_out[0] = (double)w->rand_seed;

@@ -142,6 +142,8 @@ typedef struct OdinWorld {
     /* outputs */
     int last_step_contacts;
     int record_every_step;   /* contact policy: record the pairs of every step, not the last */
+    int pairs_only;          /* record pairs without their contact forces (no joint feedback:
+                                odin_world_propagate, whose caller reads only the pairs) */
     int unordered;           /* benchmarks only: contacts made as the broad phase finds them
                                 (not deterministic), to measure what the ordering costs */
     /* the divergence guard: after every step each guarded body must be finite, slower than

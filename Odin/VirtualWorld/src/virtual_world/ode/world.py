@@ -37,7 +37,11 @@ class CWorld:
         self.struct = ffi.new("OdinWorld *")
         s = self.struct
         s.world, s.space, s.contact_group = self.world.ptr, self.space.ptr, self.contacts.ptr
-        self._arrays = {}          # keeps the arrays C points at alive, and reused buffers
+        self._arrays = {}          # keeps the action arrays alive while C points at them
+        # odin_world_propagate's buffers, kept from call to call (a planner propagates
+        # thousands of times a second): its forces, the pairs it hands back and their count
+        self._pushes = ffi.new("OdinBodyForce[]", 4)
+        self._pairs = ffi.new("uintptr_t[]", 2 * _PAIRS_KEPT)
         self._pair_count = ffi.new("int *")
         self.apply(parameters)
 
@@ -248,31 +252,26 @@ class CWorld:
         steps taken or -1 - i when value i of ``start`` cannot be put back, the recorded
         pairs' geom addresses as raw uintptr_t pairs); the world stays in the state reached,
         its collision records forgotten."""
-        pushes = self._buffer("propagation_forces", "OdinBodyForce[]", len(forces))
+        pushes = self._pushes
+        if len(forces) > len(pushes):
+            pushes = self._pushes = ffi.new("OdinBodyForce[]", len(forces))
         for f, (body, vector) in zip(pushes, forces):
             f.body = body
             f.vector = vector
-        pairs = self._buffer("record_pairs", "uintptr_t[]", 2 * _PAIRS_KEPT)
-        out = np.empty_like(start)
+        out = np.empty(start.size)
         taken = lib.odin_world_propagate(
             self.struct, bodies.array, bodies.count, ffi.from_buffer("double[]", start),
             pushes, len(forces), step_size, count, ffi.from_buffer("double[]", out),
-            pairs, _PAIRS_KEPT, self._pair_count)
+            self._pairs, _PAIRS_KEPT, self._pair_count)
         count = self._pair_count[0]
+        if not count:
+            return out, taken, b""
+        pairs = self._pairs
         if count > _PAIRS_KEPT:        # more than the buffer holds: all of them, then
-            pairs = self._buffer("record_pairs", "uintptr_t[]", 2 * count)
+            pairs = ffi.new("uintptr_t[]", 2 * count)
             lib.odin_world_record_pairs(self.struct, pairs, count)
             lib.odin_world_clear_records(self.struct)
-        return out, taken, ffi.buffer(pairs, count * _PAIR_BYTES)[:] if count else b""
-
-    def _buffer(self, name: str, ctype: str, count: int):
-        """A C array of at least ``count`` items (``ctype``), kept from call to call (a
-        planner propagates thousands of times a second); its contents are the caller's."""
-        array = self._arrays.get(name)
-        if array is None or len(array) < count:
-            array = ffi.new(ctype, max(count, 4))
-            self._arrays[name] = array
-        return array
+        return out, taken, ffi.buffer(pairs, count * _PAIR_BYTES)[:]
 
     @drains_ode_messages
     def detect(self, any_policy: bool = False) -> None:
