@@ -424,10 +424,12 @@ def test_a_state_propagation_reports_every_pair_met_on_the_way(core):
 def test_a_bad_state_propagation_is_refused_and_changes_nothing(core):
     from odin_common.limits import MAX_FORCE as FORCE_LIMIT
     arm(core)
+    core.build_object(ObjectSpec("ball", [0.1], position=(2, 0, 0.1)))   # on the ground
     core.step(H, 50)
     good = core.body_state_vector()
     core.step(H, 20)
-    before, time_before = state_bytes(core), core.sim_time
+    before, time_before, touching = state_bytes(core), core.sim_time, core.read_collisions()
+    assert [(c.first, c.second) for c in touching] == [("ball", "ground")]
     seed_broken, nan_inside = good.copy(), good.copy()
     seed_broken[0] = 0.5
     nan_inside[30] = np.nan
@@ -446,6 +448,7 @@ def test_a_bad_state_propagation_is_refused_and_changes_nothing(core):
         with pytest.raises(OdinError, match=message):
             core.propagate_state(*args)
         assert state_bytes(core) == before and core.sim_time == time_before, message
+        assert core.read_collisions() == touching, message
     assert core.body_force_ids() == ["force:l2:0"]
 
 

@@ -812,6 +812,7 @@ int odin_world_propagate(OdinWorld *w, dBodyID *bodies, int n, const double *sta
                          const OdinBodyForce *forces, int n_forces, double h, int count,
                          double *state_out, uintptr_t *pairs, int max_pairs, int *n_pairs) {
     int fault = odin_state_vector_fault(state_in, 1 + n * ODIN_BODY_STATE_SIZE);
+    *n_pairs = 0;
     if (fault >= 0) return -1 - fault;
     odin_write_body_states(bodies, n, state_in + 1);
     odin_world_clear_records(w);
