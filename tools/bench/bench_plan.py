@@ -14,10 +14,15 @@
   propagations_per_s_native the same batch through a plain ODE propagator written directly
                             against libode (native/plan_scene.c: the same bodies, forces and
                             step, no Odin), served to the planner the same way: the native
-                            limit. plan_core_over_native: the Core's rate over it, side by side.
+                            limit. plan_core_over_native: the Core's rate over it, side by side
+                            in one process: the median of ROUNDS paired rounds' ratios (the
+                            two batches of a round back to back, native first in even rounds),
+                            as bench_core measures against native C; ..._native is the median
+                            of the rounds' native rates.
   plan_sphere_native_solved KPIECE1 (seed 1, TIME_S) over the native propagator solves the
                             query too (1) or not (0): the native world is the same problem.
-Needs the Kautham data (ODIN_KAUTHAM_DIR). ``ODIN_BENCH_PLAN_SEEDS`` runs fewer seeds.
+Needs the Kautham data (ODIN_KAUTHAM_DIR). ``ODIN_BENCH_PLAN_SEEDS`` runs fewer seeds,
+``ODIN_BENCH_ROUNDS`` fewer paired rounds.
 """
 import logging
 import os
@@ -35,7 +40,7 @@ from odin_common.ros_master import RosMaster  # noqa: E402
 SEEDS = int(os.environ.get("ODIN_BENCH_PLAN_SEEDS", 10))
 TIME_S = 10.0
 BATCH = 200
-REPEATS = 3
+ROUNDS = int(os.environ.get("ODIN_BENCH_ROUNDS", 7))
 SPHERE = ("current_2025", "demos", "OMPL_ode_demos", "Sphere", "Sphere.xml")
 
 
@@ -192,19 +197,23 @@ def _native_library(out_dir: pathlib.Path) -> pathlib.Path:
 
 
 def _native(library: pathlib.Path) -> dict:
-    """The Core's and the native propagator's batch rates side by side (alternating, best of
-    REPEATS each), and one KPIECE1 search over the native propagator."""
+    """The Core's and the native propagator's batch rates side by side (ROUNDS paired rounds,
+    native first in even rounds: the medians of the rates and of the rounds' ratios), and one
+    KPIECE1 search over the native propagator."""
     from gui.planning.backend import CoreBackend
     from gui.planning.bridge import plan
     core = CoreBackend(*_sphere())
     native = NativeBackend(core, library)
     try:
-        core_rates, native_rates = [], []
-        for _ in range(REPEATS):
-            core_rates.append(_rate(core))
-            native_rates.append(_rate(native))
+        rounds = []
+        for k in range(ROUNDS):
+            first, second = (native, core) if k % 2 == 0 else (core, native)
+            rates = {first: _rate(first), second: _rate(second)}
+            rounds.append((rates[core], rates[native]))
         result = plan(native, "KPIECE1", TIME_S, 1)
-        return {"core": max(core_rates), "native": max(native_rates),
+        return {"core": statistics.median(c for c, _ in rounds),
+                "native": statistics.median(n for _, n in rounds),
+                "ratio": statistics.median(c / n for c, n in rounds),
                 "solved": result.solved}
     finally:
         core.close()
@@ -240,7 +249,7 @@ def run(out_dir: pathlib.Path) -> dict:
             "propagations_per_s_pool1": round(pool1, 1),
             "plan_pool_speedup_2": round(pool2 / pool1, 3),
             "propagations_per_s_native": round(native["native"], 1),
-            "plan_core_over_native": round(native["core"] / native["native"], 4),
+            "plan_core_over_native": round(native["ratio"], 4),
             "plan_sphere_native_solved": int(native["solved"])}
 
 

@@ -167,6 +167,19 @@ class CoreRequests(RuleBasedStateMachine):
     def propagate(self, duration, step):
         self.attempt(self.core.propagate, duration, step)
 
+    @rule(data=st.data(), duration=st.one_of(st.floats(0, 0.05), NASTY),
+          step=st.one_of(st.floats(1e-4, 0.01), NASTY), name=NAMES, force=VECTOR)
+    def propagate_state(self, data, duration, step, name, force):
+        """From this world's vector, one with a value broken, or one of another size."""
+        vector = self.core.body_state_vector()
+        change = data.draw(st.sampled_from(["none", "value", "size"]))
+        if change == "value" and vector.size:
+            vector[data.draw(st.integers(0, vector.size - 1))] = data.draw(NASTY)
+        elif change == "size":
+            vector = np.append(vector, 0.0)
+        pushes = data.draw(st.sampled_from([(), ((name, force),), ((name,),)]))
+        self.attempt(self.core.propagate_state, vector, duration, step, pushes)
+
     @rule(name=NAMES, position=VECTOR)
     def check_collision(self, name, position):
         self.attempt(self.core.check_collision, [(name, position, (1, 0, 0, 0))])

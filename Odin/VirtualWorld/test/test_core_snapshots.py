@@ -378,6 +378,80 @@ def test_a_bad_propagation_is_refused_and_changes_nothing(core):
         assert core.body_force_ids() == ["force:l2:0"] and core.motor_goals()["motor:1:&l0"] == [0.4]
 
 
+@pytest.mark.parametrize("build,pushed", [(pile, "s4"), (arm, "l2")], ids=["pile", "arm"])
+def test_a_state_propagation_is_bit_for_bit_a_kept_propagation_from_the_state(core, build,
+                                                                              pushed):
+    """propagate_state (a planner's propagation in one C call) against propagate from the
+    same vectors under the same forces, kept: the same states, pairs and world after. The
+    pushed body holds persistent forces too: ODE must sum them in the same order."""
+    build(core)
+    for persistent in ((0.31, -1.37, 0.93), (-0.57, 0.11, 0.29)):  # sums that the order
+        core.add_body_force(pushed, FORCE, persistent)              # of summands changes
+    rng = np.random.default_rng(3)
+    vectors = []
+    for _ in range(4):
+        core.step(H, 70)
+        vectors.append(core.body_state_vector())
+    for k in range(12):
+        vector = vectors[rng.integers(len(vectors))]
+        push = tuple(float(v) for v in rng.normal(0.0, 30.0, 3))
+        duration = (1, 7, 40)[k % 3] * H
+        general = core.propagate(duration, H, start_state=vector, keep=True, body_forces=[
+            dict(object_id=pushed, kind=FORCE, vector=push)])
+        world_after = state_bytes(core)
+        fast = core.propagate_state(vector, duration, H, [(pushed, push)])
+        assert fast.state.tobytes() == general.state.tobytes(), k
+        assert fast.pairs == tuple((c.first, c.second) for c in general.collisions), k
+        assert fast.steps == general.steps
+        assert state_bytes(core) == world_after
+        vectors.append(fast.state)
+    assert core.read_collisions() == []                      # nothing left over to report
+    assert len(core.body_force_ids()) == (2 if build is pile else 3)   # the pushes are gone
+
+
+def test_a_state_propagation_reports_every_pair_met_on_the_way(core):
+    core.build_object(ObjectSpec("ground", [4, 4, 1], position=(0, 0, -0.5), geometry_only=True))
+    core.build_object(ObjectSpec("ball", [0.1], position=(0, 0, 0.6)))
+    start = core.body_state_vector()
+    assert core.propagate_state(start, 0.2, H).pairs == ()            # still falling
+    landed = core.propagate_state(start, 0.6, H)
+    assert landed.pairs == (("ball", "ground"),) and landed.steps == 600
+    # the world stays where the propagation ended, and time went on
+    assert core.body_state_vector().tobytes() == landed.state.tobytes()
+    assert core.sim_time == pytest.approx(0.8)
+
+
+def test_a_bad_state_propagation_is_refused_and_changes_nothing(core):
+    from odin_common.limits import MAX_FORCE as FORCE_LIMIT
+    arm(core)
+    core.build_object(ObjectSpec("ball", [0.1], position=(2, 0, 0.1)))   # on the ground
+    core.step(H, 50)
+    good = core.body_state_vector()
+    core.step(H, 20)
+    before, time_before, touching = state_bytes(core), core.sim_time, core.read_collisions()
+    assert [(c.first, c.second) for c in touching] == [("ball", "ground")]
+    seed_broken, nan_inside = good.copy(), good.copy()
+    seed_broken[0] = 0.5
+    nan_inside[30] = np.nan
+    for args, message in (
+            ((good[:-1], 0.01, H), "values"), ((nan_inside, 0.01, H), "value 30 is nan"),
+            ((np.full(good.size, np.inf), 0.01, H), "32-bit"),
+            ((["a"] * good.size, 0.01, H), "numbers"), ((seed_broken, 0.01, H), "32-bit"),
+            ((good, -1.0, H), "duration"), ((good, 0.01, 0.0), "step_size"),
+            ((good, 1e9, H), "steps"),
+            ((good, 0.01, H, [("ground", (1, 0, 0))]), "geometry only"),
+            ((good, 0.01, H, [("nope", (1, 0, 0))]), "no object"),
+            ((good, 0.01, H, [("l1", (math.nan, 0, 0))]), "finite"),
+            ((good, 0.01, H, [("l1", (0, 0, 2 * FORCE_LIMIT))]), "beyond the limit"),
+            ((good, 0.01, H, [("l1",)]), "object id, force vector"),
+            ((good, 0.01, H, [("l1", (1, 0))]), "vector of 3 numbers")):
+        with pytest.raises(OdinError, match=message):
+            core.propagate_state(*args)
+        assert state_bytes(core) == before and core.sim_time == time_before, message
+        assert core.read_collisions() == touching, message
+    assert core.body_force_ids() == ["force:l2:0"]
+
+
 # ------------------------------------------------------------------ collision queries
 
 @pytest.mark.parametrize("contact_less", [False, True])

@@ -15,14 +15,15 @@ that the written plan replays bit for bit in a fresh world.
 """
 from __future__ import annotations
 
-from typing import List, NamedTuple, Optional, Protocol, Sequence, Tuple
+from typing import Dict, List, NamedTuple, Optional, Protocol, Sequence, Tuple
 
 import numpy as np
 
-from gui.core.control_path import Actuation, ControlRow, ServoCommand, actuation
+from gui.core.control_path import Actuation, BodyState, ControlRow, ServoCommand, actuation
 from gui.core.plan import BuildPlan, BuiltIds
 from gui.planning.problem import PlanningProblem
-from odin_common.interface import ForceKind
+from odin_common.interface import BODY_STATE_FIELDS, BODY_STATE_SIZE, ForceKind
+from odin_common.rotations import quaternion_to_matrix
 from odin_common.step_values import StepValues
 
 
@@ -159,18 +160,65 @@ def force_requests(forces) -> list:
             for body, vector in forces]
 
 
+class VectorBodies:
+    """Bodies read out of body state vectors (``Core.body_state_vector``'s layout) without a
+    world: ``slots`` {object id: (its index among the vector's bodies, its centre of mass (3,)
+    m in the object frame)}. Gives what the Core's body_state gives for the world in that
+    state, bit for bit (the same arithmetic on the same numbers)."""
+
+    def __init__(self, slots: Dict[str, Tuple[int, np.ndarray]]):
+        self._slots = {}
+        for name, (index, com) in slots.items():
+            start = 1 + index * BODY_STATE_SIZE
+            com = np.asarray(com, dtype=np.float64)
+            self._slots[name] = (*(slice(start + f.start, start + f.stop)
+                                   for f in (_POSITION, _QUATERNION, _LINEAR)),
+                                 com, not com.any())
+
+    def body(self, state: np.ndarray, name: str) -> BodyState:
+        """The body ``name``'s (frame origin (3,) m, quaternion (w, x, y, z), linear velocity
+        (3,) m/s of its centre of mass), world frame, in ``state``: read-only (views of it)."""
+        position, quaternion, linear, com, centred = self._slots[name]
+        position, quaternion = state[position], state[quaternion]
+        if centred:
+            x, y, z = position.tolist()
+            if x and y and z:
+                # origin = position - R @ 0 = position: subtracting a zero changes no value
+                # but a zero's sign, hence the non-zero position (body_state's very bits)
+                return position, quaternion, state[linear]
+        return position - quaternion_to_matrix(quaternion) @ com, quaternion, state[linear]
+
+
+def _field(name: str) -> slice:
+    """Where BODY_STATE_FIELDS puts ``name`` in a body's record."""
+    offset = 0
+    for field, size in BODY_STATE_FIELDS:
+        if field == name:
+            return slice(offset, offset + size)
+        offset += size
+    raise KeyError(name)
+
+
+_POSITION, _QUATERNION, _LINEAR = _field("position"), _field("quaternion"), _field("linear")
+
+
 class CoreBackend:
-    """The problem's world built in a Core of this process; propagations one after another."""
+    """The problem's world built in a Core of this process; propagations one after another,
+    each one Core.propagate_state (one C call)."""
 
     def __init__(self, plan: BuildPlan, problem: PlanningProblem):
         self.problem = problem
         self.world = CoreWorld()
         try:
             self.world.execute(plan)
-            self._start = self.world.core.body_state_vector()
+            core = self.world.core
+            self._start = core.body_state_vector()
+            bodies = core.state()[0]
         except Exception:
             self.world.close()
             raise
+        self.bodies = VectorBodies({b.id: (index, b.center_of_mass)
+                                    for index, b in enumerate(bodies)})
         self.port = CorePort(self.world)
         self.propagations = 0
         self._servo_sent: Optional[ServoCommand] = None
@@ -179,34 +227,38 @@ class CoreBackend:
         return self._start.copy()
 
     def tracked_state(self, state):
-        self.world.core.set_body_state_vector(state)
-        return self._tracked()
+        state = self.world.core.checked_state_vector(state)
+        return self._tracked(state)
 
-    def _tracked(self):
-        position, quaternion, linear, _ = self.world.core.body_state(self.problem.tracked_body)
-        return self.problem.tracked_origin(position, quaternion), np.asarray(linear)
+    def _tracked(self, state: np.ndarray):
+        position, quaternion, linear = self.bodies.body(state, self.problem.tracked_body)
+        return self.problem.tracked_origin(position, quaternion), linear.copy()
 
     def propagate(self, requests):
         return [self._one(state, control) for state, control in requests]
 
     def _one(self, state, control) -> Outcome:
         core, problem = self.world.core, self.problem
-        core.set_body_state_vector(state)
-        act = step_actuation(problem, control, self.port.body_state(problem.base_body))
+        state = np.asarray(state, dtype=np.float64)
+        if state.shape != self._start.shape:
+            core.checked_state_vector(state)     # raises: the Core's refusal of its size
+        act = step_actuation(problem, control, self.bodies.body(state, problem.base_body))
         if act.servo is not None and act.servo != self._servo_sent:
+            core.checked_state_vector(state)     # a bad state changes no servo either
             # the same settings again change nothing: a control held over several steps
             # is sent once (this world's servos are set by this back end alone)
             self.port.set_servo(act.servo)
             self._servo_sent = act.servo
-        result = self.port.advance(problem.step, act.forces)
+        # propagate_state checks the state's values before it changes anything
+        result = core.propagate_state(state, problem.step, self.world.step_values.step,
+                                      act.forces)
         self.propagations += 1
-        position, linear = self._tracked()
-        return Outcome(core.body_state_vector(), position, linear,
-                       tuple((c.first, c.second) for c in result.collisions))
+        position, linear = self._tracked(result.state)
+        return Outcome(result.state, position, linear, result.pairs)
 
     def close(self) -> None:
         self.world.close()
 
 
-__all__ = ["Outcome", "Backend", "CoreWorld", "CorePort", "CoreBackend", "force_requests",
-           "send_plan", "step_actuation"]
+__all__ = ["Outcome", "Backend", "CoreWorld", "CorePort", "CoreBackend", "VectorBodies",
+           "force_requests", "send_plan", "step_actuation"]

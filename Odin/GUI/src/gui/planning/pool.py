@@ -19,11 +19,10 @@ import numpy as np
 
 from gui.core.plan import BuildPlan
 from gui.errors import PlanningError
-from gui.planning.backend import Outcome, force_requests, send_plan, step_actuation
+from gui.planning.backend import (Outcome, VectorBodies, force_requests, send_plan,
+                                  step_actuation)
 from gui.planning.problem import PlanningProblem
-from odin_common.interface import body_record
 from odin_common.messages import body_force_message
-from odin_common.rotations import quaternion_to_matrix
 
 
 class PoolBackend:
@@ -51,7 +50,7 @@ class PoolBackend:
                     self.step = client.step_values().step
                 finally:
                     client.close()
-            self._start, self._bodies = self._read_start()
+            self._start, self.bodies, self._tracked_index = self._read_start()
         except PoolError as error:
             self.pool.close()
             raise PlanningError(str(error)) from None
@@ -66,13 +65,13 @@ class PoolBackend:
             raise PlanningError("the pool's worlds built the problem differently (their body "
                                 "states differ): are they all the same Odin?")
         ids = [body.id for body in answers[0].bodies]
-        bodies = {}
+        slots = {}
         for name in (self.problem.base_body, self.problem.tracked_body):
             if name not in ids:
                 raise PlanningError(f"the pool's worlds have no body {name!r}")
             com = answers[0].centers_of_mass[ids.index(name)]
-            bodies[name] = (ids.index(name), np.array([com.x, com.y, com.z]))
-        return vectors[0], bodies
+            slots[name] = (ids.index(name), np.array([com.x, com.y, com.z]))
+        return vectors[0], VectorBodies(slots), ids.index(self.problem.tracked_body)
 
     @property
     def size(self) -> int:
@@ -83,17 +82,16 @@ class PoolBackend:
 
     def tracked_state(self, state):
         position, quaternion, linear = self._body(state, self.problem.tracked_body)
-        return self.problem.tracked_origin(position, quaternion), linear
+        return self.problem.tracked_origin(position, quaternion), linear.copy()
 
     def _body(self, state, name: str):
         """A body's (frame origin m, quaternion (w, x, y, z), linear velocity m/s), world
-        frame, in a state vector: its record holds the centre of mass (the Core's
-        body_state)."""
-        index, com = self._bodies[name]
-        record = body_record(state, index)
-        quaternion = np.array(record["quaternion"])
-        origin = np.array(record["position"]) - quaternion_to_matrix(quaternion) @ com
-        return origin, quaternion, np.array(record["linear"])
+        frame, in a state vector of the problem's world."""
+        state = np.asarray(state, dtype=np.float64)
+        if state.shape != self._start.shape:
+            raise PlanningError(f"a state vector of the problem's world has "
+                                f"{self._start.size} values; got shape {state.shape}")
+        return self.bodies.body(state, name)
 
     def propagate(self, requests) -> List[Outcome]:
         calls = [self._calls(np.asarray(state, dtype=np.float64), control)
@@ -119,8 +117,7 @@ class PoolBackend:
         return calls
 
     def _outcome(self, answer) -> Outcome:
-        index, _ = self._bodies[self.problem.tracked_body]
-        body = answer.states[index]
+        body = answer.states[self._tracked_index]
         position = self.problem.tracked_origin(np.array(body.position),
                                                np.array(body.orientation))
         return Outcome(np.asarray(answer.state, dtype=np.float64), position,

@@ -8,7 +8,8 @@ acts on body1 along (about) +axis and the reaction on body2.
 """
 from __future__ import annotations
 
-from typing import Callable, Dict, Iterable, NamedTuple, Sequence
+import math
+from typing import Callable, Dict, Iterable, NamedTuple, Sequence, Tuple
 
 import numpy as np
 
@@ -30,9 +31,7 @@ def add_body_force(scene: Scene, object_id: str, kind: int, vector,
         raise InvalidArgument(f"force kind {kind!r} is not FORCE (0) or TORQUE (1)")
     kind = ForceKind(kind)
     obj = scene.body_object(object_id, "force")
-    vector = check.vector("force vector", vector)
-    check.at_most(f"{kind.name.lower()} on {object_id!r}", float(np.linalg.norm(vector)),
-                  limits.MAX_FORCE, "N" if kind == ForceKind.FORCE else "N m")
+    vector = np.array(checked_vector(object_id, kind, vector))
     vector_in_body_frame = check.flag("vector_in_body_frame", vector_in_body_frame)
     at_point = check.flag("at_point", at_point)
     point = check.within_extent("force point", check.vector("force point", point),
@@ -45,6 +44,23 @@ def add_body_force(scene: Scene, object_id: str, kind: int, vector,
     return _keep(scene, _BODY, f"{kind.name.lower()}:{object_id}",
                  BodyForceRecord(object_id, kind, vector_in_body_frame, at_point,
                                  point_in_body_frame, vector, point))
+
+
+def checked_vector(object_id: str, kind: ForceKind, vector) -> Tuple[float, float, float]:
+    """A force (N) or torque (N m) on ``object_id``: three finite numbers, at most
+    limits.MAX_FORCE. In Python floats: a planner checks one every step."""
+    try:
+        x, y, z = vector
+        x, y, z = float(x), float(y), float(z)
+    except (TypeError, ValueError):
+        raise InvalidArgument(f"force vector={vector!r} is not a vector of 3 numbers") from None
+    if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
+        raise InvalidArgument(f"force vector={vector!r} is not finite")
+    magnitude = math.sqrt(x * x + y * y + z * z)
+    if magnitude > limits.MAX_FORCE:
+        check.at_most(f"{kind.name.lower()} on {object_id!r}", magnitude, limits.MAX_FORCE,
+                      "N" if kind == ForceKind.FORCE else "N m")
+    return x, y, z
 
 
 def remove_body_force(scene: Scene, force_id: str) -> None:

@@ -38,9 +38,12 @@ def refresh(scene: Scene) -> None:
 def collect(scene: Scene, step_size: float) -> List[Divergence]:
     """The divergences of the last step call, named, now parked; kept in scene.divergences
     until taken."""
+    parked = scene.c.divergences()
+    if not parked:
+        return []      # the usual case, and a planner's propagation's: no look-up to build
     by_address = {o.body.address: i for i, o in scene.objects.items() if o.body is not None}
     found = []
-    for address, reason, value, position, velocity, angular, step in scene.c.divergences():
+    for address, reason, value, position, velocity, angular, step in parked:
         object_id = by_address[address]
         event = Divergence(object_id, REASONS[reason], value, position, velocity, angular,
                            scene.sim_time + (step - scene.c.step_count) * step_size)

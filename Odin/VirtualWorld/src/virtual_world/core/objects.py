@@ -241,7 +241,7 @@ def build(scene: Scene, prepared: _Prepared, tag: int = 0) -> Built:
     obj = ObjectRecord(p.object_id, p.spec, body, p.com, p.fixed)
     for part in p.parts:
         obj.geometries.append(_build_geometry(scene, p, part, body, tag))
-    scene.objects[p.object_id] = obj
+    scene.add_object(obj)
     if body is not None and not p.fixed:
         scene.c.add_guarded(body.ptr)
     return Built(p.object_id, _built_geometries(obj.geometries))
@@ -380,7 +380,7 @@ def remove_object(scene: Scene, object_id: str) -> Removed:
         forces.drop_body_forces(scene, obj.forces)
     names = tuple(g.name for g in obj.geometries)
     readout.carry_collisions(scene, set(names))
-    del scene.objects[object_id]
+    scene.drop_object(object_id)
     scene.parked.pop(object_id, None)
     guard.refresh(scene)        # before the body goes: C must never see a freed body
     for geometry in obj.geometries:

@@ -161,6 +161,16 @@ class Propagation(NamedTuple):
     state: np.ndarray
 
 
+class StatePropagation(NamedTuple):
+    """What a planner's propagation (``Core.propagate_state``) did: ``state`` the body state
+    vector reached (float64, ``Core.body_state_vector``'s layout); ``pairs`` the geometry pairs
+    (names, sorted within and between pairs) that collided on the way; ``steps`` the steps
+    taken."""
+    state: np.ndarray
+    pairs: Tuple[Tuple[str, str], ...]
+    steps: int
+
+
 # ---------------------------------------------------------------------------------- records
 
 class GeometryRecord:

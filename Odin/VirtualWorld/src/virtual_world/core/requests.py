@@ -16,10 +16,16 @@ def locked(method):
     @functools.wraps(method)
     def wrapper(self, *args, **kwargs):
         with self._lock:
-            if self._scene is None:
-                raise Closed(f"Core is closed ({method.__name__})")
+            _open_scene(self, method)
             return method(self, *args, **kwargs)
     return wrapper
+
+
+def _open_scene(core, method):
+    """The Core's scene; Closed once the Core is closed."""
+    if core._scene is None:
+        raise Closed(f"Core is closed ({method.__name__})")
+    return core._scene
 
 
 def _wake_sleepers(scene) -> None:
@@ -43,16 +49,18 @@ def changes_contents(method):
 
 
 def changes_state(method):
-    """A call that changes the dynamic state: first, if the contents changed since the reset
-    point was taken, the state as the last build left it becomes the reset point."""
+    """A call that changes the dynamic state, under the lock (as ``locked``, in one frame: a
+    planner makes thousands a second): first, if the contents changed since the reset point
+    was taken, the state as the last build left it becomes the reset point."""
     @functools.wraps(method)
     def wrapper(self, *args, **kwargs):
-        scene = self._scene
-        if scene.contents_changed:
-            scene.reset_point = snapshots.take(scene)
-            scene.contents_changed = False
-        return method(self, *args, **kwargs)
-    return locked(wrapper)
+        with self._lock:
+            scene = _open_scene(self, method)
+            if scene.contents_changed:
+                scene.reset_point = snapshots.take(scene)
+                scene.contents_changed = False
+            return method(self, *args, **kwargs)
+    return wrapper
 
 
 def disturbs(method):

@@ -14,7 +14,11 @@ from virtual_world.core.records import (BodyForceRecord, Collision, GeometryReco
                                         JointForceRecord, JointRecord, MotorRecord, ObjectRecord)
 from virtual_world.errors import Unsupported, UnknownName
 from virtual_world.ode.handles import TriMeshDataCache
-from virtual_world.ode.world import CWorld, PoseReader
+from virtual_world.ode.world import BodyArray, CWorld, PoseReader
+
+
+PAIR_NAMES_KEPT = 4096
+"""Sets of colliding pairs Scene.pair_names remembers (then it starts again)."""
 
 
 class Scene:
@@ -51,11 +55,14 @@ class Scene:
         self.divergences: List[object] = []             # records.Divergence not yet taken
         self._pose_reader: Optional[PoseReader] = None
         self._pose_names: List[str] = []
+        self._bodies: Optional[BodyArray] = None
+        self._pair_names: Dict[bytes, Tuple[Tuple[str, str], ...]] = {}
 
     def close(self) -> None:
         """Frees every ODE handle of the scene; idempotent."""
         self.c.close()
         self._pose_reader = None
+        self._bodies = None
 
     # -- look-ups that refuse unknown names --------------------------------------------------
     def object(self, object_id: str) -> ObjectRecord:
@@ -89,6 +96,23 @@ class Scene:
         except (KeyError, TypeError):
             raise UnknownName(f"no geometry named {name!r}") from None
 
+    # -- objects, their bodies in one C array for state vectors ------------------------------
+    def add_object(self, record: ObjectRecord) -> None:
+        self.objects[record.id] = record
+        self._bodies = None
+
+    def drop_object(self, object_id: str) -> None:
+        del self.objects[object_id]
+        self._bodies = None
+
+    def body_array(self) -> BodyArray:
+        """Every object's body, in object order (a body state vector's order), rebuilt after
+        a build or a removal."""
+        if self._bodies is None:
+            self._bodies = BodyArray([o.body.ptr for o in self.objects.values()
+                                      if o.body is not None])
+        return self._bodies
+
     # -- geometries, in one C array for pose read-out ---------------------------------------
     def take_serial(self) -> int:
         """The next geom's serial: geoms are numbered in creation order, so the same calls
@@ -101,11 +125,31 @@ class Scene:
         self.geometries[record.name] = record
         self.geometry_names[record.owner.address] = record.name
         self._pose_reader = None
+        self._pair_names = {}
 
     def drop_geometry(self, record: GeometryRecord) -> None:
         del self.geometry_names[record.owner.address]
         del self.geometries[record.name]
         self._pose_reader = None
+        self._pair_names = {}       # a new geom may come at a freed one's address
+
+    def pair_names(self, raw: bytes) -> Tuple[Tuple[str, str], ...]:
+        """The geometry pairs of collision records given as raw geom address pairs (C's
+        uintptr_t, CWorld.propagate's): names sorted within a pair and the pairs sorted.
+        Remembered until a geometry comes or goes: a planner meets the same few sets of
+        pairs again and again."""
+        pairs = self._pair_names.get(raw)
+        if pairs is None:
+            names = self.geometry_names
+            found = []
+            for address1, address2 in zip(*[iter(memoryview(raw).cast("N"))] * 2):
+                first, second = names[address1], names[address2]
+                found.append((first, second) if first <= second else (second, first))
+            pairs = tuple(sorted(found))
+            if len(self._pair_names) >= PAIR_NAMES_KEPT:
+                self._pair_names = {}
+            self._pair_names[raw] = pairs
+        return pairs
 
     def pose_reader(self) -> Tuple[List[str], PoseReader]:
         """(geometry names, a reader of their poses), rebuilt after a build or a removal."""

@@ -44,7 +44,7 @@ def vector(what: str, value, n: int = 3) -> np.ndarray:
         raise InvalidArgument(f"{what}={value!r} is not a vector of {n} numbers") from None
     if array.shape != (n,):
         raise InvalidArgument(f"{what}={value!r} has {array.size} values, expected {n}")
-    if not np.all(np.isfinite(array)):
+    if not np.isfinite(array).all():
         raise InvalidArgument(f"{what}={value!r} is not finite")
     return array
 

@@ -29,9 +29,10 @@ from virtual_world.core import (forces, guard, joints, kinematic, motors, object
 from virtual_world.core.requests import changes_contents, changes_state, disturbs, locked
 from virtual_world.core.records import (BodyState, Built, BuiltEntity, Collision, Divergence,
                                         JointReaction, JointState, MotorState, ObjectState,
-                                        Propagation, Removed, ServoState)
+                                        Propagation, Removed, ServoState,
+                                        StatePropagation)
 from virtual_world.core.scene import Scene
-from virtual_world.errors import Closed, InvalidArgument, UnknownName
+from virtual_world.errors import Closed, CoreError, InvalidArgument, UnknownName
 from virtual_world.ode import bodies
 from virtual_world.ode.handles import TriMeshDataCache
 from virtual_world.ode.runtime import init_ode
@@ -440,18 +441,32 @@ class Core:
         so a body about to fall asleep may sleep some steps later than it did."""
         self._put_state_vector(self._checked_state_vector(vector))
 
+    @locked
+    def checked_state_vector(self, vector: Sequence[float]) -> np.ndarray:
+        """``vector`` as contiguous float64 when it is a body state vector of this world (its
+        size, finite values, a 32-bit generator state); InvalidArgument otherwise."""
+        return self._checked_state_vector(vector)
+
     def _checked_state_vector(self, vector: Sequence[float]) -> np.ndarray:
-        """``vector`` as float64 when it is a body state vector of this world."""
-        count = len(self._body_ptrs())
-        vector = np.asarray(vector, dtype=np.float64)
-        size = 1 + count * bodies.BODY_STATE_SIZE
-        if vector.shape != (size,) or not np.all(np.isfinite(vector)):
+        vector = self._sized_state_vector(vector)
+        fault = bodies.state_vector_fault(vector)
+        if fault >= 0:
+            raise _state_vector_fault(vector, fault)
+        return vector
+
+    def _sized_state_vector(self, vector: Sequence[float]) -> np.ndarray:
+        """``vector`` as contiguous float64 when it has the size of this world's body state
+        vectors; its values are checked by state_vector_fault."""
+        try:
+            vector = np.ascontiguousarray(vector, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise InvalidArgument(f"a body state vector holds numbers; got "
+                                  f"{str(vector)[:60]}") from None
+        size = 1 + self._scene.body_array().count * bodies.BODY_STATE_SIZE
+        if vector.shape != (size,):
             raise InvalidArgument(f"a body state vector of this world has {size} finite "
                                   f"values (1 + {bodies.BODY_STATE_SIZE} per body); got "
                                   f"shape {vector.shape}")
-        seed = vector[0]
-        if seed != int(seed) or not 0 <= seed < 2 ** 32:
-            raise InvalidArgument(f"random generator state {seed!r} is not a 32-bit integer")
         return vector
 
     def _put_state_vector(self, vector: np.ndarray) -> None:
@@ -487,12 +502,7 @@ class Core:
         ``read_states`` False leaves the answer's ``states`` empty (a planner reads the state
         vector alone). Everything is checked before anything changes."""
         scene = self._scene
-        duration = check.number("duration", duration)
-        step_size = check.step_size(step_size)
-        if duration <= 0:
-            raise InvalidArgument(f"duration={duration!r} must be positive")
-        steps = check.step_count(max(1, round(min(duration / step_size, 1e18))),
-                                 f"duration={duration!r} s at step {step_size!r} s")
+        step_size, steps = _steps_of(duration, step_size)
         keep = check.flag("keep", keep)
         start_snapshot = self._snapshot(start) if start else None
         if start_snapshot is not None:
@@ -522,6 +532,33 @@ class Core:
         if not keep:
             snapshots.put_back(scene, before)
         return result._replace(wall_time=time.perf_counter() - started, kept=keep)
+
+    @changes_state
+    def propagate_state(self, start_state: Sequence[float], duration: float, step_size: float,
+                        forces: Sequence[Tuple[str, Sequence[float]]] = ()) -> StatePropagation:
+        """A planner's propagation, all in one C call: from the body state vector
+        ``start_state`` (``body_state_vector``'s), ``duration`` s in steps of ``step_size``
+        s under ``forces`` ((object id, force N, world frame, at the centre of mass) each, for
+        this call only), recording the pairs that collide on the way; the world stays in the
+        state reached. The states and pairs are bit for bit those of ``propagate`` from
+        ``start_state`` with these forces as body forces and ``keep`` (tests/ compare them);
+        its answer holds only what a planner reads. Everything is checked first."""
+        scene = self._scene
+        step_size, steps = _steps_of(duration, step_size)
+        start_state = self._sized_state_vector(start_state)
+        try:
+            pushes = _checked_pushes(scene, forces)
+        except CoreError:
+            self._checked_state_vector(start_state)     # a bad state is said first
+            raise
+        state, steps, pairs = scene.c.propagate(scene.body_array(), start_state, pushes,
+                                                step_size, steps)
+        if steps < 0:        # C checks the state's values before it changes anything
+            raise _state_vector_fault(start_state, -1 - steps)
+        scene.carried = {}
+        scene.sim_time += step_size * steps
+        guard.collect(scene, step_size)
+        return StatePropagation(state, scene.pair_names(pairs), steps)
 
     def _run(self, steps: int, step_size: float, read_states: bool = True) -> Propagation:
         """Steps with every step's collisions recorded; what a propagation answers."""
@@ -679,6 +716,55 @@ class Core:
         Contact-less policy: every pair seen since the last read; reading clears the set.
         Contact policy: the pairs that had contacts in the last step."""
         return readout.read_collisions(self._scene)
+
+
+def _state_vector_fault(vector: np.ndarray, index: int) -> InvalidArgument:
+    """The refusal of a body state vector whose value ``index`` cannot be put back."""
+    if index == 0:
+        return InvalidArgument(f"random generator state {float(vector[0])!r} is not a "
+                               "32-bit integer")
+    return InvalidArgument(f"a body state vector's values are finite; value {index} is "
+                           f"{float(vector[index])!r}")
+
+
+def _checked_pushes(scene: Scene, pushes: Sequence[Tuple[str, Sequence[float]]]) -> list:
+    """(object id, force N world) pairs as (body ptr, force) for CWorld.propagate, each
+    checked as add_body_force checks a force at the centre of mass."""
+    checked = []
+    for push in pushes:
+        try:
+            object_id, vector = push
+        except (TypeError, ValueError):
+            raise InvalidArgument(f"force {push!r} is not (object id, force vector)") from None
+        checked.append((scene.body_object(object_id, "force").body.ptr,
+                        forces.checked_vector(object_id, ForceKind.FORCE, vector)))
+    return checked
+
+
+_STEPS_OF: Dict[Tuple[float, float], Tuple[float, int]] = {}
+"""_steps_of's answers for float arguments: a planner asks the same every step."""
+
+
+def _steps_of(duration: float, step_size: float) -> Tuple[float, int]:
+    """(step_size, the number of steps) of a propagation of ``duration`` s, both checked."""
+    floats = type(duration) is float and type(step_size) is float   # noqa: E721 - not bool
+    if floats and (duration, step_size) in _STEPS_OF:
+        return _STEPS_OF[duration, step_size]
+    answer = _checked_steps(duration, step_size)
+    if floats:
+        if len(_STEPS_OF) >= 64:
+            _STEPS_OF.clear()
+        _STEPS_OF[duration, step_size] = answer
+    return answer
+
+
+def _checked_steps(duration: float, step_size: float) -> Tuple[float, int]:
+    duration = check.number("duration", duration)
+    step_size = check.step_size(step_size)
+    if duration <= 0:
+        raise InvalidArgument(f"duration={duration!r} must be positive")
+    return step_size, check.step_count(max(1, round(min(duration / step_size, 1e18))),
+                                       f"duration={duration!r} s at step {step_size!r} s")
 
 
 __all__ = ["Core", "ForceKind", "JointType", "MotorKind"]

@@ -111,6 +111,12 @@ def read_states(bodies: Sequence) -> np.ndarray:
     return out
 
 
+def state_vector_fault(vector: np.ndarray) -> int:
+    """-1 when a body state vector (contiguous float64) can be put back: a 32-bit integer
+    generator state, finite values; else the index of the first value that is not."""
+    return int(lib.odin_state_vector_fault(ffi.from_buffer("double[]", vector), vector.size))
+
+
 @drains_ode_messages
 def write_states(bodies: Sequence, states: np.ndarray) -> None:
     """Puts back states read by read_states, bit for bit (odin_state.c says how)."""

@@ -7,6 +7,7 @@
  * point (ODE's body record itself), then dBodySetPosition marks the body's geoms as moved. */
 #include "odin_step.h"
 
+#include <math.h>
 #include <string.h>
 
 void odin_read_body_states(dBodyID *bodies, int n, double *out) {
@@ -33,4 +34,11 @@ void odin_write_body_states(dBodyID *bodies, int n, const double *in) {
         dBodyEnable(b);                /* the rest count starts again (odin_step.h) */
         if (s[25] == 0.0) dBodyDisable(b);
     }
+}
+
+int odin_state_vector_fault(const double *v, int size) {
+    if (!(v[0] >= 0.0 && v[0] < 4294967296.0 && v[0] == floor(v[0]))) return 0;
+    for (int i = 1; i < size; ++i)
+        if (!isfinite(v[i])) return i;
+    return -1;
 }

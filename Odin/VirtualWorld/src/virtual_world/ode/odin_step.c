@@ -151,12 +151,27 @@ static int keep_pair(OdinWorld *w, dGeomID g1, dGeomID g2, long s1, long s2,
     return 1;
 }
 
-/* Sorts the pass's pairs by key: a least-significant-digit radix sort, a byte at a time,
- * skipping the bytes every key shares (with fewer than 65,536 geoms, four of the eight): a
- * few operations per pair, where qsort's comparisons cost a step 3 % of its instructions. */
+/* Up to this many pairs are sorted by insertion: the radix sort's eight passes over its 256
+ * counters cost more than a few dozen comparisons (a planner's small scenes, every step). */
+#define INSERTION_SORT_PAIRS 24
+
+/* Sorts the pass's pairs by key (keys are unique: each pair of geoms is met once a pass): by
+ * insertion when there are few, otherwise a least-significant-digit radix sort, a byte at a
+ * time, skipping the bytes every key shares (with fewer than 65,536 geoms, four of the
+ * eight): a few operations per pair, where qsort's comparisons cost a step 3 % of its
+ * instructions. */
 static void sort_pairs(OdinWorld *w) {
     int n = w->n_pairs, count[256];
     OdinPair *from = w->pairs, *to = w->pairs_sorted;
+    if (n <= INSERTION_SORT_PAIRS) {
+        for (int i = 1; i < n; ++i) {
+            OdinPair p = from[i];
+            int j = i;
+            for (; j > 0 && from[j - 1].key > p.key; --j) from[j] = from[j - 1];
+            from[j] = p;
+        }
+        return;
+    }
     for (int shift = 0; shift < 64; shift += 8) {
         memset(count, 0, sizeof count);
         for (int i = 0; i < n; ++i) count[(from[i].key >> shift) & 255]++;
@@ -272,7 +287,7 @@ static void read_contact_forces(OdinWorld *w) {
  * recording, the contacts of recorded pairs get joint feedback (read_contact_forces). */
 static void make_contacts(OdinWorld *w, double h) {
     if (!w->unordered && w->n_pairs > 1) sort_pairs(w);
-    int feedback = w->recording && feedback_room(w, w->n_contacts);
+    int feedback = w->recording && !w->pairs_only && feedback_room(w, w->n_contacts);
     w->n_feedback = 0;
     for (int k = 0; k < w->n_pairs; ++k) {
         const OdinPair *p = &w->pairs[k];
@@ -328,24 +343,30 @@ static void near_callback(void *data, dGeomID o1, dGeomID o2) {
 
 /* ---------------------------------------------------------------- persistent actions */
 
-static void apply_body_forces(const OdinWorld *w) {
-    for (int i = 0; i < w->n_forces; ++i) {
-        const OdinBodyForce *f = &w->forces[i];
-        const double *v = f->vector, *p = f->point;
-        if (f->torque) {
-            if (f->vector_in_body) dBodyAddRelTorque(f->body, v[0], v[1], v[2]);
-            else dBodyAddTorque(f->body, v[0], v[1], v[2]);
-        } else if (!f->at_point) {
-            if (f->vector_in_body) dBodyAddRelForce(f->body, v[0], v[1], v[2]);
-            else dBodyAddForce(f->body, v[0], v[1], v[2]);
-        } else if (f->vector_in_body) {
-            if (f->point_in_body) dBodyAddRelForceAtRelPos(f->body, v[0], v[1], v[2], p[0], p[1], p[2]);
-            else dBodyAddRelForceAtPos(f->body, v[0], v[1], v[2], p[0], p[1], p[2]);
-        } else {
-            if (f->point_in_body) dBodyAddForceAtRelPos(f->body, v[0], v[1], v[2], p[0], p[1], p[2]);
-            else dBodyAddForceAtPos(f->body, v[0], v[1], v[2], p[0], p[1], p[2]);
-        }
+static void apply_body_force(const OdinBodyForce *f) {
+    const double *v = f->vector, *p = f->point;
+    if (f->torque) {
+        if (f->vector_in_body) dBodyAddRelTorque(f->body, v[0], v[1], v[2]);
+        else dBodyAddTorque(f->body, v[0], v[1], v[2]);
+    } else if (!f->at_point) {
+        if (f->vector_in_body) dBodyAddRelForce(f->body, v[0], v[1], v[2]);
+        else dBodyAddForce(f->body, v[0], v[1], v[2]);
+    } else if (f->vector_in_body) {
+        if (f->point_in_body) dBodyAddRelForceAtRelPos(f->body, v[0], v[1], v[2], p[0], p[1], p[2]);
+        else dBodyAddRelForceAtPos(f->body, v[0], v[1], v[2], p[0], p[1], p[2]);
+    } else {
+        if (f->point_in_body) dBodyAddForceAtRelPos(f->body, v[0], v[1], v[2], p[0], p[1], p[2]);
+        else dBodyAddForceAtPos(f->body, v[0], v[1], v[2], p[0], p[1], p[2]);
     }
+}
+
+/* The persistent forces, then a propagation's own (odin_world_propagate): a propagation's
+ * force comes last, as it did when it was added to the persistent ones for the call, so that
+ * ODE sums a body's forces in the same order either way. */
+static void apply_body_forces(const OdinWorld *w) {
+    for (int i = 0; i < w->n_forces; ++i) apply_body_force(&w->forces[i]);
+    for (int i = 0; i < w->n_propagation_forces; ++i)
+        apply_body_force(&w->propagation_forces[i]);
 }
 
 /* Adds +v to the first body and -v to the second, as torque or force (ODE's own convention). */
@@ -784,6 +805,42 @@ int odin_world_step(OdinWorld *w, double h, int count) {
     }
     w->recording = 0;
     return s;
+}
+
+/* One propagation from a body state vector (see odin_step.h), as Core.propagate runs one from
+ * a start state and keeps it: the state put back, the records forgotten, the generator's state
+ * set, then the step loop recording every step, then the state read. */
+int odin_world_propagate(OdinWorld *w, dBodyID *bodies, int n, const double *state_in,
+                         const OdinBodyForce *forces, int n_forces, double h, int count,
+                         double *state_out, uintptr_t *pairs, int max_pairs, int *n_pairs) {
+    int fault = odin_state_vector_fault(state_in, 1 + n * ODIN_BODY_STATE_SIZE);
+    *n_pairs = 0;
+    if (fault >= 0) return -1 - fault;
+    odin_write_body_states(bodies, n, state_in + 1);
+    odin_world_clear_records(w);
+    w->rand_seed = (unsigned long)state_in[0];
+    w->propagation_forces = forces;
+    w->n_propagation_forces = n_forces;
+    w->record_every_step = w->pairs_only = 1;
+    int taken = odin_world_step(w, h, count);
+    w->record_every_step = w->pairs_only = 0;
+    w->propagation_forces = NULL;
+    w->n_propagation_forces = 0;
+    state_out[0] = (double)w->rand_seed;
+    odin_read_body_states(bodies, n, state_out + 1);
+    *n_pairs = odin_world_record_pairs(w, pairs, max_pairs);
+    if (*n_pairs <= max_pairs) odin_world_clear_records(w);
+    return taken;
+}
+
+/* The recorded pairs' geoms, two addresses per record, into out (room for 2 * max); returns the
+ * records there are (those beyond max not written). */
+int odin_world_record_pairs(const OdinWorld *w, uintptr_t *out, int max) {
+    for (int i = 0; i < w->n_records && i < max; ++i) {
+        out[2 * i] = (uintptr_t)w->records[i].g1;
+        out[2 * i + 1] = (uintptr_t)w->records[i].g2;
+    }
+    return w->n_records;
 }
 
 /* Collision detection on the present poses, no step. The pairs go into the records like a

@@ -163,9 +163,14 @@ typedef struct OdinWorld {
     OdinJointForce *joint_forces; int n_joint_forces;
     OdinMotorGoal *motors; int n_motors;
     OdinKinematicLink *kinematic; int n_kinematic;   /* parents before children */
+    /* one propagation's body forces (odin_world_propagate), applied after the persistent ones;
+       NULL between propagations */
+    const OdinBodyForce *propagation_forces; int n_propagation_forces;
     /* outputs */
     int last_step_contacts;
     int record_every_step;   /* contact policy: record the pairs of every step, not the last */
+    int pairs_only;          /* record pairs without their contact forces (no joint feedback:
+                                odin_world_propagate, whose caller reads only the pairs) */
     int unordered;           /* benchmarks only: contacts made as the broad phase finds them
                                 (not deterministic), to measure what the ordering costs */
     /* the divergence guard: after every step each guarded body must be finite, slower than
@@ -219,6 +224,23 @@ void odin_world_restart_rest_counts(OdinWorld *w);
 int odin_world_sleeping(const OdinWorld *w);
 /* Forgets the divergences Python has read. */
 void odin_world_clear_divergences(OdinWorld *w);
+/* One planner's propagation in one call: puts back the body state vector state_in (ODE's
+ * random generator state, then ODIN_BODY_STATE_SIZE values for each of the n bodies, in the
+ * order of `bodies`; odin_write_body_states), forgets the collision records, adds `forces`
+ * (n_forces, after the persistent ones) for this call only, runs odin_world_step(w, h, count)
+ * recording every step's colliding pairs, and writes the state reached into state_out (the
+ * same layout). The same ODE calls in the same order as putting the vector back, adding the
+ * forces and stepping one call at a time: bit-identical states. The recorded pairs' geoms go
+ * into `pairs` (odin_world_record_pairs) and *n_pairs says how many records there are; when
+ * they all fit (*n_pairs <= max_pairs) the records are forgotten, otherwise they stay for
+ * odin_world_record_pairs. Returns the steps taken; or, changing nothing, -1 - i when value
+ * i of state_in cannot be put back (odin_state_vector_fault). */
+int odin_world_propagate(OdinWorld *w, dBodyID *bodies, int n, const double *state_in,
+                         const OdinBodyForce *forces, int n_forces, double h, int count,
+                         double *state_out, uintptr_t *pairs, int max_pairs, int *n_pairs);
+/* The recorded pairs' geoms (g1, g2 addresses of each record) into out, which has room for
+ * 2 * max values; returns how many records there are. */
+int odin_world_record_pairs(const OdinWorld *w, uintptr_t *out, int max);
 /* Records the pairs touching now, without stepping and without contacts: under the contact-less
  * policy always; under the contact policy only when any_policy (a collision query). */
 void odin_world_detect(OdinWorld *w, int any_policy);
@@ -233,6 +255,10 @@ void odin_world_free_buffers(OdinWorld *w);
 #define ODIN_BODY_STATE_SIZE 26
 void odin_read_body_states(dBodyID *bodies, int n, double *out);
 void odin_write_body_states(dBodyID *bodies, int n, const double *in);
+/* -1 when the body state vector v (size values: ODE's random generator state, then the
+ * bodies' records) can be put back: v[0] an integer in [0, 2^32) and every value finite;
+ * otherwise the index of the first value that is not (0: the generator's state). */
+int odin_state_vector_fault(const double *v, int size);
 
 /* Vectorised read-out of geom world poses: pos (n,3), quat (n,4) wxyz. */
 void odin_read_poses(dGeomID *geoms, int n, double *pos, double *quat);

@@ -41,6 +41,11 @@ class CWorld:
         s = self.struct
         s.world, s.space, s.contact_group = self.world.ptr, self.space.ptr, self.contacts.ptr
         self._arrays = {}          # keeps the action arrays alive while C points at them
+        # odin_world_propagate's buffers, kept from call to call (a planner propagates
+        # thousands of times a second): its forces, the pairs it hands back and their count
+        self._pushes = ffi.new("OdinBodyForce[]", 4)
+        self._pairs = ffi.new("uintptr_t[]", 2 * _PAIRS_KEPT)
+        self._pair_count = ffi.new("int *")
         self.apply(parameters)
 
     @drains_ode_messages
@@ -201,6 +206,8 @@ class CWorld:
         """The bodies the guard parked since the last call (body address, reason, value,
         position, velocity, angular velocity, step count), forgotten once read."""
         s = self.struct
+        if not s.n_diverged:
+            return []
         out = [(int(ffi.cast("uintptr_t", d.body)), int(d.reason), float(d.value),
                 tuple(d.position), tuple(d.velocity), tuple(d.angular), int(d.step))
                for d in (s.diverged[i] for i in range(s.n_diverged))]
@@ -250,6 +257,38 @@ class CWorld:
         return int(lib.odin_world_step(self.struct, step_size, count))
 
     @drains_ode_messages
+    def propagate(self, bodies: "BodyArray", start: np.ndarray,
+                  forces: Sequence[Tuple[object, Sequence[float]]], step_size: float,
+                  count: int) -> Tuple[np.ndarray, int, bytes]:
+        """One planner's propagation in one C call (odin_step.h, odin_world_propagate): from
+        the body state vector ``start`` (float64, contiguous, ``bodies``' layout) under
+        ``forces`` ((body ptr, force N world, at the centre of mass) each, this call only),
+        ``count`` steps recording every step's pairs. Returns (the state vector reached, the
+        steps taken or -1 - i when value i of ``start`` cannot be put back, the recorded
+        pairs' geom addresses as raw uintptr_t pairs); the world stays in the state reached,
+        its collision records forgotten."""
+        pushes = self._pushes
+        if len(forces) > len(pushes):
+            pushes = self._pushes = ffi.new("OdinBodyForce[]", len(forces))
+        for f, (body, vector) in zip(pushes, forces):
+            f.body = body
+            f.vector = vector
+        out = np.empty(start.size)
+        taken = lib.odin_world_propagate(
+            self.struct, bodies.array, bodies.count, ffi.from_buffer("double[]", start),
+            pushes, len(forces), step_size, count, ffi.from_buffer("double[]", out),
+            self._pairs, _PAIRS_KEPT, self._pair_count)
+        count = self._pair_count[0]
+        if not count:
+            return out, taken, b""
+        pairs = self._pairs
+        if count > _PAIRS_KEPT:        # more than the buffer holds: all of them, then
+            pairs = ffi.new("uintptr_t[]", 2 * count)
+            lib.odin_world_record_pairs(self.struct, pairs, count)
+            lib.odin_world_clear_records(self.struct)
+        return out, taken, ffi.buffer(pairs, count * _PAIR_BYTES)[:]
+
+    @drains_ode_messages
     def detect(self, any_policy: bool = False) -> None:
         """Records what touches now, without stepping or contacts: under the contact-less
         policy, or under either when ``any_policy`` (a collision query)."""
@@ -291,6 +330,21 @@ class CWorld:
         self.contacts.close()
         self.world.close()        # every body, joint and motor left
         s.world = s.space = s.contact_group = ffi.NULL
+
+
+_PAIRS_KEPT = 256
+"""Collision records a propagation hands back in its buffer at once (more take a second
+call)."""
+_PAIR_BYTES = 2 * ffi.sizeof("uintptr_t")
+"""Bytes of one record's geom pair."""
+
+
+class BodyArray:
+    """A fixed list of bodies in one C array (a body state vector's bodies, in its order)."""
+
+    def __init__(self, bodies: Sequence):
+        self.count = len(bodies)
+        self.array = ffi.new("dBodyID[]", list(bodies) or 1)
 
 
 class PoseReader:
