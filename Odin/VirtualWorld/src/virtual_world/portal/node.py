@@ -68,7 +68,7 @@ from odin_common.node import MasterWatch, init_ros_node, stop_on_signals
 from odin_common.world_parameters import PARAMETERS
 from virtual_world.core import Core, step_values
 from virtual_world.core.loop import CycleReport, RealTimeFactor, WorldLoop
-from virtual_world.portal import conversions, message_cap
+from virtual_world.portal import conversions, message_cap, publish_queue
 from virtual_world.portal.interaction import InteractiveObjects
 from virtual_world.portal.mirror import WorldMirror
 from virtual_world.portal.parameters import DEFAULTS, RESOURCE_PARAMETERS
@@ -86,6 +86,7 @@ class Portal:
         resources = ResourceLimits(**{name: rospy.get_param(f"~{name}", DEFAULTS[name])
                                       for name in RESOURCE_PARAMETERS})
         message_cap.cap_incoming_messages(resources.max_request_mb * 2 ** 20)
+        publish_queue.queue_without_yield()
         self.core = Core(resources=resources)
         values = self._initial_step_values()
         initial = self._initial_world_parameters()
