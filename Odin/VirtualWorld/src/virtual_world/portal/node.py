@@ -228,22 +228,32 @@ class Portal:
         with self._poses_lock:
             self._poses_for_viewer = (names, positions.copy(), quaternions.copy())
         self.pub_world.publish(self._writer.message(names, positions, quaternions, stamp))
-        contact_less = self.core.world_parameters.contact_less
-        if contact_less and not report.stepped:
-            self.core.detect_collisions()   # paused: report what touches now, not nothing
-        collisions = self.core.read_collisions()
-        if contact_less:
-            self.pub_collided.publish(conversions.collided_message(collisions, stamp))
-        elif self.pub_contacts.get_num_connections() > 0:
-            self.pub_contacts.publish(conversions.collided_message(collisions, stamp))
+        collisions = self._publish_collisions(report.stepped, stamp)
         states = self._publish_joints(stamp)
         servos = self.core.servo_states()
         if servos:
             self.pub_servos.publish(conversions.servo_states_message(servos, stamp))
         self.pub_clock.publish(Clock(clock=stamp))
         self.pub_rtf.publish(Float64(rtf))
-        self._publish_standard(stamp, names, positions, quaternions, states,
-                               collisions if contact_less else ())
+        self._publish_standard(stamp, names, positions, quaternions, states, collisions)
+
+    def _publish_collisions(self, stepped: bool, stamp) -> list:
+        """Contact-less policy: ~collided, every publication; the pairs are returned (the
+        markers draw them grey). Contact policy: ~contacts, only while someone listens, and
+        nothing returned. Under the contact policy the Core's collisions are those of the
+        last step whether or not they are read, so the node reads them only for a listener
+        (reading the 100-sphere scene's hundred resting contacts each publication had cost
+        it about a twentieth of its stepping time)."""
+        if self.core.world_parameters.contact_less:
+            if not stepped:
+                self.core.detect_collisions()   # paused: report what touches now, not nothing
+            collisions = self.core.read_collisions()
+            self.pub_collided.publish(conversions.collided_message(collisions, stamp))
+            return collisions
+        if self.pub_contacts.get_num_connections() > 0:
+            self.pub_contacts.publish(conversions.collided_message(
+                self.core.read_collisions(), stamp))
+        return []
 
     def _publish_joints(self, stamp) -> list:
         states = self.core.joint_states()
