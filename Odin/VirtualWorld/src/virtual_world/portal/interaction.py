@@ -119,11 +119,10 @@ class InteractiveObjects:
     def sync(self, object_poses: Dict[str, Tuple[np.ndarray, np.ndarray]]) -> None:
         """Adds, moves and erases markers so they match the movable objects at
         ``object_poses`` ({object ID: (position m, quaternion (w, x, y, z))}, world frame), at
-        most SYNC_RATE times a second."""
-        now = time.monotonic()
-        if now < self._next_sync:
+        most SYNC_RATE times a second (``due``)."""
+        if not self.due():
             return
-        self._next_sync = now + 1.0 / SYNC_RATE
+        self._next_sync = time.monotonic() + 1.0 / SYNC_RATE
         movable = [o for o in self.mirror.movable_objects() if o in object_poses]
         changed = False
         for object_id in set(self._shown) - set(movable):
@@ -148,6 +147,11 @@ class InteractiveObjects:
             changed = True
         if changed:
             self.server.applyChanges()
+
+    def due(self) -> bool:
+        """Whether ``sync`` would follow the objects now (the caller may skip gathering
+        their poses otherwise)."""
+        return time.monotonic() >= self._next_sync
 
     def _moved(self, object_ids: list, object_poses: dict) -> set:
         """Those of ``object_ids`` (shown) that moved more than MOVED_BY from where their

@@ -270,10 +270,11 @@ class Portal:
         moving, static = self.mirror.frames.poses(names, positions, quaternions)
         colliding = {n for c in collisions for n in (c.first, c.second)}
         self.topics.publish(stamp, moving, static, states, colliding)
-        movable = self.mirror.movable_objects()
-        by_frame = {frame: (p, q) for frame, p, q in zip(*moving)}
-        self.interaction.sync({o: by_frame[f] for o, f in zip(
-            movable, self.mirror.frames.frames(movable)) if f in by_frame})
+        if self.interaction.due():
+            movable = self.mirror.movable_objects()
+            by_frame = {frame: (p, q) for frame, p, q in zip(*moving)}
+            self.interaction.sync({o: by_frame[f] for o, f in zip(
+                movable, self.mirror.frames.frames(movable)) if f in by_frame})
 
     def _viewer_poses(self) -> dict:
         """{geometry id: (position, orientation)} as of the last publication (any thread)."""
