@@ -230,7 +230,7 @@ class Portal:
         self.pub_world.publish(self._writer.message(names, positions, quaternions, stamp))
         collisions = self._publish_collisions(report.stepped, stamp)
         states = self._publish_joints(stamp)
-        servos = self.core.servo_states()
+        servos = self.core.servo_states() if _heard(self.pub_servos) else ()
         if servos:
             self.pub_servos.publish(conversions.servo_states_message(servos, stamp))
         self.pub_clock.publish(Clock(clock=stamp))
@@ -256,11 +256,16 @@ class Portal:
         return []
 
     def _publish_joints(self, stamp) -> list:
+        """~joint_data and ~joint_states, each built only for a listener (rospy sends nothing
+        to no one, but the node would build a message object per joint for nothing); the
+        joint states are returned for the robots' own topics."""
         states = self.core.joint_states()
-        message = JointsData(joints=conversions.joint_data(states))
-        message.header.stamp = stamp
-        self.pub_joints.publish(message)
-        self.pub_joint_states.publish(conversions.joint_state_message(states, stamp))
+        if _heard(self.pub_joints):
+            message = JointsData(joints=conversions.joint_data(states))
+            message.header.stamp = stamp
+            self.pub_joints.publish(message)
+        if _heard(self.pub_joint_states):
+            self.pub_joint_states.publish(conversions.joint_state_message(states, stamp))
         return states
 
     def _publish_standard(self, stamp, names, positions, quaternions, states,
@@ -284,6 +289,12 @@ class Portal:
             return {}
         names, positions, quaternions = snapshot
         return {name: (positions[i], quaternions[i]) for i, name in enumerate(names)}
+
+
+def _heard(publisher: rospy.Publisher) -> bool:
+    """Whether ``publisher`` has a subscriber now (a message for none is not even built)."""
+    return publisher.get_num_connections() > 0
+
 
 def main() -> None:
     # the loop runs on this thread: Ctrl-C and SIGTERM only stop it (stop_on_signals)
