@@ -136,6 +136,30 @@ def test_a_robot_link_renames_its_objects_frame_and_places_it_where_the_robot_sa
     assert frames.frame("arm/link1") == "arm/link1"
 
 
+
+def test_every_frames_pose_is_its_geometrys_composed_with_its_fixed_transform_bit_for_bit():
+    """Moving and static frames are composed in one call: each row as if composed alone."""
+    frames = ObjectFrames()
+    rng = np.random.default_rng(7)
+    names = ["absent"]
+    for k in range(7):
+        names.append(f"o{k}")
+        geometry = (tuple(rng.normal(size=3)), _quaternion(rng.normal(), rng.normal(size=3)))
+        frames.add(names[-1], ((0, 0, 0), (1, 0, 0, 0)), [(names[-1], geometry)],
+                   static=k % 3 == 0)
+    positions = rng.normal(size=(len(names), 3))
+    quaternions = rng.normal(size=(len(names), 4))
+    moving, static = frames.poses(names, positions, quaternions)
+    assert moving[0] == ["o1", "o2", "o4", "o5"] and static[0] == ["o0", "o3", "o6"]
+    for group in (moving, static):
+        for frame, p, q in zip(*group):
+            row, fixed = names.index(frame), frames._objects[frame]
+            want_p, want_q = compose_poses(positions[row], quaternions[row], fixed.position,
+                                           fixed.quaternion)
+            assert p.tobytes() == want_p.tobytes() and q.tobytes() == want_q.tobytes()
+    empty = ObjectFrames().poses(names, positions, quaternions)
+    assert [len(g[0]) for g in empty] == [0, 0] and empty[0][1].shape == (0, 3)
+
 # -- writers -----------------------------------------------------------------------------------
 
 @pytest.mark.parametrize("frames", [[], ["a"], ["ball", "TX90_SAHand_Right/Palm", "x" * 300]])

@@ -157,30 +157,28 @@ class ObjectFrames:
         if key != self._layout_key:
             self._layout = self._lay_out(names)
             self._layout_key = key
-        out = []
-        for frames, rows, local_p, local_q in self._layout:
-            if not frames:
-                out.append(([], np.zeros((0, 3)), np.zeros((0, 4))))
-                continue
-            p, q = compose_poses(positions[rows], quaternions[rows], local_p, local_q)
-            out.append((frames, p, q))
-        return out[0], out[1]
+        moving, static, rows, local_p, local_q = self._layout
+        if not rows.size:
+            return ([], np.zeros((0, 3)), np.zeros((0, 4))), ([], np.zeros((0, 3)),
+                                                               np.zeros((0, 4)))
+        # one composition for every frame: its cost is numpy's per call, not per frame
+        p, q = compose_poses(positions[rows], quaternions[rows], local_p, local_q)
+        split = len(moving)
+        return (moving, p[:split], q[:split]), (static, p[split:], q[split:])
 
     def _lay_out(self, names: Sequence[str]) -> tuple:
+        """(moving frames, static frames, the row of each one's geometry in ``names`` and
+        its pose in that geometry's frame), the moving frames first."""
         row_of = {name: i for i, name in enumerate(names)}
-        groups = {False: ([], [], [], []), True: ([], [], [], [])}
+        groups = {False: [], True: []}
         for entry in self._objects.values():
             row = row_of.get(entry.geometry)
-            if row is None:
-                continue
-            frames, rows, local_p, local_q = groups[entry.static]
-            frames.append(entry.name)
-            rows.append(row)
-            local_p.append(entry.position)
-            local_q.append(entry.quaternion)
-        return tuple((frames, np.asarray(rows, dtype=np.intp),
-                      np.asarray(local_p, float).reshape(-1, 3),
-                      np.asarray(local_q, float).reshape(-1, 4))
-                     for frames, rows, local_p, local_q in (groups[False], groups[True]))
+            if row is not None:
+                groups[entry.static].append((entry.name, row, entry.position, entry.quaternion))
+        ordered = groups[False] + groups[True]
+        return ([e[0] for e in groups[False]], [e[0] for e in groups[True]],
+                np.asarray([e[1] for e in ordered], dtype=np.intp),
+                np.asarray([e[2] for e in ordered], float).reshape(-1, 3),
+                np.asarray([e[3] for e in ordered], float).reshape(-1, 4))
 
 

@@ -136,11 +136,19 @@ class StandardTopics:
         changes = self.mirror.markers.take_changes()
         if changes is not None:
             self.pub_markers.publish(changes)
+        self._publish_robot_joints(stamp, joint_states)
+
+    def _publish_robot_joints(self, stamp: rospy.Time, joint_states) -> None:
+        """Each robot's joint_states, built only for a robot whose topic has a subscriber."""
+        heard = {namespace: publisher for namespace, publisher in self._joint_states.items()
+                 if publisher.get_num_connections() > 0}
+        if not heard:
+            return
         for robot, joint_names, values, rates in self.mirror.robots.joint_states(joint_states):
-            message = JointState(name=joint_names, position=values, velocity=rates)
-            message.header.stamp = stamp
-            publisher = self._joint_states.get(robot.namespace)
+            publisher = heard.get(robot.namespace)
             if publisher is not None:
+                message = JointState(name=joint_names, position=values, velocity=rates)
+                message.header.stamp = stamp
                 publisher.publish(message)
 
     def _publish_static(self, static, stamp) -> None:
