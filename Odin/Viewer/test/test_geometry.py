@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from viewer.errors import ViewerError
-from viewer.core.geometry import (geometry_from_parameters, pose_matrix, rotation_from_wxyz,
-                             unit_box, unit_cylinder, unit_sphere)
+from viewer.core.geometry import (GeometryCache, geometry_from_parameters, pose_matrix,
+                                  rotation_from_wxyz, unit_box, unit_cylinder, unit_sphere)
 from odin_common import OdinError
 
 S = math.sqrt(0.5)
@@ -172,3 +172,49 @@ def test_a_plane_is_a_large_unbounded_floor():
 def test_a_named_shape_with_the_wrong_parameters_is_refused(parameters, shape):
     with pytest.raises(ViewerError):
         geometry_from_parameters(parameters, shape=shape)
+
+
+def test_the_cache_gives_the_geometry_built_before_for_the_same_content():
+    cache = GeometryCache()
+    first = cache.geometry(CUBE_VERTICES, CUBE_TRIANGLES)
+    # the same numbers as a tuple and as arrays (what rospy and a marker give) are the same
+    again = cache.geometry(tuple(CUBE_VERTICES), np.array(CUBE_TRIANGLES, np.uint32))
+    assert again is first and (cache.misses, cache.hits) == (1, 1)
+    built = geometry_from_parameters(CUBE_VERTICES, CUBE_TRIANGLES)
+    np.testing.assert_array_equal(first.vertices_B, built.vertices_B)
+    np.testing.assert_array_equal(first.indices_B, built.indices_B)
+    assert first.closed == built.closed and first.radius == built.radius
+
+
+def test_the_cache_tells_apart_shapes_sizes_and_windings():
+    cache = GeometryCache()
+    inverted = np.array(CUBE_TRIANGLES).reshape(-1, 3)[:, ::-1].ravel()
+    geometries = [cache.geometry([0.5]), cache.geometry([0.6]), cache.geometry([0.5, 0.5]),
+                  cache.geometry([0.05, 0.3], shape=5), cache.geometry([0.05, 0.3]),
+                  cache.geometry(CUBE_VERTICES, CUBE_TRIANGLES),
+                  cache.geometry(CUBE_VERTICES, inverted)]
+    assert len({id(g) for g in geometries}) == len(geometries) == cache.misses
+    assert [g.kind for g in geometries[2:5]] == ["cylinder", "mesh", "cylinder"]
+
+
+def test_the_cache_refuses_bad_content_every_time_and_keeps_nothing_for_it():
+    cache = GeometryCache()
+    for _ in range(2):
+        with pytest.raises(ViewerError, match="out of range"):
+            cache.geometry([0, 0, 0, 1, 0, 0, 0, 1, 0], [0, 1, 3])
+        with pytest.raises(ViewerError, match="> 0"):
+            cache.geometry([-1.0])
+    assert len(cache) == 0
+
+
+def test_the_cache_forgets_the_least_recently_used_beyond_its_triangles():
+    cache = GeometryCache(max_triangles=24)         # two cubes of 12 triangles
+    cube = cache.geometry(CUBE_VERTICES, CUBE_TRIANGLES)
+    shifted = [v + 1.0 for v in CUBE_VERTICES]
+    other = cache.geometry(shifted, CUBE_TRIANGLES)
+    assert cache.geometry(CUBE_VERTICES, CUBE_TRIANGLES) is cube     # now the most recent
+    third = [v + 2.0 for v in CUBE_VERTICES]
+    cache.geometry(third, CUBE_TRIANGLES)                            # pushes out `other`
+    assert cache.geometry(CUBE_VERTICES, CUBE_TRIANGLES) is cube
+    assert cache.geometry(shifted, CUBE_TRIANGLES) is not other
+    assert len(cache) == 2

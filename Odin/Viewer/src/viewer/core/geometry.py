@@ -10,8 +10,11 @@ Shapes follow Messages/Object: the number of parameters decides the shape
 """
 from __future__ import annotations
 
+import collections
+import hashlib
 import itertools
 import math
+import threading
 from dataclasses import dataclass, field
 from typing import Sequence
 
@@ -340,3 +343,68 @@ def unit_box() -> tuple:
                 norms.append(normal)
             idx += [start, start + 1, start + 2, start, start + 2, start + 3]
     return np.array(verts, np.float32), np.array(norms, np.float32), np.array(idx, np.uint32)
+
+
+#: triangles a :class:`GeometryCache` keeps at most (about 60 bytes each with their levels of
+#: detail): several problems' worth of meshes (the TX90 grasp scene has ~200,000)
+GEOMETRY_CACHE_TRIANGLES = 2_000_000
+
+
+class GeometryCache:
+    """Geometries built before, by content: the same parameters, indices and shape give the
+    same Geometry object again, without building it (a mesh's welding, shading and
+    clustering cost ~20 ms per 10,000 triangles). A world re-sends its whole scene on every
+    problem load and on every Viewer restart; so does a bag of markers played in a loop.
+
+    Least recently used geometries go first once more than ``max_triangles`` are kept.
+    Thread-safe: service threads and the render thread share one. A Geometry is immutable
+    (its levels of detail are made on the render thread only), so objects may share one."""
+
+    def __init__(self, max_triangles: int = GEOMETRY_CACHE_TRIANGLES) -> None:
+        self.max_triangles = max_triangles
+        self._geometries: "collections.OrderedDict[bytes, Geometry]" = collections.OrderedDict()
+        self._triangles = 0
+        self._lock = threading.Lock()
+        self.hits = 0
+        self.misses = 0
+
+    def __len__(self) -> int:
+        return len(self._geometries)
+
+    def geometry(self, parameters: Sequence[float], indices: Sequence[int] = (),
+                 shape: int = Shape.BY_COUNT) -> Geometry:
+        """:func:`geometry_from_parameters`, from the cache when built before. Refusals are
+        raised every time (nothing is kept for them)."""
+        key = _content_key(parameters, indices, shape)
+        with self._lock:
+            found = self._geometries.get(key)
+            if found is not None:
+                self._geometries.move_to_end(key)
+                self.hits += 1
+                return found
+        built = geometry_from_parameters(parameters, indices, shape)
+        with self._lock:
+            self.misses += 1
+            if key not in self._geometries:
+                self._geometries[key] = built
+                self._triangles += built.triangle_count
+                self._evict()
+            return self._geometries[key]
+
+    def _evict(self) -> None:
+        while self._triangles > self.max_triangles and len(self._geometries) > 1:
+            _, oldest = self._geometries.popitem(last=False)
+            self._triangles -= oldest.triangle_count
+
+
+def _content_key(parameters: Sequence[float], indices: Sequence[int], shape: int) -> bytes:
+    """A digest of what decides a geometry: the shape asked for, the parameters as float64
+    and the indices as int64 (the same values sent as a list, a tuple or an array give the
+    same key)."""
+    digest = hashlib.blake2b(digest_size=20)
+    digest.update(int(shape).to_bytes(4, "little", signed=True))
+    params = np.ascontiguousarray(np.asarray(parameters, dtype=float).reshape(-1))
+    digest.update(params.size.to_bytes(8, "little"))
+    digest.update(params.tobytes())
+    digest.update(np.ascontiguousarray(np.asarray(indices, dtype=np.int64).reshape(-1)).tobytes())
+    return digest.digest()

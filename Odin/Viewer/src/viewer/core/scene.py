@@ -32,7 +32,7 @@ import numpy as np
 from odin_common.interface import COLLIDING_COLOR, DEFAULT_COLOR
 from viewer.core.camera import Camera
 from viewer.errors import ViewerError
-from viewer.core.geometry import Geometry, geometry_from_parameters, pose_matrix
+from viewer.core.geometry import Geometry, GeometryCache, geometry_from_parameters, pose_matrix
 
 #: default background (r, g, b)
 DEFAULT_BACKGROUND = (0.93, 0.94, 0.96)
@@ -67,13 +67,16 @@ class ViewRequest:
 
 def prepare_view(object_id: str, parameters: Sequence[float], indices: Sequence[int],
                  position_W: Sequence[float], orientation_wxyz: Sequence[float],
-                 color: Sequence[float], shape: int = 0) -> ViewRequest:
+                 color: Sequence[float], shape: int = 0,
+                 cache: Optional[GeometryCache] = None) -> ViewRequest:
     """Checks a View Object request and builds its geometry (no scene needed, so a service
-    callback can do it on its own thread). Raises :class:`ViewerError` if anything is wrong."""
+    callback can do it on its own thread), or takes it from ``cache`` when that content was
+    built before. Raises :class:`ViewerError` if anything is wrong."""
     object_id = check_id(object_id)
     where = f"object {object_id!r}"
+    build = geometry_from_parameters if cache is None else cache.geometry
     try:
-        geometry = geometry_from_parameters(parameters, indices, shape)
+        geometry = build(parameters, indices, shape)
     except ViewerError as error:
         raise ViewerError(f"{where}: {error}") from None
     return ViewRequest(object_id, geometry, pose_matrix(position_W, orientation_wxyz, where),

@@ -65,6 +65,7 @@ from odin_common import OdinError, replies
 from odin_common.interface import VIEWER_SERVICES
 from odin_common.node import MasterWatch, init_ros_node
 from viewer.core.camera import Camera
+from viewer.core.geometry import GeometryCache
 from viewer.errors import ViewerError
 from viewer.core.loop import RenderLoop
 from viewer.core.scene import Scene, prepare_view
@@ -120,6 +121,7 @@ class Portal:
         self.snapshot_dir.mkdir(parents=True, exist_ok=True)
         self.snapshot_every = int(rospy.get_param("~snapshot_every", DEFAULTS["snapshot_every"]))
         self.frame_writer = FrameWriter(self.snapshot_dir) if self.snapshot_every > 0 else None
+        self.geometries = GeometryCache()   # a world re-sends the same meshes on every load
 
         self.image_pub = rospy.Publisher("~image", Image, queue_size=2)
         self.compressed_pub = rospy.Publisher("~image/compressed", CompressedImage, queue_size=2)
@@ -184,7 +186,7 @@ class Portal:
             for object_id, parameters, indices, shape, color in views:
                 try:
                     scene.view(prepare_view(object_id, parameters, indices, *IDENTITY, color,
-                                            shape))
+                                            shape, self.geometries))
                 except OdinError as error:   # a marker that is no geometry the Viewer takes
                     rospy.logwarn("viewer: marker %r not drawn: %s", object_id, error)
         self.loop.post(apply)
@@ -210,7 +212,8 @@ class Portal:
     def view_object(self, req) -> dict:
         """Adds the object, or replaces the one with its ID (checked on the server's thread)."""
         request = prepare_view(req.id, req.parameters, req.indices, req.position,
-                               req.orientation, req.color, req.shape)   # on this thread
+                               req.orientation, req.color, req.shape,
+                               self.geometries)   # on this thread
         replaced = self.loop.call(lambda scene, _: scene.view(request))
         return {"message": f"replaced {req.id!r}" if replaced else f"added {req.id!r}"}
 
