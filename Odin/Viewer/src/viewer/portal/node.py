@@ -57,7 +57,6 @@ from typing import Optional, Tuple
 import rospy
 import rospkg
 from sensor_msgs.msg import CompressedImage, Image
-from visualization_msgs.msg import MarkerArray
 
 from Messages.msg import Collided, SpaceDistribution
 from Services import srv
@@ -69,7 +68,7 @@ from viewer.core.geometry import GeometryCache
 from viewer.errors import ViewerError
 from viewer.core.loop import RenderLoop
 from viewer.core.scene import Scene, prepare_view
-from viewer.portal.markers import IDENTITY, MarkerIntake
+from viewer.portal.markers import IDENTITY, MarkerIntake, RawMarkerArray, read_markers
 from viewer.portal.parameters import DEFAULTS
 from viewer.core.snapshots import (COMPRESSED_FORMAT, FrameWriter, encode_jpeg, snapshot_path,
                                    write_png)
@@ -136,7 +135,7 @@ class Portal:
                          queue_size=10)
         rospy.Subscriber(f"{world}/collided", Collided, self._collided, queue_size=1000)
         self._marker_intake = MarkerIntake()
-        rospy.Subscriber(f"{world}/markers", MarkerArray, self._markers, queue_size=10)
+        rospy.Subscriber(f"{world}/markers", RawMarkerArray, self._markers, queue_size=10)
         rospy.loginfo("viewer: rendering %dx%d at %.1f Hz, world %s, snapshots in %s",
                       camera.width, camera.height, rate, world, self.snapshot_dir)
 
@@ -177,9 +176,15 @@ class Portal:
         stamp = _stamp_seconds(msg.header)
         self.loop.post(lambda scene, _: scene.update(situations, stamp))
 
-    def _markers(self, msg: MarkerArray) -> None:
+    def _markers(self, msg: RawMarkerArray) -> None:
+        try:
+            markers = read_markers(msg.raw)
+        except ViewerError as error:
+            rospy.logwarn("viewer: markers not read: %s", error)
+            return
+
         def apply(scene: Scene, _) -> None:
-            views, removals = self._marker_intake.changes(msg.markers, scene.__contains__)
+            views, removals = self._marker_intake.changes(markers, scene.__contains__)
             for object_id in removals:
                 if object_id in scene:
                     scene.remove_object(object_id)
