@@ -5,8 +5,9 @@ import numpy as np
 import pytest
 
 from viewer.errors import ViewerError
-from viewer.core.geometry import (GeometryCache, geometry_from_parameters, pose_matrix,
-                                  rotation_from_wxyz, unit_box, unit_cylinder, unit_sphere)
+from viewer.core.geometry import (GeometryCache, geometry_from_parameters, pose_matrices,
+                                  pose_matrix, rotation_from_wxyz, unit_box, unit_cylinder,
+                                  unit_sphere)
 from odin_common import OdinError
 
 S = math.sqrt(0.5)
@@ -218,3 +219,24 @@ def test_the_cache_forgets_the_least_recently_used_beyond_its_triangles():
     assert cache.geometry(CUBE_VERTICES, CUBE_TRIANGLES) is cube
     assert cache.geometry(shifted, CUBE_TRIANGLES) is not other
     assert len(cache) == 2
+
+
+def test_poses_made_together_are_the_poses_made_one_by_one_and_bad_ones_are_flagged():
+    rng = np.random.default_rng(3)
+    quaternions = rng.normal(size=(6, 4))
+    quaternions /= np.linalg.norm(quaternions, axis=1, keepdims=True)
+    quaternions[1] *= 1.0005                        # within the tolerance: normalised
+    quaternions[2] *= 1.01                          # too far from unit length
+    quaternions[3] = 0.0                            # no rotation at all
+    positions = rng.normal(size=(6, 3))
+    positions[4, 1] = np.nan
+    quaternions[5, 0] = np.inf
+    poses, valid = pose_matrices(positions, quaternions)
+    assert valid.tolist() == [True, True, False, False, False, False]
+    for k in (0, 1):
+        np.testing.assert_allclose(poses[k], pose_matrix(positions[k], quaternions[k]),
+                                   atol=1e-15)
+    for k in range(2, 6):
+        with pytest.raises(ViewerError):
+            pose_matrix(positions[k], quaternions[k])
+    assert pose_matrices(np.zeros((0, 3)), np.zeros((0, 4)))[0].shape == (0, 4, 4)

@@ -116,6 +116,12 @@ def test_update_moves_known_objects_and_skips_unknown_names_and_bad_poses():
     np.testing.assert_allclose(scene.pose_of("ball")[:3, 3], (1, 2, 3))
     np.testing.assert_allclose(scene.pose_of("ball")[:3, :3], np.diag([-1, -1, 1]), atol=1e-12)
     np.testing.assert_allclose(scene.pose_of("cube")[:3, 3], (1, 0, 0.15))
+    # a position of the wrong size among good ones: the good ones still move, one by one
+    applied = scene.update([("ball", (4, 5, 6), (1, 0, 0, 0)), ("cube", (0, 0), (1, 0, 0, 0))])
+    assert applied == 1
+    np.testing.assert_allclose(scene.pose_of("ball"), [[1, 0, 0, 4], [0, 1, 0, 5],
+                                                       [0, 0, 1, 6], [0, 0, 0, 1]])
+    np.testing.assert_allclose(scene.pose_of("cube")[:3, 3], (1, 0, 0.15))
 
 
 def test_viewing_an_existing_id_replaces_it():

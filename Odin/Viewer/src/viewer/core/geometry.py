@@ -25,7 +25,7 @@ from odin_common.interface import (PLANE_DRAWN_SIZE, PLANE_DRAWN_THICKNESS, SHAP
                                    Shape, shape_of)
 from odin_common.meshes import (DISPLAY_TOLERANCE, capsule_mesh, cluster_vertices,  # noqa: F401
                                 display_mesh)
-from odin_common.rotations import quaternion_to_matrix, unit_quaternion
+from odin_common.rotations import QUATERNION_TOLERANCE, quaternion_to_matrix, unit_quaternion
 from viewer.errors import ViewerError
 
 _keys = itertools.count(1)
@@ -59,6 +59,25 @@ def pose_matrix(position_W: Sequence[float], quaternion_wxyz: Sequence[float],
     T[:3, :3] = rotation_from_wxyz(quaternion_wxyz, where=f"{where} orientation")
     T[:3, 3] = check_position(position_W, where=f"{where} position")
     return T
+
+
+def pose_matrices(positions_W: np.ndarray, quaternions_wxyz: np.ndarray) -> tuple:
+    """Many poses at once, as :func:`pose_matrix` makes each: (T_WB (n, 4, 4), valid (n,)
+    bool) from positions (n, 3) m and quaternions (n, 4) (w, x, y, z). A pose is valid when
+    its position is finite and its quaternion finite, non-zero and within
+    QUATERNION_TOLERANCE of unit length (then normalised); invalid ones are left identity."""
+    positions = np.asarray(positions_W, dtype=float).reshape(-1, 3)
+    quaternions = np.asarray(quaternions_wxyz, dtype=float).reshape(-1, 4)
+    with np.errstate(invalid="ignore", over="ignore"):
+        norms = np.linalg.norm(quaternions, axis=1)
+        valid = (np.all(np.isfinite(positions), axis=1) & np.isfinite(norms) & (norms > 0)
+                 & (np.abs(norms - 1.0) <= QUATERNION_TOLERANCE))
+    poses = np.tile(np.eye(4), (len(positions), 1, 1))
+    unit = quaternions[valid] / norms[valid, None]
+    if len(unit):
+        poses[valid, :3, :3] = np.moveaxis(quaternion_to_matrix(unit.T), -1, 0)
+    poses[valid, :3, 3] = positions[valid]
+    return poses, valid
 
 
 @dataclass(frozen=True, eq=False)
