@@ -422,8 +422,8 @@ def _content_key(parameters: Sequence[float], indices: Sequence[int], shape: int
     same key)."""
     digest = hashlib.blake2b(digest_size=20)
     digest.update(int(shape).to_bytes(4, "little", signed=True))
-    params = np.ascontiguousarray(np.asarray(parameters, dtype=float).reshape(-1))
+    params = np.ascontiguousarray(np.asarray(parameters, dtype="<f8").reshape(-1))
     digest.update(params.size.to_bytes(8, "little"))
-    digest.update(params.tobytes())
-    digest.update(np.ascontiguousarray(np.asarray(indices, dtype=np.int64).reshape(-1)).tobytes())
+    digest.update(params)                   # the array's own buffer: no copy
+    digest.update(np.ascontiguousarray(np.asarray(indices, dtype="<i8").reshape(-1)))
     return digest.digest()
