@@ -30,7 +30,9 @@ Published topics
 Services (odin_common.interface.VIEWER_SERVICES, each answered by the Portal's method of the
 same name)
     ``~view_object`` (Services/ViewObject): add an object, or replace the one with that ID (the
-        world may re-send its scene to a Viewer that started late). Refused: empty ID, a
+        world may re-send its scene to a Viewer that started late, and does on every problem
+        load: geometries are kept by content, viewer.core.geometry.GeometryCache, so the same
+        shape sent again is not built again). Refused: empty ID, a
         parameter count that is no shape, sizes <= 0, empty mesh, index out of range, NaN
         position, a quaternion that is not finite or whose norm is off 1 by more than 1e-3
         (odin_common.rotations.QUATERNION_TOLERANCE),
