@@ -7,7 +7,7 @@ plane as a CUBE of PLANE_DRAWN_SIZE x PLANE_DRAWN_SIZE x PLANE_DRAWN_THICKNESS, 
 capsule as a TRIANGLE_LIST of its triangles in the geometry's frame. A geometry the Viewer does
 not hold is added from its marker (at the origin: the next world_update places it); one it
 already holds (from View Object) is left alone; a DELETE or DELETEALL removes only what markers
-added. Colours are the marker's, which are the Viewer's own colours.
+added. Markers are taken MARKER_GRACE s after they arrive, in the order they arrived. Colours are the marker's, which are the Viewer's own colours.
 
 The markers are read from the message's bytes (:class:`RawMarkerArray`, :func:`read_markers`):
 genpy makes a Python object per point, ~1 s of CPU for the TX90 grasp scene's triangles, on
@@ -27,6 +27,12 @@ from odin_common.interface import PLANE_DRAWN_SIZE, PLANE_DRAWN_THICKNESS, Shape
 from viewer.errors import ViewerError
 
 IDENTITY = ((0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0))
+
+#: s the Viewer waits before it takes a MarkerArray: a live world publishes its markers when
+#: it builds and sends View Object right after, so by then the geometries are held and no
+#: mesh is built twice (once from its marker, again from View Object: a second of CPU for the
+#: TX90 grasp scene the first time); a bag played back shows its geometries this much later.
+MARKER_GRACE = 1.0
 
 
 class MarkerView(NamedTuple):

@@ -15,7 +15,8 @@ Subscribed topics
         loses no collision.
     ``<~world>/markers`` (visualization_msgs/MarkerArray): geometries the Viewer does not hold
         are added from the world's markers, so a rosbag played back drives the Viewer with no
-        world running (viewer.portal.markers).
+        world running (viewer.portal.markers); taken MARKER_GRACE (1 s) after they arrive, when
+        a live world's View Object for the same geometries has come.
 
 Published topics
     ``~image`` (sensor_msgs/Image): every rendered frame, rgb8, ``~width`` x ``~height``,
@@ -71,7 +72,8 @@ from viewer.core.geometry import GeometryCache
 from viewer.errors import ViewerError
 from viewer.core.loop import RenderLoop
 from viewer.core.scene import Scene, prepare_view
-from viewer.portal.markers import IDENTITY, MarkerIntake, RawMarkerArray, read_markers
+from viewer.portal.markers import (IDENTITY, MARKER_GRACE, MarkerIntake, RawMarkerArray,
+                                   read_markers)
 from viewer.portal.parameters import DEFAULTS
 from viewer.core.snapshots import (COMPRESSED_FORMAT, FrameWriter, encode_jpeg, snapshot_path,
                                    write_png)
@@ -197,7 +199,7 @@ class Portal:
                                             shape, self.geometries))
                 except OdinError as error:   # a marker that is no geometry the Viewer takes
                     rospy.logwarn("viewer: marker %r not drawn: %s", object_id, error)
-        self.loop.post(apply)
+        self.loop.post_later(MARKER_GRACE, apply)
 
     def _collided(self, msg: Collided) -> None:
         names = list(msg.names)
