@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from viewer.errors import ViewerError
-from viewer.core.geometry import (GeometryCache, _distinct_rows, _welded,
+from viewer.core.geometry import (GeometryCache, _welded,
                                   geometry_from_parameters, pose_matrices,
                                   pose_matrix, rotation_from_wxyz, unit_box, unit_cylinder,
                                   unit_sphere)
@@ -254,13 +254,3 @@ def test_welding_takes_vertices_at_the_same_place_as_one_as_np_unique_does():
     for index in np.unique(welded):               # one place per welded index
         assert len(np.unique(vertices[welded == index] + 0.0, axis=0)) == 1
     assert _welded(np.zeros((0, 3))).shape == (0,)
-
-
-def test_distinct_rows_are_np_unique_s_rows_with_small_and_large_indices():
-    rng = np.random.default_rng(6)
-    for high in (50, 1 << 22):
-        rows = rng.integers(0, high, size=(4000, 3))
-        rows = np.concatenate([rows, rows[::3]])  # repeats
-        got = {tuple(r) for r in _distinct_rows(rows).tolist()}
-        assert got == {tuple(r) for r in np.unique(rows, axis=0).tolist()}
-        assert len(_distinct_rows(rows)) == len(got)

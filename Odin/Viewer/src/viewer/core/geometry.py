@@ -25,6 +25,7 @@ from odin_common.interface import (PLANE_DRAWN_SIZE, PLANE_DRAWN_THICKNESS, SHAP
                                    Shape, shape_of)
 from odin_common.meshes import (DISPLAY_TOLERANCE, capsule_mesh, cluster_vertices,  # noqa: F401
                                 display_mesh)
+from odin_common.meshes import _unique_rows   # np.unique(axis=0) of int rows, 10x faster
 from odin_common.rotations import QUATERNION_TOLERANCE, quaternion_to_matrix, unit_quaternion
 from viewer.errors import ViewerError
 
@@ -227,8 +228,10 @@ def _shaded(vertices: np.ndarray, idx: np.ndarray) -> tuple:
     lengths = np.linalg.norm(area_normals, axis=1, keepdims=True)
     face_normals = np.where(lengths > 1e-20, area_normals / np.maximum(lengths, 1e-300),
                             [0.0, 0.0, 1.0])
-    vertex_normals = np.zeros_like(vertices)
-    np.add.at(vertex_normals, idx, np.repeat(area_normals, 3, axis=0))
+    # per axis, the sums in corner order as np.add.at would make them, many times faster
+    corner_normals = np.repeat(area_normals, 3, axis=0)
+    vertex_normals = np.stack([np.bincount(idx, weights=corner_normals[:, k],
+                                           minlength=len(vertices)) for k in range(3)], axis=1)
     norms = np.linalg.norm(vertex_normals, axis=1, keepdims=True)
     vertex_normals = vertex_normals / np.maximum(norms, 1e-300)
     corner_face = np.repeat(face_normals, 3, axis=0)
@@ -287,7 +290,8 @@ def _closed_winding(vertices: np.ndarray, triangles: np.ndarray) -> int:
     if len(t) == 0:
         return 0
     first = np.argmin(t, axis=1)[:, None]          # a repeated triangle counts once
-    t = _distinct_rows(np.take_along_axis(t, (first + np.arange(3)) % 3, axis=1))
+    t = np.take_along_axis(t, (first + np.arange(3)) % 3, axis=1)
+    t = t[_unique_rows(t, return_index=True)[1]]
     edges = np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]])
     n = int(t.max()) + 1
     forward = np.sort(edges[:, 0] * n + edges[:, 1])
@@ -312,15 +316,6 @@ def _welded(vertices: np.ndarray) -> np.ndarray:
     welded = np.empty(len(vertices), np.int64)
     welded[order] = np.cumsum(starts) - 1
     return welded
-
-
-def _distinct_rows(rows: np.ndarray) -> np.ndarray:
-    """The distinct rows of a (m, 3) array of indices >= 0 (in no particular order): each
-    row as one int64 key when the indices allow (below 2**21), else np.unique's rows."""
-    if len(rows) == 0 or int(rows.max()) >= 1 << 21:
-        return np.unique(rows, axis=0)
-    keys = (rows[:, 0].astype(np.int64) << 42) | (rows[:, 1].astype(np.int64) << 21) | rows[:, 2]
-    return rows[np.unique(keys, return_index=True)[1]]
 
 
 # -- unit primitives, tessellated once ------------------------------------------------------
