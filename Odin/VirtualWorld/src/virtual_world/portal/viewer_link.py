@@ -96,7 +96,7 @@ class ViewerLink:
                 if not self._outbox and not self._stop:
                     self._lock.wait(CHECK_PERIOD)
                 if self._stop:
-                    return
+                    break
                 batch = list(self._outbox)
                 self._outbox.clear()
             try:
@@ -107,6 +107,7 @@ class ViewerLink:
                                  "it is back", self._namespace, error)
                 self._synced_uri = None
                 self._close_proxies()
+        self._close_proxies()
 
     def _deliver(self, batch: list) -> None:
         uri = self._service_uri()
