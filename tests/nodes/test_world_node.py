@@ -296,6 +296,42 @@ def test_a_viewer_started_late_receives_the_current_scene(world, ros_master):
     wait_until(red_pixels, timeout=20, period=0.5)   # the early box in the late Viewer's frame
 
 
+def test_a_restarted_viewer_receives_the_scene_again_over_new_connections(world, ros_master):
+    """The world's link keeps its connections to the Viewer open between calls; when that
+    Viewer is gone and another starts, the link connects to the new one and re-sends."""
+    import rospy
+    import numpy as np
+    from PIL import Image
+    from Services.srv import SaveSnapshot
+    from world_client import box, wait_until
+
+    def has(colour_channel):
+        def check():
+            response = rospy.ServiceProxy("/viewer/save_snapshot", SaveSnapshot)("again.png")
+            assert response.success, response.message
+            image = np.asarray(Image.open(response.path).convert("RGB")).astype(int)
+            others = [image[..., c] for c in range(3) if c != colour_channel]
+            strong = (image[..., colour_channel] > 120) & (others[0] < 90) & (others[1] < 90)
+            return strong.sum() > 200
+        return check
+
+    world.ok("build_object", object=box("red", (0.5, 0.5, 0.5), (0, -0.6, 0.25),
+                                        color=[0.9, 0.1, 0.1, 1]))
+    first = ros_master.rosrun("Viewer", "viewer", f"_snapshot_dir:={ros_master.ros_home}")
+    ros_master.wait_for_service("/viewer/save_snapshot")
+    wait_until(has(0), timeout=20, period=0.5)
+    world.ok("build_object", object=box("green", (0.5, 0.5, 0.5), (0, 0.6, 0.25),
+                                        color=[0.1, 0.9, 0.1, 1]))   # over the open connection
+    wait_until(has(1), timeout=20, period=0.5)
+    first.terminate()
+    first.wait(timeout=30)
+    world.ok("build_object", object=box("blue", (0.5, 0.5, 0.5), (0, 0, 1.0),
+                                        color=[0.1, 0.1, 0.9, 1]))   # while no Viewer is up
+    ros_master.rosrun("Viewer", "viewer", f"_snapshot_dir:={ros_master.ros_home}")
+    rospy.wait_for_service("/viewer/save_snapshot", timeout=30)  # (the first one is gone)
+    wait_until(lambda: all(has(c)() for c in range(3)), timeout=30, period=0.5)
+
+
 def test_start_up_parameters_are_read(ros_master):
     import rospy
     from std_msgs.msg import Float64

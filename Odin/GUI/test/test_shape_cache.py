@@ -50,13 +50,13 @@ def test_a_cached_shape_is_the_shape_read_bit_for_bit_and_is_not_read_again(cach
     model = tmp_path / "model.iv"
     model.write_text(SCENE)
     first = _read(model)
-    assert len(list(cache.glob("*.npz"))) == 1
+    assert len(list(cache.glob("*.shape"))) == 1
     monkeypatch.setattr(shapes, "_read_raw", lambda *a: pytest.fail("read the file again"))
     _same(_read(model), first)
     copy = tmp_path / "elsewhere.iv"           # the same content elsewhere: the same entry
     copy.write_text(SCENE)
     _same(_read(copy), shapes.replace(first, source=str(copy)))
-    assert len(list(cache.glob("*.npz"))) == 1
+    assert len(list(cache.glob("*.shape"))) == 1
 
 
 def test_another_scale_or_an_edited_file_is_read_again(cache, tmp_path):
@@ -66,27 +66,40 @@ def test_another_scale_or_an_edited_file_is_read_again(cache, tmp_path):
     assert _read(model, 1.0).mesh.vertices.max() == pytest.approx(1000 * small.mesh.vertices.max())
     model.write_text(SCENE.replace("radius 2", "radius 3"))
     assert _read(model).primitives[0].parameters == pytest.approx((0.003,))
-    assert len(list(cache.glob("*.npz"))) == 3
+    assert len(list(cache.glob("*.shape"))) == 3
 
 
 def test_a_corrupt_entry_is_dropped_and_the_file_read_again(cache, tmp_path):
     model = tmp_path / "model.iv"
     model.write_text(SCENE)
     first = _read(model)
-    (entry,) = cache.glob("*.npz")
-    for damage in (b"", b"not a zip file", entry.read_bytes()[:100]):
+    (entry,) = cache.glob("*.shape")
+    whole = entry.read_bytes()
+    header_end = whole.index(b"}}") + 2 if b"}}" in whole else 80
+    damages = [b"", b"not an entry", whole[:100], whole[:-1], whole + b"\0",
+               whole[:header_end - 5] + whole[header_end:],           # header cut
+               whole[:-12] + (4000).to_bytes(4, "little") * 3]        # vertex out of range
+    for damage in damages:
         entry.write_bytes(damage)
         _same(_read(model), first)
-        assert entry.stat().st_size > 1000          # written whole again
+        assert entry.read_bytes() == whole              # written whole again
 
 
 def test_a_planted_entry_with_objects_is_refused_not_run(cache, tmp_path):
     model = tmp_path / "model.iv"
     model.write_text(SCENE)
     first = _read(model)
-    (entry,) = cache.glob("*.npz")
-    np.savez(entry, has_mesh=np.array([object()], dtype=object))     # needs pickle to load
+    (entry,) = cache.glob("*.shape")
+    with entry.open("wb") as planted:                                # needs pickle to load
+        np.savez(planted, has_mesh=np.array([object()], dtype=object))
     _same(_read(model), first)
+
+
+def test_a_file_that_only_mentions_file_or_inline_is_cached(cache, tmp_path):
+    model = tmp_path / "model.iv"
+    model.write_text(SCENE.replace("Separator {", "# a File written by Inline Tools\nSeparator {"))
+    _read(model)
+    assert len(list(cache.glob("*.shape"))) == 1
 
 
 def _read_in_child(path: str, folder: str, queue) -> None:
@@ -112,7 +125,7 @@ def test_processes_reading_at_once_all_get_the_whole_shape(cache, tmp_path):
         assert child.exitcode == 0
     expected = _read(model)
     assert set(results) == {(expected.mesh.vertices.tobytes(), 1)}
-    assert [p.name for p in cache.iterdir()] == [p.name for p in cache.glob("*.npz")]
+    assert [p.name for p in cache.iterdir()] == [p.name for p in cache.glob("*.shape")]
 
 
 def test_files_that_name_other_files_and_no_cache_are_read_every_time(cache, tmp_path,
@@ -121,12 +134,12 @@ def test_files_that_name_other_files_and_no_cache_are_read_every_time(cache, tmp
     inline.write_text("#VRML V2.0 utf8\nInline { url \"other.wrl\" }\n"
                       "Shape { geometry Sphere { radius 1 } }\n")
     _read(inline)
-    assert not cache.exists() or not list(cache.glob("*.npz"))
+    assert not cache.exists() or not list(cache.glob("*.shape"))
     model = tmp_path / "model.iv"
     model.write_text(SCENE)
     monkeypatch.setenv("ODIN_NO_CACHE", "1")
     _read(model)
-    assert not cache.exists() or not list(cache.glob("*.npz"))
+    assert not cache.exists() or not list(cache.glob("*.shape"))
 
 
 def test_an_unwritable_cache_folder_costs_only_the_speed(tmp_path, monkeypatch):
@@ -145,7 +158,7 @@ def test_the_oldest_entries_go_past_the_limit(cache, tmp_path, monkeypatch):
         model = tmp_path / f"m{radius}.iv"
         model.write_text(SCENE.replace("radius 2", f"radius {radius}"))
         _read(model)
-    assert len(list(cache.glob("*.npz"))) == 2
+    assert len(list(cache.glob("*.shape"))) == 2
 
 
 def test_problem_info_no_cache_gives_the_same_answer(cache, kautham_dir):
@@ -156,4 +169,4 @@ def test_problem_info_no_cache_gives_the_same_answer(cache, kautham_dir):
             for extra in ([], [], ["--no-cache"])]
     assert all(run.returncode == 0 for run in runs), runs[0].stderr
     assert runs[0].stdout == runs[1].stdout == runs[2].stdout
-    assert len(list(cache.glob("*.npz"))) == 16       # the distinct geometry files it reads
+    assert len(list(cache.glob("*.shape"))) == 16       # the distinct geometry files it reads

@@ -5,8 +5,10 @@ import numpy as np
 import pytest
 
 from viewer.errors import ViewerError
-from viewer.core.geometry import (geometry_from_parameters, pose_matrix, rotation_from_wxyz,
-                             unit_box, unit_cylinder, unit_sphere)
+from viewer.core.geometry import (GeometryCache, _welded,
+                                  geometry_from_parameters, pose_matrices,
+                                  pose_matrix, rotation_from_wxyz, unit_box, unit_cylinder,
+                                  unit_sphere)
 from odin_common import OdinError
 
 S = math.sqrt(0.5)
@@ -172,3 +174,83 @@ def test_a_plane_is_a_large_unbounded_floor():
 def test_a_named_shape_with_the_wrong_parameters_is_refused(parameters, shape):
     with pytest.raises(ViewerError):
         geometry_from_parameters(parameters, shape=shape)
+
+
+def test_the_cache_gives_the_geometry_built_before_for_the_same_content():
+    cache = GeometryCache()
+    first = cache.geometry(CUBE_VERTICES, CUBE_TRIANGLES)
+    # the same numbers as a tuple and as arrays (what rospy and a marker give) are the same
+    again = cache.geometry(tuple(CUBE_VERTICES), np.array(CUBE_TRIANGLES, np.uint32))
+    assert again is first and (cache.misses, cache.hits) == (1, 1)
+    built = geometry_from_parameters(CUBE_VERTICES, CUBE_TRIANGLES)
+    np.testing.assert_array_equal(first.vertices_B, built.vertices_B)
+    np.testing.assert_array_equal(first.indices_B, built.indices_B)
+    assert first.closed == built.closed and first.radius == built.radius
+
+
+def test_the_cache_tells_apart_shapes_sizes_and_windings():
+    cache = GeometryCache()
+    inverted = np.array(CUBE_TRIANGLES).reshape(-1, 3)[:, ::-1].ravel()
+    geometries = [cache.geometry([0.5]), cache.geometry([0.6]), cache.geometry([0.5, 0.5]),
+                  cache.geometry([0.05, 0.3], shape=5), cache.geometry([0.05, 0.3]),
+                  cache.geometry(CUBE_VERTICES, CUBE_TRIANGLES),
+                  cache.geometry(CUBE_VERTICES, inverted)]
+    assert len({id(g) for g in geometries}) == len(geometries) == cache.misses
+    assert [g.kind for g in geometries[2:5]] == ["cylinder", "mesh", "cylinder"]
+
+
+def test_the_cache_refuses_bad_content_every_time_and_keeps_nothing_for_it():
+    cache = GeometryCache()
+    for _ in range(2):
+        with pytest.raises(ViewerError, match="out of range"):
+            cache.geometry([0, 0, 0, 1, 0, 0, 0, 1, 0], [0, 1, 3])
+        with pytest.raises(ViewerError, match="> 0"):
+            cache.geometry([-1.0])
+    assert len(cache) == 0
+
+
+def test_the_cache_forgets_the_least_recently_used_beyond_its_triangles():
+    cache = GeometryCache(max_triangles=24)         # two cubes of 12 triangles
+    cube = cache.geometry(CUBE_VERTICES, CUBE_TRIANGLES)
+    shifted = [v + 1.0 for v in CUBE_VERTICES]
+    other = cache.geometry(shifted, CUBE_TRIANGLES)
+    assert cache.geometry(CUBE_VERTICES, CUBE_TRIANGLES) is cube     # now the most recent
+    third = [v + 2.0 for v in CUBE_VERTICES]
+    cache.geometry(third, CUBE_TRIANGLES)                            # pushes out `other`
+    assert cache.geometry(CUBE_VERTICES, CUBE_TRIANGLES) is cube
+    assert cache.geometry(shifted, CUBE_TRIANGLES) is not other
+    assert len(cache) == 2
+
+
+def test_poses_made_together_are_the_poses_made_one_by_one_and_bad_ones_are_flagged():
+    rng = np.random.default_rng(3)
+    quaternions = rng.normal(size=(6, 4))
+    quaternions /= np.linalg.norm(quaternions, axis=1, keepdims=True)
+    quaternions[1] *= 1.0005                        # within the tolerance: normalised
+    quaternions[2] *= 1.01                          # too far from unit length
+    quaternions[3] = 0.0                            # no rotation at all
+    positions = rng.normal(size=(6, 3))
+    positions[4, 1] = np.nan
+    quaternions[5, 0] = np.inf
+    poses, valid = pose_matrices(positions, quaternions)
+    assert valid.tolist() == [True, True, False, False, False, False]
+    for k in (0, 1):
+        np.testing.assert_allclose(poses[k], pose_matrix(positions[k], quaternions[k]),
+                                   atol=1e-15)
+    for k in range(2, 6):
+        with pytest.raises(ViewerError):
+            pose_matrix(positions[k], quaternions[k])
+    assert pose_matrices(np.zeros((0, 3)), np.zeros((0, 4)))[0].shape == (0, 4, 4)
+
+
+def test_welding_takes_vertices_at_the_same_place_as_one_as_np_unique_does():
+    rng = np.random.default_rng(5)
+    vertices = rng.integers(0, 4, size=(3000, 3)).astype(float) * 0.25
+    vertices[::7, 2] = -0.0                       # -0.0 and 0.0 are one place
+    welded = _welded(vertices)
+    _, reference = np.unique(vertices, axis=0, return_inverse=True)
+    pairs = set(zip(welded.tolist(), reference.ravel().tolist()))
+    assert len(pairs) == len(set(welded.tolist())) == len(set(reference.ravel().tolist()))
+    for index in np.unique(welded):               # one place per welded index
+        assert len(np.unique(vertices[welded == index] + 0.0, axis=0)) == 1
+    assert _welded(np.zeros((0, 3))).shape == (0,)

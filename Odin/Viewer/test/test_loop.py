@@ -104,3 +104,20 @@ def test_a_renderer_that_cannot_start_is_reported():
     loop = RenderLoop(Scene(), broken, 25.0)
     with pytest.raises(ViewerError, match="no OSMesa here"):
         loop.start()
+
+
+def test_work_posted_for_later_runs_after_its_delay_in_order_and_does_not_hold_up_other_work():
+    ran = []
+    with make_loop() as loop:
+        started = time.monotonic()
+        loop.post_later(0.4, lambda scene, _: ran.append(("first", time.monotonic() - started)))
+        loop.post_later(0.4, lambda scene, _: ran.append(("second", time.monotonic() - started)))
+        loop.post_later(0.4, lambda scene, _: 1 / 0)            # logged, the loop goes on
+        assert loop.call(lambda scene, _: len(ran)) == 0         # not yet, and no wait for it
+        assert time.monotonic() - started < 0.3
+        deadline = time.monotonic() + 5
+        while len(ran) < 2 and time.monotonic() < deadline:
+            time.sleep(0.02)
+        assert [name for name, _ in ran] == ["first", "second"]
+        assert all(0.4 <= at < 2.0 for _, at in ran)
+        assert loop.call(lambda scene, _: len(ran)) == 2

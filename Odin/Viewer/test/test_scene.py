@@ -6,6 +6,7 @@ import pytest
 
 from viewer.core.camera import Camera
 from viewer.errors import ViewerError
+from viewer.core.geometry import GeometryCache
 from viewer.core.scene import COLLIDING_COLOR, DEFAULT_COLOR, Scene, prepare_view
 
 RED = (1.0, 0.0, 0.0, 1.0)
@@ -115,6 +116,12 @@ def test_update_moves_known_objects_and_skips_unknown_names_and_bad_poses():
     np.testing.assert_allclose(scene.pose_of("ball")[:3, 3], (1, 2, 3))
     np.testing.assert_allclose(scene.pose_of("ball")[:3, :3], np.diag([-1, -1, 1]), atol=1e-12)
     np.testing.assert_allclose(scene.pose_of("cube")[:3, 3], (1, 0, 0.15))
+    # a position of the wrong size among good ones: the good ones still move, one by one
+    applied = scene.update([("ball", (4, 5, 6), (1, 0, 0, 0)), ("cube", (0, 0), (1, 0, 0, 0))])
+    assert applied == 1
+    np.testing.assert_allclose(scene.pose_of("ball"), [[1, 0, 0, 4], [0, 1, 0, 5],
+                                                       [0, 0, 1, 6], [0, 0, 0, 1]])
+    np.testing.assert_allclose(scene.pose_of("cube")[:3, 3], (1, 0, 0.15))
 
 
 def test_viewing_an_existing_id_replaces_it():
@@ -143,6 +150,20 @@ def test_bad_view_requests_are_refused_before_touching_the_scene():
         prepare_view("c", [1.0], [], (0, 0, 0), (1, 0, 0, 0), (2, 0, 0, 1))
     with pytest.raises(ViewerError, match="quaternion"):
         prepare_view("q", [1.0], [], (0, 0, 0), (0, 0, 0, 0), RED)
+
+
+def test_objects_of_the_same_content_share_one_cached_geometry_and_keep_their_own_poses():
+    cache = GeometryCache()
+    triangle = ([0, 0, 0, 1, 0, 0, 0, 1, 0], [0, 1, 2])
+    scene = Scene()
+    scene.view(prepare_view("left", *triangle, (-1, 0, 0), (1, 0, 0, 0), RED, cache=cache))
+    scene.view(prepare_view("right", *triangle, (1, 0, 0), (1, 0, 0, 0), BLUE, cache=cache))
+    left, right = sorted(scene.draw_list(), key=lambda item: item.id)
+    assert left.geometry is right.geometry and cache.misses == 1
+    assert (left.color, right.color) == (RED, BLUE)
+    assert left.model_W[0, 3] == -1 and right.model_W[0, 3] == 1
+    with pytest.raises(ViewerError, match="'bad'.*out of range"):
+        prepare_view("bad", triangle[0], [0, 1, 5], (0, 0, 0), (1, 0, 0, 0), RED, cache=cache)
 
 
 def test_adding_objects_refits_the_camera_unless_it_is_fixed():

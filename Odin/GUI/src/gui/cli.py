@@ -8,19 +8,38 @@ What a problem holds that Odin does not use is warned about on stderr, once each
 from __future__ import annotations
 
 import argparse
+import atexit
 import json
 import logging
 import os
 import sys
 import threading
 import time
-from typing import Optional, Sequence
+from typing import Callable, Optional, Sequence
 
 import numpy as np
 
 from gui.errors import GuiError, PlanningError
 from odin_common.errors import OdinError
 from odin_common.tool import stop_on_ctrl_c
+
+
+def without_teardown(main: Callable[[], Optional[int]]) -> Callable[[], int]:
+    """``main`` for a tool's process that ends with it: once ``main`` has returned, stdout and
+    stderr are flushed, the exit handlers run (rospy leaves the ROS graph, logging flushes
+    its files) and the process ends with ``main``'s status, without the interpreter's
+    teardown, which frees every object one at a time: 0.45 s after load_problem (a problem's
+    meshes, rospy's and numpy's modules), where the system frees the memory at once. An
+    exception (a closed pipe, Ctrl-C) leaves as usual, for odin_common.tool.run."""
+    def ended() -> int:
+        status = main() or 0
+        sys.stdout.flush()
+        sys.stderr.flush()
+        atexit._run_exitfuncs()
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(status)
+    return ended
 
 
 def _fail(tool: str, error: Exception) -> int:

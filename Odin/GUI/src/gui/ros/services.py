@@ -65,15 +65,26 @@ class ServiceCaller:
     def call(self, service: str, /, **fields):
         """Calls one service with request ``fields``; returns the response, or raises ``error``
         if the call broke or the node refused (``success: false``)."""
-        response = self.ask(service, **fields)
-        if not response.success:
-            raise self.error(self.path(service), response.message)
-        return response
+        return self._accepted(service, self.ask(service, **fields))
+
+    def send(self, service: str, request):
+        """``call`` with a request message made beforehand: an instance of the service's
+        request class (or of a subclass that serialises itself faster)."""
+        return self._accepted(service, self._exchange(service, lambda request_class: request))
 
     def ask(self, service: str, /, **fields):
         """Calls one service and returns its response, refused or not (a refused Set Step or
         Set Camera still reports the values in force); raises ``error`` only if the call
         breaks (node gone, connection dropped), after dropping its proxy."""
+        return self._exchange(service, lambda request_class: request_class(**fields))
+
+    def _accepted(self, service: str, response):
+        if not response.success:
+            raise self.error(self.path(service), response.message)
+        return response
+
+    def _exchange(self, service: str, make_request):
+        """The response to ``make_request(request class)``; a broken call raises ``error``."""
         proxy = self._proxies.get(service)
         if proxy is None:
             service_class = getattr(self._srv, self.services[service])
@@ -81,7 +92,7 @@ class ServiceCaller:
                                              persistent=self.persistent)
             self._proxies[service] = proxy
         try:
-            return proxy(proxy.request_class(**fields))
+            return proxy(make_request(proxy.request_class))
         except (self._rospy.ServiceException, OSError) as error:
             self._proxies.pop(service, None)
             raise self.error(self.path(service), f"call failed: {error}") from None

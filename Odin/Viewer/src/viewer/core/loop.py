@@ -3,7 +3,7 @@
 Other threads (rospy's service and subscriber threads) never touch the scene or GL: they hand
 work to the loop. :meth:`RenderLoop.call` runs a function on the render thread between frames
 and returns its result (or raises its exception) in the caller's thread; :meth:`RenderLoop.post`
-queues one without waiting. Work is done in the order it arrived, as soon as the thread is free,
+queues one without waiting, :meth:`RenderLoop.post_later` one to run once a delay has passed. Work is done in the order it arrived, as soon as the thread is free,
 and a frame is rendered every 1/rate seconds whatever arrives, then handed to ``on_frame`` --
 while someone wants frames (``wanted``): a Viewer nobody watches renders nothing and costs
 no CPU beyond keeping its scene up to date (a frame of the TX90 scene is tens of ms of a core).
@@ -12,6 +12,8 @@ ROS-free: the Portal wires it to topics and services.
 from __future__ import annotations
 
 import collections
+import heapq
+import itertools
 import logging
 import threading
 import time
@@ -57,6 +59,8 @@ class RenderLoop:
         self._on_frame = on_frame
         self._wanted = wanted
         self._jobs: collections.deque = collections.deque()
+        self._later: list = []                 # heap of (due, order, job): post_later
+        self._order = itertools.count()
         self._wake = threading.Condition()
         self._running = False
         self._thread: Optional[threading.Thread] = None
@@ -100,6 +104,13 @@ class RenderLoop:
             self._jobs.append(_Job(fn))
             self._wake.notify_all()
 
+    def post_later(self, delay: float, fn: Callable) -> None:
+        """Queues fn(scene, renderer) for the render thread once ``delay`` s have passed
+        (jobs of equal delay run in the order posted); errors are logged, not raised."""
+        with self._wake:
+            heapq.heappush(self._later, (time.monotonic() + delay, next(self._order), _Job(fn)))
+            self._wake.notify_all()
+
     def call(self, fn: Callable, timeout: float = 10.0):
         """Runs fn(scene, renderer) on the render thread; returns its result or raises its
         exception here. Raises ViewerError if the loop is not running or takes over timeout s."""
@@ -131,11 +142,16 @@ class RenderLoop:
         try:
             while True:
                 with self._wake:
-                    while self._running and not self._jobs and time.monotonic() < deadline:
-                        self._wake.wait(max(0.0, deadline - time.monotonic()))
+                    while self._running and not self._jobs:
+                        wake_at = min(deadline, self._later[0][0]) if self._later else deadline
+                        if time.monotonic() >= wake_at:
+                            break
+                        self._wake.wait(max(0.0, wake_at - time.monotonic()))
                     if not self._running:
                         break
                     jobs, self._jobs = self._jobs, collections.deque()
+                    while self._later and self._later[0][0] <= time.monotonic():
+                        jobs.append(heapq.heappop(self._later)[2])
                 for job in jobs:
                     self._do(job)
                 now = time.monotonic()
@@ -149,6 +165,8 @@ class RenderLoop:
             with self._wake:
                 self._running = False
                 leftover, self._jobs = self._jobs, collections.deque()
+                leftover.extend(job for _, _, job in self._later)
+                self._later = []
             for job in leftover:
                 job.error = ViewerError("the Viewer is shutting down")
                 job.done.set()

@@ -15,7 +15,8 @@ Subscribed topics
         loses no collision.
     ``<~world>/markers`` (visualization_msgs/MarkerArray): geometries the Viewer does not hold
         are added from the world's markers, so a rosbag played back drives the Viewer with no
-        world running (viewer.portal.markers).
+        world running (viewer.portal.markers); taken MARKER_GRACE (1 s) after they arrive, when
+        a live world's View Object for the same geometries has come.
 
 Published topics
     ``~image`` (sensor_msgs/Image): every rendered frame, rgb8, ``~width`` x ``~height``,
@@ -30,7 +31,9 @@ Published topics
 Services (odin_common.interface.VIEWER_SERVICES, each answered by the Portal's method of the
 same name)
     ``~view_object`` (Services/ViewObject): add an object, or replace the one with that ID (the
-        world may re-send its scene to a Viewer that started late). Refused: empty ID, a
+        world may re-send its scene to a Viewer that started late, and does on every problem
+        load: geometries are kept by content, viewer.core.geometry.GeometryCache, so the same
+        shape sent again is not built again). Refused: empty ID, a
         parameter count that is no shape, sizes <= 0, empty mesh, index out of range, NaN
         position, a quaternion that is not finite or whose norm is off 1 by more than 1e-3
         (odin_common.rotations.QUATERNION_TOLERANCE),
@@ -56,8 +59,8 @@ from typing import Optional, Tuple
 
 import rospy
 import rospkg
+from rospy.numpy_msg import numpy_msg
 from sensor_msgs.msg import CompressedImage, Image
-from visualization_msgs.msg import MarkerArray
 
 from Messages.msg import Collided, SpaceDistribution
 from Services import srv
@@ -65,10 +68,12 @@ from odin_common import OdinError, replies
 from odin_common.interface import VIEWER_SERVICES
 from odin_common.node import MasterWatch, init_ros_node
 from viewer.core.camera import Camera
+from viewer.core.geometry import GeometryCache
 from viewer.errors import ViewerError
 from viewer.core.loop import RenderLoop
 from viewer.core.scene import Scene, prepare_view
-from viewer.portal.markers import IDENTITY, MarkerIntake
+from viewer.portal.markers import (IDENTITY, MARKER_GRACE, MarkerIntake, RawMarkerArray,
+                                   read_markers)
 from viewer.portal.parameters import DEFAULTS
 from viewer.core.snapshots import (COMPRESSED_FORMAT, FrameWriter, encode_jpeg, snapshot_path,
                                    write_png)
@@ -120,6 +125,7 @@ class Portal:
         self.snapshot_dir.mkdir(parents=True, exist_ok=True)
         self.snapshot_every = int(rospy.get_param("~snapshot_every", DEFAULTS["snapshot_every"]))
         self.frame_writer = FrameWriter(self.snapshot_dir) if self.snapshot_every > 0 else None
+        self.geometries = GeometryCache()   # a world re-sends the same meshes on every load
 
         self.image_pub = rospy.Publisher("~image", Image, queue_size=2)
         self.compressed_pub = rospy.Publisher("~image/compressed", CompressedImage, queue_size=2)
@@ -134,7 +140,7 @@ class Portal:
                          queue_size=10)
         rospy.Subscriber(f"{world}/collided", Collided, self._collided, queue_size=1000)
         self._marker_intake = MarkerIntake()
-        rospy.Subscriber(f"{world}/markers", MarkerArray, self._markers, queue_size=10)
+        rospy.Subscriber(f"{world}/markers", RawMarkerArray, self._markers, queue_size=10)
         rospy.loginfo("viewer: rendering %dx%d at %.1f Hz, world %s, snapshots in %s",
                       camera.width, camera.height, rate, world, self.snapshot_dir)
 
@@ -175,19 +181,25 @@ class Portal:
         stamp = _stamp_seconds(msg.header)
         self.loop.post(lambda scene, _: scene.update(situations, stamp))
 
-    def _markers(self, msg: MarkerArray) -> None:
+    def _markers(self, msg: RawMarkerArray) -> None:
+        try:
+            markers = read_markers(msg.raw)
+        except ViewerError as error:
+            rospy.logwarn("viewer: markers not read: %s", error)
+            return
+
         def apply(scene: Scene, _) -> None:
-            views, removals = self._marker_intake.changes(msg.markers, scene.__contains__)
+            views, removals = self._marker_intake.changes(markers, scene.__contains__)
             for object_id in removals:
                 if object_id in scene:
                     scene.remove_object(object_id)
             for object_id, parameters, indices, shape, color in views:
                 try:
                     scene.view(prepare_view(object_id, parameters, indices, *IDENTITY, color,
-                                            shape))
+                                            shape, self.geometries))
                 except OdinError as error:   # a marker that is no geometry the Viewer takes
                     rospy.logwarn("viewer: marker %r not drawn: %s", object_id, error)
-        self.loop.post(apply)
+        self.loop.post_later(MARKER_GRACE, apply)
 
     def _collided(self, msg: Collided) -> None:
         names = list(msg.names)
@@ -203,14 +215,16 @@ class Portal:
         self.servers = []
         for name, type_name in VIEWER_SERVICES.items():
             service_class = getattr(srv, type_name)
+            served = _numpy_requests(service_class) if name in NUMPY_REQUESTS else service_class
             self.servers.append(rospy.Service(
-                f"~{name}", service_class,
+                f"~{name}", served,
                 replies.guarded(service_class, getattr(self, name), in_force.get(name, dict))))
 
     def view_object(self, req) -> dict:
         """Adds the object, or replaces the one with its ID (checked on the server's thread)."""
         request = prepare_view(req.id, req.parameters, req.indices, req.position,
-                               req.orientation, req.color, req.shape)   # on this thread
+                               req.orientation, req.color, req.shape,
+                               self.geometries)   # on this thread
         replaced = self.loop.call(lambda scene, _: scene.view(request))
         return {"message": f"replaced {req.id!r}" if replaced else f"added {req.id!r}"}
 
@@ -257,6 +271,20 @@ class Portal:
     def _camera_in_use(self) -> dict:
         """Set Camera's fields as the camera is now (what a refusal answers)."""
         return _camera_fields(*self.loop.call(lambda scene, _: (scene.camera, scene.fitting)))
+
+
+#: services whose requests arrive with their arrays as numpy views of the received bytes:
+#: a View Object of a mesh is hundreds of thousands of numbers, a Python float each otherwise
+#: (0.06 s for the TX90 grasp scene's meshes, on every load)
+NUMPY_REQUESTS = frozenset({"view_object"})
+
+
+def _numpy_requests(service_class):
+    """``service_class`` (same type and MD5 sum) with rospy.numpy_msg requests."""
+    return type(service_class.__name__, (), {
+        "_type": service_class._type, "_md5sum": service_class._md5sum,
+        "_request_class": numpy_msg(service_class._request_class),
+        "_response_class": service_class._response_class})
 
 
 def _camera_fields(camera: Camera, fitting: bool) -> dict:

@@ -10,6 +10,10 @@ worker thread of this module sends. The Viewer may be absent, slow, or restarted
   latest pose;
 * a call that fails marks the Viewer out of date, and the next check re-sends the scene.
 
+Calls go over one persistent connection per service (a fresh one cost a lookup at the master,
+a TCP connection and a thread in each node, for every geometry of every load); the
+connections are dropped when a call fails or another Viewer takes the services' names.
+
 The world therefore never blocks or fails because of the Viewer.
 """
 from __future__ import annotations
@@ -48,6 +52,7 @@ class ViewerLink:
         self._outbox: collections.deque = collections.deque()
         self._lock = threading.Condition()
         self._synced_uri: str | None = None
+        self._proxies: dict = {}     # service name -> persistent rospy.ServiceProxy
         self._stop = False
         self._thread = threading.Thread(target=self._work, name="viewer-link", daemon=True)
         self._thread.start()
@@ -91,7 +96,7 @@ class ViewerLink:
                 if not self._outbox and not self._stop:
                     self._lock.wait(CHECK_PERIOD)
                 if self._stop:
-                    return
+                    break
                 batch = list(self._outbox)
                 self._outbox.clear()
             try:
@@ -101,13 +106,17 @@ class ViewerLink:
                     _log.warning("Viewer at %s unreachable (%s); will re-send the scene when "
                                  "it is back", self._namespace, error)
                 self._synced_uri = None
+                self._close_proxies()
+        self._close_proxies()
 
     def _deliver(self, batch: list) -> None:
         uri = self._service_uri()
         if uri is None:
             self._synced_uri = None
+            self._close_proxies()
             return
         if uri != self._synced_uri:
+            self._close_proxies()     # connected to the Viewer that was there before
             self._resync()
             self._synced_uri = uri
             return  # the resync already sent the present state, batch included
@@ -135,14 +144,19 @@ class ViewerLink:
                   self._namespace, len(scene))
 
     def _call(self, name: str, service_class, *arguments) -> None:
-        proxy = rospy.ServiceProxy(f"{self._namespace}/{name}", service_class)
-        try:
-            response = _with_timeout(lambda: proxy(*arguments), CALL_TIMEOUT)
-        finally:
-            proxy.close()
+        proxy = self._proxies.get(name)
+        if proxy is None:
+            proxy = self._proxies[name] = rospy.ServiceProxy(
+                f"{self._namespace}/{name}", service_class, persistent=True)
+        response = _with_timeout(lambda: proxy(*arguments), CALL_TIMEOUT)
         if not response.success:
             # The Viewer refused: its scene is still consistent, only this geometry is missing.
             _log.warning("Viewer %s refused %s: %s", self._namespace, name, response.message)
+
+    def _close_proxies(self) -> None:
+        for proxy in self._proxies.values():
+            proxy.close()
+        self._proxies.clear()
 
     def _service_uri(self) -> str | None:
         try:
