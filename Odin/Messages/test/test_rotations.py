@@ -226,3 +226,13 @@ def test_pose_matrix_places_the_rotation_and_the_position():
     np.testing.assert_allclose(T[:3, :3], rodrigues(axis, angle), atol=1e-12)
     np.testing.assert_allclose(T[:3, 3], (1.0, 2.0, 3.0))
     np.testing.assert_allclose(T[3], (0, 0, 0, 1))
+
+
+def test_quaternions_stacked_give_each_one_s_matrix_bit_for_bit():
+    rng = np.random.default_rng(5)
+    quaternions = rng.normal(size=(7, 4))
+    quaternions /= np.linalg.norm(quaternions, axis=1, keepdims=True)
+    stacked = quaternion_to_matrix(quaternions.T)          # (4, n) -> (3, 3, n)
+    assert stacked.shape == (3, 3, 7)
+    for i, q in enumerate(quaternions):
+        assert np.array_equal(stacked[:, :, i], quaternion_to_matrix(q))

@@ -50,14 +50,18 @@ def unit_quaternion(quaternion_wxyz: Sequence[float], what: str = "orientation")
 
 def quaternion_to_matrix(quaternion_wxyz: Sequence[float]) -> np.ndarray:
     """(3, 3) rotation matrix of a unit quaternion (w, x, y, z); not checked (see
-    unit_quaternion for values from callers)."""
-    # Python floats: the same IEEE arithmetic as numpy's scalars, several times faster (a
-    # planner's propagation reads a few poses out of state vectors)
-    w, x, y, z = map(float, quaternion_wxyz)
+    unit_quaternion for values from callers). A (4, ...) array gives (3, 3, ...): each
+    quaternion's matrix (the Viewer's poses of a whole update at once)."""
+    if np.ndim(quaternion_wxyz) > 1:
+        w, x, y, z = np.asarray(quaternion_wxyz, dtype=float)
+    else:
+        # Python floats: the same IEEE arithmetic as numpy's scalars, several times faster (a
+        # planner's propagation reads a few poses out of state vectors)
+        w, x, y, z = map(float, quaternion_wxyz)
     return np.array([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
                      2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
                      2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]
-                    ).reshape(3, 3)
+                    ).reshape((3, 3) + np.shape(w))
 
 
 def matrix_to_quaternion(rotation: np.ndarray) -> np.ndarray:
