@@ -173,19 +173,17 @@ def test_grasp_with_the_kinematic_drive_lifts_carries_and_drops_the_can(tmp_path
     assert tracking["arm_goal_error_rad"] < 1e-9, tracking
     assert tracking["goal_error_rad"] > 0.3, tracking     # the fingers stop on the can
     _assert_tracked_grasp_held_and_carried(o)
-    checks = grasp.release_checks(o, grasp.TRACKED_FALL_SLACK_S)
-    # Two of the release's checks, set on the compliant dynamic arm, do not hold on the rigid
-    # one (measured: the can leaves 0.08 s after the opening, not 0.12 s, then rolls down the
-    # palm's face, which does not give way: the palm touches it one cycle after it left, and it
-    # reaches the floor 0.48-0.52 s after the opening where free fall allows 0.46 s). Pinned,
-    # so that a change of either shows: the touch within one cycle, the floor within two.
-    differs = ("the hand still touches it after the opening starts, not after it left",
-               "it reaches the floor no later than free fall allows")
-    failed = [name for name, held in checks.items() if not held and name not in differs]
+    # the release as a rigid arm makes it (grasp.RIGID_ARM_TOUCH_S, RIGID_ARM_FLOOR_S): the can
+    # leaves 0.08 s after the opening (the dynamic arm's 0.12 s), then rolls down the palm's
+    # face, which does not give way
+    checks = grasp.release_checks(o, grasp.TRACKED_FALL_SLACK_S, rigid_arm=True)
+    failed = [name for name, held in checks.items() if not held]
     assert not failed, (failed, o)
-    cycle = grasp.WORLD["steps_per_cycle"] * grasp.WORLD["step"]
-    assert o["hand_opens_at_s"] < o["hand_last_touches_can_at_s"] <= o["left_hand_at_s"] + cycle
-    assert o["on_floor_after_opening_s"] <= o["latest_on_floor_after_opening_s"] + 2 * cycle
+    assert grasp.verdict(facts)[0]
+    # the two checks the compliant arm's release keeps and the rigid one's relaxes: one fails
+    # here, or the rigid arm's are no different and the relaxation goes
+    compliant = grasp.release_checks(o, grasp.TRACKED_FALL_SLACK_S)
+    assert not all(compliant.values()), compliant
 
 
 @pytest.mark.forked
