@@ -68,3 +68,12 @@ def test_waiting_for_a_service_probes_it_as_rospy_does_and_the_node_logs_no_warn
         assert master.run(["rosservice", "call", "/virtual_world/step_once", "cycles: 1"]
                           ).returncode == 0           # the log holds the whole start-up
         assert "Inbound TCP/IP connection failed" not in master.log_text(world)
+
+
+def test_the_in_process_rosrun_search_prints_no_package_name_lint(capfd):
+    # catkin_pkg lints the thesis's capitalised package names on stderr at every search
+    import os
+    from odin_common import ros_master
+    ros_master._rosrun_choice.cache_clear()
+    assert ros_master.find_executable("GUI", "load_problem", dict(os.environ))
+    assert "naming conventions" not in capfd.readouterr().err

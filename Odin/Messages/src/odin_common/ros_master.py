@@ -20,14 +20,18 @@ before rospy is used in that process).
 """
 from __future__ import annotations
 
+import contextlib
 import functools
+import io
 import os
 import pathlib
 import random
+import re
 import signal
 import socket
 import struct
 import subprocess
+import sys
 import tempfile
 import time
 import urllib.parse
@@ -296,8 +300,9 @@ def _rosrun_choice(package: str, executable: str, package_path: str,
                    prefix_path: str) -> str | None:
     from catkin.find_in_workspaces import find_in_workspaces
     workspaces = _catkin_workspaces(prefix_path)
-    folders = find_in_workspaces(["libexec", "share"], package, _workspaces=workspaces,
-                                 first_matching_workspace_only=True)
+    with _without_naming_lint():
+        folders = find_in_workspaces(["libexec", "share"], package, _workspaces=workspaces,
+                                     first_matching_workspace_only=True)
     rospack = subprocess.run(["rospack", "find", package], capture_output=True, text=True,
                              env=dict(os.environ, ROS_PACKAGE_PATH=package_path,
                                       CMAKE_PREFIX_PATH=prefix_path))
@@ -306,11 +311,28 @@ def _rosrun_choice(package: str, executable: str, package_path: str,
         executable, [*folders, *([package_folder] if package_folder else [])],
         package_folder))
     if len(found) == 2:
-        shares = find_in_workspaces(["share"], package, _workspaces=workspaces,
-                                    first_matching_workspace_only=True)
+        with _without_naming_lint():
+            shares = find_in_workspaces(["share"], package, _workspaces=workspaces,
+                                        first_matching_workspace_only=True)
         outside = [f for f in found if not any(f.startswith(s) for s in shares)]
         found = outside if len(outside) == 1 else found
     return found[0] if len(found) == 1 else None
+
+
+#: catkin_pkg's lint of a package name with capitals, printed on stderr each time it reads a
+#: package.xml: Odin's packages keep the thesis's names (VirtualWorld, GUI, ...) on purpose
+_NAMING_LINT = re.compile(r'^WARNING: Package name "[^"]+" does not follow the naming conventions')
+
+
+@contextlib.contextmanager
+def _without_naming_lint():
+    """catkin_pkg's output on stderr, less its package-name lint (six lines per search)."""
+    captured = io.StringIO()
+    with contextlib.redirect_stderr(captured):
+        yield
+    for line in captured.getvalue().splitlines(keepends=True):
+        if not _NAMING_LINT.match(line):
+            sys.stderr.write(line)
 
 
 def _catkin_workspaces(prefix_path: str) -> list:
