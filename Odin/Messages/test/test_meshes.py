@@ -36,12 +36,12 @@ def test_packed_rows_give_numpys_unique_rows(scale):
     rows[::7] = rows[3]                                      # repeated rows
     for option in ("return_inverse", "return_index"):
         expected = np.unique(rows, axis=0, **{option: True})[1].reshape(-1)
-        got = meshes._unique_rows(rows, **{option: True})[1].reshape(-1)
+        got = meshes.unique_rows(rows, **{option: True})[1].reshape(-1)
         assert np.array_equal(got, expected), option
 
 
 def test_no_rows():
-    _, inverse = meshes._unique_rows(np.zeros((0, 3), np.int64), return_inverse=True)
+    _, inverse = meshes.unique_rows(np.zeros((0, 3), np.int64), return_inverse=True)
     assert inverse.size == 0
 
 

@@ -36,7 +36,7 @@ def cluster_vertices(vertices: np.ndarray, indices: np.ndarray,
     if not cell > 0:
         raise ValueError(f"cluster cell {cell!r} must be a positive length (m)")
     cells = np.floor(vertices / cell).astype(np.int64)
-    _, cluster = _unique_rows(cells, return_inverse=True)
+    _, cluster = unique_rows(cells, return_inverse=True)
     cluster = cluster.reshape(-1)
     count = int(cluster.max()) + 1
     # per axis, the sums in vertex order as np.add.at would make them, many times faster
@@ -47,11 +47,11 @@ def cluster_vertices(vertices: np.ndarray, indices: np.ndarray,
     keep = ((triangles[:, 0] != triangles[:, 1]) & (triangles[:, 1] != triangles[:, 2])
             & (triangles[:, 0] != triangles[:, 2]))
     triangles = triangles[keep]
-    _, first = _unique_rows(np.sort(triangles, axis=1), return_index=True)
+    _, first = unique_rows(np.sort(triangles, axis=1), return_index=True)
     return merged, triangles[np.sort(first)].reshape(-1)
 
 
-def _unique_rows(rows: np.ndarray, **options):
+def unique_rows(rows: np.ndarray, **options):
     """``np.unique(rows, axis=0, **options)`` for an (n, 3) int64 array, the same answer in the
     same order: each row packed into one int64 that sorts as the row does (ten times faster
     than numpy's sort of rows as records, which set the time of loading a CAD hand), unless

@@ -24,8 +24,7 @@ from odin_common.errors import InvalidArgument
 from odin_common.interface import (PLANE_DRAWN_SIZE, PLANE_DRAWN_THICKNESS, SHAPE_PARAMETERS,
                                    Shape, shape_of)
 from odin_common.meshes import (DISPLAY_TOLERANCE, capsule_mesh, cluster_vertices,  # noqa: F401
-                                display_mesh)
-from odin_common.meshes import _unique_rows   # np.unique(axis=0) of int rows, 10x faster
+                                display_mesh, unique_rows)
 from odin_common.rotations import QUATERNION_TOLERANCE, quaternion_to_matrix, unit_quaternion
 from viewer.errors import ViewerError
 
@@ -291,7 +290,7 @@ def _closed_winding(vertices: np.ndarray, triangles: np.ndarray) -> int:
         return 0
     first = np.argmin(t, axis=1)[:, None]          # a repeated triangle counts once
     t = np.take_along_axis(t, (first + np.arange(3)) % 3, axis=1)
-    t = t[_unique_rows(t, return_index=True)[1]]
+    t = t[unique_rows(t, return_index=True)[1]]
     edges = np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]])
     n = int(t.max()) + 1
     forward = np.sort(edges[:, 0] * n + edges[:, 1])
