@@ -13,6 +13,7 @@ moved by forces or contacts, infinite mass for them.
 """
 from __future__ import annotations
 
+import functools
 import math
 import threading
 import time
@@ -741,21 +742,17 @@ def _checked_pushes(scene: Scene, pushes: Sequence[Tuple[str, Sequence[float]]])
     return checked
 
 
-_STEPS_OF: Dict[Tuple[float, float], Tuple[float, int]] = {}
-"""_steps_of's answers for float arguments: a planner asks the same every step."""
-
-
 def _steps_of(duration: float, step_size: float) -> Tuple[float, int]:
-    """(step_size, the number of steps) of a propagation of ``duration`` s, both checked."""
-    floats = type(duration) is float and type(step_size) is float   # noqa: E721 - not bool
-    if floats and (duration, step_size) in _STEPS_OF:
-        return _STEPS_OF[duration, step_size]
-    answer = _checked_steps(duration, step_size)
-    if floats:
-        if len(_STEPS_OF) >= 64:
-            _STEPS_OF.clear()
-        _STEPS_OF[duration, step_size] = answer
-    return answer
+    """(step_size, the number of steps) of a propagation of ``duration`` s, both checked;
+    remembered for plain floats (a planner asks the same every step)."""
+    if type(duration) is float and type(step_size) is float:   # noqa: E721 - not bool
+        return _remembered_steps(duration, step_size)
+    return _checked_steps(duration, step_size)
+
+
+@functools.lru_cache(maxsize=64)
+def _remembered_steps(duration: float, step_size: float) -> Tuple[float, int]:
+    return _checked_steps(duration, step_size)
 
 
 def _checked_steps(duration: float, step_size: float) -> Tuple[float, int]:
