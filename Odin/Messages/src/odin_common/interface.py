@@ -6,6 +6,7 @@ rule, the composite-ID rule, and the services each node offers with their types.
 """
 from __future__ import annotations
 
+import itertools
 import re
 from enum import IntEnum
 from typing import Any, Dict, NamedTuple, Sequence, Tuple
@@ -390,6 +391,10 @@ ODE's 3x4 rotation matrix, linear velocity m/s, angular velocity rad/s (world fr
 (1.0 or 0.0). A vector is ODE's random generator state, then one record per object with a body,
 in the world's object order (Propagate's ``states`` order)."""
 BODY_STATE_SIZE = sum(size for _, size in BODY_STATE_FIELDS)
+#: where each field (BODY_STATE_FIELDS) lies in a body's record: {name: slice}
+BODY_STATE_SLICES: Dict[str, slice] = {
+    name: slice(start - size, start) for (name, size), start in zip(
+        BODY_STATE_FIELDS, itertools.accumulate(size for _, size in BODY_STATE_FIELDS))}
 
 
 def body_record(vector: Sequence[float], index: int) -> Dict[str, Sequence[float]]:
@@ -398,11 +403,8 @@ def body_record(vector: Sequence[float], index: int) -> Dict[str, Sequence[float
     if index < 0 or offset + BODY_STATE_SIZE > len(vector):
         raise InvalidArgument(f"a body state vector of {len(vector)} values has no body "
                               f"{index}")
-    record = {}
-    for name, size in BODY_STATE_FIELDS:
-        record[name] = vector[offset:offset + size]
-        offset += size
-    return record
+    return {name: vector[offset + field.start:offset + field.stop]
+            for name, field in BODY_STATE_SLICES.items()}
 
 
 # ---------------------------------------------------------------------------------- services

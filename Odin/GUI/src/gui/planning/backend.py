@@ -22,7 +22,7 @@ import numpy as np
 from gui.core.control_path import Actuation, BodyState, ControlRow, ServoCommand, actuation
 from gui.core.plan import BuildPlan, BuiltIds
 from gui.planning.problem import PlanningProblem
-from odin_common.interface import BODY_STATE_FIELDS, BODY_STATE_SIZE, ForceKind
+from odin_common.interface import BODY_STATE_SIZE, BODY_STATE_SLICES, ForceKind
 from odin_common.rotations import quaternion_to_matrix
 from odin_common.step_values import StepValues
 
@@ -189,17 +189,8 @@ class VectorBodies:
         return position - quaternion_to_matrix(quaternion) @ com, quaternion, state[linear]
 
 
-def _field(name: str) -> slice:
-    """Where BODY_STATE_FIELDS puts ``name`` in a body's record."""
-    offset = 0
-    for field, size in BODY_STATE_FIELDS:
-        if field == name:
-            return slice(offset, offset + size)
-        offset += size
-    raise KeyError(name)
-
-
-_POSITION, _QUATERNION, _LINEAR = _field("position"), _field("quaternion"), _field("linear")
+_POSITION, _QUATERNION, _LINEAR = (BODY_STATE_SLICES[name]
+                                   for name in ("position", "quaternion", "linear"))
 
 
 class CoreBackend:
