@@ -250,7 +250,7 @@ class Portal:
             collisions = self.core.read_collisions()
             self.pub_collided.publish(conversions.collided_message(collisions, stamp))
             return collisions
-        if self.pub_contacts.get_num_connections() > 0:
+        if _heard(self.pub_contacts):
             self.pub_contacts.publish(conversions.collided_message(
                 self.core.read_collisions(), stamp))
         return []
