@@ -136,7 +136,7 @@ def test_motor_goal_joint_value_and_forward_kinematics_share_one_sign(world, leg
     joints = rospy.wait_for_message("/virtual_world/joint_data", JointsData, timeout=10)
     values = {j.id: j.positions[0] for j in joints.joints if j.positions}
     assert 0.4 < values[handle.joint_ids[0]] < 0.55     # positive, as commanded
-    q = np.array(handle.home, dtype=float) + [values[j] for j in handle.joint_ids]
+    q = np.array(handle.built_at, dtype=float) + [values[j] for j in handle.joint_ids]
     expected = {n: p for n, p, _ in handle.situations(q)}
     update = rospy.wait_for_message("/virtual_world/world_update", SpaceDistribution, timeout=10)
     got = {s.name: s.position for s in update.situations}

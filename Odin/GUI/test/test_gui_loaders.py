@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from gui.core.plan import EntityStep, JointStep
-from gui.core.translate import plan_problem
+from gui.core.translate import BuildDefaults, plan_problem
 from odin_common.specs import CompositeSpec
 from gui.errors import GuiError, ProblemError, ShapeError
 from gui.core.kautham.corpus import corpus_dir
@@ -223,7 +223,9 @@ def test_current_format_obstacles_use_home_in_metres():
 
 
 def test_robot_plan_joints_motors_and_names():
-    plan = plan_problem(load_problem(LEGACY / "Staubli_R6_two_columns.xml"))
+    # at Home (all joints 0): a joint's stops are relative to the angle it is built at
+    plan = plan_problem(load_problem(LEGACY / "Staubli_R6_two_columns.xml"),
+                        BuildDefaults(start_at_query=False))
     joints = [s.spec for s in plan.steps if isinstance(s, JointStep)]
     base = _bodies(plan)["TX90/Base"]
     assert base.fixed and all(j.body1 and j.body2 for j in joints)   # no joint to the world

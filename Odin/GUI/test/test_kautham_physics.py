@@ -147,7 +147,7 @@ def test_problem_info_lists_what_odin_does_not_use_and_warns_once_each():
 
 # -- legacy problems are built as before ---------------------------------------------------------
 @pytest.mark.usefixtures("kautham_dir")
-def test_a_2012_problem_gets_no_physics_and_is_built_at_home():
+def test_a_2012_problem_gets_no_physics_and_is_built_at_its_query_start():
     plan = plan_problem(load_problem(KAUTHAM / "legacy_2012" / "examples" /
                                      "Staubli_R6_two_columns.xml"))
     assert not plan.physics
@@ -156,12 +156,18 @@ def test_a_2012_problem_gets_no_physics_and_is_built_at_home():
     assert world.parameters == _default_parameters() and world.own == ()
     assert (step.step, step.steps_per_cycle, step.rate) == (0.001, 40, 25.0)
     assert not any(s.spec.shape == Shape.PLANE for s in _steps(plan, ObjectStep))
+    # where Kautham 2012 leaves it after loading: at the query's <Init>, which
+    # Problem::createCSpaceFromFile collision-checks by moving the robots there
     handle = plan.robot()
-    assert handle.start is not None               # the query is known...
-    np.testing.assert_allclose(handle.built_at, handle.home)   # ...but the build is at Home
+    start = np.asarray(handle.start.joints, dtype=float)
+    assert not np.allclose(start, handle.home)
+    np.testing.assert_allclose(handle.built_at, start)
     bodies = {b.id: b for b in plan.bodies()}
-    for body_id, position, _ in handle.situations(handle.home):
+    for body_id, position, _ in handle.situations(start):
         np.testing.assert_allclose(bodies[body_id].position, position, atol=1e-12)
+    # --at-home: the .rob's Home, as the thesis's tool built every 2012 robot
+    at_home = plan_problem(plan.problem, BuildDefaults(start_at_query=False)).robot()
+    np.testing.assert_allclose(at_home.built_at, at_home.home)
 
 
 # -- formats the corpus lacks: files written from Kautham's formats -------------------------------

@@ -134,9 +134,10 @@ def _build_options(parser: argparse.ArgumentParser) -> None:
                         help="no ground plane, Odin's default world settings")
     start = parser.add_mutually_exclusive_group()
     start.add_argument("--at-home", dest="start_at_query", action="store_const", const=False,
-                       help="build robots at Home [default for 2012 problems]")
+                       help="build robots at Home (as the thesis's tool built 2012 problems)")
     start.add_argument("--at-start", dest="start_at_query", action="store_const", const=True,
-                       help="build robots at the query's start [default for current ones]")
+                       help="build robots at the query's start, where Kautham leaves a problem it "
+                       "loads [default; Home when the problem has no query]")
     parser.add_argument("--inertia", choices=("auto", "file", "shape"), default="auto",
                         help="links' inertia: the file's where plausible (auto), always the "
                         "file's, or the shape's")

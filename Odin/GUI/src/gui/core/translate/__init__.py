@@ -47,9 +47,12 @@ How a problem maps to the world:
   simulates nothing and only the controls place the base) a fixed (kinematic) body held at
   the pose it is built at, as a fixed-base robot's joints are held: gravity and contacts never
   move it, a Set Velocity or Set Position does (``run_path --tracked`` drives it so).
-- A robot is built at its start (the query's ``<Init>``) in current problems, at Home in 2012
-  ones (``BuildDefaults.start_at_query``); ``RobotHandle.built_at`` keeps the joint values the
-  world's joint readings are relative to.
+- A robot is built at its start (the query's ``<Init>``), at Home when the problem has no query
+  (``BuildDefaults.start_at_query``): where Kautham leaves a problem it loads, in both formats
+  (2012's ``Problem::createCSpaceFromFile`` collision-checks ``<Init>`` by moving the robots
+  there; a 2012 Home may put an arm inside its scene, e.g. the TX90's elbow 4.5 mm into
+  teleoperation_test.iv). ``RobotHandle.built_at`` keeps the joint values the world's joint
+  readings are relative to.
 - A robot made of one link (a bare shape or a one-link URDF) is a free-flying body: an entity
   of one object, no joint.
 - A static obstacle -> Build Object/Composite with ``geometry_only``. A movable obstacle (a .rob

@@ -44,8 +44,9 @@ class BuildDefaults:
     plane) for every problem (True), none (False: Odin's default world settings, no ground
     plane), or where Kautham simulates the problem (None: ``Problem.physics``); every plan
     sets every world parameter and step value either way (``gui.core.world_settings``).
-    ``start_at_query``: robots built at the query's start (True), at Home (False), or the
-    start in current problems and Home in 2012 ones (None).
+    ``start_at_query``: robots built at the query's start (True or None: where Kautham
+    leaves a problem it loads; Home when there is no query) or at Home (False: as the
+    thesis's tool built 2012 problems).
     ``hold_start``: robots' joints held by servos where they are built (``HoldStep``), or
     left to their motors at zero speed (False: as the thesis's experiments were run).
     ``link_mass``, ``massless_density``: what a link whose file gives no mass weighs
@@ -75,8 +76,7 @@ class _Planner:
     def __init__(self, problem: Problem, defaults: BuildDefaults):
         self.problem, self.defaults = problem, defaults
         self.physics = problem.physics if defaults.ground is None else defaults.ground
-        start = defaults.start_at_query
-        self.start_at_query = problem.format == "current" if start is None else start
+        self.start_at_query = defaults.start_at_query is not False
         attached = {a.obstacle for a in problem.attachments}
         # bodies: movable obstacles (2012 .rob scenes), attached ones, and every current
         # obstacle under Kautham's physics (its ODE environment makes them all dynamic); in a
