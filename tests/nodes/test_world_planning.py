@@ -89,6 +89,13 @@ def test_a_collision_query_answers_without_changing_the_world(world):
     before = world.ok("propagate", duration=0.001)
     hit = world.ok("check_collision", situations=[_situation("bob", (0, 0, 0.05))])
     assert ("bob", "ground") in {(p.first, p.second) for p in hit.pairs}
+    # no situation: the scene as it stands (the spheres 1 cm apart, bob 0.9 m up)
+    assert world.ok("check_collision", situations=[]).pairs == []
+    world.ok("build_object", object=__import__("world_client").sphere("inside", 0.1, (2, 0, 0.95)))
+    inside = world.ok("check_collision", situations=[]).pairs
+    assert [(p.first, p.second) for p in inside] == [("bob", "inside")]
+    assert inside[0].depth > 0.1
+    world.ok("remove_object", id="inside")
     assert _states(world.ok("propagate", duration=0.001)) == _states(before)
 
 
@@ -108,7 +115,6 @@ def test_bad_planning_requests_are_refused_and_change_nothing(world):
             ("propagate", dict(duration=0.1, start="nope")),
             ("propagate", dict(duration=0.1, motors=["motor:1:bob&"], velocities=[1.0, 2.0])),
             ("propagate", dict(duration=0.1, motors=["motor:x"], velocities=[1.0])),
-            ("check_collision", dict(situations=[])),
             ("check_collision", dict(situations=[_situation("ghost", (0, 0, 0))]))]:
         response = world(service, **fields)
         assert not response.success and response.message, (service, fields)

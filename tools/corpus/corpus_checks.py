@@ -220,7 +220,7 @@ def simulate_one(client, path: pathlib.Path, seconds: float, world_log) -> dict:
     defaults = StepValues()
     client.set_step(step=defaults.step, steps_per_cycle=defaults.steps_per_cycle,
                     rate=defaults.rate)
-    client.execute(plan)
+    overlaps = client.execute(plan)["overlaps"]
     load_s = time.monotonic() - started
     diverged_before = world_log().count(" diverged at ")
     before = _states(client)
@@ -236,6 +236,7 @@ def simulate_one(client, path: pathlib.Path, seconds: float, world_log) -> dict:
                   objects=len(client.world().objects), bodies=len(after),
                   diverged=world_log().count(" diverged at ") - diverged_before,
                   fell=_fell(plan, before, after), robots=_robots(plan, before, after),
+                  overlaps=[list(o) for o in overlaps],
                   ground=plan.world is not None, drop_m=round(max(
                       (float(before[i][0][2] - a[0][2]) for i, a in after.items()
                        if i in before), default=0.0), 4))
@@ -303,4 +304,9 @@ def _faults(result: dict, after: dict) -> list:
         if robot["outside_limits"]:
             faults.append(f"robot {robot['name']} built outside the limits of "
                           f"{', '.join(robot['outside_limits'])}")
+    if faults and result["overlaps"]:     # what explains a move: the file's placement
+        first, second, depth = result["overlaps"][0]
+        faults.append(f"built with {len(result['overlaps'])} pairs inside each other where "
+                      f"the problem places them (deepest {first} in {second}, "
+                      f"{depth * 1000:.1f} mm)")
     return faults

@@ -23,7 +23,9 @@ The corpus is what ``tools/get_kautham.sh --all`` lays out (``$ODIN_KAUTHAM_ALL_
    anything diverged (the world parks such a body and logs it), a body fell through the ground
    (problems with Kautham's physics: its origin more than ``FELL_BELOW`` m under the ground
    plane z = 0 when it started above that), a fixed-base robot's link moved more than
-   ``FIXED_BASE_HOLD`` m, or a robot was built outside its joint limits. The largest move of
+   ``FIXED_BASE_HOLD`` m, or a robot was built outside its joint limits; the pairs built
+   inside each other (``gui.core.overlaps``) are recorded and named in a failure's reason,
+   where they explain a move. The largest move of
    each robot's links is reported for every robot kind, and the largest drop of any body
    (in a problem without a ground, a dynamic body falls for as long as it is simulated).
 

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import dataclasses
 import io
+import logging
 import os
 import struct
 import time
@@ -28,6 +29,7 @@ from typing import Callable, Dict, NamedTuple, Optional, Sequence, Tuple
 
 import numpy as np
 
+from gui.core.overlaps import built_overlaps, overlap_warning
 from gui.core.plan import BuildPlan, BuiltIds, RobotHandle
 from gui.core.robot_description import RobotDescription, describe_robot
 from gui.errors import WorldError
@@ -411,7 +413,9 @@ class WorldClient:
         generated robot descriptions' meshes go (default ``robot_mesh_dir()``).
 
         Joint and motor IDs the world returns replace the predicted ones in ``plan.robots``.
-        Stops at the first refusal (``WorldError``); what was built before stays built."""
+        Stops at the first refusal (``WorldError``); what was built before stays built.
+        Parts built inside each other (``gui.core.overlaps``) are warned about once and
+        answered as "overlaps": [Overlap]."""
         ids = BuiltIds()
         for k, step in enumerate(plan.steps, start=1):
             answer = step.send(self, ids)
@@ -421,7 +425,11 @@ class WorldClient:
         folder = robot_mesh_dir() if mesh_dir is None else mesh_dir
         namespaces = {handle.name: self.set_robot(describe_robot(handle, folder))
                       for handle in plan.robots}
-        return {**ids.as_dict(), "robots": namespaces}
+        overlaps = built_overlaps(plan, self.check_collision([]))
+        if overlaps:
+            logging.getLogger("gui.core.overlaps").warning(
+                overlap_warning(plan.problem.source, overlaps))
+        return {**ids.as_dict(), "robots": namespaces, "overlaps": overlaps}
 
 
 # -- requests whose meshes go out as numpy bytes -----------------------------------------

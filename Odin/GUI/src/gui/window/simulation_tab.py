@@ -162,6 +162,9 @@ class SimulationTab(QWidget):
             self.tree.expandAll()
             self.window.show_info(f"Built {pathlib.Path(path).name} in "
                                   f"{self.last_build_seconds:.2f} s")
+            if ids["overlaps"]:
+                from gui.core.overlaps import overlap_warning
+                self.window.show_info(overlap_warning(pathlib.Path(path).name, ids["overlaps"]))
             self.problem_built.emit(path)
 
         def failed(message):

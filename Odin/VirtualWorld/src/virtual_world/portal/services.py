@@ -279,8 +279,6 @@ class WorldServices:
                            + (", kept" if result.kept else "")}
 
     def check_collision(self, request) -> dict:
-        if not request.situations:
-            raise InvalidArgument("no situation given")
         pairs = self.core.check_collision(messages.situation_poses(request.situations))
         return {"pairs": conversions.collision_pairs(pairs),
                 "message": f"{len(pairs)} colliding pair(s)"}
