@@ -50,3 +50,27 @@ def test_the_readme_block_is_rewritten_between_its_markers_only(tmp_path):
     readme.write_text("no markers\n")
     with pytest.raises(ValueError, match="markers"):
         report.rewrite_readme("x\n", readme)
+
+
+def test_parts_built_inside_each_other_are_counted_shown_and_explain_a_failure():
+    """A file's pairs built inside each other (gui.core.overlaps) show in its row, whatever
+    its outcome, and join the reason of a failure they explain."""
+    from gui.core.model import FIXED_BASE
+    overlaps = [["TX90/Arm", "columns#2", 0.0473], ["TX90/Base", "columns#0", 0.04]]
+    robot = dict(name="TX90", kind=FIXED_BASE, moved_m=0.0588, outside_limits=[])
+    result = dict(diverged=0, fell=[], robots=[robot], overlaps=overlaps)
+    faults = checks._faults(result, {})
+    assert faults == ["fixed-base robot TX90 moved 58.8 mm",
+                      "built with 2 pairs inside each other where the problem places them "
+                      "(deepest TX90/Arm in columns#2, 47.3 mm)"]
+    assert checks._faults(dict(result, overlaps=[]), {}) == faults[:1]
+    results = {"a.xml": dict(status="ok", world="failed", world_reason="; ".join(faults),
+                             robots=[robot], overlaps=overlaps),
+               "b.xml": dict(status="ok", world="ok", robots=[], overlaps=[])}
+    run = dict(corpus="/c", seconds=2.0, simulated=True, only="", started=0.0, tests=None)
+    text = report.markdown(run, results, report.counts(results))
+    assert "1 files build parts inside each other" in text
+    row = next(line for line in text.splitlines() if line.startswith("| a.xml "))
+    assert row.endswith("| 2 (TX90/Arm in columns#2, 47.3) |")
+    assert next(line for line in text.splitlines()
+                if line.startswith("| b.xml ")).endswith("|  |")

@@ -77,9 +77,13 @@ def markdown(run: dict, results: dict, c: dict) -> str:
              + (f"; only files holding `{run['only']}`" if run["only"] else "") + ".", "",
              "Tests over the whole corpus (fuzz; URDF kinematics against KDL): "
              + (run["tests"]["summary"] if run.get("tests") else "not run") + ".", "",
+             f"{_overlapping(results)} files build parts inside each other where the problem "
+             "places them (gui.core.overlaps: contacts push them apart when the world runs; "
+             "last column).", "",
              "| file | outcome | reason | load s | bodies | diverged | fell | ground | "
-             "largest drop m | robots (kind: largest link move mm) |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+             "largest drop m | robots (kind: largest link move mm) | built inside each other: "
+             "pairs (deepest mm) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for name, result in sorted(results.items()):
         reason = result.get("world_reason") or result.get("reason") or ""
         if result["status"] == "refused":
@@ -89,5 +93,18 @@ def markdown(run: dict, results: dict, c: dict) -> str:
         lines.append(f"| {name} | {outcome(result)} | {reason.replace('|', '/')} | "
                      f"{result.get('load_s', '')} | {result.get('bodies', '')} | "
                      f"{result.get('diverged', '')} | {len(result.get('fell', []))} | "
-                     f"{result.get('ground', '')} | {result.get('drop_m', '')} | {robots} |")
+                     f"{result.get('ground', '')} | {result.get('drop_m', '')} | {robots} | "
+                     f"{_overlap_cell(result.get('overlaps', []))} |")
     return "\n".join(lines) + "\n"
+
+
+def _overlapping(results: dict) -> int:
+    return sum(bool(r.get("overlaps")) for r in results.values())
+
+
+def _overlap_cell(overlaps: list) -> str:
+    """"5 (TX90/Arm in columns#2, 47.3)" for a file's pairs built inside each other."""
+    if not overlaps:
+        return ""
+    first, second, depth = overlaps[0]
+    return f"{len(overlaps)} ({first} in {second}, {depth * 1000:.1f})"

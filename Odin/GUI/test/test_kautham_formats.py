@@ -18,7 +18,7 @@ from gui.cli import problem_info_main
 from gui.core.kautham.problem import load_problem
 from gui.core.kautham.robot_rob import read_dh_robot
 from gui.core.kautham.urdf import read_urdf
-from gui.core.model import FREE_BODY
+from gui.core.model import FIXED_BASE, FREE_BODY, MOBILE
 from gui.core.shapes import read_shape
 from gui.errors import ProblemError
 
@@ -323,3 +323,23 @@ def test_files_that_mention_problem_but_are_not_problems_get_one_line_saying_wha
     assert status == 2 and out == ""
     lines = err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith(f"problem_info: error: {path}:2: {says}")
+
+
+def test_a_2012_robot_whose_control_set_moves_its_base_is_mobile(tmp_path):
+    """Kautham 2012 enables a robot's SE3 base when its .rob's <ControlSet> names X, Y, Z, X1,
+    X2 or X3 in a control or the offset (Robot::setControlSet: se3Enabled): a hand or an arm
+    on a free base, moved by the controls, not a fixed-base robot."""
+    _write(tmp_path, "cube.iv", CUBE_IV)
+    joints = _joint("Base", False) + _joint("J1", True, "Base", -90, 90, d=100)
+    _write(tmp_path, "hand.rob", _rob("hand", joints, _control_set(
+        {"Z": 0.5, "J1": 0.5}, {"z": {"Z": 1.0}, "j": {"J1": 1.0}})))
+    _write(tmp_path, "offset.rob", _rob("offset", joints, _control_set(
+        {"X": 0.5, "J1": 0.5}, {"j": {"J1": 1.0}})))
+    _write(tmp_path, "arm.rob", _rob("arm", joints, _control_set(
+        {"J1": 0.5}, {"j": {"J1": 1.0}})))
+    for name, kind in [("hand", MOBILE), ("offset", MOBILE), ("arm", FIXED_BASE)]:
+        controls = "0.5 0.5" if name == "hand" else "0.5"
+        problem = _write(tmp_path, f"{name}.xml", _problem_2012(
+            f'<Robot robot="{name}.rob"><Limits name="Z" min="0" max="500"/></Robot>',
+            controls))
+        assert load_problem(problem).instances[0].kind == kind, name

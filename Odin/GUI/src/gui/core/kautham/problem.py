@@ -314,10 +314,17 @@ class _Loader:
             return CAR
         if planned == FIXED_BASE:
             return FIXED_BASE
-        if model.free_base or (robot.controls is not None and robot.controls.se3
-                               and self.current and self.cntr is not None):
+        if model.free_base or self._controls_move_base(robot):
             return MOBILE
         return FIXED_BASE
+
+    def _controls_move_base(self, robot: Instance) -> bool:
+        """Whether the robot's controls move its base (Kautham's se3Enabled): a current
+        problem's .cntr, or a 2012 .rob's own <ControlSet>, naming X, Y, Z, X1, X2 or X3 in
+        a control or the offset (2012 Robot::setControlSet)."""
+        if robot.controls is None or not robot.controls.se3:
+            return False
+        return self.cntr is not None if self.current else True
 
     # -- the planner and the query ------------------------------------------------------------
     def _planner(self, node: Node) -> Planner:
