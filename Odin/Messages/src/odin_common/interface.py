@@ -108,7 +108,9 @@ AUTO_SOLVER_MAX_ROWS = 120
 """Solver.AUTO's small-system bound: the most constraint rows a whole step may have (each joint
 counted at its most: 6 for a hinge, slider or fixed joint, 3 for a contact, ball or motor) to be
 solved by dWorldStep whatever its islands; the pinned planning experiments were recorded under
-this clause, so it stays beside the island rule (docs/PERFORMANCE.md)."""
+this clause, so it stays beside the island rule (docs/PERFORMANCE.md). The island rule takes an
+articulation this clause can never admit: an island whose joints and motors, counted the same
+way, have more rows."""
 
 AUTO_SOLVER_MAX_ISLAND_ROWS = 400
 """Solver.AUTO's bound: the most constraint rows the largest island of a step may have to be

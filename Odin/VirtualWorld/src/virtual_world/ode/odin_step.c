@@ -684,10 +684,13 @@ static int articulated(const OdinWorld *w) {
  * and kinematic bodies join nothing, as in ODE's dxProcessIslands) and sets island_rows (the
  * largest island's rows) and articulated_rows (the most rows of non-contact joints, motors and
  * limits included, in one island); both 0 when nothing is articulated. Each joint is counted
- * once, at its first dynamic body. 0 when memory ran out (auto then takes QuickStep). */
-static int measure_islands(OdinWorld *w) {
+ * once, at its first dynamic body. `most`: the most rows of non-contact joints in one island
+ * counted as the small-system clause counts them (joint_rows_at_most). 0 when memory ran out
+ * (auto then takes QuickStep). */
+static int measure_islands(OdinWorld *w, int *most) {
     int n = w->n_guarded;
     w->island_rows = w->articulated_rows = 0;
+    *most = 0;
     if (!articulated(w)) return 1;
     if (w->island_cap < 2 * n) {
         int cap = 16;
@@ -715,7 +718,7 @@ static int measure_islands(OdinWorld *w) {
     for (int i = 0; i < n; ++i) {
         dBodyID start = w->guarded[i];
         if (seen[i] || !dBodyIsEnabled(start) || dBodyIsKinematic(start)) continue;
-        int top = 0, rows = 0, articulated = 0;
+        int top = 0, rows = 0, articulated = 0, articulated_most = 0;
         seen[i] = 1;
         w->island_stack[top++] = i;
         while (top) {
@@ -729,7 +732,10 @@ static int measure_islands(OdinWorld *w) {
                 if (first == b) {
                     int r = joint_rows(j);
                     rows += r;
-                    if (dJointGetType(j) != dJointTypeContact) articulated += r;
+                    if (dJointGetType(j) != dJointTypeContact) {
+                        articulated += r;
+                        articulated_most += joint_rows_at_most(j);
+                    }
                 }
                 dBodyID other = dJointGetBody(j, 0) == b ? second : dJointGetBody(j, 0);
                 if (!dynamic(other)) continue;
@@ -741,6 +747,7 @@ static int measure_islands(OdinWorld *w) {
         }
         if (rows > w->island_rows) w->island_rows = rows;
         if (articulated > w->articulated_rows) w->articulated_rows = articulated;
+        if (articulated_most > *most) *most = articulated_most;
     }
     return 1;
 }
@@ -750,12 +757,15 @@ static int measure_islands(OdinWorld *w) {
  *  - a small system: the whole step has at most auto_step_rows rows by joint_rows_at_most
  *    (a few bodies, a short arm, a car on the ground: exact and faster than QuickStep's
  *    iterations; the pinned planning experiments were recorded under this clause alone);
- *  - a large articulation: an island whose joints and motors alone (contacts aside) have
- *    more than auto_step_rows rows, so that it can never pass the first clause (the TX90 with
- *    its hand: 24 joints, about 170 rows), while the largest island has at most auto_rows
- *    rows. QuickStep's iterations let such a chain held by its motors fold; ODE steps each
- *    island on its own and dWorldStep's cost is cubic in an island's rows, so the largest
- *    island bounds its cost (the TX90 + hand grasping a can: about 300).
+ *  - a large articulation: an island whose joints and motors alone (contacts aside), counted
+ *    as the first clause counts them (joint_rows_at_most), have more than auto_step_rows
+ *    rows, so that it can never pass the first clause (the TX90 with its hand: 24 joints,
+ *    216 rows so counted; a 12-hinge arm and gripper, 150, whose 114 rows by ODE's count
+ *    left it to QuickStep when the clause counted ODE's rows), while the largest island has
+ *    at most auto_rows rows by ODE's count. QuickStep's iterations let such a chain held by
+ *    its motors fold or shake; ODE steps each island on its own and dWorldStep's cost is
+ *    cubic in an island's rows, so the largest island bounds its cost (the TX90 + hand
+ *    grasping a can: about 300).
  * Anything else (piles, many bodies at rest, a small robot among many contacts, a larger
  * island) takes QuickStep, linear in the rows, as it did before the second clause existed.
  * docs/PERFORMANCE.md has the measurements behind both bounds. The choice depends on the
@@ -764,8 +774,9 @@ static int step_solver(OdinWorld *w) {
     if (w->solver != 2) return w->solver;
     w->island_rows = w->articulated_rows = 0;
     if (step_rows_at_most(w, w->auto_step_rows) <= w->auto_step_rows) return 1;
-    if (!measure_islands(w)) return 0;
-    return w->articulated_rows > w->auto_step_rows && w->island_rows <= w->auto_rows;
+    int articulated_most;
+    if (!measure_islands(w, &articulated_most)) return 0;
+    return articulated_most > w->auto_step_rows && w->island_rows <= w->auto_rows;
 }
 
 int odin_world_step(OdinWorld *w, double h, int count) {
