@@ -671,6 +671,35 @@ def test_without_kautham_physics_only_the_controls_and_attachments_move_anything
     np.testing.assert_allclose(world.position("rover/base")[:2], (1.0, -1.0), atol=1e-6)
 
 
+TORSO = """<?xml version="1.0"?><robot name="torso"><link name="body"><collision><origin
+ xyz="0 0 0.03"/><geometry><box size="0.24 0.24 0.06"/></geometry></collision></link></robot>"""
+"""A static obstacle (no mass) around the lower 6 cm of the arm's base, clear of its links."""
+
+
+def test_a_geometric_problems_arm_stands_where_its_base_is_put_inside_an_obstacle(tmp_path,
+                                                                                 world):
+    """A fixed-base arm whose base lies partly inside a static obstacle (as the YuMi's arm
+    bases lie inside its torso), under a geometric planner: Kautham simulates nothing and the
+    base stands where the problem puts it, so it is a fixed (kinematic) body, not a body held
+    by a joint to the world that the obstacle's contact pushes away (the YuMi's arms moved
+    13-20 mm, the whole arm with them). Under Kautham's chain planner (its physics) the base
+    keeps the FIXED joint of Kautham's ODE environment."""
+    (tmp_path / "torso.urdf").write_text(TORSO)
+    torso = ('<Obstacle obstacle="torso.urdf"><Home X="0" Y="0" Z="0.05" WX="0" WY="0" WZ="1" '
+             'TH="0"/></Obstacle>')
+    plan = plan_problem(load_problem(_arm(tmp_path, obstacle=torso, planner=KINEMATIC)))
+    assert not plan.physics
+    entity = _steps(plan, EntityStep)[0].spec
+    assert [o.fixed for o in entity.objects] == [True, False, False]
+    assert "arm/<base>" not in {s.key for s in _steps(plan, JointStep)}
+    world.execute(plan)
+    links = ("arm/base", "arm/upper", "arm/fore")
+    assert max(world.drift_mm(links, 2.0).values()) < 0.1
+    physics = plan_problem(load_problem(_arm(tmp_path, obstacle=torso)))
+    assert not _steps(physics, EntityStep)[0].spec.objects[0].fixed
+    assert "arm/<base>" in {s.key for s in _steps(physics, JointStep)}
+
+
 FINGER = """<?xml version="1.0"?><robot name="hand">
  <link name="palm"><inertial><mass value="0.5"/><inertia ixx="0.001" iyy="0.001" izz="0.001"
   ixy="0" ixz="0" iyz="0"/></inertial><collision><geometry><box size="0.1 0.1 0.02"/>

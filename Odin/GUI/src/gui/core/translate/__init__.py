@@ -40,9 +40,11 @@ How a problem maps to the world:
   alone let an arm creep (3.3 mm in 10 s for the KUKA LWR), servos hold it within 0.1 mm; a
   Set Velocity of a motor takes it out of servo mode, a Set Position of the robot moves the
   servos' targets with it.
-- The base by the robot's kind (``gui.core.model``): FIXED_BASE -> in a 2012 problem a fixed
-  (kinematic) body that never moves; in a current one a dynamic body held by a FIXED joint to
-  the world (Kautham's chain); FREE_BODY, MOBILE, CAR -> under Kautham's physics a dynamic
+- The base by the robot's kind (``gui.core.model``): FIXED_BASE -> in a current problem under
+  Kautham's physics a dynamic body held by a FIXED joint to the world (Kautham's chain),
+  anywhere else (a 2012 problem, a geometric planner's) a fixed (kinematic) body that never
+  moves, whatever overlaps it (the YuMi's arm bases lie inside its torso); FREE_BODY,
+  MOBILE, CAR -> under Kautham's physics a dynamic
   body, free; FREE_BODY and MOBILE otherwise (a geometric planner's problem, where Kautham
   simulates nothing and only the controls place the base) a fixed (kinematic) body held at
   the pose it is built at, as a fixed-base robot's joints are held: gravity and contacts never

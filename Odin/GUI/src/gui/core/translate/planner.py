@@ -157,7 +157,8 @@ class _Planner:
         robot = inst.role == "robot"
         holding: List[JointStep] = []
         if robot and inst.kind == FIXED_BASE and not single:
-            specs, holding = chain.hold_base(inst.name, specs, self.problem.format)
+            specs, holding = chain.hold_base(inst.name, specs, self.problem.format,
+                                              self.physics)
         held = self.hold_free_bases and (not robot or inst.kind in (FREE_BODY, MOBILE))
         if held:
             specs = [dataclasses.replace(specs[0], fixed=True)] + specs[1:]
