@@ -11,7 +11,8 @@ import math
 import pytest
 
 import virtual_world.ode.world
-from odin_common.interface import (AUTO_SOLVER_MAX_ISLAND_ROWS, AUTO_SOLVER_MAX_ROWS, JointType,
+from odin_common.interface import (AUTO_SOLVER_ARTICULATION_ROWS, AUTO_SOLVER_MAX_ISLAND_ROWS,
+                                   AUTO_SOLVER_MAX_ROWS, JointType,
                                    Shape, Solver)
 from virtual_world.core import Core, ObjectSpec, WorldParameters
 
@@ -91,9 +92,11 @@ def test_an_arm_held_by_its_servos_does_not_sag_under_the_default_solver(solver,
 @pytest.fixture
 def island_rule_only(monkeypatch):
     """AUTO_SOLVER_MAX_ROWS at 0: the small-system clause narrowed to steps without a joint
-    (free fall) and any articulation large, so a test sees the island rule alone on scenes
-    the small-system clause would send to dWorldStep anyway."""
+    (free fall) and AUTO_SOLVER_ARTICULATION_ROWS at 0: any articulation large, so a test
+    sees the island rule alone on scenes the small-system clause would send to dWorldStep
+    anyway."""
     monkeypatch.setattr(virtual_world.ode.world, "AUTO_SOLVER_MAX_ROWS", 0)
+    monkeypatch.setattr(virtual_world.ode.world, "AUTO_SOLVER_ARTICULATION_ROWS", 0)
 
 
 def _run(solver, build, steps):
@@ -166,19 +169,44 @@ def test_a_few_bodies_resting_on_the_ground_keep_the_exact_solver(bodies):
 
 
 def test_a_small_arm_among_many_contacts_keeps_quickstep_as_before_the_island_rule():
-    """The 7-link arm (42 rows of joints, within the small-system bound) beside 50 spheres
-    resting on the ground (150 contact rows): the step is no small system and the arm no large
-    articulation, so auto keeps QuickStep, as it did when the planning experiments (a car
-    among contacts) were pinned."""
+    """A 4-link arm (36 rows of joints as the small-system clause counts them, under the
+    articulation bound) beside 50 spheres resting on the ground (150 contact rows): the step
+    is no small system and the arm no articulation of the island rule, so auto keeps
+    QuickStep, as it did when the planning experiments (a car among contacts: 36 rows) were
+    pinned."""
+    assert 4 * 9 < AUTO_SOLVER_ARTICULATION_ROWS
     core = Core()
     try:
-        arm(core)
+        arm(core, links=4)
         core.build_object(GROUND)
         resting_spheres(core, 50, first_row_y=-4)
         core.step(H, 2)
-        assert last_step(core) == (50, (42, 42), Solver.QUICKSTEP)
+        assert last_step(core) == (50, (24, 24), Solver.QUICKSTEP)
     finally:
         core.close()
+
+
+@pytest.mark.parametrize("links", [5, 7])
+def test_an_arm_of_five_servo_held_joints_or_more_among_many_contacts_is_exact_and_holds(links):
+    """An arm of five or seven servo-held joints (45 or 63 rows as the small-system clause
+    counts them: at the articulation bound, AUTO_SOLVER_ARTICULATION_ROWS, or past it) beside
+    the same 50 resting spheres: the step is no small system, but the arm is an articulation,
+    solved exactly, and it holds its pose where QuickStep's iterations let it sag."""
+    assert links * 9 >= AUTO_SOLVER_ARTICULATION_ROWS
+    sags = {}
+    for solver in (Solver.AUTO, Solver.QUICKSTEP):
+        core = Core(WorldParameters(solver=solver))
+        try:
+            tip = arm(core, links=links)
+            core.build_object(GROUND)
+            resting_spheres(core, 50, first_row_y=-4)
+            core.step(H, 2)
+            if solver == Solver.AUTO:
+                assert last_step(core) == (50, (6 * links, 6 * links), Solver.WORLDSTEP)
+            sags[solver] = sag_mm(core, tip)
+        finally:
+            core.close()
+    assert sags[Solver.AUTO] < 1.0 < sags[Solver.QUICKSTEP], sags
 
 
 def sphere_chain(core, n, radius=0.05, gap=0.12):
@@ -219,6 +247,7 @@ def test_a_choice_that_changes_mid_run_is_bit_identical_run_after_run_and_from_a
     (QuickStep). The same calls give the same bytes, and a snapshot taken while falling replays
     them."""
     monkeypatch.setattr(virtual_world.ode.world, "AUTO_SOLVER_MAX_ROWS", 0)
+    monkeypatch.setattr(virtual_world.ode.world, "AUTO_SOLVER_ARTICULATION_ROWS", 0)
     monkeypatch.setattr(virtual_world.ode.world, "AUTO_SOLVER_MAX_ISLAND_ROWS", 60)
 
     def held_pile(core):

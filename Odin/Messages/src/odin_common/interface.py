@@ -109,8 +109,19 @@ AUTO_SOLVER_MAX_ROWS = 120
 counted at its most: 6 for a hinge, slider or fixed joint, 3 for a contact, ball or motor) to be
 solved by dWorldStep whatever its islands; the pinned planning experiments were recorded under
 this clause, so it stays beside the island rule (docs/PERFORMANCE.md). The island rule takes an
-articulation this clause can never admit: an island whose joints and motors, counted the same
-way, have more rows."""
+articulation (AUTO_SOLVER_ARTICULATION_ROWS) that this clause does not admit among other
+bodies' rows."""
+
+AUTO_SOLVER_ARTICULATION_ROWS = 45
+"""Solver.AUTO's island rule: an island whose joints and motors alone, counted as
+AUTO_SOLVER_MAX_ROWS counts them (9 for a hinge held by its servo), have at least this many
+rows is an articulation dWorldStep solves (while the largest island stays within
+AUTO_SOLVER_MAX_ISLAND_ROWS): five servo-held joints or more, any manipulator arm, with or
+without its gripper or hand. QuickStep's iterations let such a chain shake off its pose among
+other bodies' contacts: a YuMi arm and gripper on its kinematic base (9 joints) moved 6.4 mm in
+2 s, a UR arm of MADAR (6) 3.4 mm; under dWorldStep 0.04 mm. Smaller articulations among
+contacts keep QuickStep, as Kautham's car (36 rows) had when its plans were pinned (they and
+the chain's and the sphere's stay bit-identical); docs/PERFORMANCE.md."""
 
 AUTO_SOLVER_MAX_ISLAND_ROWS = 400
 """Solver.AUTO's bound: the most constraint rows the largest island of a step may have to be
@@ -445,7 +456,7 @@ class NodeParameter(NamedTuple):
 
 
 __all__ = ["NodeParameter", "SERVO_GAIN", "SERVO_MAX_SPEED", "JointType", "JointParameter", "SetJointAction", "MotorKind", "AxisFrame", "ServoDrive",
-           "ForceKind", "Solver", "DivergencePolicy", "AUTO_SOLVER_MAX_ROWS", "AUTO_SOLVER_MAX_ISLAND_ROWS", "JOINT_AXES_USED", "JOINT_USES_ANCHOR",
+           "ForceKind", "Solver", "DivergencePolicy", "AUTO_SOLVER_MAX_ROWS", "AUTO_SOLVER_ARTICULATION_ROWS", "AUTO_SOLVER_MAX_ISLAND_ROWS", "JOINT_AXES_USED", "JOINT_USES_ANCHOR",
            "JOINT_NEEDS_TWO_BODIES", "JOINT_AXIS2_ON_BODY2", "JOINT_FORCE_MAGNITUDES", "JOINT_STATE_AXES", "JOINT_PARAMETERS",
            "JOINT_PARAMETER_AXES", "MOTOR_PARAMETERS", "UNIT_PARAMETERS",
            "NON_NEGATIVE_PARAMETERS", "joint_type", "default_joint_id", "MOTOR_PREFIX", "default_motor_id", "motor_joint",

@@ -758,11 +758,12 @@ static int measure_islands(OdinWorld *w, int *most) {
  *    (a few bodies, a short arm, a car on the ground: exact and faster than QuickStep's
  *    iterations; the pinned planning experiments were recorded under this clause alone);
  *  - a large articulation: an island whose joints and motors alone (contacts aside), counted
- *    as the first clause counts them (joint_rows_at_most), have more than auto_step_rows
- *    rows, so that it can never pass the first clause (the TX90 with its hand: 24 joints,
- *    216 rows so counted; a 12-hinge arm and gripper, 150, whose 114 rows by ODE's count
- *    left it to QuickStep when the clause counted ODE's rows), while the largest island has
- *    at most auto_rows rows by ODE's count. QuickStep's iterations let such a chain held by
+ *    as the first clause counts them (joint_rows_at_most), have at least
+ *    auto_articulation_rows rows: five servo-held joints or more, a manipulator arm with or
+ *    without its gripper or hand (the TX90 with its hand: 24 joints, 216 rows so counted; a 12-hinge arm
+ *    and gripper, 150, whose 114 rows by ODE's count left it to QuickStep when the clause
+ *    counted ODE's rows; a YuMi arm on its kinematic base, 9 joints), while the largest
+ *    island has at most auto_rows rows by ODE's count. QuickStep's iterations let such a chain held by
  *    its motors fold or shake; ODE steps each island on its own and dWorldStep's cost is
  *    cubic in an island's rows, so the largest island bounds its cost (the TX90 + hand
  *    grasping a can: about 300).
@@ -776,7 +777,7 @@ static int step_solver(OdinWorld *w) {
     if (step_rows_at_most(w, w->auto_step_rows) <= w->auto_step_rows) return 1;
     int articulated_most;
     if (!measure_islands(w, &articulated_most)) return 0;
-    return articulated_most > w->auto_step_rows && w->island_rows <= w->auto_rows;
+    return articulated_most >= w->auto_articulation_rows && w->island_rows <= w->auto_rows;
 }
 
 int odin_world_step(OdinWorld *w, double h, int count) {

@@ -150,6 +150,8 @@ typedef struct OdinWorld {
                                 island has at most auto_rows rows, QuickStep otherwise */
     int auto_step_rows;      /* auto's small-system bound (rows of the whole step) */
     int auto_rows;           /* auto's island bound (rows of one island) */
+    int auto_articulation_rows; /* auto's articulation bound (an island's joints and motors,
+                                   counted by joint_rows_at_most) */
     int last_solver;         /* output: the solver the last step used (0 or 1) */
     int island_rows;         /* output (auto): the last step's largest island's rows (0 when
                                 not searched: the small-system clause held, or no awake body

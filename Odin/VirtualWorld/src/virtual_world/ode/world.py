@@ -13,7 +13,8 @@ from typing import List, Sequence, Tuple
 
 import numpy as np
 
-from odin_common.interface import AUTO_SOLVER_MAX_ISLAND_ROWS, AUTO_SOLVER_MAX_ROWS, DivergencePolicy
+from odin_common.interface import (AUTO_SOLVER_ARTICULATION_ROWS, AUTO_SOLVER_MAX_ISLAND_ROWS,
+                                   AUTO_SOLVER_MAX_ROWS, DivergencePolicy)
 from odin_common.world_parameters import WorldParameters
 from virtual_world.ode import handles
 from virtual_world.ode.bindings import ffi, lib
@@ -72,6 +73,7 @@ class CWorld:
         s.solver = int(p.solver)
         s.auto_step_rows = AUTO_SOLVER_MAX_ROWS
         s.auto_rows = AUTO_SOLVER_MAX_ISLAND_ROWS
+        s.auto_articulation_rows = AUTO_SOLVER_ARTICULATION_ROWS
         s.max_speed = p.divergence_speed
         s.max_spin = p.divergence_angular_speed
         s.extent = p.world_extent
