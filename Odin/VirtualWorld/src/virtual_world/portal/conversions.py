@@ -6,7 +6,6 @@ sides), so these functions only reshape.
 """
 from __future__ import annotations
 
-import io
 import struct
 from typing import Sequence
 
@@ -17,6 +16,7 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Point, Vector3, Wrench
 from sensor_msgs.msg import JointState
 from Services.srv import ViewObjectRequest
+from odin_common.packed import PrePacked, serialised, with_mesh_arrays
 from virtual_world.core.arrays import flat_float64, uint32_array
 
 
@@ -34,41 +34,21 @@ def view_requests(geometries) -> list:
     return requests
 
 
-_COUNT = struct.Struct("<I")
-
-
-class PackedViewObjectRequest(ViewObjectRequest):
-    """A View Object request that writes bytes made by ``pack`` as its serialisation (the
-    Viewer receives an ordinary request). genpy packs a float64[] or uint32[] from Python
-    numbers one by one: the TX90 + hand's meshes took ~30 ms of the world's Viewer thread at
-    every load, holding the GIL its loop thread needed to answer the next requests; numpy's
-    bytes of the arrays the Core already made (core.arrays) take ~1 ms. No ``__slots__`` of
-    its own: genpy checks keyword fields against the class's."""
+class PackedViewObjectRequest(PrePacked, ViewObjectRequest):
+    """A View Object request sent as bytes made by ``pack`` (odin_common.packed): genpy packed
+    the TX90 + hand's meshes one Python number at a time, ~30 ms of the world's Viewer thread
+    at every load, holding the GIL its loop thread needed to answer the next requests; numpy's
+    bytes of the arrays the Core made already (core.arrays) take ~1 ms."""
 
     def pack(self, parameters, indices) -> None:
         """Makes the bytes from the request's other fields and ``parameters``, ``indices``
-        (the same numbers as its own, as the Core holds them). Relies on ViewObject.srv
-        beginning with id, parameters, indices (pinned to genpy by test_conversions)."""
-        light = io.BytesIO()
-        ViewObjectRequest(self.id, [], [], self.position, self.orientation, self.color,
-                          self.shape).serialize(light)
-        light = light.getvalue()
-        head = _COUNT.size + len(self.id.encode("utf-8"))
-        values = flat_float64(parameters).astype("<f8", copy=False)
+        (the same numbers as its own, as the Core holds them)."""
+        light = serialised(ViewObjectRequest(self.id, [], [], self.position, self.orientation,
+                                             self.color, self.shape))
         index_values = uint32_array(indices)
-        if index_values is None:
-            index_values = np.asarray(indices, dtype=np.uint32).reshape(-1)
-        index_values = index_values.astype("<u4", copy=False)
-        self.packed = b"".join((light[:head], _COUNT.pack(values.size), values.tobytes(),
-                                _COUNT.pack(index_values.size), index_values.tobytes(),
-                                light[head + 2 * _COUNT.size:]))
-
-    def serialize(self, buff) -> None:
-        packed = getattr(self, "packed", None)
-        if packed is None:
-            super().serialize(buff)
-        else:
-            buff.write(packed)
+        self.packed = with_mesh_arrays(
+            light, self.id, flat_float64(parameters),
+            np.asarray(indices, dtype=np.uint32) if index_values is None else index_values)
 
 
 def collision_pairs(collisions) -> list:
