@@ -47,3 +47,29 @@ def test_the_arrays_kept_are_bounded_by_their_numbers(monkeypatch):
     assert arrays._kept.numbers <= 2500
     assert float64_array(held[0]) is not converted[0]      # fell out, converted again
     assert float64_array(held[3]) is converted[3]
+
+
+def test_threads_converting_at_once_get_their_own_numbers(monkeypatch):
+    """Two Cores may build at once: the kept arrays stay consistent under threads that
+    convert, find and push out tuples all the time."""
+    import threading
+    monkeypatch.setattr(arrays, "KEPT_NUMBERS", 300)
+    monkeypatch.setattr(arrays, "_kept", arrays._Kept())
+    failures = []
+
+    def work(seed: int) -> None:
+        try:
+            for k in range(300):
+                values = tuple(float(seed * 10_000 + k + v) for v in range(50))
+                for _ in range(2):
+                    assert float64_array(values).tolist() == list(values)
+        except Exception as error:  # handed to the test's thread
+            failures.append(error)
+
+    threads = [threading.Thread(target=work, args=(seed,)) for seed in range(4)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert not failures
+    assert arrays._kept.numbers == sum(len(v) for v, _ in arrays._kept.arrays.values())

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import array
 import collections
+import threading
 from typing import Optional, Tuple
 
 import numpy as np
@@ -43,28 +44,32 @@ KEPT_NUMBERS = 1_500_000
 
 
 class _Kept:
-    """The arrays of the tuples converted last, least recently used first."""
+    """The arrays of the tuples converted last, least recently used first (any thread: two
+    Cores may build at once)."""
 
     def __init__(self) -> None:
         self.arrays: "collections.OrderedDict[Tuple[int, str], Tuple[tuple, np.ndarray]]" = \
             collections.OrderedDict()
         self.numbers = 0
+        self._lock = threading.Lock()
 
     def get(self, values: tuple, typecode: str) -> Optional[np.ndarray]:
         key = (id(values), typecode)
-        kept = self.arrays.get(key)
-        if kept is None or kept[0] is not values:
-            return None
-        self.arrays.move_to_end(key)
-        return kept[1]
+        with self._lock:
+            kept = self.arrays.get(key)
+            if kept is None or kept[0] is not values:
+                return None
+            self.arrays.move_to_end(key)
+            return kept[1]
 
     def put(self, values: tuple, typecode: str, converted: np.ndarray) -> None:
         key = (id(values), typecode)
-        old = self.arrays.pop(key, None)     # a tuple gone, its identity reused
-        self.numbers += len(values) - (len(old[0]) if old is not None else 0)
-        self.arrays[key] = (values, converted)
-        while len(self.arrays) > 1 and self.numbers > KEPT_NUMBERS:
-            self.numbers -= len(self.arrays.popitem(last=False)[1][0])
+        with self._lock:
+            old = self.arrays.pop(key, None)     # a tuple gone, its identity reused
+            self.numbers += len(values) - (len(old[0]) if old is not None else 0)
+            self.arrays[key] = (values, converted)
+            while len(self.arrays) > 1 and self.numbers > KEPT_NUMBERS:
+                self.numbers -= len(self.arrays.popitem(last=False)[1][0])
 
 
 _kept = _Kept()

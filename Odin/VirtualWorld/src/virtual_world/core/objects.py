@@ -9,6 +9,7 @@ before the first ODE call.
 from __future__ import annotations
 
 import collections
+import threading
 from dataclasses import dataclass
 from typing import Dict, List, Sequence, Set, Tuple
 
@@ -86,6 +87,7 @@ converting a message's tuples took ~0.13 s of the TX90 + hand's Build Entity, an
 robot comes back after every New Scene. Only meshes that passed are kept (a refusal is checked
 again, with its message); their arrays are read-only, shared by every geometry built over
 them."""
+_MESH_SHAPES_LOCK = threading.Lock()     # two Cores may build at once
 #: bytes of parameters and indices the cache of checked meshes keeps at most (the TX90 +
 #: hand + cans: ~4.5 MB of keys, as much again of arrays)
 MESH_SHAPE_BYTES = 64 * 2 ** 20
@@ -95,19 +97,21 @@ def _shape(what: str, given) -> Shape:
     """prepare_shape of ``given``'s parameters, indices and shape, a mesh from _MESH_SHAPES
     when the very same one passed before."""
     values, indices = float64_array(given.parameters), uint32_array(given.indices)
-    if (values is None or indices is None or not indices.size or not isinstance(given.shape, int)
-            or not np.all(np.isfinite(values))):
+    if (values is None or indices is None or not indices.size
+            or not isinstance(given.shape, int) or not np.all(np.isfinite(values))):
         return prepare_shape(what, given.parameters, given.indices, given.shape)
     key = (values.tobytes(), indices.tobytes(), int(given.shape))
-    shape = _MESH_SHAPES.pop(key, None)
+    with _MESH_SHAPES_LOCK:
+        shape = _MESH_SHAPES.pop(key, None)
     if shape is None:
         shape = prepare_shape(what, values, indices, given.shape)
         if shape.kind != "mesh":
             return shape
         shape.vertices.flags.writeable = False
         shape.triangles.flags.writeable = False
-    _MESH_SHAPES[key] = shape     # most recently used last
-    _trim_mesh_shapes()
+    with _MESH_SHAPES_LOCK:
+        _MESH_SHAPES[key] = shape     # most recently used last
+        _trim_mesh_shapes()
     return shape
 
 
