@@ -9,15 +9,13 @@ from __future__ import annotations
 
 import argparse
 import atexit
-import contextlib
-import gc
 import json
 import logging
 import os
 import sys
 import threading
 import time
-from typing import Callable, Iterator, Optional, Sequence
+from typing import Callable, Optional, Sequence
 
 import numpy as np
 
@@ -220,31 +218,6 @@ def load_problem_main(argv: Optional[Sequence[str]] = None) -> int:
     _build_options(parser)
     args = parser.parse_args(argv)
     _warnings_to_stderr("load_problem")
-    with _without_cycle_collection():
-        return _load_problem(args)
-
-
-@contextlib.contextmanager
-def _without_cycle_collection() -> Iterator[None]:
-    """Within the block, Python's cycle collector does not run. Reading, planning and sending
-    a problem make millions of objects and almost no cycles: the collector ran ~70 times in
-    every load_problem, each run walking the young objects again (~0.05-0.1 s of the TX90 +
-    hand's load), to free nearly nothing. Objects without cycles are freed as always. What
-    the block made then counts as old (freeze, unfreeze: a move, no walk), so that the first
-    collection after it does not walk it all at once; its few cycles wait for the next full
-    collection (or the process's end)."""
-    was_enabled = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        gc.freeze()
-        gc.unfreeze()
-        if was_enabled:
-            gc.enable()
-
-
-def _load_problem(args) -> int:
     started = time.monotonic()
     try:
         _check_master("load_problem", args.timeout)
