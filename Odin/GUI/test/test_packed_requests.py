@@ -68,3 +68,11 @@ def test_an_entity_without_objects_packs_too():
                                composites=[composite_message(c) for c in spec.composites],
                                internal_collisions=True)
     assert _bytes(_packed_build_entity(spec)) == _bytes(genpy)
+
+
+def test_a_pre_packed_request_without_its_bytes_serialises_as_genpy():
+    from gui.ros.client import _PackedBuildEntity
+    spec = _entity()
+    fields = dict(name=spec.name, objects=[object_message(o) for o in spec.objects],
+                  composites=[], internal_collisions=True)
+    assert _bytes(_PackedBuildEntity(**fields)) == _bytes(BuildEntityRequest(**fields))

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from virtual_world.core import TORQUE, Core, ObjectSpec, WorldParameters
+from virtual_world.errors import InvalidArgument
 
 H = 0.001
 
@@ -107,3 +108,46 @@ def test_a_built_geometry_keeps_a_messages_arrays_and_flattens_any_other_sequenc
                                         position=(6, 0, 0))).geometries[0]
     assert mesh.parameters == corners and mesh.indices == faces
     assert {type(v) for v in mesh.parameters + mesh.indices} == {float, int}
+
+
+def _tetrahedron(scale: float = 1.0):
+    corners = tuple(scale * v for v in (0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0,
+                                        0.0, 0.0, 1.0))
+    return corners, (0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3)
+
+
+def test_a_mesh_built_again_reuses_its_checked_shape_and_builds_the_same_body(core):
+    """The same mesh after a New Scene (new tuples, the same numbers) is not checked again:
+    its Shape is the one checked before, read-only, and the body is the same bit for bit."""
+    corners, faces = _tetrahedron(0.37)
+    core.build_object(ObjectSpec("tet", corners, faces, mass=2.0))
+    first = core._scene.geometry("tet").shape
+    before = core.mass_properties("tet")
+    core.new_scene()
+    core.build_object(ObjectSpec("tet", tuple(list(corners)), tuple(list(faces)), mass=2.0))
+    again = core._scene.geometry("tet").shape
+    assert again is first
+    assert not again.vertices.flags.writeable and not again.triangles.flags.writeable
+    for a, b in zip(before, core.mass_properties("tet")):
+        assert np.asarray(a).tobytes() == np.asarray(b).tobytes()
+
+
+def test_meshes_differing_in_one_bit_or_in_the_shape_asked_are_checked_apart(core):
+    corners, faces = _tetrahedron()
+    core.build_object(ObjectSpec("a", corners, faces))
+    signed = (-0.0,) + corners[1:]
+    core.build_object(ObjectSpec("b", signed, faces, position=(3, 0, 0)))
+    a, b = core._scene.geometry("a").shape, core._scene.geometry("b").shape
+    assert a is not b and np.signbit(b.vertices[0, 0]) and not np.signbit(a.vertices[0, 0])
+
+
+def test_a_refused_mesh_is_refused_again_with_the_same_message(core):
+    corners, _ = _tetrahedron()
+    for _ in range(2):
+        with pytest.raises(InvalidArgument, match=r"mesh index 7 out of range \[0, 3\]"):
+            core.build_object(ObjectSpec("bad", corners, (0, 1, 7)))
+    flat = (0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 2.0, 0.0, 0.0)
+    for _ in range(2):
+        with pytest.raises(InvalidArgument, match="every mesh triangle is degenerate"):
+            core.build_object(ObjectSpec("flat", flat, (0, 1, 2)))
+    assert "bad" not in core._scene.objects and "flat" not in core._scene.objects

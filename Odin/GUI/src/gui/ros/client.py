@@ -20,10 +20,8 @@ importing this module does not import rospy (only the generated message classes)
 from __future__ import annotations
 
 import dataclasses
-import io
 import logging
 import os
-import struct
 import time
 from typing import Callable, Dict, NamedTuple, Optional, Sequence, Tuple
 
@@ -39,6 +37,7 @@ from odin_common.errors import InvalidArgument
 from odin_common.interface import WORLD_NAMESPACE, WORLD_SERVICES, ForceKind, SetJointAction
 from odin_common.messages import (body_force_message, composite_message, object_message,
                                   parameter_messages, situation_messages, world_parameters_of)
+from odin_common.packed import COUNT, PrePacked, serialised, string_size, with_mesh_arrays
 from odin_common.specs import CompositeSpec, EntitySpec, JointSpec, MotorSpec, ObjectSpec
 from odin_common.step_values import StepValues
 from odin_common.world_parameters import (PARAMETER_INFO, PARAMETERS, ParameterInfo,
@@ -435,37 +434,17 @@ class WorldClient:
 # -- requests whose meshes go out as numpy bytes -----------------------------------------
 # genpy serialises a float64[] or uint32[] field from a Python list (a float object per
 # number, packed one by one): for the TX90 hand's entity, 800,000 numbers, 0.17 s of
-# load_problem's CPU. Here an Object's mesh arrays are written from numpy instead. This
-# relies on two facts of the .msg files, pinned byte for byte to genpy by
-# Odin/GUI/test/test_packed_requests.py: Object.msg begins with name, parameters, indices,
-# and BuildEntity's request with name, objects.
-
-_COUNT = struct.Struct("<I")
-
-
-def _serialised(message) -> bytes:
-    buffer = io.BytesIO()
-    message.serialize(buffer)
-    return buffer.getvalue()
-
-
-def _string_size(text: str) -> int:
-    """Bytes of a serialised string field: its length and its UTF-8 bytes."""
-    return _COUNT.size + len(text.encode("utf-8"))
+# load_problem's CPU. Here an Object's mesh arrays are written from numpy instead
+# (odin_common.packed). This relies on BuildEntity's request beginning with name, objects,
+# pinned byte for byte to genpy by Odin/GUI/test/test_packed_requests.py.
 
 
 def packed_object(spec: ObjectSpec) -> bytes:
     """Object (Messages/Object) ``spec`` serialised as genpy would, its parameters (float64)
     and indices (uint32) written from numpy arrays."""
-    light = _serialised(object_message(dataclasses.replace(spec, parameters=(), indices=())))
-    head = _string_size(spec.name)
-    parameters = np.ascontiguousarray(np.asarray(spec.parameters, dtype=float).reshape(-1),
-                                      dtype="<f8")
-    indices = np.ascontiguousarray(np.asarray(spec.indices, dtype=np.uint32).reshape(-1),
-                                   dtype="<u4")
-    return b"".join((light[:head], _COUNT.pack(parameters.size), parameters.tobytes(),
-                     _COUNT.pack(indices.size), indices.tobytes(),
-                     light[head + 2 * _COUNT.size:]))
+    light = serialised(object_message(dataclasses.replace(spec, parameters=(), indices=())))
+    return with_mesh_arrays(light, spec.name, np.asarray(spec.parameters, dtype=float),
+                            np.asarray(spec.indices, dtype=np.uint32))
 
 
 def _packed_build_entity(spec: EntitySpec) -> "_PackedBuildEntity":
@@ -474,25 +453,16 @@ def _packed_build_entity(spec: EntitySpec) -> "_PackedBuildEntity":
         name=spec.name, objects=[],
         composites=[composite_message(c) for c in spec.composites],
         internal_collisions=bool(spec.internal_collisions))
-    rest = _serialised(request)
-    head = _string_size(spec.name)
+    rest = serialised(request)
+    head = string_size(spec.name)
     parts = [packed_object(o) for o in spec.objects]
-    request.packed = b"".join((rest[:head], _COUNT.pack(len(parts)), *parts,
-                               rest[head + _COUNT.size:]))
+    request.packed = b"".join((rest[:head], COUNT.pack(len(parts)), *parts,
+                               rest[head + COUNT.size:]))
     return request
 
 
-class _PackedBuildEntity(BuildEntityRequest):
-    """A Build Entity request that writes bytes made beforehand (``packed``) as its
-    serialisation, once they are set (rospy checks the class with isinstance). No
-    ``__slots__`` of its own: genpy checks keyword fields against the class's."""
-
-    def serialize(self, buff) -> None:
-        packed = getattr(self, "packed", None)
-        if packed is None:
-            super().serialize(buff)
-        else:
-            buff.write(packed)
+class _PackedBuildEntity(PrePacked, BuildEntityRequest):
+    """A Build Entity request sent as bytes made beforehand (odin_common.packed.PrePacked)."""
 
 
 def robot_mesh_dir() -> str:

@@ -16,8 +16,10 @@ import rospy.
 """
 from __future__ import annotations
 
+import contextlib
+import time
 import xmlrpc.client
-from typing import Dict, Mapping, Type
+from typing import Dict, Iterator, Mapping, Type
 
 from gui.errors import ServiceError
 
@@ -29,9 +31,41 @@ def join_ros_graph(node_name: str) -> None:
     the caller's tool or window handles Ctrl-C), unless it is a node already."""
     import rospy
     if not rospy.core.is_initialized():
-        rospy.init_node(node_name, anonymous=True, disable_signals=True)
+        with _prompt_registration():
+            rospy.init_node(node_name, anonymous=True, disable_signals=True)
         from odin_common.node import prompt_shutdown
         prompt_shutdown()
+
+
+class _PollingTime:
+    """The ``time`` module as rospy.impl.init sees it during ``_prompt_registration``: every
+    sleep at most REGISTRATION_POLL s."""
+
+    def __getattr__(self, name: str):
+        return getattr(time, name)
+
+    @staticmethod
+    def sleep(seconds: float) -> None:
+        time.sleep(min(seconds, REGISTRATION_POLL))
+
+
+#: s between two looks at whether the master registered this node (rospy's own: 0.1 s)
+REGISTRATION_POLL = 0.002
+
+
+@contextlib.contextmanager
+def _prompt_registration() -> Iterator[None]:
+    """rospy.init_node waits for the node's registration with the master by looking every
+    0.1 s, and the first look always comes before the registration (a few ms, on the node's
+    XML-RPC thread): every tool's start waited 0.1 s for nothing (python3-rospy 1.15,
+    rospy.impl.init.start_node). Within the block it looks every REGISTRATION_POLL s."""
+    from rospy.impl import init
+    module_time = init.time
+    init.time = _PollingTime()
+    try:
+        yield
+    finally:
+        init.time = module_time
 
 
 class ServiceCaller:

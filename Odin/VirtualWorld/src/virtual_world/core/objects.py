@@ -8,6 +8,8 @@ before the first ODE call.
 """
 from __future__ import annotations
 
+import collections
+import threading
 from dataclasses import dataclass
 from typing import Dict, List, Sequence, Set, Tuple
 
@@ -18,6 +20,7 @@ from odin_common.interface import composite_id
 from odin_common.rotations import quaternion_multiply, quaternion_to_matrix
 from odin_common.specs import CompositeSpec, EntitySpec, ObjectSpec, PartSpec
 from virtual_world.core import forces, guard, joints, motors, readout, validation as check
+from virtual_world.core.arrays import float64_array, uint32_array
 from virtual_world.core.mass import check_mass, shape_mass
 from virtual_world.core.records import (Built, BuiltEntity, BuiltGeometry, GeometryRecord,
                                         ObjectRecord, Removed)
@@ -65,7 +68,7 @@ class _Prepared:
 
 def _part(what: str, given, mass: float, position, orientation) -> _Part:
     """The checked geometry of an ObjectSpec or PartSpec ``given``."""
-    shape = prepare_shape(what, given.parameters, given.indices, given.shape)
+    shape = _shape(what, given)
     surface = check.surface(what, given.surface)
     if shape.kind == "plane" and surface.friction2 is not None:
         raise InvalidArgument(f"{what}: anisotropic friction (friction2) on a plane is not "
@@ -74,6 +77,49 @@ def _part(what: str, given, mass: float, position, orientation) -> _Part:
                  check.quaternion(f"{what}: orientation", orientation),
                  tuple(check.vector(f"{what}: color", given.color, 4).tolist()),
                  given.parameters, given.indices, int(given.shape), surface)
+
+
+_MESH_SHAPES: "collections.OrderedDict[Tuple[bytes, bytes, int], Shape]" = \
+    collections.OrderedDict()
+"""Meshes checked lately, by their exact parameters (float64 bytes), indices (uint32 bytes) and
+shape asked: checking a mesh (its indices in range, not every triangle degenerate) and
+converting a message's tuples took ~0.13 s of the TX90 + hand's Build Entity, and the same
+robot comes back after every New Scene. Only meshes that passed are kept (a refusal is checked
+again, with its message); their arrays are read-only, shared by every geometry built over
+them."""
+_MESH_SHAPES_LOCK = threading.Lock()     # two Cores may build at once
+#: bytes of parameters and indices the cache of checked meshes keeps at most (the TX90 +
+#: hand + cans: ~4.5 MB of keys, as much again of arrays)
+MESH_SHAPE_BYTES = 64 * 2 ** 20
+
+
+def _shape(what: str, given) -> Shape:
+    """prepare_shape of ``given``'s parameters, indices and shape, a mesh from _MESH_SHAPES
+    when the very same one passed before."""
+    values, indices = float64_array(given.parameters), uint32_array(given.indices)
+    if (values is None or indices is None or not indices.size
+            or not isinstance(given.shape, int) or not np.all(np.isfinite(values))):
+        return prepare_shape(what, given.parameters, given.indices, given.shape)
+    key = (values.tobytes(), indices.tobytes(), int(given.shape))
+    with _MESH_SHAPES_LOCK:
+        shape = _MESH_SHAPES.pop(key, None)
+    if shape is None:
+        shape = prepare_shape(what, values, indices, given.shape)
+        if shape.kind != "mesh":
+            return shape
+        shape.vertices.flags.writeable = False
+        shape.triangles.flags.writeable = False
+    with _MESH_SHAPES_LOCK:
+        _MESH_SHAPES[key] = shape     # most recently used last
+        _trim_mesh_shapes()
+    return shape
+
+
+def _trim_mesh_shapes() -> None:
+    held = sum(len(key[0]) + len(key[1]) for key in _MESH_SHAPES)
+    while len(_MESH_SHAPES) > 1 and held > MESH_SHAPE_BYTES:
+        key, _ = _MESH_SHAPES.popitem(last=False)
+        held -= len(key[0]) + len(key[1])
 
 
 def _given_mass(what: str, mass: float, inertia, center_of_mass):

@@ -16,13 +16,40 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Point, Vector3, Wrench
 from sensor_msgs.msg import JointState
 from Services.srv import ViewObjectRequest
+from odin_common.packed import PrePacked, serialised, with_mesh_arrays
+from virtual_world.core.arrays import flat_float64, uint32_array
 
 
 def view_requests(geometries) -> list:
     """View Object requests for geometries as the Core built them (core.BuiltGeometry), or
-    as they are now (at their present poses)."""
-    return [ViewObjectRequest(g.name, list(g.parameters), list(g.indices), list(g.position),
-                              list(g.orientation), list(g.color), g.shape) for g in geometries]
+    as they are now (at their present poses); each serialises itself from bytes made here
+    (see PackedViewObjectRequest)."""
+    requests = []
+    for g in geometries:
+        # the mesh arrays as the Core holds them: a list copy of a hand's meshes cost ~20 ms
+        # to make and free again at each load
+        request = PackedViewObjectRequest(g.name, g.parameters, g.indices, list(g.position),
+                                          list(g.orientation), list(g.color), g.shape)
+        request.pack(g.parameters, g.indices)
+        requests.append(request)
+    return requests
+
+
+class PackedViewObjectRequest(PrePacked, ViewObjectRequest):
+    """A View Object request sent as bytes made by ``pack`` (odin_common.packed): genpy packed
+    the TX90 + hand's meshes one Python number at a time, ~30 ms of the world's Viewer thread
+    at every load, holding the GIL its loop thread needed to answer the next requests; numpy's
+    bytes of the arrays the Core made already (core.arrays) take ~1 ms."""
+
+    def pack(self, parameters, indices) -> None:
+        """Makes the bytes from the request's other fields and ``parameters``, ``indices``
+        (the same numbers as its own, as the Core holds them)."""
+        light = serialised(ViewObjectRequest(self.id, [], [], self.position, self.orientation,
+                                             self.color, self.shape))
+        index_values = uint32_array(indices)
+        self.packed = with_mesh_arrays(
+            light, self.id, flat_float64(parameters),
+            np.asarray(indices, dtype=np.uint32) if index_values is None else index_values)
 
 
 def collision_pairs(collisions) -> list:

@@ -30,6 +30,7 @@ from odin_common.interface import (COLLIDING_COLOR, DEFAULT_COLOR, PLANE_DRAWN_S
                                    PLANE_DRAWN_THICKNESS, Shape, shape_of)
 from odin_common.meshes import capsule_mesh, display_mesh, facing_outwards
 from odin_common.rotations import compose_poses, wxyz_to_xyzw
+from virtual_world.core.arrays import flat_float64, uint32_array
 
 MARKER_NAMESPACE = "odin"
 """The namespace of the world's geometry markers."""
@@ -66,7 +67,7 @@ class _Shape:
 def marker_shape(parameters: Sequence[float], indices: Sequence[int], shape: int) -> _Shape:
     """The marker of a geometry built with these Object/Part fields (already checked by the
     Core)."""
-    params = np.asarray(parameters, dtype=float).reshape(-1)
+    params = flat_float64(parameters)
     kind = shape_of(params.size, shape)
     if kind == Shape.SPHERE:
         d = 2 * params[0]
@@ -81,7 +82,10 @@ def marker_shape(parameters: Sequence[float], indices: Sequence[int], shape: int
                       ((0.0, 0.0, -PLANE_DRAWN_THICKNESS / 2), (1.0, 0.0, 0.0, 0.0)), b"", 0)
     if kind == Shape.CAPSULE:
         return _triangle_list(*capsule_mesh(params[0], params[1]))
-    key = (params.tobytes(), np.asarray(indices, np.int64).tobytes())
+    index_values = uint32_array(indices)
+    if index_values is None:
+        index_values = np.asarray(indices)
+    key = (params.tobytes(), index_values.astype(np.int64).tobytes())
     marker = _MESH_MARKERS.pop(key, None)
     if marker is None:
         vertices, triangles = display_mesh(params.reshape(-1, 3), indices)

@@ -24,6 +24,7 @@ import numpy as np
 
 from odin_common.interface import Shape, shape_of
 from odin_common.specs import CompositeSpec
+from virtual_world.core.arrays import flat_float64
 from virtual_world.portal.clock import WorldClock
 from virtual_world.portal.frames import IDENTITY_POSE, ObjectFrames
 from virtual_world.portal.markers import GeometryMarkers
@@ -159,7 +160,7 @@ def _size(spec) -> float:
     composite = isinstance(spec, CompositeSpec)
     extent = 0.05
     for part in (spec.parts if composite else [spec]):
-        values = np.asarray(part.parameters, dtype=float).reshape(-1)
+        values = flat_float64(part.parameters)
         if shape_of(values.size, part.shape) == Shape.MESH:
             size = float(np.ptp(values.reshape(-1, 3), axis=0).max())
         else:

@@ -180,8 +180,7 @@ class StandardTopics:
                 publisher = self._joint_states.pop(robot.namespace, None)
                 if publisher is not None:
                     publisher.unregister()
-                if rospy.has_param(f"{namespace}/robot_description"):
-                    rospy.delete_param(f"{namespace}/robot_description")
+                _delete_param(f"{namespace}/robot_description")
             except Exception as error:   # the master gone: the node goes on
                 _log.warning("virtual_world: robot %s: master: %s", robot.name, error)
 
@@ -194,3 +193,12 @@ class StandardTopics:
                 rospy.delete_param(f"/{robot.namespace}/robot_description")
             except Exception:   # master gone at shutdown
                 pass
+
+
+def _delete_param(name: str) -> None:
+    """Deletes the parameter ``name`` if it is set: one call to the master, where asking
+    first made two on every New Scene's path."""
+    try:
+        rospy.delete_param(name)
+    except KeyError:    # not set (a user may have deleted it)
+        pass
