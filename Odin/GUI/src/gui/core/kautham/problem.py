@@ -92,8 +92,10 @@ _ROBOT_CHILDREN = {
     "viewlink": "the link Kautham's view follows",
     "constraint": "a planner's constraint on the robot",
     "constrainedkinematic": "Kautham's constrained kinematics",
-    "start": "a 2012 base pose for the planner's query; Odin builds the robot at <Home>",
-    "goal": "a 2012 base pose for the planner's query; Odin builds the robot at <Home>",
+    "start": "Kautham 1's base pose, which Kautham 2 and later do not read: the robot stands at "
+             "the query's <Init>, else at <Home> (the origin without one)",
+    "goal": "Kautham 1's goal base pose, which Kautham 2 and later do not read (a query's "
+            "<Goal> is the goal)",
 }
 _OBSTACLE_CHILDREN = {"home": None, "location": None, "collision": None, "kauthamname": None,
                       "limits": "an obstacle's control limits (obstacle controls are not "
