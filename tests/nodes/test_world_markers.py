@@ -94,8 +94,14 @@ def test_interactive_markers_follow_only_the_objects_that_moved(ros_master):
     ros_master.wait_for_service("/virtual_world/set_position")
     rospy.init_node("odin_test_client", anonymous=True, disable_signals=True)
     updates = []
-    rospy.Subscriber("/virtual_world/interactive/update", InteractiveMarkerUpdate,
-                     lambda message: updates.append(message), queue_size=100)
+    subscriber = rospy.Subscriber("/virtual_world/interactive/update", InteractiveMarkerUpdate,
+                                  lambda message: updates.append(message), queue_size=100)
+    # an update goes only to the subscribers connected when it is sent (RViz reads the rest
+    # from update_full): build nothing before this one is connected
+    deadline = time.monotonic() + 20
+    while subscriber.get_num_connections() < 1 and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert subscriber.get_num_connections() >= 1, "never connected to ~interactive/update"
     world = WorldClient()
     world.ok("build_object", object=box("floor", (4, 4, 0.1), (0, 0, -0.05), geometry_only=True))
     world.ok("build_object", object=sphere("still", 0.1, (-1, 0, 0.1)))
