@@ -157,12 +157,18 @@ class ObjectFrames:
         if key != self._layout_key:
             self._layout = self._lay_out(names)
             self._layout_key = key
-        moving, static, rows, local_p, local_q = self._layout
+        moving, static, rows, offset, local_p, local_q = self._layout
         if not rows.size:
             return ([], np.zeros((0, 3)), np.zeros((0, 4))), ([], np.zeros((0, 3)),
                                                                np.zeros((0, 4)))
-        # one composition for every frame: its cost is numpy's per call, not per frame
-        p, q = compose_poses(positions[rows], quaternions[rows], local_p, local_q)
+        p = np.asarray(positions, float)[rows]          # copies: the Core's arrays stay
+        q = np.asarray(quaternions, float)[rows]
+        if offset.size:
+            # one composition for every frame away from its geometry: its cost is numpy's per
+            # call, not per frame; a frame at its geometry's pose (a lone object's, as the
+            # 100-sphere scene's) is that pose, and composing those had cost the node's
+            # loop a twentieth of its time at 25 publications a second
+            p[offset], q[offset] = compose_poses(p[offset], q[offset], local_p, local_q)
         split = len(moving)
         return (moving, p[:split], q[:split]), (static, p[split:], q[split:])
 
@@ -176,9 +182,12 @@ class ObjectFrames:
             if row is not None:
                 groups[entry.static].append((entry.name, row, entry.position, entry.quaternion))
         ordered = groups[False] + groups[True]
+        local_p = np.asarray([e[2] for e in ordered], float).reshape(-1, 3)
+        local_q = np.asarray([e[3] for e in ordered], float).reshape(-1, 4)
+        offset = np.flatnonzero(np.any(local_p != 0.0, axis=1)
+                                | np.any(local_q != IDENTITY_POSE[1], axis=1))
         return ([e[0] for e in groups[False]], [e[0] for e in groups[True]],
-                np.asarray([e[1] for e in ordered], dtype=np.intp),
-                np.asarray([e[2] for e in ordered], float).reshape(-1, 3),
-                np.asarray([e[3] for e in ordered], float).reshape(-1, 4))
+                np.asarray([e[1] for e in ordered], dtype=np.intp), offset,
+                local_p[offset], local_q[offset])
 
 
