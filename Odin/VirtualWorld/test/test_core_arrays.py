@@ -20,8 +20,20 @@ def test_indices_convert_to_uint32_and_other_values_are_left_to_the_caller():
     assert uint32_array((0, 5, 2 ** 32 - 1)).dtype == np.uint32
     for values in ((0, -1), (0, 2 ** 32), (0, 1.0), (0, "1"), ((0, 1), (2, 3))):
         assert uint32_array(values) is None, values
-    for values in ((1.0, "x"), ((1.0, 2.0),), np.zeros(3), range(3), None):
+    for values in ((1.0, "x"), ((1.0, 2.0),), np.zeros(3, np.float32), range(3), None):
         assert float64_array(values) is None, values
+    for values in (np.zeros(3, np.int64), np.zeros(3, np.float64)):
+        assert uint32_array(values) is None, values
+
+
+def test_an_array_of_the_type_is_taken_flat_without_a_copy():
+    """A numpy request's fields (odin_common.packed.numpy_requests) arrive as arrays."""
+    vertices = np.arange(12.0).reshape(4, 3)
+    flat = float64_array(vertices)
+    assert flat.shape == (12,) and np.shares_memory(flat, vertices)
+    indices = np.arange(6, dtype=np.uint32).reshape(2, 3)
+    assert uint32_array(indices).shape == (6,)
+    assert np.shares_memory(uint32_array(indices), indices)
 
 
 def test_flat_float64_falls_back_to_numpy_for_other_sequences():

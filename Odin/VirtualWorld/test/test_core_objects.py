@@ -94,8 +94,9 @@ def test_set_poses_keeps_the_velocities_unless_told_to_reset_them(core):
 
 
 def test_a_built_geometry_keeps_a_messages_arrays_and_flattens_any_other_sequence(core):
-    """A message's float64[] and uint32[] arrive as tuples of floats and ints: given back as
-    they are (no copy of a large mesh); lists, arrays and ints become flat float and int
+    """A message's float64[] and uint32[] arrive as tuples of floats and ints (or, from a
+    numpy request, float64 and uint32 arrays): given back as they are (no copy of a large
+    mesh; arrays flat and read-only); lists, other arrays and ints become flat float and int
     tuples."""
     corners = (0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
     faces = (0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3)
@@ -103,11 +104,16 @@ def test_a_built_geometry_keeps_a_messages_arrays_and_flattens_any_other_sequenc
     assert built.parameters is corners and built.indices is faces
     box = core.build_object(ObjectSpec("box", [1, 2, 3], position=(3, 0, 0))).geometries[0]
     assert box.parameters == (1.0, 2.0, 3.0) and type(box.parameters[0]) is float
-    mesh = core.build_object(ObjectSpec("mesh", np.array(corners).reshape(4, 3),
-                                        np.array(faces, np.uint32).reshape(4, 3),
-                                        position=(6, 0, 0))).geometries[0]
+    given = np.array(corners, np.float32).reshape(4, 3), np.array(faces, np.int64)
+    mesh = core.build_object(ObjectSpec("mesh", *given, position=(6, 0, 0))).geometries[0]
     assert mesh.parameters == corners and mesh.indices == faces
     assert {type(v) for v in mesh.parameters + mesh.indices} == {float, int}
+    vertices, triangles = np.array(corners).reshape(4, 3), np.array(faces, np.uint32)
+    kept = core.build_object(ObjectSpec("kept", vertices, triangles,
+                                        position=(12, 0, 0))).geometries[0]
+    assert kept.parameters.shape == (12,) and np.shares_memory(kept.parameters, vertices)
+    assert kept.indices.dtype == np.uint32 and np.shares_memory(kept.indices, triangles)
+    assert not kept.parameters.flags.writeable and vertices.flags.writeable
 
 
 def _tetrahedron(scale: float = 1.0):

@@ -72,9 +72,15 @@ def object_message(spec: ObjectSpec) -> Object:
                   center_of_mass=_floats(spec.center_of_mass))
 
 
+def _mesh_numbers(values):
+    """A message's parameters or indices as a spec holds them: a numpy array as it came
+    (a service's numpy requests: odin_common.packed.numpy_requests), anything else a tuple."""
+    return values if isinstance(values, np.ndarray) else tuple(values)
+
+
 def object_spec(message: Object) -> ObjectSpec:
-    return ObjectSpec(name=message.name, parameters=tuple(message.parameters),
-                      indices=tuple(message.indices), mass=message.mass,
+    return ObjectSpec(name=message.name, parameters=_mesh_numbers(message.parameters),
+                      indices=_mesh_numbers(message.indices), mass=message.mass,
                       inertia=tuple(message.inertia), position=tuple(message.position),
                       orientation=tuple(message.orientation), color=tuple(message.color),
                       fixed=message.fixed, geometry_only=message.geometry_only,
@@ -92,8 +98,8 @@ def part_message(spec: PartSpec) -> Part:
 
 
 def part_spec(message: Part) -> PartSpec:
-    return PartSpec(name=message.name, parameters=tuple(message.parameters),
-                    indices=tuple(message.indices), mass=message.mass,
+    return PartSpec(name=message.name, parameters=_mesh_numbers(message.parameters),
+                    indices=_mesh_numbers(message.indices), mass=message.mass,
                     position=tuple(message.position), orientation=tuple(message.orientation),
                     color=tuple(message.color), shape=message.shape,
                     surface=surface_of(message.surface))

@@ -59,7 +59,6 @@ from typing import Optional, Tuple
 
 import rospy
 import rospkg
-from rospy.numpy_msg import numpy_msg
 from sensor_msgs.msg import CompressedImage, Image
 
 from Messages.msg import Collided, SpaceDistribution
@@ -67,6 +66,7 @@ from Services import srv
 from odin_common import OdinError, replies
 from odin_common.interface import VIEWER_SERVICES
 from odin_common.node import MasterWatch, init_ros_node
+from odin_common.packed import numpy_requests
 from viewer.core.camera import Camera
 from viewer.core.geometry import GeometryCache
 from viewer.errors import ViewerError
@@ -215,7 +215,7 @@ class Portal:
         self.servers = []
         for name, type_name in VIEWER_SERVICES.items():
             service_class = getattr(srv, type_name)
-            served = _numpy_requests(service_class) if name in NUMPY_REQUESTS else service_class
+            served = numpy_requests(service_class) if name in NUMPY_REQUESTS else service_class
             self.servers.append(rospy.Service(
                 f"~{name}", served,
                 replies.guarded(service_class, getattr(self, name), in_force.get(name, dict))))
@@ -277,14 +277,6 @@ class Portal:
 #: a View Object of a mesh is hundreds of thousands of numbers, a Python float each otherwise
 #: (0.06 s for the TX90 grasp scene's meshes, on every load)
 NUMPY_REQUESTS = frozenset({"view_object"})
-
-
-def _numpy_requests(service_class):
-    """``service_class`` (same type and MD5 sum) with rospy.numpy_msg requests."""
-    return type(service_class.__name__, (), {
-        "_type": service_class._type, "_md5sum": service_class._md5sum,
-        "_request_class": numpy_msg(service_class._request_class),
-        "_response_class": service_class._response_class})
 
 
 def _camera_fields(camera: Camera, fitting: bool) -> dict:

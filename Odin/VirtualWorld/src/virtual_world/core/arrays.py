@@ -1,5 +1,7 @@
 """Message arrays as numpy arrays, fast.
 
+A numpy request's array field (odin_common.packed.numpy_requests) is taken as it is.
+
 A deserialised float64[] or uint32[] field is a tuple of Python numbers. numpy converts such a
 tuple one object at a time (~18 ms for the 270,000 vertex coordinates of the TX90 + hand,
 ~20 ms more for its 545,000 indices); ``array.array`` reads it in one C loop, about four times
@@ -21,8 +23,9 @@ import numpy as np
 
 
 def float64_array(values) -> Optional[np.ndarray]:
-    """``values`` (a flat tuple or list of Python numbers) as a float64 array; None when they
-    are anything else (the caller converts them as before, with its own errors)."""
+    """``values`` (a flat tuple or list of Python numbers, or a float64 array: flattened, not
+    copied) as a float64 array; None when they are anything else (the caller converts them as
+    before, with its own errors)."""
     return _converted(values, "d", np.float64)
 
 
@@ -33,8 +36,9 @@ def flat_float64(values) -> np.ndarray:
 
 
 def uint32_array(values) -> Optional[np.ndarray]:
-    """``values`` (a flat tuple or list of Python ints in [0, 2**32)) as a uint32 array; None
-    when they are anything else (floats, negatives, nested sequences)."""
+    """``values`` (a flat tuple or list of Python ints in [0, 2**32), or a uint32 array:
+    flattened, not copied) as a uint32 array; None when they are anything else (floats,
+    negatives, nested sequences, arrays of other types)."""
     return _converted(values, "I", np.uint32)
 
 
@@ -77,6 +81,8 @@ _kept = _Kept()
 
 def _converted(values, typecode: str, dtype) -> Optional[np.ndarray]:
     kind = type(values)
+    if kind is np.ndarray:       # a numpy request's field (odin_common.packed.numpy_requests)
+        return values.reshape(-1) if values.dtype == dtype else None
     if kind is tuple:
         converted = _kept.get(values, typecode)
         if converted is not None:

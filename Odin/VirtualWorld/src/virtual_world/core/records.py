@@ -6,7 +6,7 @@ at the centre of mass ``com`` (in the object frame), with the object's axes.
 """
 from __future__ import annotations
 
-from typing import List, NamedTuple, Optional, Set, Tuple
+from typing import List, NamedTuple, Optional, Sequence, Set, Tuple
 
 import numpy as np
 
@@ -19,11 +19,12 @@ from virtual_world.ode.handles import Owner
 
 class BuiltGeometry(NamedTuple):
     """One geometry as built: name, the shape's Object/Part parameters and indices (m, its
-    own frame), colour (RGBA), its world pose (m; quaternion (w, x, y, z)) right after the
+    own frame: flat tuples, or read-only flat float64 and uint32 arrays when they were given
+    as such), colour (RGBA), its world pose (m; quaternion (w, x, y, z)) right after the
     build, and the shape as asked (odin_common.interface.Shape). What a Viewer needs."""
     name: str
-    parameters: Tuple[float, ...]
-    indices: Tuple[int, ...]
+    parameters: Sequence[float]
+    indices: Sequence[int]
     color: Tuple[float, ...]
     position: Tuple[float, float, float]
     orientation: Tuple[float, float, float, float]

@@ -65,6 +65,7 @@ from odin_common import OdinError, replies
 from odin_common.interface import WORLD_SERVICES, DivergencePolicy
 from odin_common.limits import ResourceLimits
 from odin_common.node import MasterWatch, init_ros_node, stop_on_signals
+from odin_common.packed import numpy_requests
 from odin_common.world_parameters import PARAMETERS
 from virtual_world.core import Core, step_values
 from virtual_world.core.loop import CycleReport, RealTimeFactor, WorldLoop
@@ -147,7 +148,8 @@ class Portal:
         for name, type_name in WORLD_SERVICES.items():
             service_class = getattr(srv, type_name)
             self._answers[name] = self._guarded(service_class, self._handler(name))
-            self.servers.append(rospy.Service(f"~{name}", service_class, self._answers[name]))
+            served = numpy_requests(service_class) if name in NUMPY_REQUESTS else service_class
+            self.servers.append(rospy.Service(f"~{name}", served, self._answers[name]))
 
     def serve(self, name: str, request):
         """Answers ``request`` as the service ``name`` does over ROS (any thread)."""
@@ -289,6 +291,12 @@ class Portal:
             return {}
         names, positions, quaternions = snapshot
         return {name: (positions[i], quaternions[i]) for i, name in enumerate(names)}
+
+
+#: services whose requests arrive with their arrays as numpy views of the received bytes
+#: (odin_common.packed.numpy_requests): a build's meshes, whose numbers the Core takes as
+#: arrays (odin_common.specs)
+NUMPY_REQUESTS = frozenset({"build_object", "build_composite", "build_entity"})
 
 
 def _heard(publisher: rospy.Publisher) -> bool:
