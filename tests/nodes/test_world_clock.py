@@ -128,6 +128,14 @@ def test_time_never_goes_back_across_new_scenes_for_tf_and_sim_time_nodes(ros_ma
     for scene in range(3):
         client.new_scene()
         _scene(client)
+        # the robot's joint_states topic is advertised anew with each scene: step until this
+        # subscriber is connected to it again (a message came), then count the 15 steps
+        heard = len(stamps.by_topic["joint_states"])
+        deadline = time.monotonic() + 30
+        while len(stamps.by_topic["joint_states"]) == heard and time.monotonic() < deadline:
+            before = stamps.latest("world_update")
+            client.step_once(2)
+            stamps.wait_for_the_clock(before)
         for _ in range(15):
             before = stamps.latest("world_update")
             client.step_once(2)

@@ -27,7 +27,7 @@ def test_indices_convert_to_uint32_and_other_values_are_left_to_the_caller():
 
 
 def test_an_array_of_the_type_is_taken_flat_without_a_copy():
-    """A numpy request's fields (odin_common.packed.numpy_requests) arrive as arrays."""
+    """A numpy request's fields (odin_common.node.numpy_requests) arrive as arrays."""
     vertices = np.arange(12.0).reshape(4, 3)
     flat = float64_array(vertices)
     assert flat.shape == (12,) and np.shares_memory(flat, vertices)

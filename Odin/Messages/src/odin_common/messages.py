@@ -74,7 +74,7 @@ def object_message(spec: ObjectSpec) -> Object:
 
 def _mesh_numbers(values):
     """A message's parameters or indices as a spec holds them: a numpy array as it came
-    (a service's numpy requests: odin_common.packed.numpy_requests), anything else a tuple."""
+    (a service's numpy requests: odin_common.node.numpy_requests), anything else a tuple."""
     return values if isinstance(values, np.ndarray) else tuple(values)
 
 

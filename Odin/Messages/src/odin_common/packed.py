@@ -9,8 +9,8 @@ those two arrays into genpy's bytes of the same message serialised without them,
 genpy byte for byte (Odin/GUI/test/test_packed_requests.py,
 Odin/VirtualWorld/test/test_conversions.py).
 
-At the receiving end, ``numpy_requests`` makes a service whose requests arrive with their
-arrays as numpy views of the received bytes (rospy.numpy_msg) instead of a Python number each.
+At the receiving end, odin_common.node.numpy_requests makes a service whose requests arrive
+with their arrays as numpy views of the received bytes (rospy.numpy_msg).
 """
 from __future__ import annotations
 
@@ -62,14 +62,3 @@ class PrePacked:
         else:
             buff.write(self.packed)
 
-
-def numpy_requests(service_class):
-    """``service_class`` (same type and MD5 sum, the same bytes on the wire) with
-    rospy.numpy_msg requests: every array field arrives as a read-only numpy view of the
-    received bytes. genpy unpacked the TX90 + hand's ~800,000 mesh numbers one Python object
-    each, ~0.05 s of the world's and the Viewer's time at every load."""
-    from rospy.numpy_msg import numpy_msg
-    return type(service_class.__name__, (), {
-        "_type": service_class._type, "_md5sum": service_class._md5sum,
-        "_request_class": numpy_msg(service_class._request_class),
-        "_response_class": service_class._response_class})

@@ -65,8 +65,7 @@ from Messages.msg import Collided, SpaceDistribution
 from Services import srv
 from odin_common import OdinError, replies
 from odin_common.interface import VIEWER_SERVICES
-from odin_common.node import MasterWatch, init_ros_node
-from odin_common.packed import numpy_requests
+from odin_common.node import MasterWatch, init_ros_node, numpy_requests
 from viewer.core.camera import Camera
 from viewer.core.geometry import GeometryCache
 from viewer.errors import ViewerError

@@ -1,6 +1,6 @@
 """Message arrays as numpy arrays, fast.
 
-A numpy request's array field (odin_common.packed.numpy_requests) is taken as it is.
+A numpy request's array field (odin_common.node.numpy_requests) is taken as it is.
 
 A deserialised float64[] or uint32[] field is a tuple of Python numbers. numpy converts such a
 tuple one object at a time (~18 ms for the 270,000 vertex coordinates of the TX90 + hand,
@@ -81,7 +81,7 @@ _kept = _Kept()
 
 def _converted(values, typecode: str, dtype) -> Optional[np.ndarray]:
     kind = type(values)
-    if kind is np.ndarray:       # a numpy request's field (odin_common.packed.numpy_requests)
+    if kind is np.ndarray:       # a numpy request's field (odin_common.node.numpy_requests)
         return values.reshape(-1) if values.dtype == dtype else None
     if kind is tuple:
         converted = _kept.get(values, typecode)

@@ -334,7 +334,7 @@ def _flat_tuple(values, kind: type):
     """``values`` as a flat tuple of ``kind`` (float or int), or a read-only flat numpy array
     of float64 (float) or uint32 (int). A message's array already is one and is kept as it
     is: converting a hand's meshes (~800,000 numbers) through numpy and back took ~0.25 s of
-    every load; a numpy request's arrays (odin_common.packed.numpy_requests) ~0.03 s more."""
+    every load; a numpy request's arrays (odin_common.node.numpy_requests) ~0.03 s more."""
     if type(values) is np.ndarray and values.dtype == (np.float64 if kind is float
                                                        else np.uint32):
         flat = values.reshape(-1).view()

@@ -64,8 +64,7 @@ from Services import srv
 from odin_common import OdinError, replies
 from odin_common.interface import WORLD_SERVICES, DivergencePolicy
 from odin_common.limits import ResourceLimits
-from odin_common.node import MasterWatch, init_ros_node, stop_on_signals
-from odin_common.packed import numpy_requests
+from odin_common.node import MasterWatch, init_ros_node, numpy_requests, stop_on_signals
 from odin_common.world_parameters import PARAMETERS
 from virtual_world.core import Core, step_values
 from virtual_world.core.loop import CycleReport, RealTimeFactor, WorldLoop
@@ -294,7 +293,7 @@ class Portal:
 
 
 #: services whose requests arrive with their arrays as numpy views of the received bytes
-#: (odin_common.packed.numpy_requests): a build's meshes, whose numbers the Core takes as
+#: (odin_common.node.numpy_requests): a build's meshes, whose numbers the Core takes as
 #: arrays (odin_common.specs)
 NUMPY_REQUESTS = frozenset({"build_object", "build_composite", "build_entity"})
 
