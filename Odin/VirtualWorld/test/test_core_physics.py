@@ -313,6 +313,33 @@ def test_open_mesh_falls_back_to_bounding_box():
     np.testing.assert_allclose(np.diag(flat.inertia), [1, 4, 5])
 
 
+PRELOADED_MESH_MASS = """
+import sys
+from virtual_world.core import mass
+assert "trimesh" not in sys.modules
+mass.preload_trimesh()
+assert mass._PRELOAD.name == "preload trimesh"
+import numpy as np
+corners = np.array([[x, y, z] for x in (0, 1.0) for y in (0, 1.0) for z in (0, 1.0)])
+faces = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
+                  [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
+print(mass.mesh_mass(corners, faces, 6.0).rule)      # waits for the preload, then uses it
+assert not mass._PRELOAD.is_alive() and "trimesh" in sys.modules
+"""
+
+
+def test_a_node_preloads_trimesh_and_the_first_mesh_waits_for_that_import():
+    """The world node imports trimesh on a thread of its own once it serves; the first mesh
+    mass waits for that import rather than making a second one beside it (a fresh process:
+    this one has imported trimesh already)."""
+    import subprocess
+    import sys
+    done = subprocess.run([sys.executable, "-c", PRELOADED_MESH_MASS], capture_output=True,
+                          text=True, timeout=120)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.split() == ["closed"]
+
+
 def test_mesh_collides_with_sphere(core):
     ground(core)
     corners = np.array([[x, y, z] for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (0, 0.2)])

@@ -17,7 +17,9 @@ The result is expressed in the mesh's own frame.
 """
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Dict, NamedTuple, Tuple
+import sys
+import threading
+from typing import TYPE_CHECKING, Dict, NamedTuple, Optional, Tuple
 
 import numpy as np
 
@@ -61,10 +63,39 @@ def _rigid(inertia: np.ndarray) -> bool:
     return principal[0] > 0 and principal[0] + principal[1] >= principal[2] * (1 - 1e-9)
 
 
+_PRELOAD: Optional[threading.Thread] = None
+
+
+def preload_trimesh() -> None:
+    """Starts importing trimesh (with scipy: ~0.4 s) on a thread of its own, for a node that
+    has just started serving: imported on the first mesh instead, it was more than half of a
+    fresh world's first load of the TX90 + hand (0.58 of 1.0 s of Core time). Imported at
+    start-up on the node's own thread, it had been a third of every world node's start-up,
+    and most worlds never build a mesh. Only this thread imports it: ``mesh_mass`` waits for
+    it first (two threads importing the same modules at once can deadlock)."""
+    global _PRELOAD
+    if _PRELOAD is None and "trimesh" not in sys.modules:
+        _PRELOAD = threading.Thread(target=_import_trimesh, name="preload trimesh", daemon=True)
+        _PRELOAD.start()
+
+
+def join_preload(timeout: Optional[float] = None) -> None:
+    """Waits for ``preload_trimesh``'s import (a node exiting lets it end first: a daemon
+    thread cut off mid-import at interpreter shutdown can abort the process)."""
+    if _PRELOAD is not None:
+        _PRELOAD.join(timeout)
+
+
+def _import_trimesh() -> None:
+    try:
+        import trimesh  # noqa: F401
+    except Exception:   # mesh_mass imports it again and raises where a mesh needs it
+        pass
+
+
 def mesh_mass(vertices: np.ndarray, triangles: np.ndarray, mass: float) -> MeshMass:
     """Mass properties of a mesh: vertices (n,3) m, triangles (m,3) indices, mass kg > 0."""
-    # imported on the first mesh: trimesh (with scipy) was a third of every world node's
-    # start-up, and most worlds never build a mesh
+    join_preload()
     import trimesh
     mesh = trimesh.Trimesh(np.asarray(vertices, float), np.asarray(triangles, np.int64),
                            process=True, validate=False)

@@ -66,7 +66,7 @@ from odin_common.interface import WORLD_SERVICES, DivergencePolicy
 from odin_common.limits import ResourceLimits
 from odin_common.node import MasterWatch, init_ros_node, numpy_requests, stop_on_signals
 from odin_common.world_parameters import PARAMETERS
-from virtual_world.core import Core, step_values
+from virtual_world.core import Core, mass, step_values
 from virtual_world.core.loop import CycleReport, RealTimeFactor, WorldLoop
 from virtual_world.portal import conversions, message_cap, publish_queue
 from virtual_world.portal.interaction import InteractiveObjects
@@ -321,5 +321,9 @@ def main() -> None:
     stop_on_signals(portal.loop.stop)
     if asked.is_set():
         portal.loop.stop()
-    portal.run()
+    mass.preload_trimesh()                      # the services are up: now, for the first meshes
+    try:
+        portal.run()
+    finally:
+        mass.join_preload(timeout=30.0)
     rospy.signal_shutdown("the world loop stopped")
