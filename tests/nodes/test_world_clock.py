@@ -89,6 +89,12 @@ class _Stamps:
             time.sleep(0.005)
         raise TimeoutError(f"world_update {update} and /clock {clock} after {after}")
 
+    def step(self, client) -> None:
+        """One Step Once of 2 steps, paced by its publication's arrival."""
+        before = self.latest("world_update")
+        client.step_once(2)
+        self.wait_for_the_clock(before)
+
     def close(self) -> None:
         for subscriber in self._subscribers:
             subscriber.unregister()
@@ -133,13 +139,9 @@ def test_time_never_goes_back_across_new_scenes_for_tf_and_sim_time_nodes(ros_ma
         heard = len(stamps.by_topic["joint_states"])
         deadline = time.monotonic() + 30
         while len(stamps.by_topic["joint_states"]) == heard and time.monotonic() < deadline:
-            before = stamps.latest("world_update")
-            client.step_once(2)
-            stamps.wait_for_the_clock(before)
+            stamps.step(client)
         for _ in range(15):
-            before = stamps.latest("world_update")
-            client.step_once(2)
-            stamps.wait_for_the_clock(before)
+            stamps.step(client)
         time.sleep(0.3)
         # tf answers the ball's latest pose: its buffer was never reset by a jump back
         latest = buffer.lookup_transform("world", "pendulum/bob", rospy.Time(0),

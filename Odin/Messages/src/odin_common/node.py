@@ -23,8 +23,8 @@ from typing import Callable, Optional
 
 import rosgraph
 import rospy
-from rospy.numpy_msg import numpy_msg
 from rospy.impl.registration import RegManager, get_service_manager, get_topic_manager
+from rospy.numpy_msg import numpy_msg
 
 from odin_common.errors import NoMasterError
 from odin_common.ros_master import _TimeoutTransport

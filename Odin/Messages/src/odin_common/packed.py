@@ -61,4 +61,3 @@ class PrePacked:
             super().serialize(buff)
         else:
             buff.write(self.packed)
-

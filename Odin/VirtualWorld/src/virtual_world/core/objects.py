@@ -323,23 +323,24 @@ def _build_geometry(scene: Scene, p: _Prepared, part: _Part, body, tag: int) -> 
 
 def _built_geometries(records: Sequence[GeometryRecord]) -> Tuple[BuiltGeometry, ...]:
     positions, quaternions = PoseReader([r.owner for r in records]).read()
-    return tuple(BuiltGeometry(r.name, _flat_tuple(r.parameters, float),
-                               _flat_tuple(r.indices, int), r.color,
+    return tuple(BuiltGeometry(r.name, _flat_numbers(r.parameters, float),
+                               _flat_numbers(r.indices, int), r.color,
                                tuple(positions[k].tolist()), tuple(quaternions[k].tolist()),
                                r.shape_asked)
                  for k, r in enumerate(records))
 
 
-def _flat_tuple(values, kind: type):
+def _flat_numbers(values, kind: type):
     """``values`` as a flat tuple of ``kind`` (float or int), or a read-only flat numpy array
     of float64 (float) or uint32 (int). A message's array already is one and is kept as it
     is: converting a hand's meshes (~800,000 numbers) through numpy and back took ~0.25 s of
     every load; a numpy request's arrays (odin_common.node.numpy_requests) ~0.03 s more."""
-    if type(values) is np.ndarray and values.dtype == (np.float64 if kind is float
-                                                       else np.uint32):
-        flat = values.reshape(-1).view()
-        flat.flags.writeable = False     # the view only: its owner's array stays as it was
-        return flat
+    if type(values) is np.ndarray:
+        flat = (float64_array if kind is float else uint32_array)(values)
+        if flat is not None:
+            flat = flat.view()
+            flat.flags.writeable = False     # the view only: its owner's array stays as it was
+            return flat
     if type(values) is tuple and set(map(type, values)) <= {kind}:
         return values
     return tuple(np.asarray(values, float if kind is float else np.int64).reshape(-1).tolist())

@@ -185,7 +185,7 @@ class ObjectFrames:
         local_p = np.asarray([e[2] for e in ordered], float).reshape(-1, 3)
         local_q = np.asarray([e[3] for e in ordered], float).reshape(-1, 4)
         offset = np.flatnonzero(np.any(local_p != 0.0, axis=1)
-                                | np.any(local_q != IDENTITY_POSE[1], axis=1))
+                                | np.any(local_q != IDENTITY_WXYZ, axis=1))
         return ([e[0] for e in groups[False]], [e[0] for e in groups[True]],
                 np.asarray([e[1] for e in ordered], dtype=np.intp), offset,
                 local_p[offset], local_q[offset])
