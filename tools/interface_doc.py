@@ -98,6 +98,9 @@ SERVICES = {
     "CheckCollision": (f"{PLANNING}; the thesis's PQP-like use, synchronous",
                        "{situations: [{name: ball, position: [0, 0, 0.05], "
                        "orientation: [1, 0, 0, 0]}]}"),
+    "ExemptOverlaps": (f"{PLANNING}; Kautham's geometric problems, which it never "
+                       f"simulates, standing as their files place them",
+                       "{min_depth: 0.001}"),
     "ViewObject": (f"{KNOWN}: thesis 3.3.2, 6.4.1; fields {RECON} (those of Build Object's "
                    f"shape)",
                    "{id: marker, parameters: [0.05], position: [0, 0, 0], "

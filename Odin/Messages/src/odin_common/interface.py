@@ -402,7 +402,8 @@ BODY_STATE_FIELDS: Tuple[Tuple[str, int], ...] = (
 ``state_vector``; the C world's odin_step.h): centre of mass position m, quaternion (w, x, y, z),
 ODE's 3x4 rotation matrix, linear velocity m/s, angular velocity rad/s (world frame), enabled
 (1.0 or 0.0). A vector is ODE's random generator state, then one record per object with a body,
-in the world's object order (Propagate's ``states`` order)."""
+in the world's object order (Propagate's ``states`` order), then one value per exempt pair
+(Exempt Overlaps: 1.0 still exempt, 0.0 parted; none in a world without exempt pairs)."""
 BODY_STATE_SIZE = sum(size for _, size in BODY_STATE_FIELDS)
 #: where each field (BODY_STATE_FIELDS) lies in a body's record: {name: slice}
 BODY_STATE_SLICES: Dict[str, slice] = {
@@ -435,6 +436,7 @@ WORLD_SERVICES: Dict[str, str] = {
     "get_world": "GetWorld", "get_state": "GetState", "save_state": "SaveState", "restore_state": "RestoreState",
     "reset": "Reset", "propagate": "Propagate", "check_collision": "CheckCollision",
     "set_surface": "SetSurface", "set_servo": "SetServo", "set_robot": "SetRobot",
+    "exempt_overlaps": "ExemptOverlaps",
 }
 """The VirtualWorld's services: name under ``~`` -> type in the Services package (the
 thesis's 15, then Odin's own)."""

@@ -19,7 +19,8 @@ from odin_common import limits
 from odin_common.interface import composite_id
 from odin_common.rotations import quaternion_multiply, quaternion_to_matrix
 from odin_common.specs import CompositeSpec, EntitySpec, ObjectSpec, PartSpec
-from virtual_world.core import forces, guard, joints, motors, readout, validation as check
+from virtual_world.core import (exemptions, forces, guard, joints, motors, readout,
+                                validation as check)
 from virtual_world.core.arrays import float64_array, uint32_array
 from virtual_world.core.mass import check_mass, shape_mass
 from virtual_world.core.records import (Built, BuiltEntity, BuiltGeometry, GeometryRecord,
@@ -433,6 +434,7 @@ def remove_object(scene: Scene, object_id: str) -> Removed:
         forces.drop_body_forces(scene, obj.forces)
     names = tuple(g.name for g in obj.geometries)
     readout.carry_collisions(scene, set(names))
+    exemptions.drop_geometries(scene, set(names))
     scene.drop_object(object_id)
     scene.parked.pop(object_id, None)
     guard.refresh(scene)        # before the body goes: C must never see a freed body

@@ -51,6 +51,8 @@ class Scene:
         self.snapshots: Dict[str, object] = {}          # name -> snapshots.Snapshot
         self.reset_point: Optional[object] = None       # the state right after the last build
         self.contents_changed = True                    # a build or removal since reset_point
+        self.exempt_pairs: Tuple = ()                   # core.exemptions.ExemptPair, key order
+        self.exempt_depth = 0.0                         # m: no deeper, an exempt pair parts
         self.parked: Dict[str, object] = {}             # object id -> records.Divergence
         self.divergences: List[object] = []             # records.Divergence not yet taken
         self._pose_reader: Optional[PoseReader] = None

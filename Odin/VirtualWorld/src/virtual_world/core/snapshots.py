@@ -4,11 +4,12 @@ A snapshot holds everything a step reads that calls can change: every body's pos
 velocities (ODE's own numbers, odin_state.c), static geometries' poses, every joint's and
 motor's parameters, motor goals, persistent body and joint forces, simulated time and the
 step count, the world's state of ODE's random generator (QuickStep's constraint order), the
-collisions recorded but not yet read, which bodies the divergence guard had parked and which
-links the kinematic drive moved. Putting one back, then stepping as before, gives
+collisions recorded but not yet read, which bodies the divergence guard had parked, which
+links the kinematic drive moved and which exempt pairs had not yet parted (core.exemptions). Putting one back, then stepping as before, gives
 bit-identical poses and velocities (tests/ compare raw float64 bytes).
 
-A snapshot belongs to the scene's contents when it was taken (its objects, joints and motors):
+A snapshot belongs to the scene's contents when it was taken (its objects, joints, motors and
+exempt pairs):
 it can be put back while they are the same, and is refused otherwise. World parameters are not
 state: they stay as they are.
 """
@@ -20,20 +21,20 @@ from typing import Dict, Tuple
 import numpy as np
 
 from odin_common.interface import JOINT_PARAMETER_AXES, JOINT_PARAMETERS, MOTOR_PARAMETERS
-from virtual_world.core import forces, guard, kinematic, motors, readout
+from virtual_world.core import exemptions, forces, guard, kinematic, motors, readout
 from virtual_world.core.records import BodyForceRecord, Collision, JointForceRecord
 from virtual_world.core.scene import Scene
 from virtual_world.errors import InvalidArgument
 from virtual_world.ode import bodies
 from virtual_world.ode import joints as ode_joints
 
-Contents = Tuple[Tuple[str, ...], Tuple[str, ...], Tuple[str, ...]]
+Contents = Tuple[Tuple[str, ...], Tuple[str, ...], Tuple[str, ...], Tuple]
 
 
 @dataclass(frozen=True, eq=False)
 class Snapshot:
     """A scene's dynamic state (see the module's docstring); private to the Core."""
-    contents: Contents                          # object, joint and motor ids
+    contents: Contents                          # object, joint, motor ids, exempt pairs
     body_ids: Tuple[str, ...]
     body_states: np.ndarray                     # (n, bodies.BODY_STATE_SIZE)
     static_names: Tuple[str, ...]               # geometries without a body
@@ -50,10 +51,11 @@ class Snapshot:
     rand_seed: int
     parked: Tuple[str, ...]                     # objects the divergence guard had parked
     kinematic: Dict[str, str]                   # the kinematic drive's links (motor -> object)
+    exempt_live: np.ndarray                     # exempt pairs' states (core.exemptions)
 
 
 def contents(scene: Scene) -> Contents:
-    return tuple(scene.objects), tuple(scene.joints), tuple(scene.motors)
+    return tuple(scene.objects), tuple(scene.joints), tuple(scene.motors), scene.exempt_pairs
 
 
 def take(scene: Scene) -> Snapshot:
@@ -73,7 +75,8 @@ def take(scene: Scene) -> Snapshot:
         body_forces=dict(scene.body_forces), joint_forces=dict(scene.joint_forces),
         carried=dict(scene.carried), sim_time=scene.sim_time,
         step_count=scene.c.step_count, rand_seed=scene.c.rand_seed,
-        parked=tuple(scene.parked), kinematic=dict(scene.kinematic))
+        parked=tuple(scene.parked), kinematic=dict(scene.kinematic),
+        exempt_live=exemptions.live(scene))
 
 
 def _joint_parameters(scene: Scene):
@@ -97,7 +100,8 @@ def check_fits(scene: Scene, snapshot: Snapshot, what: str) -> None:
     if now == snapshot.contents:
         return
     changes = []
-    for label, then, present in zip(("objects", "joints", "motors"), snapshot.contents, now):
+    labels = ("objects", "joints", "motors", "exempt pairs")
+    for label, then, present in zip(labels, snapshot.contents, now):
         added = [i for i in present if i not in set(then)]
         gone = [i for i in then if i not in set(present)]
         if added:
@@ -132,3 +136,4 @@ def put_back(scene: Scene, snapshot: Snapshot) -> None:
     scene.sim_time = snapshot.sim_time
     scene.c.step_count = snapshot.step_count
     scene.c.rand_seed = snapshot.rand_seed
+    exemptions.put_live(scene, snapshot.exempt_live)

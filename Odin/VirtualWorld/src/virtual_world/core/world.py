@@ -25,8 +25,8 @@ from odin_common.interface import ForceKind, JointType, MotorKind, ServoDrive, S
 from odin_common.limits import ResourceLimits
 from odin_common.specs import CompositeSpec, EntitySpec, JointSpec, MotorSpec, ObjectSpec
 from odin_common.world_parameters import WorldParameters
-from virtual_world.core import (forces, guard, joints, kinematic, motors, objects, readout,
-                                snapshots, validation as check)
+from virtual_world.core import (exemptions, forces, guard, joints, kinematic, motors, objects,
+                                readout, snapshots, validation as check)
 from virtual_world.core.requests import changes_contents, changes_state, disturbs, locked
 from virtual_world.core.records import (BodyState, Built, BuiltEntity, Collision, Divergence,
                                         JointReaction, JointState, MotorState, ObjectState,
@@ -421,7 +421,8 @@ class Core:
         states themselves (OMPL): ODE's random generator state (QuickStep's constraint order),
         then per body with a body (object order) its raw record (position, quaternion wxyz,
         rotation matrix, linear and angular velocity, enabled: ``BODY_STATE_SIZE`` values,
-        m, m/s, rad/s, world frame; odin_common.interface.BODY_STATE_FIELDS).
+        m, m/s, rad/s, world frame; odin_common.interface.BODY_STATE_FIELDS), then one value
+        per exempt pair (``exempt_overlaps``: 1.0 exempt, 0.0 parted; none without them).
         ``set_body_state_vector`` puts it back bit for bit. Motors, servos and persistent
         forces are not in it: they stay as they are."""
         return self._state_vector()
@@ -429,7 +430,8 @@ class Core:
     def _state_vector(self) -> np.ndarray:
         scene = self._scene
         return np.concatenate(([float(scene.c.rand_seed)],
-                               bodies.read_states(self._body_ptrs()).ravel()))
+                               bodies.read_states(self._body_ptrs()).ravel(),
+                               exemptions.live(scene)))
 
     def _body_ptrs(self) -> list:
         return [o.body.ptr for o in self._scene.objects.values() if o.body is not None]
@@ -450,9 +452,9 @@ class Core:
 
     def _checked_state_vector(self, vector: Sequence[float]) -> np.ndarray:
         vector = self._sized_state_vector(vector)
-        fault = bodies.state_vector_fault(vector)
+        fault = bodies.state_vector_fault(vector, len(self._scene.exempt_pairs))
         if fault >= 0:
-            raise _state_vector_fault(vector, fault)
+            raise _state_vector_fault(vector, fault, len(self._scene.exempt_pairs))
         return vector
 
     def _sized_state_vector(self, vector: Sequence[float]) -> np.ndarray:
@@ -463,16 +465,20 @@ class Core:
         except (TypeError, ValueError):
             raise InvalidArgument(f"a body state vector holds numbers; got "
                                   f"{str(vector)[:60]}") from None
-        size = 1 + self._scene.body_array().count * bodies.BODY_STATE_SIZE
+        exempt = len(self._scene.exempt_pairs)
+        size = 1 + self._scene.body_array().count * bodies.BODY_STATE_SIZE + exempt
         if vector.shape != (size,):
+            pairs = f" + {exempt} exempt pairs" if exempt else ""
             raise InvalidArgument(f"a body state vector of this world has {size} finite "
-                                  f"values (1 + {bodies.BODY_STATE_SIZE} per body); got "
-                                  f"shape {vector.shape}")
+                                  f"values (1 + {bodies.BODY_STATE_SIZE} per body{pairs}); "
+                                  f"got shape {vector.shape}")
         return vector
 
     def _put_state_vector(self, vector: np.ndarray) -> None:
         scene, ptrs = self._scene, self._body_ptrs()
-        bodies.write_states(ptrs, vector[1:].reshape(len(ptrs), bodies.BODY_STATE_SIZE))
+        end = 1 + len(ptrs) * bodies.BODY_STATE_SIZE
+        bodies.write_states(ptrs, vector[1:end].reshape(len(ptrs), bodies.BODY_STATE_SIZE))
+        exemptions.put_live(scene, vector[end:])
         scene.c.clear_records()
         scene.carried = {}
         scene.c.rand_seed = int(vector[0])
@@ -555,7 +561,7 @@ class Core:
         state, steps, pairs = scene.c.propagate(scene.body_array(), start_state, pushes,
                                                 step_size, steps)
         if steps < 0:        # C checks the state's values before it changes anything
-            raise _state_vector_fault(start_state, -1 - steps)
+            raise _state_vector_fault(start_state, -1 - steps, len(scene.exempt_pairs))
         scene.carried = {}
         scene.sim_time += step_size * steps
         guard.collect(scene, step_size)
@@ -584,6 +590,18 @@ class Core:
             if read_states else ()
         return Propagation(start_time, step_size, steps, states, collisions, 0.0, False,
                            self._state_vector())
+
+    @changes_contents
+    def exempt_overlaps(self, min_depth: float) -> List[Collision]:
+        """The pairs inside each other now deeper than ``min_depth`` m, where a part has a
+        body, do not collide until they have parted (no deeper than ``min_depth``, or apart,
+        at a step's collide pass); they replace the exempt pairs before (core.exemptions).
+        What a loader asks after building a problem that places parts inside each other.
+        Returns the pairs exempted (names, depth, points)."""
+        min_depth = check.number("min_depth", min_depth)
+        if min_depth < 0:
+            raise InvalidArgument(f"min_depth={min_depth!r} m must not be negative")
+        return exemptions.exempt(self._scene, min_depth)
 
     @locked
     def check_collision(self, poses: Sequence[Tuple[str, Sequence[float], Sequence[float]]]
@@ -719,11 +737,15 @@ class Core:
         return readout.read_collisions(self._scene)
 
 
-def _state_vector_fault(vector: np.ndarray, index: int) -> InvalidArgument:
-    """The refusal of a body state vector whose value ``index`` cannot be put back."""
+def _state_vector_fault(vector: np.ndarray, index: int, exempt: int) -> InvalidArgument:
+    """The refusal of a body state vector whose value ``index`` cannot be put back (its last
+    ``exempt`` values are exempt pairs' states)."""
     if index == 0:
         return InvalidArgument(f"random generator state {float(vector[0])!r} is not a "
                                "32-bit integer")
+    if index >= vector.size - exempt:
+        return InvalidArgument(f"an exempt pair's state is 0.0 or 1.0; value {index} is "
+                               f"{float(vector[index])!r}")
     return InvalidArgument(f"a body state vector's values are finite; value {index} is "
                            f"{float(vector[index])!r}")
 

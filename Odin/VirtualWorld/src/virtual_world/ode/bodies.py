@@ -111,10 +111,12 @@ def read_states(bodies: Sequence) -> np.ndarray:
     return out
 
 
-def state_vector_fault(vector: np.ndarray) -> int:
+def state_vector_fault(vector: np.ndarray, flags: int = 0) -> int:
     """-1 when a body state vector (contiguous float64) can be put back: a 32-bit integer
-    generator state, finite values; else the index of the first value that is not."""
-    return int(lib.odin_state_vector_fault(ffi.from_buffer("double[]", vector), vector.size))
+    generator state, finite values, its last ``flags`` values (exempt pairs' states) 0.0 or
+    1.0; else the index of the first value that is not."""
+    return int(lib.odin_state_vector_fault(ffi.from_buffer("double[]", vector), vector.size,
+                                           flags))
 
 
 @drains_ode_messages

@@ -36,9 +36,11 @@ void odin_write_body_states(dBodyID *bodies, int n, const double *in) {
     }
 }
 
-int odin_state_vector_fault(const double *v, int size) {
+int odin_state_vector_fault(const double *v, int size, int flags) {
     if (!(v[0] >= 0.0 && v[0] < 4294967296.0 && v[0] == floor(v[0]))) return 0;
-    for (int i = 1; i < size; ++i)
+    for (int i = 1; i < size - flags; ++i)
         if (!isfinite(v[i])) return i;
+    for (int i = size - flags > 1 ? size - flags : 1; i < size; ++i)
+        if (v[i] != 0.0 && v[i] != 1.0) return i;
     return -1;
 }

@@ -315,6 +315,46 @@ static void make_contacts(OdinWorld *w, double h) {
     w->n_pairs = w->n_contacts = 0;
 }
 
+/* ---------------------------------------------------------------- exempt pairs */
+
+/* The index of the live exempt pair with this key, or -1 (a binary search: keys ascend). */
+static int live_exempt(const OdinWorld *w, uint64_t key) {
+    int lo = 0, hi = w->n_exempt - 1;
+    while (lo <= hi) {
+        int mid = lo + (hi - lo) / 2;
+        uint64_t k = w->exempt_keys[mid];
+        if (k == key) return w->exempt_live[mid] != 0.0 ? mid : -1;
+        if (k < key) lo = mid + 1;
+        else hi = mid - 1;
+    }
+    return -1;
+}
+
+/* A live exempt pair met by the broad phase. Deeper than its limit: it parts now and 0 is
+ * returned (the caller collides it as any pair). Otherwise 1: recorded like any colliding
+ * pair, no contacts, and marked as still inside each other while deeper than exempt_depth. */
+static int collide_exempt(OdinWorld *w, dGeomID o1, dGeomID o2, int e) {
+    dContact contact[ODIN_MAX_CONTACTS];
+    int n = dCollide(o1, o2, w->max_contacts, &contact[0].geom, sizeof(dContact));
+    double depth = 0.0;
+    for (int i = 0; i < n; ++i)
+        if (contact[i].geom.depth > depth) depth = contact[i].geom.depth;
+    if (depth > w->exempt_limit[e]) {
+        w->exempt_live[e] = 0.0;
+        return 0;
+    }
+    if (n > 0 && w->recording) record_pair(w, o1, o2, contact, n);
+    if (depth > w->exempt_depth) w->exempt_seen[e] = 1;
+    return 1;
+}
+
+/* After a step's collide pass: the live pairs it did not find deeper than exempt_depth have
+ * parted, for good. */
+static void part_exempt_pairs(OdinWorld *w) {
+    for (int i = 0; i < w->n_exempt; ++i)
+        if (!w->exempt_seen[i]) w->exempt_live[i] = 0.0;
+}
+
 /* ---------------------------------------------------------------- near-callback */
 
 static void near_callback(void *data, dGeomID o1, dGeomID o2) {
@@ -328,6 +368,10 @@ static void near_callback(void *data, dGeomID o1, dGeomID o2) {
     dBodyID b1 = dGeomGetBody(o1), b2 = dGeomGetBody(o2);
     if (b1 == b2) return; /* parts of one composite, or two static geoms */
     if (b1 && b2 && dAreConnectedExcluding(b1, b2, dJointTypeContact)) return;
+    if (w->n_exempt) {
+        int e = live_exempt(w, (uint64_t)i1->serial << 32 | (uint64_t)(uint32_t)i2->serial);
+        if (e >= 0 && collide_exempt(w, o1, o2, e)) return;
+    }
     if (!w->contact_less) {
         int dynamic = (b1 && !dBodyIsKinematic(b1)) || (b2 && !dBodyIsKinematic(b2));
         if (!dynamic) return; /* nothing can move: no contact needed */
@@ -791,7 +835,9 @@ int odin_world_step(OdinWorld *w, double h, int count) {
             w->recording = (s == count - 1);
             if (w->recording) odin_world_clear_records(w);
         }
+        if (w->n_exempt) memset(w->exempt_seen, 0, (size_t)w->n_exempt);
         dSpaceCollide(w->space, w, &near_callback);   /* 1. collisions, */
+        if (w->n_exempt) part_exempt_pairs(w);        /*    exempt pairs apart now part */
         if (!w->contact_less) make_contacts(w, h);    /*    contacts in serial order */
         apply_body_forces(w);                         /* 2. forces and torques on bodies */
         apply_joint_forces(w);                        /* 3. joint forces and motor goals */
@@ -825,10 +871,13 @@ int odin_world_step(OdinWorld *w, double h, int count) {
 int odin_world_propagate(OdinWorld *w, dBodyID *bodies, int n, const double *state_in,
                          const OdinBodyForce *forces, int n_forces, double h, int count,
                          double *state_out, uintptr_t *pairs, int max_pairs, int *n_pairs) {
-    int fault = odin_state_vector_fault(state_in, 1 + n * ODIN_BODY_STATE_SIZE);
+    int size = 1 + n * ODIN_BODY_STATE_SIZE;
+    int fault = odin_state_vector_fault(state_in, size + w->n_exempt, w->n_exempt);
     *n_pairs = 0;
     if (fault >= 0) return -1 - fault;
     odin_write_body_states(bodies, n, state_in + 1);
+    if (w->n_exempt)
+        memcpy(w->exempt_live, state_in + size, (size_t)w->n_exempt * sizeof(double));
     odin_world_clear_records(w);
     w->rand_seed = (unsigned long)state_in[0];
     w->propagation_forces = forces;
@@ -840,6 +889,8 @@ int odin_world_propagate(OdinWorld *w, dBodyID *bodies, int n, const double *sta
     w->n_propagation_forces = 0;
     state_out[0] = (double)w->rand_seed;
     odin_read_body_states(bodies, n, state_out + 1);
+    if (w->n_exempt)
+        memcpy(state_out + size, w->exempt_live, (size_t)w->n_exempt * sizeof(double));
     *n_pairs = odin_world_record_pairs(w, pairs, max_pairs);
     if (*n_pairs <= max_pairs) odin_world_clear_records(w);
     return taken;

@@ -175,6 +175,18 @@ typedef struct OdinWorld {
                                 odin_world_propagate, whose caller reads only the pairs) */
     int unordered;           /* benchmarks only: contacts made as the broad phase finds them
                                 (not deterministic), to measure what the ordering costs */
+    /* pairs a build left inside each other that do not collide until they have parted
+     * (Core.exempt_overlaps, docs/INTERFACE.md): their keys (OdinPair.key's, serial << 32 |
+     * serial), ascending, the depth (m) each may reach, and each one's state, 1.0 exempt or
+     * 0.0 parted (the last values of a body state vector). A live exempt pair makes no
+     * contacts and is recorded as colliding while it is deeper than exempt_depth (m) and no
+     * deeper than its limit; the first step whose collide pass finds it no deeper than
+     * exempt_depth (or apart) parts it for good, and it collides as any pair from the next
+     * step; found deeper than its limit, it parts at once and collides in that very pass (an
+     * exempt pair may move apart, never further in). Arrays owned by Python. */
+    const uint64_t *exempt_keys; const double *exempt_limit; double *exempt_live; int n_exempt;
+    double exempt_depth;
+    unsigned char *exempt_seen;  /* internal (Python's array): met deeper in this step's pass */
     /* the divergence guard: after every step each guarded body must be finite, slower than
      * max_speed (m/s) and max_spin (rad/s) and within extent (m) of the origin on every axis;
      * one that is not is parked (made kinematic, still, colliding with nothing, put back
@@ -228,7 +240,7 @@ int odin_world_sleeping(const OdinWorld *w);
 void odin_world_clear_divergences(OdinWorld *w);
 /* One planner's propagation in one call: puts back the body state vector state_in (ODE's
  * random generator state, then ODIN_BODY_STATE_SIZE values for each of the n bodies, in the
- * order of `bodies`; odin_write_body_states), forgets the collision records, adds `forces`
+ * order of `bodies`, odin_write_body_states, then the n_exempt exempt pairs' states), forgets the collision records, adds `forces`
  * (n_forces, after the persistent ones) for this call only, runs odin_world_step(w, h, count)
  * recording every step's colliding pairs, and writes the state reached into state_out (the
  * same layout). The same ODE calls in the same order as putting the vector back, adding the
@@ -257,10 +269,11 @@ void odin_world_free_buffers(OdinWorld *w);
 #define ODIN_BODY_STATE_SIZE 26
 void odin_read_body_states(dBodyID *bodies, int n, double *out);
 void odin_write_body_states(dBodyID *bodies, int n, const double *in);
-/* -1 when the body state vector v (size values: ODE's random generator state, then the
- * bodies' records) can be put back: v[0] an integer in [0, 2^32) and every value finite;
- * otherwise the index of the first value that is not (0: the generator's state). */
-int odin_state_vector_fault(const double *v, int size);
+/* -1 when the body state vector v (size values: ODE's random generator state, the bodies'
+ * records, then `flags` exempt pairs' states) can be put back: v[0] an integer in [0, 2^32),
+ * every value finite and each of the last `flags` 0.0 or 1.0; otherwise the index of the first
+ * value that is not (0: the generator's state). */
+int odin_state_vector_fault(const double *v, int size, int flags);
 
 /* Vectorised read-out of geom world poses: pos (n,3), quat (n,4) wxyz. */
 void odin_read_poses(dGeomID *geoms, int n, double *pos, double *quat);

@@ -245,6 +245,38 @@ class CWorld:
         goal = self._arrays["motors"][slot]
         return tuple(sign * goal.position[k] for k, sign in enumerate(signs))
 
+    # -- exempt pairs -------------------------------------------------------------------------
+    def set_exemptions(self, keys: Sequence[int], limits: Sequence[float],
+                       live: Sequence[float], depth: float) -> None:
+        """The pairs that do not collide until they have parted (odin_step.h: OdinWorld's
+        exempt_keys): their keys (serial << 32 | serial, ascending), the depth (m) each may
+        reach, each one's state (1.0 exempt, 0.0 parted) and the depth (m) at most which a
+        pair has parted."""
+        keys = np.array(keys, dtype=np.uint64)
+        limits = np.array(limits, dtype=np.float64)
+        live = np.array(live, dtype=np.float64)
+        seen = np.zeros(max(len(keys), 1), dtype=np.uint8)
+        s, some = self.struct, len(keys) > 0
+        s.exempt_keys = ffi.from_buffer("uint64_t[]", keys) if some else ffi.NULL
+        s.exempt_limit = ffi.from_buffer("double[]", limits) if some else ffi.NULL
+        s.exempt_live = ffi.from_buffer("double[]", live) if some else ffi.NULL
+        s.exempt_seen = ffi.from_buffer("unsigned char[]", seen)
+        s.exempt_depth = depth
+        s.n_exempt = len(keys)
+        self._arrays["exempt"] = (keys, limits, live, seen)
+
+    @property
+    def exempt_live(self) -> np.ndarray:
+        """Each exempt pair's state now (1.0 exempt, 0.0 parted), a copy."""
+        arrays = self._arrays.get("exempt")
+        return arrays[2].copy() if arrays else np.empty(0)
+
+    @exempt_live.setter
+    def exempt_live(self, values: np.ndarray) -> None:
+        arrays = self._arrays.get("exempt")
+        if arrays:
+            arrays[2][:] = values
+
     def _install(self, field: str, array, count: int) -> None:
         setattr(self.struct, field, array)
         setattr(self.struct, "n_" + field, count)
@@ -325,6 +357,8 @@ class CWorld:
         for field in ("forces", "joint_forces", "motors", "kinematic", "guarded"):
             setattr(s, field, ffi.NULL)
             setattr(s, "n_" + field, 0)
+        s.exempt_keys = s.exempt_limit = s.exempt_live = s.exempt_seen = ffi.NULL
+        s.n_exempt = 0
         self._arrays.clear()
         lib.odin_world_clear_records(s)
         lib.odin_world_free_buffers(s)

@@ -283,6 +283,11 @@ class WorldServices:
         return {"pairs": conversions.collision_pairs(pairs),
                 "message": f"{len(pairs)} colliding pair(s)"}
 
+    def exempt_overlaps(self, request) -> dict:
+        pairs = self.core.exempt_overlaps(request.min_depth)
+        return {"pairs": conversions.collision_pairs(pairs),
+                "message": f"{len(pairs)} pair(s) exempt until they part"}
+
     def set_joint_force(self, request) -> dict:
         if request.remove:
             self.core.remove_joint_force(request.id)
