@@ -180,7 +180,12 @@ def test_a_control_path_drives_the_sphere_demo_to_its_goal(world, kautham_dir, t
 def test_load_problem_warns_of_parts_the_problem_builds_inside_each_other(world, tmp_path):
     """A 2012 robot without <Home> stands at the origin (Kautham: "If robot hasn't a home, it
     will be assumed in the origin"), here inside a box of its scene: built as the problem
-    says, with one warning naming the pair; a robot clear of the box gets none."""
+    says, with one warning naming the pair, and it stands there when the world runs (the pair
+    is exempt until it has moved apart: Kautham never simulates this problem); a robot clear
+    of the box gets none."""
+    import rospy
+    from Messages.msg import SpaceDistribution
+    from gui.ros.client import WorldClient
     cube = "#Inventor V2.1 ascii\n\nSeparator { Cube { width 100 height 100 depth 100 } }\n"
     (tmp_path / "cube.iv").write_text(cube)
     (tmp_path / "arm.rob").write_text(
@@ -206,6 +211,20 @@ def test_load_problem_warns_of_parts_the_problem_builds_inside_each_other(world,
     assert warnings[0].startswith(f"load_problem: warning: {inside}: built with parts inside "
                                   "each other, where the problem places them: arm/J1 in ")
     assert " by 50.0 mm" in warnings[0]
+    assert warnings[0].endswith("they do not collide until they have moved apart (Kautham "
+                                "never simulates this problem)")
+    rospy.init_node("overlap_test", anonymous=True, disable_signals=True)
+    client = WorldClient()
+
+    def link_position() -> np.ndarray:
+        update = rospy.wait_for_message("/virtual_world/world_update", SpaceDistribution,
+                                        timeout=10)
+        return np.array(next(s.position for s in update.situations if s.name == "arm/J1"))
+
+    built = link_position()
+    client.call("step_once", cycles=25)                          # 1 s of simulated time
+    assert np.linalg.norm(link_position() - built) < 0.001     # not pushed out of the box
+    client.close()
     clear = problem("clear.xml", 500.0)
     result = world.run(["rosrun", "GUI", "load_problem", str(clear)], timeout=120)
     assert "inside each other" not in result.stderr, result.stderr

@@ -29,9 +29,45 @@ def test_deep_pairs_with_a_part_that_moves_count_deepest_first():
 
 def test_the_warning_names_the_file_the_deepest_pairs_and_counts_the_rest():
     overlaps = [Overlap(f"arm/link{k}", "floor", 0.01 - k * 0.001) for k in range(5)]
-    line = overlap_warning("p.xml", overlaps)
+    line = overlap_warning("p.xml", overlaps, exempt=True)
     assert line.startswith("p.xml: built with parts inside each other, where the problem "
                            "places them: arm/link0 in floor by 10.0 mm, arm/link1 in floor by "
-                           "9.0 mm, arm/link2 in floor by 8.0 mm and 2 more pairs;")
+                           "9.0 mm, arm/link2 in floor by 8.0 mm and 2 more pairs; they do not "
+                           "collide until they have moved apart")
     assert "\n" not in line
-    assert "more" not in overlap_warning("p.xml", overlaps[:1])
+    assert "more" not in overlap_warning("p.xml", overlaps[:1], exempt=True)
+    assert overlap_warning("p.xml", overlaps[:1], exempt=False).endswith(
+        "; their contacts push them apart when the world runs, as in Kautham's ODE world")
+
+
+def test_a_problem_kautham_never_simulates_stands_where_it_places_its_parts(tmp_path):
+    """A 2012 arm without <Home> at the origin, its link 50 mm inside a box of the scene:
+    built, its pair exempt, and after 1 s of simulation the link is where it was built; the
+    same arm clear of the box has nothing to exempt."""
+    import numpy as np
+    from gui_core_world import CoreWorld
+    cube = "#Inventor V2.1 ascii\n\nSeparator { Cube { width 100 height 100 depth 100 } }\n"
+    (tmp_path / "cube.iv").write_text(cube)
+    (tmp_path / "arm.rob").write_text(
+        '<?xml version="1.0"?>\n<Robot name="arm" DHType="Modified" robType="Chain">\n'
+        '<Joints size="2"><Joint name="Base" ivFile="cube.iv"><DHPars alpha="0" a="0" '
+        'theta="0" d="0"/><Description rotational="true" movable="false"/><Limits Hi="0" '
+        'Low="0"/><Parent name=""/></Joint><Joint name="J1" ivFile="cube.iv"><DHPars '
+        'alpha="0" a="0" theta="0" d="300"/><Description rotational="true" movable="true"/>'
+        '<Limits Hi="90" Low="-90"/><Parent name="Base"/></Joint></Joints>\n</Robot>\n')
+    for name, box_x_mm, expected in (("inside.xml", 50.0, 1), ("clear.xml", 500.0, 0)):
+        path = tmp_path / name
+        path.write_text(
+            '<?xml version="1.0"?>\n<Problem>\n<Robot robot="arm.rob"/>\n'
+            f'<Scene scene="cube.iv" scale="1.0"><Location X="{box_x_mm}" Y="0" Z="300" '
+            'WX="0" WY="0" WZ="1" TH="0"/></Scene>\n</Problem>\n')
+        plan = plan_problem(load_problem(path))
+        world = CoreWorld()
+        try:
+            ids = world.execute(plan)
+            assert ids["overlaps_exempt"] and len(ids["overlaps"]) == expected
+            built = world.position("arm/J1")
+            world.run(1.0)
+            assert np.linalg.norm(world.position("arm/J1") - built) < 0.001
+        finally:
+            world.close()

@@ -5,8 +5,12 @@ Kautham places robots and obstacles where the problem says, and a geometric prob
 simulates them: a 2012 robot without ``<Home>`` stands at the origin (``Problem::
 setupFromFile``: "If robot hasn't a home, it will be assumed in the origin"), which may be
 inside its scene. In a physical world the contacts of such a pair push the parts apart as soon
-as the world runs: the robot moves off the pose it was built at. Odin builds what the problem
-says and says so, once, naming the pairs.
+as the world runs: the robot would move off the pose it was built at. So after building a
+problem Kautham never simulates, the loader asks the world to exempt such pairs (Exempt
+Overlaps): they stand where the problem put them and collide once they have moved apart, never
+further in. Under Kautham's physics (one of its ODE planners) Kautham's own ODE world pushes
+them apart, and so does Odin's. Either way Odin builds what the problem says and says so, once,
+naming the pairs.
 
 A pair counts when it overlaps by more than ``BUILT_OVERLAP`` (resting contact is a fraction
 of a millimetre deep) and at least one of its parts can move (two static parts never push each
@@ -39,14 +43,31 @@ def built_overlaps(plan, pairs: Sequence[Tuple[str, str, float]],
     return sorted(found, key=lambda o: (-o.depth, o.first, o.second))
 
 
-def overlap_warning(source: str, overlaps: Sequence[Overlap]) -> str:
-    """One line for the user: ``source`` (the problem file) and the deepest pairs."""
+def settle_overlaps(world, plan) -> Tuple[List[Overlap], bool]:
+    """After ``plan`` was built in ``world`` (a gui.ros WorldClient or a planning CoreWorld):
+    the pairs it built inside each other and whether they are exempt. In a problem Kautham
+    never simulates the world is asked to exempt them (Exempt Overlaps) until they have moved
+    apart; under Kautham's physics they are only found (Check Collision)."""
+    exempt = not plan.problem.physics
+    found = world.exempt_overlaps(BUILT_OVERLAP) if exempt else world.check_collision([])
+    return built_overlaps(plan, found), exempt
+
+
+def overlap_warning(source: str, overlaps: Sequence[Overlap], exempt: bool) -> str:
+    """One line for the user: ``source`` (the problem file), the deepest pairs and what the
+    world does with them (``exempt``: they do not collide until they have moved apart)."""
     named = ", ".join(f"{o.first} in {o.second} by {o.depth * 1000:.1f} mm"
                       for o in overlaps[:PAIRS_NAMED])
     more = len(overlaps) - PAIRS_NAMED
     rest = f" and {more} more pair{'s' if more > 1 else ''}" if more > 0 else ""
     return (f"{source}: built with parts inside each other, where the problem places them: "
-            f"{named}{rest}; their contacts push them apart when the world runs")
+            f"{named}{rest}; " + (EXEMPT if exempt else PUSHED))
+
+
+#: what the world does with the pairs of a problem Kautham never simulates
+EXEMPT = "they do not collide until they have moved apart (Kautham never simulates this problem)"
+#: ... and under Kautham's physics
+PUSHED = "their contacts push them apart when the world runs, as in Kautham's ODE world"
 
 
 def _static_geometries(plan) -> set:

@@ -20,6 +20,7 @@ from typing import Dict, List, NamedTuple, Optional, Protocol, Sequence, Tuple
 import numpy as np
 
 from gui.core.control_path import Actuation, BodyState, ControlRow, ServoCommand, actuation
+from gui.core.overlaps import settle_overlaps
 from gui.core.plan import BuildPlan, BuiltIds
 from gui.planning.problem import PlanningProblem
 from odin_common.interface import BODY_STATE_SIZE, BODY_STATE_SLICES, ForceKind
@@ -108,19 +109,28 @@ class CoreWorld:
                     servos[motor][name] = split
         self.core.set_servos(servos)
 
+    def exempt_overlaps(self, min_depth: float) -> list:
+        return [(c.first, c.second, c.depth) for c in self.core.exempt_overlaps(min_depth)]
+
+    def check_collision(self, poses) -> list:
+        return [(c.first, c.second, c.depth) for c in self.core.check_collision(poses)]
+
     def execute(self, plan: BuildPlan) -> dict:
         return send_plan(self, plan)
 
 
 def send_plan(world, plan: BuildPlan) -> dict:
-    """Sends every step of ``plan`` to ``world`` (a CoreWorld or a gui.ros WorldClient) and
-    records the world's IDs in it; no robot is declared (the planner's worlds publish
-    nothing anyone reads)."""
+    """Sends every step of ``plan`` to ``world`` (a CoreWorld or a gui.ros WorldClient),
+    records the world's IDs in it and settles the parts it built inside each other as the
+    world node's loads do (gui.core.overlaps.settle_overlaps, answered as "overlaps" and
+    "overlaps_exempt", warned about by no one); no robot is declared (the planner's worlds
+    publish nothing anyone reads)."""
     ids = BuiltIds()
     for step in plan.steps:
         step.send(world, ids)
     plan.record_world_ids(ids)
-    return ids.as_dict()
+    overlaps, exempt = settle_overlaps(world, plan)
+    return {**ids.as_dict(), "overlaps": overlaps, "overlaps_exempt": exempt}
 
 
 def step_actuation(problem: PlanningProblem, control: Sequence[float], base) -> Actuation:

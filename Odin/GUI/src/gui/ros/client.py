@@ -27,7 +27,7 @@ from typing import Callable, Dict, NamedTuple, Optional, Sequence, Tuple
 
 import numpy as np
 
-from gui.core.overlaps import built_overlaps, overlap_warning
+from gui.core.overlaps import overlap_warning, settle_overlaps
 from gui.core.plan import BuildPlan, BuiltIds, RobotHandle
 from gui.core.robot_description import RobotDescription, describe_robot
 from gui.errors import WorldError
@@ -379,6 +379,13 @@ class WorldClient:
         r = self.call("check_collision", situations=situation_messages(poses))
         return [(p.first, p.second, p.depth) for p in r.pairs]
 
+    def exempt_overlaps(self, min_depth: float) -> list:
+        """Exempt Overlaps: the pairs inside each other deeper than ``min_depth`` m (where a
+        part has a body) do not collide until they have moved apart; [(first, second, depth
+        m)] of those pairs."""
+        r = self.call("exempt_overlaps", min_depth=min_depth)
+        return [(p.first, p.second, p.depth) for p in r.pairs]
+
     def check_configuration(self, handle: RobotHandle, values: Sequence[float]) -> list:
         """Check Collision for a robot at joint ``values`` (rad / m, the robot's movable joints
         in order), every link placed by forward kinematics."""
@@ -414,7 +421,8 @@ class WorldClient:
         Joint and motor IDs the world returns replace the predicted ones in ``plan.robots``.
         Stops at the first refusal (``WorldError``); what was built before stays built.
         Parts built inside each other (``gui.core.overlaps``) are warned about once and
-        answered as "overlaps": [Overlap]."""
+        answered as "overlaps": [Overlap]; in a problem Kautham never simulates they are
+        exempt until they have moved apart ("overlaps_exempt": True)."""
         ids = BuiltIds()
         for k, step in enumerate(plan.steps, start=1):
             answer = step.send(self, ids)
@@ -424,11 +432,12 @@ class WorldClient:
         folder = robot_mesh_dir() if mesh_dir is None else mesh_dir
         namespaces = {handle.name: self.set_robot(describe_robot(handle, folder))
                       for handle in plan.robots}
-        overlaps = built_overlaps(plan, self.check_collision([]))
+        overlaps, exempt = settle_overlaps(self, plan)
         if overlaps:
             logging.getLogger("gui.core.overlaps").warning(
-                overlap_warning(plan.problem.source, overlaps))
-        return {**ids.as_dict(), "robots": namespaces, "overlaps": overlaps}
+                overlap_warning(plan.problem.source, overlaps, exempt))
+        return {**ids.as_dict(), "robots": namespaces, "overlaps": overlaps,
+                "overlaps_exempt": exempt}
 
 
 # -- requests whose meshes go out as numpy bytes -----------------------------------------

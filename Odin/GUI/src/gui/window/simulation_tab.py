@@ -164,7 +164,8 @@ class SimulationTab(QWidget):
                                   f"{self.last_build_seconds:.2f} s")
             if ids["overlaps"]:
                 from gui.core.overlaps import overlap_warning
-                self.window.show_info(overlap_warning(pathlib.Path(path).name, ids["overlaps"]))
+                self.window.show_info(overlap_warning(pathlib.Path(path).name, ids["overlaps"],
+                                                      ids["overlaps_exempt"]))
             self.problem_built.emit(path)
 
         def failed(message):
