@@ -382,6 +382,10 @@ def test_motion_tab_runs_a_control_path_on_the_sphere_demo(window, kautham_dir, 
     window.simulation.open_problem(str(problem))
     wait_for(lambda: "SphereDE" in window.scene.robots and not window.simulation.building, 30,
              "the sphere demo")
+    # the demo builds its ball 50 mm into the ground: pushed out, as Kautham's ODE world does
+    wait_for(lambda: "SphereDE in ground by 50.0 mm" in window.log.toPlainText(), 5,
+             "the overlap's line in the log")
+    assert "push them apart when the world runs, as in Kautham's ODE" in window.log.toPlainText()
     window.tabs.setCurrentWidget(window.motion)
     tab = window.motion
     tab.toolbox.setCurrentIndex(3)
