@@ -5,13 +5,13 @@ velocities (ODE's own numbers, odin_state.c), static geometries' poses, every jo
 motor's parameters, motor goals, persistent body and joint forces, simulated time and the
 step count, the world's state of ODE's random generator (QuickStep's constraint order), the
 collisions recorded but not yet read, which bodies the divergence guard had parked, which
-links the kinematic drive moved and which exempt pairs had not yet parted (core.exemptions). Putting one back, then stepping as before, gives
-bit-identical poses and velocities (tests/ compare raw float64 bytes).
+links the kinematic drive moved and which exempt pairs had not yet parted (core.exemptions).
+Putting one back, then stepping as before, gives bit-identical poses and velocities (tests/
+compare raw float64 bytes).
 
 A snapshot belongs to the scene's contents when it was taken (its objects, joints, motors and
-exempt pairs):
-it can be put back while they are the same, and is refused otherwise. World parameters are not
-state: they stay as they are.
+exempt pairs): it can be put back while they are the same, and is refused otherwise. World
+parameters are not state: they stay as they are.
 """
 from __future__ import annotations
 

@@ -240,10 +240,10 @@ int odin_world_sleeping(const OdinWorld *w);
 void odin_world_clear_divergences(OdinWorld *w);
 /* One planner's propagation in one call: puts back the body state vector state_in (ODE's
  * random generator state, then ODIN_BODY_STATE_SIZE values for each of the n bodies, in the
- * order of `bodies`, odin_write_body_states, then the n_exempt exempt pairs' states), forgets the collision records, adds `forces`
- * (n_forces, after the persistent ones) for this call only, runs odin_world_step(w, h, count)
- * recording every step's colliding pairs, and writes the state reached into state_out (the
- * same layout). The same ODE calls in the same order as putting the vector back, adding the
+ * order of `bodies`, odin_write_body_states, then the n_exempt exempt pairs' states), forgets
+ * the collision records, adds `forces` (n_forces, after the persistent ones) for this call
+ * only, runs odin_world_step(w, h, count) recording every step's colliding pairs, and writes
+ * the state reached into state_out (the same layout). The same ODE calls in the same order as putting the vector back, adding the
  * forces and stepping one call at a time: bit-identical states. The recorded pairs' geoms go
  * into `pairs` (odin_world_record_pairs) and *n_pairs says how many records there are; when
  * they all fit (*n_pairs <= max_pairs) the records are forgotten, otherwise they stay for
