@@ -62,6 +62,16 @@ def test_an_exempt_pair_may_move_apart_never_further_in(core):
     assert x_of(core) < 0.35 + 0.0015                      # stopped 1 mm deeper than built
 
 
+def test_a_collision_query_changes_no_exemption(core):
+    box_in_wall(core)
+    core.exempt_overlaps(0.001)
+    for x, touching in ((0.2, False), (0.45, True)):       # apart; far deeper than built
+        assert bool(core.check_collision([("box", (x, 0, 0), (1, 0, 0, 0))])) == touching
+    assert core.body_state_vector()[-1] == 1.0
+    core.step(H, 100)
+    assert x_of(core) == 0.35                              # still exempt: not pushed
+
+
 def test_a_pair_parts_when_no_deeper_than_the_depth_asked(core):
     box_in_wall(core)
     core.exempt_overlaps(0.03)                             # 50 mm deep: exempt

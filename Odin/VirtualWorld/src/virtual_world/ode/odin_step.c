@@ -330,16 +330,17 @@ static int live_exempt(const OdinWorld *w, uint64_t key) {
     return -1;
 }
 
-/* A live exempt pair met by the broad phase. Deeper than its limit: it parts now and 0 is
- * returned (the caller collides it as any pair). Otherwise 1: recorded like any colliding
- * pair, no contacts, and marked as still inside each other while deeper than exempt_depth. */
+/* A live exempt pair met by the broad phase. Deeper than its limit in a step's pass: it parts
+ * now and 0 is returned (the caller collides it as any pair). Otherwise 1: recorded like any
+ * colliding pair, no contacts, and marked as still inside each other while deeper than
+ * exempt_depth. */
 static int collide_exempt(OdinWorld *w, dGeomID o1, dGeomID o2, int e) {
     dContact contact[ODIN_MAX_CONTACTS];
     int n = dCollide(o1, o2, w->max_contacts, &contact[0].geom, sizeof(dContact));
     double depth = 0.0;
     for (int i = 0; i < n; ++i)
         if (contact[i].geom.depth > depth) depth = contact[i].geom.depth;
-    if (depth > w->exempt_limit[e]) {
+    if (depth > w->exempt_limit[e] && w->stepping) {
         w->exempt_live[e] = 0.0;
         return 0;
     }
@@ -836,7 +837,9 @@ int odin_world_step(OdinWorld *w, double h, int count) {
             if (w->recording) odin_world_clear_records(w);
         }
         if (w->n_exempt) memset(w->exempt_seen, 0, (size_t)w->n_exempt);
+        w->stepping = 1;
         dSpaceCollide(w->space, w, &near_callback);   /* 1. collisions, */
+        w->stepping = 0;
         if (w->n_exempt) part_exempt_pairs(w);        /*    exempt pairs apart now part */
         if (!w->contact_less) make_contacts(w, h);    /*    contacts in serial order */
         apply_body_forces(w);                         /* 2. forces and torques on bodies */

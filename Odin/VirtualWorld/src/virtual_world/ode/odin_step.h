@@ -187,6 +187,8 @@ typedef struct OdinWorld {
     const uint64_t *exempt_keys; const double *exempt_limit; double *exempt_live; int n_exempt;
     double exempt_depth;
     unsigned char *exempt_seen;  /* internal (Python's array): met deeper in this step's pass */
+    int stepping;            /* internal: 1 during a step's collide pass (only a step parts
+                                exempt pairs: a collision query changes nothing) */
     /* the divergence guard: after every step each guarded body must be finite, slower than
      * max_speed (m/s) and max_spin (rad/s) and within extent (m) of the origin on every axis;
      * one that is not is parked (made kinematic, still, colliding with nothing, put back
