@@ -76,6 +76,18 @@ def carry_collisions(scene: Scene, removed_names: Set[str]) -> None:
         del scene.carried[key]
 
 
+def touching_now(scene: Scene) -> List[Collision]:
+    """The pairs touching on the present poses (names, deepest depth, points), found without
+    stepping or contacts whatever the collision policy (a collision query); the records not
+    yet read are kept for the next read, and the query leaves none of its own."""
+    carry_collisions(scene, set())
+    try:
+        scene.c.detect(any_policy=True)
+        return sorted(c for c, _ in named_records(scene))
+    finally:
+        scene.c.clear_records()
+
+
 def forget_collisions(scene: Scene) -> None:
     scene.c.clear_records()
     scene.carried = {}

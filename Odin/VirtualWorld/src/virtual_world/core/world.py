@@ -615,13 +615,10 @@ class Core:
         statics = [g for o in moved if o.body is None for g in o.geometries]
         saved_bodies = bodies.read_states([o.body.ptr for o in bodies_moved])
         saved_statics = [bodies.static_geom_pose(g.owner.ptr) for g in statics]
-        readout.carry_collisions(scene, set())
         try:
             objects.set_poses(scene, poses)
-            scene.c.detect(any_policy=True)
-            found = sorted(c for c, _ in readout.named_records(scene))
+            found = readout.touching_now(scene)
         finally:
-            scene.c.clear_records()
             bodies.write_states([o.body.ptr for o in bodies_moved], saved_bodies)
             for g, pose in zip(statics, saved_statics):
                 bodies.set_static_geom_pose(g.owner.ptr, pose)

@@ -43,13 +43,19 @@ static int grow_records(OdinWorld *w) {
     return 1;
 }
 
+/* The deepest of n contacts' depths (m); 0 for none. */
+static double deepest(const dContact *c, int n) {
+    double depth = 0.0;
+    for (int i = 0; i < n; ++i)
+        if (c[i].geom.depth > depth) depth = c[i].geom.depth;
+    return depth;
+}
+
 /* Records a colliding pair (o1 the lower serial), keeping its deepest occurrence; returns the
  * record's index, or -1 (memory ran out, or a shallower occurrence of a recorded pair). */
 static int record_pair(OdinWorld *w, dGeomID o1, dGeomID o2, const dContact *c, int n) {
     dGeomID a = o1, b = o2;
-    double depth = 0.0;
-    for (int i = 0; i < n; ++i)
-        if (c[i].geom.depth > depth) depth = c[i].geom.depth;
+    double depth = deepest(c, n);
     OdinCollision *r = NULL;
     if (w->table_cap) {
         size_t mask = (size_t)(w->table_cap - 1);
@@ -337,9 +343,7 @@ static int live_exempt(const OdinWorld *w, uint64_t key) {
 static int collide_exempt(OdinWorld *w, dGeomID o1, dGeomID o2, int e) {
     dContact contact[ODIN_MAX_CONTACTS];
     int n = dCollide(o1, o2, w->max_contacts, &contact[0].geom, sizeof(dContact));
-    double depth = 0.0;
-    for (int i = 0; i < n; ++i)
-        if (contact[i].geom.depth > depth) depth = contact[i].geom.depth;
+    double depth = deepest(contact, n);
     if (depth > w->exempt_limit[e] && w->stepping) {
         w->exempt_live[e] = 0.0;
         return 0;
