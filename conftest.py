@@ -100,6 +100,32 @@ def tro_singularity(kautham_dir, tmp_path) -> pathlib.Path:
     return examples / "TRO"
 
 
+@pytest.fixture
+def arm_and_box(tmp_path):
+    """``problem(name, box_x_mm) -> path``: a 2012 Kautham problem written from the format in
+    tmp_path, an arm (a fixed Base, a movable link J1 300 mm up, 100 mm cubes) without <Home>,
+    hence at the origin as Kautham places it, and a 100 mm box of its scene at x = box_x_mm,
+    300 mm up: at 50 mm the link is 50 mm inside the box, at 500 mm clear of it."""
+    cube = "#Inventor V2.1 ascii\n\nSeparator { Cube { width 100 height 100 depth 100 } }\n"
+    (tmp_path / "cube.iv").write_text(cube)
+    (tmp_path / "arm.rob").write_text(
+        '<?xml version="1.0"?>\n<Robot name="arm" DHType="Modified" robType="Chain">\n'
+        '<Joints size="2"><Joint name="Base" ivFile="cube.iv"><DHPars alpha="0" a="0" '
+        'theta="0" d="0"/><Description rotational="true" movable="false"/><Limits Hi="0" '
+        'Low="0"/><Parent name=""/></Joint><Joint name="J1" ivFile="cube.iv"><DHPars '
+        'alpha="0" a="0" theta="0" d="300"/><Description rotational="true" movable="true"/>'
+        '<Limits Hi="90" Low="-90"/><Parent name="Base"/></Joint></Joints>\n</Robot>\n')
+
+    def problem(name: str, box_x_mm: float) -> pathlib.Path:
+        path = tmp_path / name
+        path.write_text(
+            '<?xml version="1.0"?>\n<Problem>\n<Robot robot="arm.rob"/>\n'
+            f'<Scene scene="cube.iv" scale="1.0"><Location X="{box_x_mm}" Y="0" Z="300" '
+            'WX="0" WY="0" WZ="1" TH="0"/></Scene>\n</Problem>\n')
+        return path
+    return problem
+
+
 def pytest_collection_modifyitems(items):
     """Tests marked ``slow`` run first: pytest-xdist hands them out while every worker is
     free, instead of one worker finishing a 40 s test while the others wait."""

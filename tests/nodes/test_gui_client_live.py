@@ -177,7 +177,7 @@ def test_a_control_path_drives_the_sphere_demo_to_its_goal(world, kautham_dir, t
     assert result.returncode != 0 and len(errors) == 1 and f"{bad}:2:" in errors[0]
 
 
-def test_load_problem_warns_of_parts_the_problem_builds_inside_each_other(world, tmp_path):
+def test_load_problem_warns_of_parts_the_problem_builds_inside_each_other(world, arm_and_box):
     """A 2012 robot without <Home> stands at the origin (Kautham: "If robot hasn't a home, it
     will be assumed in the origin"), here inside a box of its scene: built as the problem
     says, with one warning naming the pair, and it stands there when the world runs (the pair
@@ -186,24 +186,7 @@ def test_load_problem_warns_of_parts_the_problem_builds_inside_each_other(world,
     import rospy
     from Messages.msg import SpaceDistribution
     from gui.ros.client import WorldClient
-    cube = "#Inventor V2.1 ascii\n\nSeparator { Cube { width 100 height 100 depth 100 } }\n"
-    (tmp_path / "cube.iv").write_text(cube)
-    (tmp_path / "arm.rob").write_text(
-        '<?xml version="1.0"?>\n<Robot name="arm" DHType="Modified" robType="Chain">\n'
-        '<Joints size="2"><Joint name="Base" ivFile="cube.iv"><DHPars alpha="0" a="0" '
-        'theta="0" d="0"/><Description rotational="true" movable="false"/><Limits Hi="0" '
-        'Low="0"/><Parent name=""/></Joint><Joint name="J1" ivFile="cube.iv"><DHPars '
-        'alpha="0" a="0" theta="0" d="300"/><Description rotational="true" movable="true"/>'
-        '<Limits Hi="90" Low="-90"/><Parent name="Base"/></Joint></Joints>\n</Robot>\n')
-
-    def problem(name: str, box_x_mm: float) -> pathlib.Path:
-        path = tmp_path / name
-        path.write_text(
-            '<?xml version="1.0"?>\n<Problem>\n<Robot robot="arm.rob"/>\n'
-            f'<Scene scene="cube.iv" scale="1.0"><Location X="{box_x_mm}" Y="0" Z="300" '
-            'WX="0" WY="0" WZ="1" TH="0"/></Scene>\n</Problem>\n')
-        return path
-
+    problem = arm_and_box
     inside = problem("inside.xml", 50.0)
     result = world.run(["rosrun", "GUI", "load_problem", str(inside)], timeout=120)
     warnings = [l for l in result.stderr.splitlines() if "inside each other" in l]

@@ -40,27 +40,14 @@ def test_the_warning_names_the_file_the_deepest_pairs_and_counts_the_rest():
         "; their contacts push them apart when the world runs, as in Kautham's ODE world")
 
 
-def test_a_problem_kautham_never_simulates_stands_where_it_places_its_parts(tmp_path):
+def test_a_problem_kautham_never_simulates_stands_where_it_places_its_parts(arm_and_box):
     """A 2012 arm without <Home> at the origin, its link 50 mm inside a box of the scene:
     built, its pair exempt, and after 1 s of simulation the link is where it was built; the
     same arm clear of the box has nothing to exempt."""
     import numpy as np
     from gui_core_world import CoreWorld
-    cube = "#Inventor V2.1 ascii\n\nSeparator { Cube { width 100 height 100 depth 100 } }\n"
-    (tmp_path / "cube.iv").write_text(cube)
-    (tmp_path / "arm.rob").write_text(
-        '<?xml version="1.0"?>\n<Robot name="arm" DHType="Modified" robType="Chain">\n'
-        '<Joints size="2"><Joint name="Base" ivFile="cube.iv"><DHPars alpha="0" a="0" '
-        'theta="0" d="0"/><Description rotational="true" movable="false"/><Limits Hi="0" '
-        'Low="0"/><Parent name=""/></Joint><Joint name="J1" ivFile="cube.iv"><DHPars '
-        'alpha="0" a="0" theta="0" d="300"/><Description rotational="true" movable="true"/>'
-        '<Limits Hi="90" Low="-90"/><Parent name="Base"/></Joint></Joints>\n</Robot>\n')
     for name, box_x_mm, expected in (("inside.xml", 50.0, 1), ("clear.xml", 500.0, 0)):
-        path = tmp_path / name
-        path.write_text(
-            '<?xml version="1.0"?>\n<Problem>\n<Robot robot="arm.rob"/>\n'
-            f'<Scene scene="cube.iv" scale="1.0"><Location X="{box_x_mm}" Y="0" Z="300" '
-            'WX="0" WY="0" WZ="1" TH="0"/></Scene>\n</Problem>\n')
+        path = arm_and_box(name, box_x_mm)
         plan = plan_problem(load_problem(path))
         world = CoreWorld()
         try:
