@@ -68,3 +68,21 @@ def test_names_come_when_the_robots_are_known(scene):
     _robots(scene)
     panel.relabel()
     assert panel.list.item(0).text() == "TX90 SAHand Right: Shoulder"
+
+
+def test_the_list_follows_the_joints_the_world_has_across_scenes(scene):
+    """The world's clock runs on across New Scenes, so the list cannot wait for time to go
+    back: a joint no message names any more left the world and leaves the list (a 2025
+    problem loaded after a 2012 one listed both robots' joints); one checked comes back
+    checked when its joint does (the same problem loaded again)."""
+    from gui.window.plot_panel import JointPlotPanel
+    panel = JointPlotPanel()
+    panel.on_joint_states(_message(1.0, [HAND, "loose"]))
+    panel.choose(HAND)
+    panel.on_joint_states(_message(2.0, [WHEEL]))           # another problem, later in time
+    assert [panel.list.item(i).text() for i in range(panel.list.count())] == [WHEEL]
+    assert set(panel.samples) == {WHEEL} and panel.chosen() == []
+    panel.on_joint_states(_message(3.0, []))                # New Scene: no joint at all
+    assert panel.list.count() == 0
+    panel.on_joint_states(_message(4.0, [HAND, "loose"]))   # the first one again
+    assert panel.chosen() == [HAND] and set(panel.samples) == {HAND, "loose"}

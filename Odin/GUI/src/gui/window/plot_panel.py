@@ -133,12 +133,16 @@ class JointPlotPanel(QWidget):
 
     def on_joint_states(self, msg) -> None:
         t = msg.header.stamp.to_sec()
-        if t < self.latest_time - 1e-9 or not self.samples:   # New Scene, a restarted world
-            chosen = set(self.chosen())
+        if t < self.latest_time - 1e-9 or not self.samples:   # a first message, a restarted world
+            self._rechoose |= set(self.chosen())
             self.samples.clear()
             self.list.clear()
             self.first_time = t
-            self._rechoose = chosen
+        # every message names every joint of the world, whose clock runs on across New
+        # Scenes: a channel missing from this one left the world (New Scene, a removal)
+        gone = self.samples.keys() - set(msg.name)
+        if gone:
+            self._forget(gone)
         self.latest_time = t
         keep = int(self.history * 100) + 1
         for k, name in enumerate(msg.name):
@@ -153,6 +157,20 @@ class JointPlotPanel(QWidget):
             position = msg.position[k] if k < len(msg.position) else math.nan
             velocity = msg.velocity[k] if k < len(msg.velocity) else math.nan
             data.append((t, position, velocity))
+        self._dirty = True
+
+    def _forget(self, channels: set) -> None:
+        """Drops the channels of joints that left the world: their samples and list items (a
+        checked one is checked again if its joint comes back, as after a reload)."""
+        for i in reversed(range(self.list.count())):
+            item = self.list.item(i)
+            name = item.data(Qt.UserRole)
+            if name in channels:
+                if item.checkState() == Qt.Checked:
+                    self._rechoose.add(name)
+                self.list.takeItem(i)
+        for name in channels:
+            del self.samples[name]
         self._dirty = True
 
     def _repaint(self) -> None:
