@@ -48,9 +48,55 @@ MAX_INPUT_FILE_MB = 256
 """MB: the largest file the GUI reads (a problem, robot, URDF, control, path or geometry file);
 a larger one is refused before it is read. The real Kautham corpus's largest is under 10 MB."""
 
+MAX_NAME_BYTES = 256
+"""Bytes (UTF-8) of a name a request gives (an object, part, joint, snapshot, robot): longer
+names are refused before anything is stored, as are names with a control character (NUL, a
+newline, a tab...), which would make logs, frames and file names ambiguous."""
+
+MAX_SHOWN_CHARS = 80
+"""Characters of an offending value that an error message quotes (``shown``): a refusal of a
+10 MB name or a 100,000-row array is one short line, not a copy of the request."""
+
 MAX_STEPS_PER_CALL = 1_000_000
 """Steps one call may ask for (a Step Once, a Propagate): the node answers nothing else
 meanwhile, so a longer run is asked for in pieces (at 1 ms steps, 1,000 s of simulated time)."""
+
+
+def shown(value, limit: int = MAX_SHOWN_CHARS) -> str:
+    """``repr(value)`` cut to ``limit`` characters (saying how long it was), for error messages
+    that quote what a request or file gave."""
+    if isinstance(value, np.ndarray) and value.size > limit:
+        return f"<array of {value.size:,} values, shape {value.shape}>"
+    if isinstance(value, (list, tuple)) and len(value) > limit:
+        return f"<{type(value).__name__} of {len(value):,} items>"
+    if isinstance(value, (str, bytes)) and len(value) > limit:
+        # the repr of the head only: a huge value is never copied whole
+        return f"{repr(value[:limit])[:limit - 1]}… ({len(value):,} characters)"
+    text = repr(value)
+    if len(text) <= limit:
+        return text
+    return f"{text[:limit - 1]}… ({len(text):,} characters of repr)"
+
+
+def name_problem(value) -> Optional[str]:
+    """Why ``value`` is not a valid name (MAX_NAME_BYTES, printable, non-empty), or None."""
+    if not isinstance(value, str) or not value:
+        return "must be a non-empty string"
+    if len(value) > MAX_NAME_BYTES or len(value.encode("utf-8", "surrogatepass")) > \
+            MAX_NAME_BYTES:
+        return f"is longer than {MAX_NAME_BYTES} bytes (MAX_NAME_BYTES)"
+    if not value.isprintable():
+        return "holds a control character (NUL, newline, tab...): names must be printable"
+    return None
+
+
+def check_name(what: str, value) -> str:
+    """``value`` if it is a valid name (``name_problem``), else InvalidArgument naming ``what``
+    and the value (cut to MAX_SHOWN_CHARS)."""
+    problem = name_problem(value)
+    if problem is not None:
+        raise InvalidArgument(f"{what}={shown(value)} {problem}")
+    return value
 
 
 _CORNERS = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float)
