@@ -1,5 +1,10 @@
-"""Snapshot files stay inside their folder, and what is written is the frame."""
+"""Snapshot files stay inside their folder, what is written is the frame, and a file is
+written whole or not at all (a full disk leaves the old one as it was)."""
+import errno
+import logging
 import os
+import subprocess
+import time
 
 import numpy as np
 import pytest
@@ -56,3 +61,108 @@ def test_frame_writer_numbers_frames_in_order(tmp_path):
     assert names == ["frame_000001.png", "frame_000002.png", "frame_000003.png"]
     third = np.asarray(Image.open(tmp_path / "frames" / "frame_000003.png"))
     assert tuple(third[5, 5]) == (150, 0, 0) and writer.written == 3 and writer.dropped == 0
+
+
+class FillingDisk:
+    """An ``os.write`` of a disk that takes ``room`` bytes more (then ENOSPC), or any amount
+    while ``full`` is False."""
+
+    def __init__(self, room: int = 100) -> None:
+        self.room = room
+        self.full = True
+
+    def write(self, fd: int, data) -> int:
+        if not self.full:
+            return os.write(fd, data)
+        if self.room <= 0:
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        taken = os.write(fd, bytes(data[:self.room]))
+        self.room -= taken
+        return taken
+
+
+def test_a_full_disk_leaves_the_old_snapshot_whole_and_creates_nothing(tmp_path):
+    kept = write_png(snapshot_path(tmp_path, "kept"), frame_of((0, 90, 0)))
+    before = kept.read_bytes()
+    disk = FillingDisk(room=50)
+    with pytest.raises(ViewerError, match=r"^cannot write snapshot .*kept\.png: "
+                                          r"No space left on device$"):
+        write_png(kept, frame_of((200, 0, 0)), disk.write)
+    with pytest.raises(ViewerError, match=r"fresh\.png: No space left on device$"):
+        write_png(snapshot_path(tmp_path, "fresh"), frame_of((200, 0, 0)), disk.write)
+    assert kept.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["kept.png"]
+
+
+def test_a_folder_gone_is_one_line_naming_the_file(tmp_path):
+    path = snapshot_path(tmp_path / "gone", "shot")
+    with pytest.raises(ViewerError, match=r"^cannot write snapshot .*gone/shot\.png: No such "
+                                          r"file or directory$"):
+        write_png(path, frame_of((1, 1, 1)))
+
+
+def test_frame_writer_on_a_full_disk_warns_once_leaves_no_frames_and_resumes(tmp_path, caplog):
+    disk = FillingDisk(room=0)
+    writer = FrameWriter(tmp_path / "frames", max_pending=100, write=disk.write)
+    with caplog.at_level(logging.WARNING, logger="viewer.core.snapshots"):
+        for value in range(20):
+            writer.put(frame_of((value, 0, 0)))
+        while writer.failed < 20:
+            time.sleep(0.01)
+        assert list((tmp_path / "frames").iterdir()) == []
+        disk.full = False
+        writer.put(frame_of((99, 0, 0)))
+        writer.close()
+    frames = list((tmp_path / "frames").iterdir())
+    assert [p.name for p in frames] == ["frame_000021.png"] and frames[0].stat().st_size > 0
+    not_written = [r for r in caplog.records if "not written" in r.getMessage()]
+    assert len(not_written) == 2, [r.getMessage() for r in caplog.records]
+    assert "No space left on device" in not_written[0].getMessage()
+    assert "written again from frame 21, after 20 not written" in not_written[1].getMessage()
+    assert (writer.written, writer.failed) == (1, 20)
+
+
+@pytest.mark.parametrize("name, problem", [
+    ("s" * 300, "longer than 256 bytes"),                  # MAX_NAME_BYTES
+    ("s" * 252, "longer than the 255 bytes a file name"),  # + ".png": over NAME_MAX
+    ("é" * 127 + "x", "longer than the 255 bytes"),        # 255 bytes: ".png" makes 259
+    ("two\nlines", "control character"),
+    ("tab\there", "control character"),
+])
+def test_names_no_file_system_takes_are_refused_by_name_not_by_os_error(tmp_path, name,
+                                                                         problem):
+    with pytest.raises(ViewerError, match=problem) as refusal:
+        snapshot_path(tmp_path, name)
+    assert "\n" not in str(refusal.value) and len(str(refusal.value)) < 250
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_the_longest_file_name_is_written(tmp_path):
+    path = write_png(snapshot_path(tmp_path, "n" * 251), frame_of((5, 5, 5)))
+    assert path.name == "n" * 251 + ".png" and path.stat().st_size > 0
+
+
+@pytest.fixture
+def tiny_tmpfs(tmp_path):
+    """A 64 KiB tmpfs at tmp_path/tiny (skipped where mounting is not allowed)."""
+    mount_point = tmp_path / "tiny"
+    mount_point.mkdir()
+    done = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs",
+                           str(mount_point)], capture_output=True, text=True)
+    if done.returncode != 0:
+        pytest.skip(f"cannot mount a tmpfs here: {done.stderr.strip() or done.returncode}")
+    try:
+        yield mount_point
+    finally:
+        subprocess.run(["umount", "-l", str(mount_point)], check=False)
+
+
+def test_a_real_full_disk_keeps_the_old_snapshot(tiny_tmpfs):
+    kept = write_png(snapshot_path(tiny_tmpfs, "kept"), frame_of((0, 0, 200)))
+    before = kept.read_bytes()
+    noise = np.random.default_rng(7).integers(0, 256, (160, 160, 3), dtype=np.uint8)  # 75 KB
+    for name in ("kept", "new"):
+        with pytest.raises(ViewerError, match=r"\.png: No space left on device$"):
+            write_png(snapshot_path(tiny_tmpfs, name), noise)
+    assert kept.read_bytes() == before
+    assert sorted(p.name for p in tiny_tmpfs.iterdir()) == ["kept.png"]
