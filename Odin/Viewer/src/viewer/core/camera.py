@@ -17,6 +17,9 @@ from viewer.errors import ViewerError
 #: in front (+x), a little to the left (+y) and above (+z), looking back at the scene
 FIT_DIRECTION_W = np.array([1.0, 0.55, 0.6]) / np.linalg.norm([1.0, 0.55, 0.6])
 MIN_SIZE, MAX_SIZE = 16, 4096
+#: rad, the narrowest vertical field of view: a camera fitted to the widest scene the Viewer
+#: takes (geometry.MAX_EXTENT) stays at a finite distance (~1e15 m at the most extreme aspect)
+MIN_FOV_Y = 1e-3
 
 
 @dataclass(frozen=True)
@@ -44,8 +47,9 @@ class Camera:
         if np.linalg.norm(self.up_W) < 1e-9 or cross < 1e-6 * np.linalg.norm(self.up_W):
             raise ViewerError(f"camera up {self.up_W} is zero or parallel to the line of sight "
                               f"from {self.eye_W} to {self.target_W}")
-        if not (math.isfinite(self.fov_y) and 0.0 < self.fov_y < math.pi):
-            raise ViewerError(f"camera fov_y must be in (0, pi) rad, got {self.fov_y}")
+        if not (math.isfinite(self.fov_y) and MIN_FOV_Y <= self.fov_y < math.pi):
+            raise ViewerError(f"camera fov_y must be in [{MIN_FOV_Y:g}, pi) rad, got "
+                              f"{self.fov_y}")
         for name in ("width", "height"):
             value = getattr(self, name)
             if int(value) != value or not MIN_SIZE <= value <= MAX_SIZE:

@@ -23,12 +23,23 @@ import numpy as np
 from odin_common.errors import InvalidArgument
 from odin_common.interface import (PLANE_DRAWN_SIZE, PLANE_DRAWN_THICKNESS, SHAPE_PARAMETERS,
                                    Shape, shape_of)
+from odin_common.limits import MIN_SIZE, shown
 from odin_common.meshes import (DISPLAY_TOLERANCE, capsule_mesh, cluster_vertices,  # noqa: F401
                                 display_mesh, unique_rows)
 from odin_common.rotations import QUATERNION_TOLERANCE, quaternion_to_matrix, unit_quaternion
+from odin_common.world_parameters import PARAMETER_INFO
 from viewer.errors import ViewerError
 
 _keys = itertools.count(1)
+
+MAX_EXTENT = float(PARAMETER_INFO["world_extent"].high)
+"""m: the farthest a position or a mesh vertex may be from the origin along any axis: the
+widest ``world_extent`` a world may be set to, so that the Viewer takes every object any world
+may hold (the world checks its own, narrower extent) and a camera fitted to them stays finite."""
+
+MAX_SIZE = 2 * MAX_EXTENT
+"""m: the largest dimension of a primitive (a world's is twice its extent); the smallest is
+odin_common.limits.MIN_SIZE."""
 
 
 def rotation_from_wxyz(quaternion_wxyz: Sequence[float], where: str = "orientation") -> np.ndarray:
@@ -48,7 +59,10 @@ def check_position(position_W: Sequence[float], where: str = "position") -> np.n
     """(3,) float, metres; raises :class:`ViewerError` unless three finite numbers."""
     p = np.asarray(position_W, dtype=float).reshape(-1)
     if p.shape != (3,) or not np.all(np.isfinite(p)):
-        raise ViewerError(f"{where}: expected 3 finite numbers (m), got {list(p)}")
+        raise ViewerError(f"{where}: expected 3 finite numbers (m), got {shown(p)}")
+    if np.max(np.abs(p)) > MAX_EXTENT:
+        raise ViewerError(f"{where}: {shown(p.tolist())} is farther than {MAX_EXTENT:g} m from "
+                          "the origin along an axis (MAX_EXTENT)")
     return p
 
 
@@ -64,14 +78,14 @@ def pose_matrix(position_W: Sequence[float], quaternion_wxyz: Sequence[float],
 def pose_matrices(positions_W: np.ndarray, quaternions_wxyz: np.ndarray) -> tuple:
     """Many poses at once, as :func:`pose_matrix` makes each: (T_WB (n, 4, 4), valid (n,)
     bool) from positions (n, 3) m and quaternions (n, 4) (w, x, y, z). A pose is valid when
-    its position is finite and its quaternion finite, non-zero and within
+    its position is finite and within MAX_EXTENT and its quaternion finite, non-zero and within
     QUATERNION_TOLERANCE of unit length (then normalised); invalid ones are left identity."""
     positions = np.asarray(positions_W, dtype=float).reshape(-1, 3)
     quaternions = np.asarray(quaternions_wxyz, dtype=float).reshape(-1, 4)
     with np.errstate(invalid="ignore", over="ignore"):
         norms = np.linalg.norm(quaternions, axis=1)
-        valid = (np.all(np.isfinite(positions), axis=1) & np.isfinite(norms) & (norms > 0)
-                 & (np.abs(norms - 1.0) <= QUATERNION_TOLERANCE))
+        valid = (np.all(np.abs(positions) <= MAX_EXTENT, axis=1) & np.isfinite(norms)
+                 & (norms > 0) & (np.abs(norms - 1.0) <= QUATERNION_TOLERANCE))
     poses = np.tile(np.eye(4), (len(positions), 1, 1))
     unit = quaternions[valid] / norms[valid, None]
     if len(unit):
@@ -123,10 +137,12 @@ class Geometry:
 
 
 def _positive(values: Sequence[float], names: Sequence[str], shape: str) -> list:
+    """The sizes (m), each finite and in [MIN_SIZE, MAX_SIZE]."""
     out = []
     for value, name in zip(values, names):
-        if not math.isfinite(value) or value <= 0:
-            raise ViewerError(f"{shape} {name} must be a finite number > 0 (m), got {value}")
+        if not math.isfinite(value) or not MIN_SIZE <= value <= MAX_SIZE:
+            raise ViewerError(f"{shape} {name} must be a finite number in [{MIN_SIZE:g}, "
+                              f"{MAX_SIZE:g}] m (MIN_SIZE, MAX_SIZE), got {shown(value)}")
         out.append(float(value))
     return out
 
@@ -140,8 +156,8 @@ def geometry_from_parameters(parameters: Sequence[float], indices: Sequence[int]
     """The shape that ``parameters`` (and, for meshes, ``indices``) describe, asked for as
     ``shape`` (odin_common.interface.Shape; 0: by their count); see the module doc.
 
-    Raises :class:`ViewerError` for a wrong parameter count, non-positive or non-finite sizes,
-    an empty mesh, an index count that is not a multiple of 3 or an index out of range.
+    Raises :class:`ViewerError` for a wrong parameter count, sizes not finite or outside
+    [MIN_SIZE, MAX_SIZE], mesh vertices beyond MAX_EXTENT, an empty mesh, an index count that is not a multiple of 3 or an index out of range.
     """
     params = np.asarray(parameters, dtype=float).reshape(-1)
     try:
@@ -196,8 +212,9 @@ def mesh_geometry(vertices_B: np.ndarray, indices: Sequence[int]) -> Geometry:
     inwards (clockwise, as some Kautham VRML files are) is turned outwards, so that it is drawn
     as a closed one: back faces culled, one side lit (half the cost of an open one)."""
     vertices = np.asarray(vertices_B, dtype=float)
-    if not np.all(np.isfinite(vertices)):
-        raise ViewerError("mesh vertices must be finite numbers (m)")
+    if not np.all(np.abs(vertices) <= MAX_EXTENT):       # False for NaN too
+        raise ViewerError(f"mesh vertices must be finite numbers within {MAX_EXTENT:g} m of "
+                          "the origin along each axis (MAX_EXTENT)")
     idx = np.asarray(indices, dtype=np.int64).reshape(-1)
     if idx.size == 0:
         raise ViewerError(f"mesh with {len(vertices)} vertices has no triangles (empty indices)")

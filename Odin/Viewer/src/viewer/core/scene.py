@@ -29,7 +29,9 @@ import numpy as np
 
 # DEFAULT_COLOR: an object sent with an all-zero colour; COLLIDING_COLOR: while reported as
 # colliding (thesis 6.4.1: "dark gray"); shared with the world's RViz markers
+from odin_common.errors import InvalidArgument
 from odin_common.interface import COLLIDING_COLOR, DEFAULT_COLOR
+from odin_common.limits import check_name, shown
 from viewer.core.camera import Camera
 from viewer.errors import ViewerError
 from viewer.core.geometry import (Geometry, GeometryCache, geometry_from_parameters,
@@ -44,17 +46,20 @@ def check_color(color: Sequence[float], where: str = "color") -> tuple:
     c = np.asarray(color, dtype=float).reshape(-1)
     if c.size == 3:
         c = np.r_[c, 1.0]
-    if c.shape != (4,) or not np.all(np.isfinite(c)) or np.any((c < 0) | (c > 1)):
-        raise ViewerError(f"{where}: expected r, g, b, a in [0, 1], got {list(c)}")
+    if c.shape != (4,) or not np.all((c >= 0) & (c <= 1)):        # False for NaN too
+        raise ViewerError(f"{where}: expected r, g, b, a in [0, 1], got {shown(c)}")
     if not np.any(c):
         return DEFAULT_COLOR
     return tuple(float(v) for v in c)
 
 
 def check_id(object_id: str) -> str:
-    if not isinstance(object_id, str) or not object_id:
-        raise ViewerError(f"object ID must be a non-empty string, got {object_id!r}")
-    return object_id
+    """``object_id`` if it is a valid name (odin_common.limits.check_name: non-empty, at
+    most MAX_NAME_BYTES, printable: no NUL, no newline), else :class:`ViewerError`."""
+    try:
+        return check_name("object ID", object_id)
+    except InvalidArgument as error:
+        raise ViewerError(str(error)) from None
 
 
 @dataclass(frozen=True)
@@ -72,9 +77,11 @@ def prepare_view(object_id: str, parameters: Sequence[float], indices: Sequence[
                  cache: Optional[GeometryCache] = None) -> ViewRequest:
     """Checks a View Object request and builds its geometry (no scene needed, so a service
     callback can do it on its own thread), or takes it from ``cache`` when that content was
-    built before. Raises :class:`ViewerError` if anything is wrong."""
+    built before. Everything is checked here (ID, sizes, mesh, pose, colour: geometry's
+    MIN_SIZE, MAX_SIZE and MAX_EXTENT), so that a request the scene takes can change nothing
+    it cannot hold. Raises :class:`ViewerError` if anything is wrong."""
     object_id = check_id(object_id)
-    where = f"object {object_id!r}"
+    where = f"object {shown(object_id)}"
     build = geometry_from_parameters if cache is None else cache.geometry
     try:
         geometry = build(parameters, indices, shape)
@@ -139,13 +146,18 @@ class Scene:
 
     def view(self, request: ViewRequest) -> bool:
         """Adds the object, or replaces the one with the same ID (the world may re-send its scene
-        to a Viewer that started late). Returns True if it replaced one. Re-fits the camera."""
-        replaced = request.id in self._objects
-        self._objects[request.id] = SceneObject(request.id, request.geometry,
-                                                np.array(request.pose_W, dtype=float),
-                                                request.color)
+        to a Viewer that started late). Returns True if it replaced one. Re-fits the camera.
+        All or nothing: the camera is fitted to the scene with the object before either
+        changes, so a refusal leaves the scene and the camera as they were."""
+        added = SceneObject(request.id, request.geometry, np.array(request.pose_W, dtype=float),
+                            request.color)
+        camera = self._camera
         if not self.camera_fixed:
-            self.fit_camera()
+            others = (o for o in self._objects.values() if o.id != request.id)
+            camera = self._fitted(camera, [*others, added])
+        replaced = request.id in self._objects
+        self._objects[request.id] = added
+        self._camera = camera
         return replaced
 
     def view_object(self, object_id: str, parameters: Sequence[float], indices: Sequence[int] = (),
@@ -158,7 +170,7 @@ class Scene:
 
     def remove_object(self, object_id: str) -> None:
         if object_id not in self._objects:
-            raise ViewerError(f"no object {object_id!r} in the Viewer's scene "
+            raise ViewerError(f"no object {shown(object_id)} in the Viewer's scene "
                               f"({len(self._objects)} objects)")
         del self._objects[object_id]
         self._grey.discard(object_id)
@@ -234,7 +246,7 @@ class Scene:
     def color_of(self, object_id: str) -> tuple:
         """The colour the object is drawn in now."""
         if object_id not in self._objects:
-            raise ViewerError(f"no object {object_id!r} in the Viewer's scene")
+            raise ViewerError(f"no object {shown(object_id)} in the Viewer's scene")
         return COLLIDING_COLOR if object_id in self._grey else self._objects[object_id].color
 
     def pose_of(self, object_id: str) -> np.ndarray:
@@ -251,16 +263,7 @@ class Scene:
     def bounds(self) -> Optional[tuple]:
         """(centre (3,) m, radius m) of a sphere holding every bounded object (planes are
         infinite), or None if there is none."""
-        bounded = [o for o in self._objects.values() if o.geometry.bounded]
-        if not bounded:
-            return None
-        centres = np.array([o.pose_W[:3, 3] for o in bounded])
-        radii = np.array([o.geometry.radius for o in bounded])
-        low = (centres - radii[:, None]).min(axis=0)
-        high = (centres + radii[:, None]).max(axis=0)
-        centre = (low + high) / 2
-        radius = float(np.max(np.linalg.norm(centres - centre, axis=1) + radii))
-        return centre, radius
+        return _bounds(self._objects.values())
 
     @property
     def camera(self) -> Camera:
@@ -272,17 +275,22 @@ class Scene:
 
     def fit_camera(self) -> None:
         """Moves the camera to show the whole scene (nothing to do for an empty scene)."""
-        bounds = self.bounds()
-        if bounds is not None:
-            self._camera = self._camera.fitted(*bounds)
+        self._camera = self._fitted(self._camera, self._objects.values())
+
+    @staticmethod
+    def _fitted(camera: Camera, objects) -> Camera:
+        """``camera`` fitted to ``objects`` (as it is when none is bounded); raises
+        ViewerError, changing nothing, when the fit is no camera."""
+        bounds = _bounds(objects)
+        return camera if bounds is None else camera.fitted(*bounds)
 
     def set_camera(self, camera: Camera, fixed: Optional[bool] = None) -> None:
-        """Uses ``camera``; ``fixed`` True stops re-fitting, False re-fits now and on adds."""
-        self._camera = camera
-        if fixed is not None:
-            self.camera_fixed = fixed
-        if not self.camera_fixed:
-            self.fit_camera()
+        """Uses ``camera``; ``fixed`` True stops re-fitting, False re-fits now and on adds.
+        All or nothing: a camera whose fit fails changes nothing."""
+        fixed = self.camera_fixed if fixed is None else fixed
+        if not fixed:
+            camera = self._fitted(camera, self._objects.values())
+        self._camera, self.camera_fixed = camera, fixed
 
     def grid(self) -> Grid:
         """The floor grid under the scene: about 3 scene radii across, 10-25 lines a side."""
@@ -309,3 +317,17 @@ class Scene:
         near = max(distance - radius, far / 2000.0)
         return near, far
 
+
+def _bounds(objects) -> Optional[tuple]:
+    """(centre (3,) m, radius m) of a sphere holding every bounded one of ``objects``
+    (SceneObject; planes are infinite), or None if there is none."""
+    bounded = [o for o in objects if o.geometry.bounded]
+    if not bounded:
+        return None
+    centres = np.array([o.pose_W[:3, 3] for o in bounded])
+    radii = np.array([o.geometry.radius for o in bounded])
+    low = (centres - radii[:, None]).min(axis=0)
+    high = (centres + radii[:, None]).max(axis=0)
+    centre = (low + high) / 2
+    radius = float(np.max(np.linalg.norm(centres - centre, axis=1) + radii))
+    return centre, radius
