@@ -211,7 +211,10 @@ def load_problem_main(argv: Optional[Sequence[str]] = None) -> int:
         prog="load_problem", description="Build a Kautham problem in a running VirtualWorld.")
     parser.add_argument("problem", help="problem XML file")
     parser.add_argument("--keep", action="store_true",
-                        help="add to the current scene instead of calling New Scene first")
+                        help="add to the current scene instead of calling New Scene first "
+                        "(the problem is first built alone, in the room the world has left, "
+                        "in this process; a clash with what the world holds is refused by "
+                        "the world, and what was built of the problem removed)")
     parser.add_argument("--timeout", type=float, default=10.0,
                         help="seconds to wait for the ROS master, then for the world's "
                         "services [10]")
@@ -229,14 +232,13 @@ def load_problem_main(argv: Optional[Sequence[str]] = None) -> int:
     print(f"loaded {args.problem} in {time.monotonic() - started:.2f} s: {total} requests",
           flush=True)
     try:
+        from gui.planning.rehearsal import load_scene
         client = connection.client()
-        if not args.keep:
-            client.new_scene()
 
         def progress(k: int, step, answer_id: str) -> None:
             print(f"[{k}/{total}] {step.label()} -> {answer_id}", flush=True)
 
-        client.execute(plan, progress=progress)
+        load_scene(client, plan, keep=args.keep, progress=progress)
     except OdinError as error:
         return _fail("load_problem", error)
     print(f"built {args.problem} in {time.monotonic() - started:.2f} s; the world is paused "

@@ -61,10 +61,14 @@ class CoreWorld:
     """A VirtualWorld Core behind the WorldClient methods a build plan calls (``execute``
     sends the whole plan), and ``step_values``, the Set Step values in force."""
 
-    def __init__(self):
+    def __init__(self, parameters=None, resources=None,
+                 step_values: Optional[StepValues] = None):
+        """``parameters`` (WorldParameters), ``resources`` (ResourceLimits) and
+        ``step_values``: the world's to start from (None: the defaults)."""
         from virtual_world.core import Core
-        self.core = Core()
-        self.step_values = StepValues()
+        from odin_common.limits import ResourceLimits
+        self.core = Core(parameters, ResourceLimits() if resources is None else resources)
+        self.step_values = StepValues() if step_values is None else step_values
 
     def close(self) -> None:
         self.core.close()

@@ -34,6 +34,7 @@ from gui.errors import WorldError
 from gui.ros.services import ServiceCaller, join_ros_graph
 from Services.srv import BuildEntityRequest
 from odin_common.errors import InvalidArgument
+from odin_common.limits import ResourceLimits
 from odin_common.interface import WORLD_NAMESPACE, WORLD_SERVICES, ForceKind, SetJointAction
 from odin_common.messages import (body_force_message, composite_message, object_message,
                                   parameter_messages, situation_messages, world_parameters_of)
@@ -192,6 +193,21 @@ class WorldClient:
     def world_parameters(self) -> WorldParameters:
         """The world parameters in force."""
         return self.world().parameters
+
+    def resource_limits(self) -> ResourceLimits:
+        """What the world node may hold (its ``~max_objects``, ``~max_mesh_triangles``...
+        private parameters, read once when it started; the defaults where it was given
+        none), read from the parameter server."""
+        import rospy
+        defaults = ResourceLimits()
+        try:
+            values = {f.name: rospy.get_param(f"{self.namespace}/{f.name}",
+                                              getattr(defaults, f.name))
+                      for f in dataclasses.fields(ResourceLimits)}
+        except (OSError, rospy.ROSException) as error:
+            raise WorldError(self.namespace, f"its limits cannot be read from the parameter "
+                             f"server: {error}") from None
+        return ResourceLimits(**values)
 
     def set_step(self, step: Optional[float] = None, steps_per_cycle: Optional[int] = None,
                  cycle_time: Optional[float] = None, rate: Optional[float] = None) -> StepValues:
@@ -411,7 +427,7 @@ class WorldClient:
 
     def execute(self, plan: BuildPlan,
                 progress: Optional[Callable[[int, object, str], None]] = None,
-                mesh_dir: Optional[str] = None) -> dict:
+                mesh_dir: Optional[str] = None, ids: Optional[BuiltIds] = None) -> dict:
         """Sends every step of ``plan`` in order, then declares each robot it built (Set
         Robot); returns the world's IDs: {"bodies": {planned body ID: world ID}, "joints":
         {joint key: world ID}, "motors": {joint key: world motor ID}, "robots": {robot name:
@@ -419,11 +435,13 @@ class WorldClient:
         generated robot descriptions' meshes go (default ``robot_mesh_dir()``).
 
         Joint and motor IDs the world returns replace the predicted ones in ``plan.robots``.
-        Stops at the first refusal (``WorldError``); what was built before stays built.
-        Parts built inside each other (``gui.core.overlaps``) are warned about once and
-        answered as "overlaps": [Overlap]; in a problem Kautham never simulates they are
-        exempt until they have moved apart ("overlaps_exempt": True)."""
-        ids = BuiltIds()
+        Stops at the first refusal (``WorldError``); what was built before stays built, its
+        world IDs in ``ids`` when given (gui.planning.rehearsal.load_scene, which builds a
+        plan all or nothing, removes them). Parts built inside each other
+        (``gui.core.overlaps``) are warned about once and answered as "overlaps": [Overlap];
+        in a problem Kautham never simulates they are exempt until they have moved apart
+        ("overlaps_exempt": True)."""
+        ids = BuiltIds() if ids is None else ids
         for k, step in enumerate(plan.steps, start=1):
             answer = step.send(self, ids)
             if progress is not None:

@@ -7,9 +7,10 @@ own joint names), then the Scene objects (under the Kautham instance that made t
 window built them), the Joints and Motors of no robot, and the Forces.
 
 Opening runs on the worker: the problem is read and planned
-(``gui.core.translate.plan_problem``) and sent step by step (``WorldClient.execute``); while it
-is built each answer adds the step's entries to the tree as it comes; once built, the world's
-answer replaces them.
+(``gui.core.translate.plan_problem``), rehearsed whole in a Core of this process and only then
+sent step by step (``gui.planning.rehearsal.load_scene``: all or nothing, a problem the world
+would refuse midway leaves the scene as it was); while it is built each answer adds the step's
+entries to the tree as it comes; once built, the world's answer replaces them.
 
 The button follows the world's real state: the Start answer, then the stamps of
 ``world_update`` (simulated time advancing = running), so a world started or paused by another
@@ -132,13 +133,15 @@ class SimulationTab(QWidget):
         def work(client, job):
             from gui.core.translate import plan_problem
             from gui.core.kautham.problem import load_problem
+            from gui.planning.rehearsal import load_scene
             plan = plan_problem(load_problem(path))
-            job.progress(("plan", plan))
-            if replace:
-                client.new_scene()
             total = len(plan.steps)
-            return client.execute(plan, progress=lambda k, step, answer: job.progress(
-                ("step", k, total, step, answer)))
+
+            def step_done(k: int, step, answer: str) -> None:
+                if k == 1:      # the plan was rehearsed whole: the tree changes from here
+                    job.progress(("plan", plan))
+                job.progress(("step", k, total, step, answer))
+            return load_scene(client, plan, keep=not replace, progress=step_done)
 
         def progress(value):
             if value[0] == "plan":

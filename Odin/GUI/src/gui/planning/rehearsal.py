@@ -1,0 +1,150 @@
+"""Loading a build plan into a running world, all or nothing (issue 39).
+
+A world node checks each request as it comes: a problem it refuses midway (a body beyond
+``world_extent``, one object more than its ``~max_objects``, a mesh over
+``~max_mesh_triangles``, a name it refuses) would leave half a robot, without its motors, in
+place of the scene before. So ``load_scene`` first builds the whole plan in a VirtualWorld
+Core of this process (``rehearse``: the same ROS-free Core the node runs, started from the
+node's world parameters, step values and resource limits, then set as the plan sets them) and
+sends it to the node only when every step was taken there. The Core being the node's own
+rules, what the rehearsal takes the node takes, but for what only the node knows (another
+client's requests in between); if the node still refuses a step, what this load built is
+removed and the world parameters and step values it set are put back, and the error names the
+step.
+
+With ``keep`` (the plan added to the scene the world holds), the rehearsal checks the plan
+alone, with the room the world has left under ``max_objects``: a clash with what the world
+holds (a name already taken) is found by the node only, and then undone as above, leaving
+the scene as it was.
+
+This module is the one home of the rule: ``load_problem`` (gui.cli) and the window's Open
+file (gui.window.simulation_tab) call ``load_scene``. It needs no ROS: ``client`` is a
+``gui.ros.client.WorldClient`` (only its methods are called).
+"""
+from __future__ import annotations
+
+import dataclasses
+from typing import Callable, Optional
+
+from gui.core.plan import BuildPlan, BuiltIds
+from gui.errors import GuiError
+from gui.planning.backend import CoreWorld
+from odin_common.errors import OdinError
+from odin_common.limits import ResourceLimits
+from odin_common.step_values import StepValues
+from odin_common.world_parameters import WorldParameters
+
+Progress = Callable[[int, object, str], None]
+"""``progress(k, step, answer)`` after step k (1-based) of a plan was answered."""
+
+
+class _RehearsalWorld(CoreWorld):
+    """A CoreWorld whose Set Step is checked as the node checks it (a CoreWorld of the
+    planner takes the plan's step values as they are)."""
+
+    def set_step(self, step=None, steps_per_cycle=None, cycle_time=None, rate=None):
+        from virtual_world.core.step_values import resolve
+        self.step_values, _ = resolve(self.step_values, step=step or 0.0,
+                                      steps_per_cycle=steps_per_cycle or 0,
+                                      cycle_time=cycle_time or 0.0, rate=rate or 0.0)
+        return self.step_values
+
+
+def rehearse(plan: BuildPlan, parameters: WorldParameters, step_values: StepValues,
+             resources: ResourceLimits) -> None:
+    """Builds every step of ``plan`` in a Core of this process that starts as the world does
+    (its ``parameters``, ``step_values`` and ``resources``); raises GuiError naming the first
+    step the Core refuses ("step k/n (label) ..."). ``plan`` is left as it was (the world IDs
+    of the rehearsal are not recorded in it)."""
+    world = _RehearsalWorld(parameters, resources, step_values)
+    try:
+        ids = BuiltIds()
+        for k, step in enumerate(plan.steps, start=1):
+            try:
+                step.send(world, ids)
+            except OdinError as error:
+                raise GuiError(f"step {k}/{len(plan.steps)} ({step.label()}) would be "
+                               f"refused: {_one_line(error)}") from None
+    finally:
+        world.close()
+
+
+def load_scene(client, plan: BuildPlan, keep: bool = False,
+               progress: Optional[Progress] = None) -> dict:
+    """Builds ``plan`` in the world of ``client`` (a WorldClient) whole, after New Scene
+    unless ``keep``, or changes nothing: rehearsed first (``rehearse``), sent only if every
+    step was taken; a step the world still refuses is undone (``_undo``). Returns
+    ``client.execute``'s answer (the world's IDs, robots, overlaps); raises GuiError, one
+    line naming the problem and the step."""
+    before = client.world()
+    source = plan.problem.source
+    try:
+        rehearse(plan, before.parameters, before.step_values,
+                 _room(client.resource_limits(), before, keep))
+    except OdinError as error:
+        raise GuiError(f"{source}: {_one_line(error)}; nothing was sent: the world is "
+                       "unchanged") from None
+    if not keep:
+        client.new_scene()
+    ids, answered = BuiltIds(), [0]
+
+    def counted(k: int, step, answer: str) -> None:
+        answered[0] = k
+        if progress is not None:
+            progress(k, step, answer)
+
+    try:
+        return client.execute(plan, progress=counted, ids=ids)
+    except OdinError as error:
+        k = answered[0] + 1
+        what = (f"step {k}/{len(plan.steps)} ({plan.steps[k - 1].label()})"
+                if k <= len(plan.steps) else "declaring its robots (Set Robot)")
+        raise GuiError(f"{source}: the world refused {what}, which the rehearsal took: "
+                       f"{_one_line(error)}; {_undo(client, plan, before, ids, keep)}") from None
+
+
+def _room(resources: ResourceLimits, before, keep: bool) -> ResourceLimits:
+    """The limits the plan must fit: the world's, less the objects it holds when it keeps
+    them (``before``: its Get World)."""
+    if not keep:
+        return resources
+    room = resources.max_objects - len(before.objects)
+    if room < 1:
+        raise GuiError(f"the world holds {len(before.objects):,} objects, its limit "
+                       f"(max_objects {resources.max_objects:,}): no room to add any")
+    return dataclasses.replace(resources, max_objects=room)
+
+
+def _undo(client, plan: BuildPlan, before, ids: BuiltIds, keep: bool) -> str:
+    """Removes what a refused load built (everything, after its New Scene; its bodies, with
+    their joints and motors, and its robots, with ``keep``) and sets the world parameters and
+    step values of ``before`` (Get World before the load) again; says what it did."""
+    try:
+        if keep:
+            held = set(client.world().objects)
+            for world_id in ids.bodies.values():
+                if world_id in held and world_id not in before.objects:
+                    client.remove_object(world_id)
+        else:
+            client.new_scene()
+        kept = {robot.name for robot in before.robots}
+        planned = {handle.name for handle in plan.robots}
+        for robot in client.world().robots:
+            if robot.name in planned and robot.name not in kept:
+                client.remove_robot(robot.name)
+        client.set_world(**before.parameters.as_dict())
+        values = before.step_values
+        client.set_step(step=values.step, steps_per_cycle=values.steps_per_cycle,
+                        rate=values.rate)
+    except OdinError as error:
+        return f"undoing what it built failed too: {_one_line(error)}"
+    if keep:
+        return "what it built was removed: the scene is as it was"
+    return "what it built was removed (the scene before it was cleared by its New Scene)"
+
+
+def _one_line(error: BaseException) -> str:
+    return " ".join(str(error).split())
+
+
+__all__ = ["load_scene", "rehearse"]

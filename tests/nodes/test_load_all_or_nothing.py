@@ -1,0 +1,116 @@
+"""load_problem builds a problem whole or leaves the scene as it was (issue 39): a problem the
+world would refuse midway (a box beyond the world's extent, more objects than the node's
+``~max_objects``) is refused in one line, exit status 2, before New Scene, and the problem
+built before keeps its objects, robots, joints, motors and state, bit for bit. Before, New
+Scene went first and the refused step left half a robot, without its motors."""
+from __future__ import annotations
+
+import pathlib
+
+import numpy as np
+import pytest
+
+pytestmark = pytest.mark.forked
+
+
+def _boxes(path: pathlib.Path, count: int, spacing_mm: float) -> pathlib.Path:
+    """A Kautham problem of the arm (``arm_and_box``'s arm.rob, in the same folder) and
+    ``count`` 100 mm boxes of its scene, ``spacing_mm`` apart along y, 300 mm up."""
+    scenes = "".join(f'<Scene scene="cube.iv" scale="1.0"><Location X="700" Y="{k * spacing_mm}"'
+                     ' Z="300" WX="0" WY="0" WZ="1" TH="0"/></Scene>\n' for k in range(count))
+    path.write_text('<?xml version="1.0"?>\n<Problem>\n<Robot robot="arm.rob"/>\n'
+                    f'{scenes}</Problem>\n')
+    return path
+
+
+def _scene(client):
+    """What a refused load must leave as it was: every ID, robot and every body's state."""
+    world = client.world()
+    state = np.array(client.call("get_state").state_vector)
+    return (world.objects, world.entities, world.joints, world.motors, world.robots,
+            world.parameters, world.step_values), state.tobytes()
+
+
+def _load(master, problem: pathlib.Path, *options: str):
+    return master.run(["rosrun", "GUI", "load_problem", str(problem), *options], check=False,
+                      timeout=120)
+
+
+def _refused_in_one_line(result, *words: str) -> str:
+    errors = [line for line in result.stderr.splitlines() if ": warning: " not in line]
+    assert result.returncode == 2, result.stderr
+    assert len(errors) == 1 and errors[0].startswith("load_problem: error: "), result.stderr
+    for word in words:
+        assert word in errors[0], errors[0]
+    return errors[0]
+
+
+@pytest.fixture
+def small_world(ros_master):
+    """A world node that holds at most 6 objects."""
+    node = ros_master.rosrun("VirtualWorld", "virtualWorld", "_max_objects:=6")
+    ros_master.wait_for_service("/virtual_world/set_servo")
+    yield ros_master
+    assert node.poll() is None, "virtualWorld died:\n" + ros_master.log_text(node)[-3000:]
+
+
+def test_a_problem_beyond_the_world_extent_leaves_the_scene_built_before(world, arm_and_box):
+    from gui.ros.client import WorldClient
+    good = arm_and_box("good.xml", 600)
+    far = arm_and_box("far.xml", 3.5e7)          # 35 km: beyond the 10 km world extent
+    assert _load(world, good).returncode == 0
+    client = WorldClient()
+    before = _scene(client)
+    assert before[0][4] and before[0][3], "the good problem built a robot with motors"
+
+    refused = _load(world, far)
+    assert _scene(client) == before
+    line = _refused_in_one_line(refused, "far.xml", "world_extent")
+    assert "unchanged" in line
+    client.close()
+
+
+def test_more_objects_than_the_node_holds_leave_the_scene_built_before(small_world,
+                                                                          arm_and_box):
+    from gui.ros.client import WorldClient
+    good = _boxes(arm_and_box("unused.xml", 600).with_name("two.xml"), 2, 200)
+    many = _boxes(good.with_name("many.xml"), 9, 200)    # 2 links + 9 boxes > 6
+    assert _load(small_world, good).returncode == 0
+    client = WorldClient()
+    before = _scene(client)
+    assert len(before[0][0]) == 4
+
+    refused = _load(small_world, many)
+    assert _scene(client) == before
+    _refused_in_one_line(refused, "many.xml", "max_objects")
+    # --keep: the problem alone is over the limit; what the world holds leaves less room
+    refused = _load(small_world, many, "--keep")
+    assert _scene(client) == before
+    _refused_in_one_line(refused, "max_objects")
+    client.close()
+
+
+def test_the_window_refuses_a_problem_beyond_the_world_extent_and_keeps_its_scene(
+        world, arm_and_box):
+    """The window's Open file has the same rule (gui.planning.rehearsal.load_scene)."""
+    import os
+    os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+    from gui.ros.client import WorldClient
+    from gui.window.testing import open_window, wait_for
+    window = open_window()
+    try:
+        wait_for(lambda: window.connected and window.updates > 0, 15, "the window to connect")
+        tab = window.simulation
+        tab.open_problem(str(arm_and_box("near.xml", 450)))
+        wait_for(lambda: not tab.building and "arm" in window.scene.robots, 30, "the arm")
+        client = WorldClient(node_name="probe")
+        before = _scene(client)
+        shown = tab.element_count()
+        tab.open_problem(str(arm_and_box("beyond.xml", -2.5e7)))    # 25 km away
+        wait_for(lambda: not tab.building, 30, "the refusal")
+        assert _scene(client) == before
+        assert "beyond.xml" in window.last_error and "world_extent" in window.last_error
+        wait_for(lambda: tab.element_count() == shown, 5, "the tree as it was")
+        client.close()
+    finally:
+        window.shutdown()
