@@ -33,18 +33,27 @@ same name)
     ``~view_object`` (Services/ViewObject): add an object, or replace the one with that ID (the
         world may re-send its scene to a Viewer that started late, and does on every problem
         load: geometries are kept by content, viewer.core.geometry.GeometryCache, so the same
-        shape sent again is not built again). Refused: empty ID, a
-        parameter count that is no shape, sizes <= 0, empty mesh, index out of range, NaN
-        position, a quaternion that is not finite or whose norm is off 1 by more than 1e-3
-        (odin_common.rotations.QUATERNION_TOLERANCE),
-        colour outside [0, 1].
+        shape sent again is not built again). Checked whole before the scene or the camera
+        changes (a refusal changes nothing): refused are an ID that is no name
+        (odin_common.limits.check_name: empty, over 256 bytes, NUL, newline...), a parameter
+        count that is no shape, sizes outside [MIN_SIZE, MAX_SIZE], an empty mesh, an index
+        out of range, a position or mesh vertex not finite or beyond MAX_EXTENT (the widest
+        world_extent; viewer.core.geometry), a quaternion that is not finite or whose norm is
+        off 1 by more than 1e-3 (odin_common.rotations.QUATERNION_TOLERANCE), a colour outside
+        [0, 1].
     ``~remove_object`` (Services/ViewerRemoveObject): refused for an unknown ID.
     ``~new_scene`` (Services/ViewerNewScene): empty the scene (the camera stays).
     ``~save_snapshot`` (Services/SaveSnapshot): render now and write ``<~snapshot_dir>/<name>``
-        (".png" added); names with '/', "..", absolute paths and symbolic links are refused.
+        (".png" added); names that are no name (check_name), names with '/', "..", a file name
+        over 255 bytes with its ".png", and symbolic links are refused. The file is written
+        whole or not at all (a temporary file renamed onto the name): a full disk leaves an
+        older file of that name as it was and answers one line with the cause.
         Answers the stamps of the last world update and Collided message the frame shows.
     ``~set_camera`` (Services/SetCamera): pose (fixes the camera), re-fit, image size, field of
         view; answers the camera now in use.
+
+``~snapshot_every`` frames are written the same way; while the disk is full no frame file is
+left, one warning a minute says so, and frames are written again once there is room.
 
 Parameters: ``viewer.portal.parameters.NODE_PARAMETERS`` (``~world``, ``~rate``, ``~width``,
 ``~height``, ``~fov_y``, ``~eye``, ``~target``, ``~up``, ``~background``, ``~snapshot_dir``,
