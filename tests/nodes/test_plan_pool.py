@@ -130,3 +130,58 @@ def test_plan_with_the_pool_refuses_an_absent_world_in_one_line(ros_master, kaut
     errors = [line for line in run.stderr.splitlines() if not line.startswith("plan: warning")]
     assert errors == ["plan: error: /nobody/virtual_world: no world answering after 2 s"]
     assert not out.exists()
+
+
+def test_a_pool_world_killed_during_the_search_ends_plan_with_its_one_line(ros_master,
+                                                                           kautham_dir,
+                                                                           tmp_path):
+    """The world dies while the planner searches (a goal too tight to reach first): plan
+    says so in one line on stderr and exits 2; before, 55 lines of nanobind's "leaked
+    instances" report followed it (OMPL's objects were still alive at the interpreter's
+    teardown)."""
+    node = ros_master.rosrun("VirtualWorld", "virtualWorld", "__ns:=/w9")
+    ros_master.wait_for_service("/w9/virtual_world/propagate")
+    out = tmp_path / "never.path"
+    search = subprocess.Popen(
+        ros_master.rosrun_command(["rosrun", "GUI", "plan", str(kautham_dir.joinpath(*SPHERE)),
+                                   "--backend", "pool", "--worlds", "/w9/virtual_world",
+                                   "--goal-tolerance", "1e-6", "--seed", "3", "--time", "120",
+                                   "--out", str(out)]),
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=ros_master.env,
+        stdin=subprocess.DEVNULL)
+    try:
+        for line in search.stdout:
+            if "searching for up to" in line:
+                break
+        node.kill()
+        node.wait(30)
+        _, stderr = search.communicate(timeout=120)
+    finally:
+        if search.poll() is None:
+            search.kill()
+    errors = [line for line in stderr.splitlines() if not line.startswith("plan: warning")]
+    assert search.returncode == 2, stderr
+    assert len(errors) == 1 and errors[0].startswith("plan: error: "), stderr
+    assert "nanobind" not in stderr and "Traceback" not in stderr
+    assert not out.exists()
+
+
+def test_a_pool_world_killed_before_plan_starts_is_said_in_one_line(ros_master, kautham_dir,
+                                                                    tmp_path):
+    """A world killed (SIGKILL) stays registered with the master: waiting for it, rospy
+    tried to contact it and logged "failed to contact, will keep trying" on stderr around
+    the tool's one line."""
+    node = ros_master.rosrun("VirtualWorld", "virtualWorld", "__ns:=/w8")
+    ros_master.wait_for_service("/w8/virtual_world/propagate")
+    node.kill()
+    node.wait(30)
+    out = tmp_path / "never.path"
+    run = subprocess.run(
+        ros_master.rosrun_command(["rosrun", "GUI", "plan", str(kautham_dir.joinpath(*SPHERE)),
+                                   "--backend", "pool", "--worlds", "/w8/virtual_world",
+                                   "--world-timeout", "3", "--time", "1", "--out", str(out)]),
+        capture_output=True, text=True, timeout=120, env=ros_master.env)
+    errors = [line for line in run.stderr.splitlines() if not line.startswith("plan: warning")]
+    assert run.returncode == 2, run.stderr
+    assert errors == ["plan: error: /w8/virtual_world: no world answering after 3 s"]
+    assert not out.exists()

@@ -582,10 +582,11 @@ def _search(args, stop):
     from gui.planning.bridge import plan
     make_backend, time_limit = _planning_backends(args)
     seed = args.seed if args.seed is not None else _fresh_seed(args.parallel)
-    print(f"plan: {args.planner} searching for up to {time_limit:g} s, seed {seed}"
-          f"{_searches(args)} (--seed {seed} repeats it)", flush=True)
+    searching = (f"plan: {args.planner} searching for up to {time_limit:g} s, seed {seed}"
+                 f"{_searches(args)} (--seed {seed} repeats it)")
     if args.parallel == 1:
         backend = make_backend(0)
+        print(searching, flush=True)        # once the world is built: the search starts now
         try:
             result = plan(backend, args.planner, time_limit, seed, stop)
         finally:
@@ -593,6 +594,7 @@ def _search(args, stop):
         print(json.dumps(result.statistics(), indent=1), flush=True)
         return result, time_limit, seed
     from gui.planning.parallel import plan_in_parallel
+    print(searching, flush=True)
     result, outcomes = plan_in_parallel(make_backend, args.parallel, args.planner,
                                         time_limit, seed, stop)
     print(json.dumps({**result.statistics(), "searches": [o.summary() for o in outcomes]},

@@ -135,7 +135,7 @@ class _Callbacks:
                 vector = outcome.state
             self.write(result, vector, outcome)
         except BaseException as error:      # noqa: B902 - handed back to plan()
-            self.error = self.error or error
+            self.error = self.error or _without_frames(error)
             self.write(result, self._vector(start), None)
             result[1][self.world_size - 1] = 1.0   # invalid: the search stops using it
 
@@ -145,6 +145,25 @@ class _Callbacks:
         velocity = [robot[3], robot[4], robot[5]]
         return state[1][self.world_size - 1] == 0.0 and self.problem.in_bounds(position,
                                                                                 velocity)
+
+
+def _without_frames(error: BaseException) -> BaseException:
+    """``error`` and the exceptions it was raised from or during, without their tracebacks.
+    A traceback's frames lead (through each frame's caller) to this callback's frame, whose
+    ``start`` and ``result`` are OMPL's, and to plan()'s, which holds the whole setup: kept by
+    the callbacks, which the SpaceInformation holds, that is a cycle through C++ that Python's
+    collector cannot see, and the search's OMPL objects would outlive it (nanobind reporting
+    dozens of them leaked when the interpreter ends: a tool whose world died said so after
+    its one line)."""
+    seen = set()
+    links: List[Optional[BaseException]] = [error]
+    while links:
+        link = links.pop()
+        if link is not None and id(link) not in seen:
+            seen.add(id(link))
+            link.__traceback__ = None
+            links += [link.__cause__, link.__context__]
+    return error
 
 
 class _Setup:

@@ -17,6 +17,7 @@ import rospy.
 from __future__ import annotations
 
 import contextlib
+import logging
 import time
 import xmlrpc.client
 from typing import Dict, Iterator, Mapping, Type
@@ -68,6 +69,24 @@ def _prompt_registration() -> Iterator[None]:
         init.time = module_time
 
 
+class _WaitingNoise(logging.Filter):
+    """Drops rospy.wait_for_service's "failed to contact, will keep trying" (and its "finally
+    were able to contact"): a node killed stays registered with the master, and rospy says so
+    on stderr every 10 s while it waits, around the one line a tool ends with (the wait's
+    outcome is said by ``ServiceCaller.wait``'s error)."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return not str(record.msg).startswith("wait_for_service(")
+
+
+_WAITING_NOISE = _WaitingNoise()
+
+
+def _quiet_waits() -> None:
+    """Puts ``_WaitingNoise`` on rospy's logger (once: a logger keeps a filter once)."""
+    logging.getLogger("rosout").addFilter(_WAITING_NOISE)
+
+
 class ServiceCaller:
     """Calls ``<namespace>/<service>`` for the services of ``services`` ({name: srv type name
     in the Services package}); failures raise ``error(service path, message)``."""
@@ -90,7 +109,9 @@ class ServiceCaller:
 
     def wait(self, service: str, timeout: float, absent: str) -> None:
         """Waits up to ``timeout`` s for ``service`` to be registered; raises
-        ``error(namespace, absent)`` if it is not."""
+        ``error(namespace, absent)`` if it is not. Quietly: rospy's own word on a registered
+        service whose node does not answer (``_WaitingNoise``) is left out."""
+        _quiet_waits()
         try:
             self._rospy.wait_for_service(self.path(service), timeout=timeout)
         except self._rospy.ROSException:
