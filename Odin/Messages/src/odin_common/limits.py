@@ -32,6 +32,21 @@ velocities when contacts push it at arm's length, and ODE then aborts the proces
 quaternion normalisation (a 12 m room of 0.05 kg and 7e-8 kg m^2, a radius of gyration of
 0.02 % of its reach, did; 0.1 % did not). Uniform solids have 20 % and more."""
 
+MAX_GYRATION_MULTIPLE = 10.0
+"""A given inertia's radius of gyration about each principal axis, as a multiple of the
+farthest any point of the body's geometry lies from its centre of mass: the most allowed. No
+rigid body's exceeds 1 (its mass is within its geometry's reach); a larger multiple leaves
+room for geometry that only roughly covers the mass (a link's collision shape). A body
+heavier in rotation than its size allows turns ODE's rotation update into overflow: 1 kg of
+sphere with 1e200 kg m^2 ended the process in ODE's quaternion normalisation at its first
+step."""
+
+MAX_INERTIA = 1e30
+"""kg m^2: the largest principal moment of a given inertia, whatever its mass and geometry.
+The heaviest body (MAX_MASS) the size of the largest world (2 x 1e8 m) has ~4e25; with
+angular speeds below the divergence guard's (<= 1e8 rad/s) every product ODE forms (I w,
+w x I w) stays below 1e50, far inside float64."""
+
 MAX_MOTOR_SPEED = 1e5
 """rad/s or m/s: a motor's goal speed."""
 
@@ -47,6 +62,18 @@ MAX_MESH_TRIANGLES = 2_000_000
 MAX_INPUT_FILE_MB = 256
 """MB: the largest file the GUI reads (a problem, robot, URDF, control, path or geometry file);
 a larger one is refused before it is read. The real Kautham corpus's largest is under 10 MB."""
+
+MAX_XML_ELEMENTS = 200_000
+"""Elements of one XML file the GUI reads (problem, robot, URDF, control, path, solution,
+benchmark files), counted while parsing: the parse stops at the next one. The largest file of
+the public Kautham corpus holds 250 (a .rob); a tree node costs ~0.5 KB, so the bound keeps a
+tree near 100 MB where 200 MB of empty elements would otherwise need gigabytes."""
+
+MAX_XML_DEPTH = 100
+"""Levels of nested elements in one XML file the GUI reads (Kautham's files: at most 5)."""
+
+MAX_XML_ATTRIBUTES = 1_000
+"""Attributes of one element of an XML file the GUI reads (Kautham's files: at most 7)."""
 
 MAX_NAME_BYTES = 256
 """Bytes (UTF-8) of a name a request gives (an object, part, joint, snapshot, robot): longer
@@ -76,6 +103,20 @@ def shown(value, limit: int = MAX_SHOWN_CHARS) -> str:
     if len(text) <= limit:
         return text
     return f"{text[:limit - 1]}… ({len(text):,} characters of repr)"
+
+
+MAX_LISTED = 10
+"""Items of a list (saved snapshot names, unknown IDs...) an error message names before it
+says how many more there are (``shown_list``)."""
+
+
+def shown_list(items, limit: int = MAX_LISTED) -> str:
+    """The first ``limit`` of ``items``, each ``shown``, and "N more": a refusal that lists
+    what a world holds stays short however much it holds."""
+    items = list(items)
+    head = ", ".join(shown(item) for item in items[:limit])
+    more = len(items) - limit
+    return f"[{head}{f', and {more:,} more' if more > 0 else ''}]"
 
 
 def name_problem(value) -> Optional[str]:
@@ -133,6 +174,30 @@ def thin_inertia(inertia: np.ndarray, mass: float, points: np.ndarray) -> Option
                     f"{MIN_GYRATION_FRACTION:g} of the {reach:.3g} m its geometry reaches from "
                     "that axis (MIN_GYRATION_FRACTION)")
     return None
+
+
+def heavy_inertia(inertia: np.ndarray, mass: float, points: np.ndarray) -> Optional[str]:
+    """Why a body of ``mass`` kg whose ``inertia`` ((3, 3) kg m^2, about its centre of mass) is
+    too heavy in rotation for its geometry (``points`` as ``thin_inertia``'s): a principal
+    moment above MAX_INERTIA, or a radius of gyration above MAX_GYRATION_MULTIPLE times the
+    farthest point's distance from the centre of mass; None when it is not."""
+    moments = np.linalg.eigvalsh(inertia)
+    points = np.asarray(points, dtype=float).reshape(-1, 3)
+    reach = float(np.sqrt(np.max(np.einsum("ij,ij->i", points, points), initial=0.0)))
+    most = min(mass * (MAX_GYRATION_MULTIPLE * reach) ** 2, MAX_INERTIA)
+    if moments[-1] > most:
+        why = ("MAX_INERTIA" if most == MAX_INERTIA else
+               f"a radius of gyration {MAX_GYRATION_MULTIPLE:g} times the {reach:.3g} m its "
+               "geometry reaches from the centre of mass (MAX_GYRATION_MULTIPLE)")
+        return (f"principal moment {moments[-1]:.3g} kg m^2 is above {most:.3g} kg m^2 for "
+                f"{mass:.3g} kg: {why}")
+    return None
+
+
+def inertia_problem(inertia: np.ndarray, mass: float, points: np.ndarray) -> Optional[str]:
+    """Why a given inertia cannot be this body's (``thin_inertia`` or ``heavy_inertia``), or
+    None: the one check of a given inertia against mass and geometry, both ways."""
+    return thin_inertia(inertia, mass, points) or heavy_inertia(inertia, mass, points)
 
 
 @dataclass(frozen=True)

@@ -15,6 +15,7 @@ import numpy as np
 
 from odin_common import limits
 from odin_common.interface import JOINT_FORCE_MAGNITUDES, ForceKind
+from odin_common.limits import shown
 from virtual_world.core import validation as check
 from virtual_world.core.records import BodyForceRecord, JointForceRecord
 from virtual_world.core.scene import Scene
@@ -28,7 +29,7 @@ def add_body_force(scene: Scene, object_id: str, kind: int, vector,
     """Adds a persistent force or torque; returns "force:<object>:<n>" or
     "torque:<object>:<n>", n the first free number."""
     if isinstance(kind, bool) or kind not in set(ForceKind):
-        raise InvalidArgument(f"force kind {kind!r} is not FORCE (0) or TORQUE (1)")
+        raise InvalidArgument(f"force kind {shown(kind)} is not FORCE (0) or TORQUE (1)")
     kind = ForceKind(kind)
     obj = scene.body_object(object_id, "force")
     vector = np.array(checked_vector(object_id, kind, vector))
@@ -53,12 +54,13 @@ def checked_vector(object_id: str, kind: ForceKind, vector) -> Tuple[float, floa
         x, y, z = vector
         x, y, z = float(x), float(y), float(z)
     except (TypeError, ValueError):
-        raise InvalidArgument(f"force vector={vector!r} is not a vector of 3 numbers") from None
+        raise InvalidArgument(f"force vector={shown(vector)} is not a vector of 3 "
+                              "numbers") from None
     if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
-        raise InvalidArgument(f"force vector={vector!r} is not finite")
+        raise InvalidArgument(f"force vector={shown(vector)} is not finite")
     magnitude = math.sqrt(x * x + y * y + z * z)
     if magnitude > limits.MAX_FORCE:
-        check.at_most(f"{kind.name.lower()} on {object_id!r}", magnitude, limits.MAX_FORCE,
+        check.at_most(f"{kind.name.lower()} on {shown(object_id)}", magnitude, limits.MAX_FORCE,
                       "N" if kind == ForceKind.FORCE else "N m")
     return x, y, z
 
@@ -78,17 +80,17 @@ def add_joint_force(scene: Scene, joint_id: str, magnitudes: Sequence[float]) ->
     joint = scene.joint(joint_id)
     if joint.type not in JOINT_FORCE_MAGNITUDES:
         raise Unsupported(f"ODE has no force or torque for {joint.type.label} joint "
-                          f"{joint_id!r}")
+                          f"{shown(joint_id)}")
     count = len(JOINT_FORCE_MAGNITUDES[joint.type])
     try:
         n_values = len(magnitudes)
     except TypeError:
-        raise InvalidArgument(f"magnitudes {magnitudes!r} is not a sequence") from None
+        raise InvalidArgument(f"magnitudes {shown(magnitudes)} is not a sequence") from None
     if n_values != count:
         raise InvalidArgument(f"a {joint.type.label} joint force takes {count} magnitude(s); "
-                              f"got {list(magnitudes)!r}")
+                              f"got {shown(list(magnitudes))}")
     values = check.vector("joint force magnitudes", magnitudes, count)
-    check.at_most(f"joint force on {joint_id!r}", float(np.max(np.abs(values))),
+    check.at_most(f"joint force on {shown(joint_id)}", float(np.max(np.abs(values))),
                   limits.MAX_FORCE, "N or N m")
     return _keep(scene, _JOINT, f"jointforce:{joint_id}", JointForceRecord(joint_id, values))
 
@@ -157,7 +159,7 @@ def _keep(scene: Scene, kind: _Kind, prefix: str, record) -> str:
 def _remove(scene: Scene, kind: _Kind, force_id: str) -> None:
     records = kind.records(scene)
     if force_id not in records:
-        raise UnknownName(f"no {kind.noun} {force_id!r}")
+        raise UnknownName(f"no {kind.noun} {shown(force_id)}")
     kind.owners(scene)[kind.owner_id(records[force_id])].forces.discard(force_id)
     _drop(scene, kind, [force_id])
 

@@ -14,6 +14,7 @@ from odin_common.interface import (JOINT_AXES_USED, JOINT_NEEDS_TWO_BODIES,
                                    JOINT_PARAMETER_AXES, JOINT_PARAMETERS,
                                    MOTOR_PARAMETERS, NON_NEGATIVE_PARAMETERS, UNIT_PARAMETERS,
                                    JointParameter, JointType, joint_type)
+from odin_common.limits import shown
 from odin_common.specs import JointSpec
 from virtual_world.core import forces, motors, validation as check
 from virtual_world.core.records import JointRecord, JointState, Removed
@@ -35,7 +36,7 @@ def create_joint(scene: Scene, spec: JointSpec) -> str:
     if not body1 and not body2:
         raise InvalidArgument("a joint needs at least one body (both are '')")
     if body1 == body2:
-        raise InvalidArgument(f"a joint cannot join {body1!r} to itself")
+        raise InvalidArgument(f"a joint cannot join {shown(body1)} to itself")
     objects = [scene.body_object(b, "joint") if b else None for b in (body1, body2)]
     if kind in JOINT_NEEDS_TWO_BODIES and not (body1 and body2):
         raise Unsupported(f"a {kind.label} joint needs two bodies (ODE cannot attach it to "
@@ -45,10 +46,13 @@ def create_joint(scene: Scene, spec: JointSpec) -> str:
     pair = frozenset((body1, body2))
     if pair in scene.pairs:
         raise DuplicateName(
-            f"bodies {body1!r} and {body2!r} are already joined by {scene.pairs[pair]!r}")
-    joint_id = check.text("joint id", spec.id) or spec.default_id
+            f"bodies {shown(body1)} and {shown(body2)} are already joined by "
+            f"{shown(scene.pairs[pair])}")
+    joint_id = check.text("joint id", spec.id)
+    joint_id = check.name("joint id", joint_id, allow_marker=True) if joint_id else \
+        spec.default_id
     if joint_id in scene.joints or joint_id in scene.motors:
-        raise DuplicateName(f"joint id {joint_id!r} is already taken")
+        raise DuplicateName(f"joint id {shown(joint_id)} is already taken")
     anchor = check.within_extent("anchor", check.vector("anchor", spec.anchor),
                                  scene.parameters.world_extent)
     # only the axes the type uses are checked: a request leaves the others at zero
@@ -96,42 +100,43 @@ def set_joint_parameters(scene: Scene, joint_id: str,
 
 def _checked_parameters(kind: JointType, joint_id: str, parameters) -> list:
     if kind not in JOINT_PARAMETERS:
-        raise Unsupported(f"joint {joint_id!r} ({kind.label}) takes no parameters")
+        raise Unsupported(f"joint {shown(joint_id)} ({kind.label}) takes no parameters")
     return _check_parameters(parameters, JOINT_PARAMETERS[kind], JOINT_PARAMETER_AXES[kind],
                              kind.label, joint_id)
 
 
 def _check_parameters(parameters, allowed, axes: int, kind: str, joint_id: str) -> list:
-    """[(JointParameter, axis, value)] with values in range; MAX_FORCE < 0 -> infinity."""
+    """[(JointParameter, axis, value)] with values in range; MAX_FORCE < 0 (unlimited) ->
+    ode.joints.UNLIMITED_FORCE."""
     checked = []
     for item in parameters:
         try:
             parameter, axis, value = item
         except (TypeError, ValueError):
-            raise InvalidArgument(f"{item!r} is not a (parameter, axis, value) triple") \
+            raise InvalidArgument(f"{shown(item)} is not a (parameter, axis, value) triple") \
                 from None
         if isinstance(parameter, bool) or parameter not in set(JointParameter):
-            raise InvalidArgument(f"joint parameter {parameter!r} is not one of 0..11")
+            raise InvalidArgument(f"joint parameter {shown(parameter)} is not one of 0..11")
         parameter = JointParameter(parameter)
         label = parameter.label
         if parameter not in allowed:
-            raise Unsupported(f"parameter {label} does not fit {kind} {joint_id!r}")
+            raise Unsupported(f"parameter {label} does not fit {kind} {shown(joint_id)}")
         if isinstance(axis, bool) or axis not in range(1, axes + 1):
-            raise InvalidArgument(f"axis {axis!r} for {label} of {kind} {joint_id!r} must be"
-                                  f" in 1..{axes}")
+            raise InvalidArgument(f"axis {shown(axis)} for {label} of {kind} {shown(joint_id)} "
+                                  f"must be in 1..{axes}")
         value = check.number(f"{label} value", value, allow_inf=parameter in (
             JointParameter.LO_STOP, JointParameter.HI_STOP))
         if parameter in UNIT_PARAMETERS and not 0 <= value <= 1:
-            raise InvalidArgument(f"{label}={value!r} must be in [0, 1]")
+            raise InvalidArgument(f"{label}={shown(value)} must be in [0, 1]")
         if parameter in NON_NEGATIVE_PARAMETERS and value < 0:
-            raise InvalidArgument(f"{label}={value!r} must be >= 0")
+            raise InvalidArgument(f"{label}={shown(value)} must be >= 0")
         if parameter == JointParameter.MAX_FORCE and value < 0:
-            value = ode_joints.INFINITY
+            value = ode_joints.unlimited_force(value)
         elif parameter == JointParameter.MAX_FORCE:
-            check.at_most(f"{label} of {kind} {joint_id!r}", value, limits.MAX_FORCE,
+            check.at_most(f"{label} of {kind} {shown(joint_id)}", value, limits.MAX_FORCE,
                           "N or N m (negative: infinite)")
         if parameter == JointParameter.VELOCITY:
-            check.at_most(f"{label} of {kind} {joint_id!r}", abs(value),
+            check.at_most(f"{label} of {kind} {shown(joint_id)}", abs(value),
                           limits.MAX_MOTOR_SPEED, "rad/s or m/s")
         checked.append((parameter, int(axis), value))
     return checked

@@ -38,6 +38,7 @@ from __future__ import annotations
 from typing import Dict, Iterable, Optional, Sequence
 
 from odin_common.interface import JointType, ServoDrive
+from odin_common.limits import shown
 from virtual_world.core import guard
 from virtual_world.core.scene import Scene
 from virtual_world.errors import InvalidArgument, Unsupported
@@ -53,7 +54,7 @@ def plan(scene: Scene, motor_ids: Sequence[str], drive: int) -> Optional[Dict[st
     motors' joints: KINEMATIC adds them to the drive, DYNAMIC takes them out; None for
     UNCHANGED. Checks everything, changes nothing (``install`` applies it)."""
     if isinstance(drive, bool) or drive not in set(ServoDrive):
-        raise InvalidArgument(f"drive {drive!r} is not UNCHANGED (0), DYNAMIC (1) or "
+        raise InvalidArgument(f"drive {shown(drive)} is not UNCHANGED (0), DYNAMIC (1) or "
                               "KINEMATIC (2)")
     drive = ServoDrive(drive)
     if drive == ServoDrive.UNCHANGED:
@@ -73,7 +74,7 @@ def _check_drivable(scene: Scene, motor_id: str) -> None:
     motor = scene.motor(motor_id)
     joint = scene.joints.get(motor.joint) if motor.joint else None
     if joint is None or not motor.on_joint_axes or joint.type not in DRIVEN_TYPES:
-        raise Unsupported(f"motor {motor_id!r} cannot take the kinematic drive: it must be "
+        raise Unsupported(f"motor {shown(motor_id)} cannot take the kinematic drive: it must be "
                           "made on a hinge or a slider with the joint's own axis")
 
 
@@ -85,8 +86,9 @@ def links_of(scene: Scene, motor_ids: Iterable[str]) -> Dict[str, str]:
     for motor_id in pending:
         joint_id = scene.motors[motor_id].joint
         if joint_id in driver:
-            raise InvalidArgument(f"motors {driver[joint_id]!r} and {motor_id!r} both drive "
-                                  f"joint {joint_id!r}: one motor drives a joint kinematically")
+            raise InvalidArgument(f"motors {shown(driver[joint_id])} and {shown(motor_id)} both "
+                                  f"drive joint {shown(joint_id)}: one motor drives a joint "
+                                  "kinematically")
         driver[joint_id] = motor_id
     links: Dict[str, str] = {}
     held = {o for o, obj in scene.objects.items() if obj.fixed}
@@ -98,8 +100,8 @@ def links_of(scene: Scene, motor_ids: Iterable[str]) -> Dict[str, str]:
             if len(free) != 1:      # both held, or neither (yet)
                 continue
             if free[0] in scene.parked:
-                raise InvalidArgument(f"motor {motor_id!r}: its link {free[0]!r} is parked by "
-                                      "the divergence guard")
+                raise InvalidArgument(f"motor {shown(motor_id)}: its link {shown(free[0])} is "
+                                      "parked by the divergence guard")
             links[motor_id] = free[0]
             held.add(free[0])
             progress.append(motor_id)
@@ -107,8 +109,9 @@ def links_of(scene: Scene, motor_ids: Iterable[str]) -> Dict[str, str]:
             joint_id = scene.motors[pending[0]].joint
             bodies_ = scene.joints[joint_id].bodies
             raise InvalidArgument(
-                f"motor {pending[0]!r}: its joint {joint_id!r} between {bodies_[0] or 'world'!r}"
-                f" and {bodies_[1] or 'world'!r} needs exactly one body held by the world, a "
+                f"motor {shown(pending[0])}: its joint {shown(joint_id)} between "
+                f"{shown(bodies_[0] or 'world')}"
+                f" and {shown(bodies_[1] or 'world')} needs exactly one body held by the world, a "
                 "fixed object or a kinematic link (drive the joints between it and the world "
                 "kinematically too)")
         pending = [m for m in pending if m not in links]

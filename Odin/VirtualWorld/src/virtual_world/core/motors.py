@@ -14,6 +14,7 @@ import numpy as np
 from odin_common import limits
 from odin_common.interface import (JOINT_AXIS2_ON_BODY2, SERVO_GAIN, SERVO_MAX_SPEED, AxisFrame,
                                    JointParameter, MotorKind)
+from odin_common.limits import shown
 from odin_common.specs import MotorSpec
 from virtual_world.core import kinematic, validation as check
 from virtual_world.core.records import MotorRecord, Servo, ServoState
@@ -27,7 +28,7 @@ def create_motor(scene: Scene, spec: MotorSpec) -> str:
     """Creates the motor of ``spec`` (see MotorSpec); returns its id."""
     kind = spec.kind
     if isinstance(kind, bool) or kind not in set(MotorKind):
-        raise InvalidArgument(f"motor kind {kind!r} is not ANGULAR (0) or LINEAR (1)")
+        raise InvalidArgument(f"motor kind {shown(kind)} is not ANGULAR (0) or LINEAR (1)")
     kind = MotorKind(kind)
     motor_id, joint_id, body1, body2 = (check.text(what, value) for what, value in (
         ("motor_id", spec.id), ("joint", spec.joint), ("body1", spec.body1),
@@ -39,13 +40,13 @@ def create_motor(scene: Scene, spec: MotorSpec) -> str:
     if joint_id:
         joint = scene.joint(joint_id)
         if (body1 or body2) and (body1, body2) != joint.bodies:
-            raise InvalidArgument(f"bodies {body1!r}, {body2!r} differ from joint "
-                                  f"{joint_id!r}'s {joint.bodies}")
+            raise InvalidArgument(f"bodies {shown(body1)}, {shown(body2)} differ from joint "
+                                  f"{shown(joint_id)}'s {joint.bodies}")
         body1, body2 = joint.bodies
         if axes_values.size == 0:
             found = ode_joints.joint_axes(joint.owner.ptr, joint.type, kind)
             if not found:
-                raise Unsupported(f"joint {joint_id!r} ({joint.type.label}) has no "
+                raise Unsupported(f"joint {shown(joint_id)} ({joint.type.label}) has no "
                                   f"{kind.name.lower()} axis; give axes")
             axes_values = np.concatenate(found)
             on_joint_axes = True
@@ -57,10 +58,10 @@ def create_motor(scene: Scene, spec: MotorSpec) -> str:
     if not body1 and not body2:
         raise InvalidArgument("a motor needs a joint or at least one body")
     if body1 == body2:
-        raise InvalidArgument(f"a motor cannot join {body1!r} to itself")
+        raise InvalidArgument(f"a motor cannot join {shown(body1)} to itself")
     objects = [scene.body_object(b, "motor") if b else None for b in (body1, body2)]
     if axes_values.size % 3 or not 3 <= axes_values.size <= 9:
-        raise InvalidArgument(f"axes {list(spec.axes)!r}: need 1..3 axes of 3 numbers each")
+        raise InvalidArgument(f"axes {shown(list(spec.axes))}: need 1..3 axes of 3 numbers each")
     naxes = axes_values.size // 3
     unit_axes = [check.axis(f"motor axis {i + 1}", axes_values[3 * i:3 * i + 3])
                  for i in range(naxes)]
@@ -71,11 +72,12 @@ def create_motor(scene: Scene, spec: MotorSpec) -> str:
         if math.isfinite(force):
             check.at_most("max force", force, limits.MAX_FORCE, "N or N m (negative: infinite)")
     if len(max_forces) != naxes:
-        raise InvalidArgument(f"max_forces {list(spec.max_forces)!r}: need one per axis "
+        raise InvalidArgument(f"max_forces {shown(list(spec.max_forces))}: need one per axis "
                               f"({naxes})")
-    motor_id = motor_id or spec.default_id
+    motor_id = check.name("motor id", motor_id, allow_marker=True) if motor_id else \
+        spec.default_id
     if motor_id in scene.motors or motor_id in scene.joints:
-        raise DuplicateName(f"motor id {motor_id!r} is already taken")
+        raise DuplicateName(f"motor id {shown(motor_id)} is already taken")
     # ---- ODE
     owner = handles.new_motor(scene.c.world, kind, [o.body for o in objects if o is not None])
     if ode_frames is not None:
@@ -102,10 +104,10 @@ def _axis_frames(given: Sequence[int], naxes: int, objects) -> List[AxisFrame]:
     default = AxisFrame.FIRST_BODY if objects[0] is not None else AxisFrame.SECOND_BODY
     frames = list(given) if len(given) else [default] * naxes
     if len(frames) != naxes:
-        raise InvalidArgument(f"axis_frames {list(given)!r}: need one per axis ({naxes})")
+        raise InvalidArgument(f"axis_frames {shown(list(given))}: need one per axis ({naxes})")
     for frame in frames:
         if isinstance(frame, bool) or frame not in set(AxisFrame):
-            raise InvalidArgument(f"axis frame {frame!r} is not 0 (world), 1 or 2")
+            raise InvalidArgument(f"axis frame {shown(frame)} is not 0 (world), 1 or 2")
         if frame and objects[frame - 1] is None:
             raise InvalidArgument(f"axis frame {frame} names the world ('' body)")
     return [AxisFrame(f) for f in frames]
@@ -134,12 +136,12 @@ def set_velocities(scene: Scene, velocities: Mapping[str, Sequence[float]]) -> N
     checked = []
     for motor_id, values in dict(velocities).items():
         motor = scene.motor(motor_id)
-        vector = check.flat_vector(f"velocities of {motor_id!r}", values) \
+        vector = check.flat_vector(f"velocities of {shown(motor_id)}", values) \
             if hasattr(values, "__len__") else None
         if vector is None or vector.size != motor.naxes:
-            raise InvalidArgument(f"motor {motor_id!r} has {motor.naxes} axes; got "
-                                  f"{values!r}")
-        check.at_most(f"goal speed of {motor_id!r}", float(np.max(np.abs(vector))),
+            raise InvalidArgument(f"motor {shown(motor_id)} has {motor.naxes} axes; got "
+                                  f"{shown(values)}")
+        check.at_most(f"goal speed of {shown(motor_id)}", float(np.max(np.abs(vector))),
                       limits.MAX_MOTOR_SPEED, "rad/s or m/s")
         checked.append((motor, vector.tolist()))
     for motor, values in checked:
@@ -206,26 +208,26 @@ def set_servos(scene: Scene, servos: Mapping[str, Mapping]) -> None:
         motor = scene.motor(motor_id)
         if not motor.on_joint_axes or motor.joint not in scene.joints or \
                 scene.joints[motor.joint].type not in ode_joints.SERVO_COMPONENTS[motor.kind]:
-            raise Unsupported(f"motor {motor_id!r} is no servo: a servo drives a motor made "
+            raise Unsupported(f"motor {shown(motor_id)} is no servo: a servo drives a motor made "
                               "on a joint with the joint's own axes")
         fields = dict(fields)
         unknown = set(fields) - {"targets", "rates", "gains", "max_speeds", "max_forces"}
         if unknown or "targets" not in fields:
-            raise InvalidArgument(f"servo of {motor_id!r}: give targets (and optionally rates, "
-                                  f"gains, max_speeds, max_forces); got {sorted(fields)}")
+            raise InvalidArgument(f"servo of {shown(motor_id)}: give targets (and optionally "
+                                  f"rates, gains, max_speeds, max_forces); got {sorted(fields)}")
 
         def per_axis(name, default, low, high, unit):
             given = fields.get(name)
             if given is None or len(given) == 0:
                 return (default,) * motor.naxes
-            values = check.flat_vector(f"{name} of servo {motor_id!r}", given)
+            values = check.flat_vector(f"{name} of servo {shown(motor_id)}", given)
             if values.size != motor.naxes:
-                raise InvalidArgument(f"servo {motor_id!r} has {motor.naxes} axes; got "
+                raise InvalidArgument(f"servo {shown(motor_id)} has {motor.naxes} axes; got "
                                       f"{values.size} {name}")
             for v in values:
                 if not low <= v <= high:
-                    raise InvalidArgument(f"{name} of servo {motor_id!r}: {v!r} {unit} is "
-                                          f"outside [{low:g}, {high:g}] {unit}")
+                    raise InvalidArgument(f"{name} of servo {shown(motor_id)}: {shown(v)} {unit} "
+                                          f"is outside [{low:g}, {high:g}] {unit}")
             return tuple(values.tolist())
         extent = scene.parameters.world_extent
         servo = Servo(per_axis("targets", 0.0, -extent, extent, "rad or m"),

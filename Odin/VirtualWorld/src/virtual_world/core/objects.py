@@ -17,6 +17,7 @@ import numpy as np
 
 from odin_common import limits
 from odin_common.interface import composite_id
+from odin_common.limits import shown
 from odin_common.rotations import quaternion_multiply, quaternion_to_matrix
 from odin_common.specs import CompositeSpec, EntitySpec, ObjectSpec, PartSpec
 from virtual_world.core import (exemptions, forces, guard, joints, motors, readout,
@@ -76,7 +77,7 @@ def _part(what: str, given, mass: float, position, orientation) -> _Part:
                               "supported")
     return _Part(given.name, shape, mass, check.vector(f"{what}: position", position),
                  check.quaternion(f"{what}: orientation", orientation),
-                 tuple(check.vector(f"{what}: color", given.color, 4).tolist()),
+                 check.color(f"{what}: color", given.color),
                  given.parameters, given.indices, int(given.shape), surface)
 
 
@@ -132,6 +133,9 @@ def _given_mass(what: str, mass: float, inertia, center_of_mass):
             raise InvalidArgument(f"{what}: center_of_mass needs an inertia")
         return None
     i = check.vector(f"{what}: inertia", inertia, 6)
+    # before ODE forms its matrix: sums of such values would overflow to inf
+    check.at_most(f"{what}: inertia", float(np.max(np.abs(i))), limits.MAX_INERTIA,
+                  "kg m^2 (MAX_INERTIA)")
     center = check.vector(f"{what}: center_of_mass", center_of_mass) \
         if len(center_of_mass) else np.zeros(3)
     matrix = np.array([[i[0], i[3], i[4]], [i[3], i[1], i[5]], [i[4], i[5], i[2]]])
@@ -157,24 +161,26 @@ def _part_points(part: _Part) -> np.ndarray:
 
 def _check_given_inertia(what: str, dmass, com: np.ndarray, parts: Sequence[_Part],
                          mass: float) -> None:
-    """InvalidArgument when a given inertia (centred ``dmass``) is too light in rotation for
-    the parts' geometry (odin_common.limits.thin_inertia): ODE's solver would then return
-    non-finite velocities, and ODE aborts the process on those."""
+    """InvalidArgument when a given inertia (centred ``dmass``) is too light or too heavy in
+    rotation for the parts' geometry and mass (odin_common.limits.inertia_problem): ODE's
+    solver would then return non-finite velocities, and ODE aborts the process on those."""
     points = np.concatenate([_part_points(part) for part in parts]) - com
-    problem = limits.thin_inertia(bodies.inertia_matrix(dmass), mass, points)
+    problem = limits.inertia_problem(bodies.inertia_matrix(dmass), mass, points)
     if problem is not None:
         raise InvalidArgument(f"{what}: inertia: {problem}")
 
 
 def prepare_object(spec: ObjectSpec) -> _Prepared:
     if not isinstance(spec, ObjectSpec):
-        raise InvalidArgument(f"{spec!r} is not an ObjectSpec")
+        raise InvalidArgument(f"{shown(spec)} is not an ObjectSpec")
     name = check.name("object name", spec.name)
-    what = f"object {name!r}"
+    what = f"object {shown(name)}"
     geometry_only = check.flag(f"{what}: geometry_only", spec.geometry_only)
     no_collisions = check.flag(f"{what}: no_collisions", spec.no_collisions)
     mass = check.number(f"{what}: mass", spec.mass)
-    if not geometry_only:  # a body-less geometry has no mass to check
+    if geometry_only:   # no body: 0 or a mass a body could have, never a wrong one
+        check.ignored_mass(what, mass)
+    else:
         check.mass(what, mass)
     part = _part(what, spec, mass, (0.0, 0.0, 0.0), IDENTITY)
     if part.shape.kind == "plane" and not geometry_only:
@@ -195,22 +201,22 @@ def prepare_object(spec: ObjectSpec) -> _Prepared:
 
 def prepare_composite(spec: CompositeSpec) -> _Prepared:
     if not isinstance(spec, CompositeSpec):
-        raise InvalidArgument(f"{spec!r} is not a CompositeSpec")
+        raise InvalidArgument(f"{shown(spec)} is not a CompositeSpec")
     if len(spec.parts) == 0:
         raise InvalidArgument("a composite needs at least one part")
     parts = []
     for given in spec.parts:
         if not isinstance(given, PartSpec):
-            raise InvalidArgument(f"{given!r} is not a PartSpec")
+            raise InvalidArgument(f"{shown(given)} is not a PartSpec")
         name = check.name("part name", given.name)
-        what = f"part {name!r}"
+        what = f"part {shown(name)}"
         mass = check.mass(what, check.number(f"{what}: mass", given.mass))
         part = _part(what, given, mass, given.position, given.orientation)
         if part.shape.kind == "plane":
             raise InvalidArgument(f"{what}: a plane cannot be a part of a composite")
         parts.append(part)
     object_id = composite_id([p.name for p in parts])
-    what = f"composite {object_id!r}"
+    what = f"composite {shown(object_id)}"
     position = check.vector(f"{what}: position", spec.position)
     orientation = check.quaternion(f"{what}: orientation", spec.orientation)
     fixed = check.flag("composite fixed", spec.fixed)
@@ -224,12 +230,12 @@ def prepare_composite(spec: CompositeSpec) -> _Prepared:
         if dmass is None:
             dmass = bodies.zero_mass()
             for part in parts:
-                bodies.add_mass(dmass, shape_mass(f"part {part.name!r}", part.shape,
+                bodies.add_mass(dmass, shape_mass(f"part {shown(part.name)}", part.shape,
                                                   part.mass),
                                 part.position.tolist(), part.orientation.tolist())
-        com = _centred(f"object {object_id!r}", dmass)
+        com = _centred(f"object {shown(object_id)}", dmass)
         if given is not None:
-            _check_given_inertia(f"object {object_id!r}", dmass, com, parts,
+            _check_given_inertia(f"object {shown(object_id)}", dmass, com, parts,
                                  sum(part.mass for part in parts))
     return _Prepared(spec, object_id, parts, position, orientation, fixed, geometry_only,
                      no_collisions, dmass, com)
@@ -244,10 +250,10 @@ def check_ranges(scene: Scene, prepared: Sequence[_Prepared]) -> None:
         raise InvalidArgument(f"{len(prepared)} more object(s) would exceed the world's limit "
                               f"of {resources.max_objects:,} objects (max_objects)")
     for p in prepared:
-        what = f"object {p.object_id!r}"
+        what = f"object {shown(p.object_id)}"
         check.within_extent(f"{what}: position", p.position, extent)
         for part in p.parts:
-            shape, where = part.shape, f"{what}: part {part.name!r}"
+            shape, where = part.shape, f"{what}: part {shown(part.name)}"
             check.within_extent(f"{where}: position", part.position, extent)
             if shape.kind == "mesh":
                 check.at_most(f"{where}: mesh (max_mesh_triangles)", len(shape.triangles),
@@ -256,7 +262,7 @@ def check_ranges(scene: Scene, prepared: Sequence[_Prepared]) -> None:
             elif shape.dims:
                 check.at_most(f"{where}: size", max(shape.dims), 2 * extent, "m")
                 if min(shape.dims) < limits.MIN_SIZE:
-                    raise InvalidArgument(f"{where}: size {min(shape.dims)!r} m is below the "
+                    raise InvalidArgument(f"{where}: size {shown(min(shape.dims))} m is below the "
                                           f"limit {limits.MIN_SIZE:g} m")
 
 
@@ -265,12 +271,12 @@ def check_new_names(scene: Scene, prepared: Sequence[_Prepared]) -> None:
     seen: Set[str] = set()
     for name in (part.name for p in prepared for part in p.parts):
         if name in scene.geometries or name in seen:
-            raise DuplicateName(f"geometry name {name!r} is already taken")
+            raise DuplicateName(f"geometry name {shown(name)} is already taken")
         seen.add(name)
     seen = set()
     for p in prepared:
         if p.object_id in scene.objects or p.object_id in seen:
-            raise DuplicateName(f"object id {p.object_id!r} is already taken")
+            raise DuplicateName(f"object id {shown(p.object_id)} is already taken")
         seen.add(p.object_id)
 
 
@@ -382,15 +388,17 @@ def build_composite(scene: Scene, spec: CompositeSpec) -> Built:
 def build_entity(scene: Scene, spec: EntitySpec) -> BuiltEntity:
     """Builds an entity's members all or nothing; name "" gives "entity<n>"."""
     if not isinstance(spec, EntitySpec):
-        raise InvalidArgument(f"{spec!r} is not an EntitySpec")
+        raise InvalidArgument(f"{shown(spec)} is not an EntitySpec")
     internal = check.flag("internal_collisions", spec.internal_collisions)
-    name = check.text("entity name", spec.name) or _free_entity_name(scene)
+    name = check.text("entity name", spec.name)
+    name = check.name("entity name", name, allow_marker=True) if name else \
+        _free_entity_name(scene)
     if name in scene.entities:
-        raise DuplicateName(f"entity {name!r} already exists")
+        raise DuplicateName(f"entity {shown(name)} already exists")
     prepared = [prepare_object(s) for s in spec.objects]
     prepared += [prepare_composite(s) for s in spec.composites]
     if not prepared:
-        raise InvalidArgument(f"entity {name!r} has no objects")
+        raise InvalidArgument(f"entity {shown(name)} has no objects")
     check_ranges(scene, prepared)
     check_new_names(scene, prepared)
     tag = 0
@@ -461,12 +469,12 @@ def check_poses(scene: Scene, poses) -> list:
         try:
             object_id, position, orientation = item
         except (TypeError, ValueError):
-            raise InvalidArgument(f"{item!r} is not (id, position, orientation)") from None
+            raise InvalidArgument(f"{shown(item)} is not (id, position, orientation)") from None
         obj = scene.object(object_id)
-        where = f"position of {object_id!r}"
+        where = f"position of {shown(object_id)}"
         checked.append((obj, check.within_extent(where, check.vector(where, position),
                                                  scene.parameters.world_extent),
-                        check.quaternion(f"orientation of {object_id!r}", orientation)))
+                        check.quaternion(f"orientation of {shown(object_id)}", orientation)))
     return checked
 
 
@@ -497,13 +505,13 @@ def set_velocity(scene: Scene, object_id: str, linear=None, angular=None) -> Non
 def set_surface(scene: Scene, name: str, surface) -> None:
     """The contact properties of an object's geometries (an object ID) or of one geometry (a
     composite part's name), from the next step on."""
-    surface = check.surface(f"surface of {name!r}", surface)
+    surface = check.surface(f"surface of {shown(name)}", surface)
     if name in scene.objects:
         geometries = scene.objects[name].geometries
     else:
         geometries = [scene.geometry(name)]
     if surface.friction2 is not None and any(g.shape.kind == "plane" for g in geometries):
-        raise InvalidArgument(f"{name!r}: anisotropic friction (friction2) on a plane is not "
+        raise InvalidArgument(f"{shown(name)}: anisotropic friction (friction2) on a plane is not "
                               "supported")
     for geometry in geometries:
         bodies.set_surface(geometry.owner, surface)

@@ -9,6 +9,7 @@ misnames, what the next read reports.
 """
 from __future__ import annotations
 
+import math
 from typing import List, Set, Tuple
 
 import numpy as np
@@ -133,5 +134,12 @@ def motor_states(scene: Scene, motor_ids) -> List[MotorState]:
     ids = list(motor_ids) or list(scene.motors)
     records = [scene.motor(m) for m in ids]
     return [MotorState(m.id, m.joint or "", tuple(m.velocity), tuple(
-        ode_joints.motor_parameter(m.owner.ptr, m.kind, JointParameter.MAX_FORCE, axis)
+        _reported_force(ode_joints.motor_parameter(m.owner.ptr, m.kind,
+                                                   JointParameter.MAX_FORCE, axis))
         for axis in range(1, m.naxes + 1))) for m in records]
+
+
+def _reported_force(fmax: float) -> float:
+    """A motor's maximum force as ODE holds it -> as a client reads it: ODE is given
+    ode.joints.UNLIMITED_FORCE for an unlimited one, which reads as math.inf again."""
+    return math.inf if fmax >= ode_joints.UNLIMITED_FORCE else fmax

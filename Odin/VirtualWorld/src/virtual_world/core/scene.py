@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import Dict, FrozenSet, List, Optional, Tuple
 
-from odin_common.limits import ResourceLimits
+from odin_common.limits import ResourceLimits, shown
 from odin_common.world_parameters import WorldParameters
 from virtual_world.core.records import (BodyForceRecord, Collision, GeometryRecord,
                                         JointForceRecord, JointRecord, MotorRecord, ObjectRecord)
@@ -71,32 +71,32 @@ class Scene:
         try:
             return self.objects[object_id]
         except (KeyError, TypeError):
-            raise UnknownName(f"no object {object_id!r}") from None
+            raise UnknownName(f"no object {shown(object_id)}") from None
 
     def body_object(self, object_id: str, what: str) -> ObjectRecord:
         """The object, which must have a body (``what`` names the request)."""
         obj = self.object(object_id)
         if obj.body is None:
-            raise Unsupported(f"{what}: object {object_id!r} is geometry only (no body)")
+            raise Unsupported(f"{what}: object {shown(object_id)} is geometry only (no body)")
         return obj
 
     def joint(self, joint_id: str) -> JointRecord:
         try:
             return self.joints[joint_id]
         except (KeyError, TypeError):
-            raise UnknownName(f"no joint {joint_id!r}") from None
+            raise UnknownName(f"no joint {shown(joint_id)}") from None
 
     def motor(self, motor_id: str) -> MotorRecord:
         try:
             return self.motors[motor_id]
         except (KeyError, TypeError):
-            raise UnknownName(f"no motor {motor_id!r}") from None
+            raise UnknownName(f"no motor {shown(motor_id)}") from None
 
     def geometry(self, name: str) -> GeometryRecord:
         try:
             return self.geometries[name]
         except (KeyError, TypeError):
-            raise UnknownName(f"no geometry named {name!r}") from None
+            raise UnknownName(f"no geometry named {shown(name)}") from None
 
     # -- objects, their bodies in one C array for state vectors ------------------------------
     def add_object(self, record: ObjectRecord) -> None:

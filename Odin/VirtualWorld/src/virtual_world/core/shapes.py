@@ -11,6 +11,7 @@ import numpy as np
 
 from odin_common import errors as common
 from odin_common.interface import shape_kind
+from odin_common.limits import shown
 from odin_common.meshes import cluster_vertices
 from virtual_world.errors import InvalidArgument
 
@@ -40,7 +41,7 @@ def prepare_shape(what: str, parameters, indices, shape: int = 0) -> Shape:
     except (TypeError, ValueError):
         raise InvalidArgument(f"{what}: parameters/indices are not numbers") from None
     if not np.all(np.isfinite(values)):
-        raise InvalidArgument(f"{what}: parameters {list(parameters)!r} are not finite")
+        raise InvalidArgument(f"{what}: parameters {shown(list(parameters))} are not finite")
     try:
         kind = shape_kind(values.size, shape)
     except common.InvalidArgument as error:

@@ -21,6 +21,7 @@ from typing import Dict, Tuple
 import numpy as np
 
 from odin_common.interface import JOINT_PARAMETER_AXES, JOINT_PARAMETERS, MOTOR_PARAMETERS
+from odin_common.limits import shown_list
 from virtual_world.core import exemptions, forces, guard, kinematic, motors, readout
 from virtual_world.core.records import BodyForceRecord, Collision, JointForceRecord
 from virtual_world.core.scene import Scene
@@ -102,12 +103,13 @@ def check_fits(scene: Scene, snapshot: Snapshot, what: str) -> None:
     changes = []
     labels = ("objects", "joints", "motors", "exempt pairs")
     for label, then, present in zip(labels, snapshot.contents, now):
-        added = [i for i in present if i not in set(then)]
-        gone = [i for i in then if i not in set(present)]
+        then_set, present_set = set(then), set(present)    # once: scenes hold 100,000s
+        added = [i for i in present if i not in then_set]
+        gone = [i for i in then if i not in present_set]
         if added:
-            changes.append(f"{label} added since: {added[:5]}")
+            changes.append(f"{label} added since: {shown_list(added, 5)}")
         if gone:
-            changes.append(f"{label} removed since: {gone[:5]}")
+            changes.append(f"{label} removed since: {shown_list(gone, 5)}")
     raise InvalidArgument(f"{what}: the scene changed since it was taken ("
                           + "; ".join(changes or ["built in another order"]) + ")")
 

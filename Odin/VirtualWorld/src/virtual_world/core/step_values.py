@@ -10,15 +10,18 @@ from __future__ import annotations
 
 import math
 
+from odin_common.limits import MIN_STEP, shown
 from odin_common.step_values import MAX_RATE, MAX_STEP, MAX_STEPS_PER_CYCLE, StepValues
 from virtual_world.errors import InvalidArgument
 
 _RELATIVE_TOLERANCE = 1e-9
 
 
-def _positive(name: str, value: float, upper: float) -> float:
-    if not math.isfinite(value) or value <= 0.0 or value > upper:
-        raise InvalidArgument(f"{name} must be in (0, {upper:g}], got {value!r}")
+def _positive(name: str, value: float, upper: float, lower: float = 0.0) -> float:
+    """``value`` if finite and in (0, upper] (and >= lower); the refusal quotes it short."""
+    if not math.isfinite(value) or value <= 0.0 or value > upper or value < lower:
+        low = f"[{lower:g}" if lower > 0 else "(0"
+        raise InvalidArgument(f"{name} must be in {low}, {upper:g}], got {shown(value)}")
     return float(value)
 
 
@@ -34,17 +37,17 @@ def resolve(current: StepValues, step: float = 0.0, steps_per_cycle: int = 0,
     given_cycle = cycle_time != 0.0
     if not (given_step or given_count or given_cycle or rate != 0.0):
         raise InvalidArgument("no step value given (step, steps_per_cycle, cycle_time, rate)")
-    new_step = _positive("step", step, MAX_STEP) if given_step else current.step
+    new_step = _positive("step", step, MAX_STEP, MIN_STEP) if given_step else current.step
     if given_count and not 1 <= steps_per_cycle <= MAX_STEPS_PER_CYCLE:
         raise InvalidArgument(f"steps_per_cycle must be in [1, {MAX_STEPS_PER_CYCLE}], "
-                              f"got {steps_per_cycle}")
+                              f"got {shown(steps_per_cycle)}")
     new_rate = _positive("rate", rate, MAX_RATE) if rate != 0.0 else current.rate
     notes = []
     if given_cycle:
         cycle = _positive("cycle_time", cycle_time, MAX_STEP * MAX_STEPS_PER_CYCLE)
         if given_count and not given_step:
             new_step = _positive("step (cycle_time / steps_per_cycle)",
-                                 cycle / steps_per_cycle, MAX_STEP)
+                                 cycle / steps_per_cycle, MAX_STEP, MIN_STEP)
             count = steps_per_cycle
         else:
             count = _steps_in(cycle, new_step)
@@ -70,6 +73,7 @@ def _steps_in(cycle_time: float, step: float) -> int:
     if count < 1:
         raise InvalidArgument(f"cycle_time {cycle_time:g} s is shorter than one step of {step:g} s")
     if count > MAX_STEPS_PER_CYCLE:
-        raise InvalidArgument(f"cycle_time {cycle_time:g} s needs {count} steps of {step:g} s, "
+        raise InvalidArgument(f"cycle_time {cycle_time:g} s needs {float(count):.3g} steps of "
+                              f"{step:g} s, "
                               f"more than {MAX_STEPS_PER_CYCLE}")
     return count

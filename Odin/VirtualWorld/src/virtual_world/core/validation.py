@@ -11,6 +11,7 @@ import numpy as np
 from odin_common import errors as common
 from odin_common import limits, rotations
 from odin_common.interface import COMPOSITE_MARK
+from odin_common.limits import shown
 from virtual_world.errors import InvalidArgument
 
 R = TypeVar("R")
@@ -25,14 +26,14 @@ def shared(check: Callable[..., R], *args, **kwargs) -> R:
 
 
 def number(what: str, value, allow_inf: bool = False) -> float:
-    if isinstance(value, bool):
-        raise InvalidArgument(f"{what}={value!r} is not a number")
+    if isinstance(value, (bool, str, bytes)):     # float("1e3") would read a string
+        raise InvalidArgument(f"{what}={shown(value)} is not a number")
     try:
         result = float(value)
     except (TypeError, ValueError):
-        raise InvalidArgument(f"{what}={value!r} is not a number") from None
+        raise InvalidArgument(f"{what}={shown(value)} is not a number") from None
     if math.isnan(result) or (not allow_inf and math.isinf(result)):
-        raise InvalidArgument(f"{what}={value!r} is not finite")
+        raise InvalidArgument(f"{what}={shown(value)} is not finite")
     return result
 
 
@@ -41,11 +42,11 @@ def vector(what: str, value, n: int = 3) -> np.ndarray:
     try:
         array = np.array(value, dtype=float).reshape(-1)
     except (TypeError, ValueError):
-        raise InvalidArgument(f"{what}={value!r} is not a vector of {n} numbers") from None
+        raise InvalidArgument(f"{what}={shown(value)} is not a vector of {n} numbers") from None
     if array.shape != (n,):
-        raise InvalidArgument(f"{what}={value!r} has {array.size} values, expected {n}")
+        raise InvalidArgument(f"{what}={shown(value)} has {array.size} values, expected {n}")
     if not np.isfinite(array).all():
-        raise InvalidArgument(f"{what}={value!r} is not finite")
+        raise InvalidArgument(f"{what}={shown(value)} is not finite")
     return array
 
 
@@ -54,17 +55,18 @@ def flat_vector(what: str, value) -> np.ndarray:
     try:
         count = len(value)
     except TypeError:
-        raise InvalidArgument(f"{what}={value!r} is not a sequence of numbers") from None
+        raise InvalidArgument(f"{what}={shown(value)} is not a sequence of numbers") from None
     return vector(what, value, count)
 
 
 def axis(what: str, value) -> np.ndarray:
     """(3,) unit vector."""
     a = vector(what, value)
-    norm = float(np.linalg.norm(a))
-    if norm < 1e-9:
-        raise InvalidArgument(f"{what}={value!r} is a zero axis")
-    return a / norm
+    largest = float(np.max(np.abs(a)))
+    if largest < 1e-9:
+        raise InvalidArgument(f"{what}={shown(value)} is a zero axis")
+    a = a / largest     # first to ~1: the norm of (1e200, 0, 1e200) would overflow to inf
+    return a / float(np.linalg.norm(a))
 
 
 def quaternion(what: str, value) -> np.ndarray:
@@ -73,32 +75,33 @@ def quaternion(what: str, value) -> np.ndarray:
 
 
 def name(what: str, value, allow_marker: bool = False) -> str:
-    """A non-empty string; without allow_marker it may not hold the composite mark
+    """A name a request stores (odin_common.limits.check_name: non-empty, at most
+    MAX_NAME_BYTES, printable); without allow_marker it may not hold the composite mark
     (odin_common.interface.COMPOSITE_MARK)."""
-    if not isinstance(value, str) or not value:
-        raise InvalidArgument(f"{what}={value!r} must be a non-empty string")
+    shared(limits.check_name, what, value)
     if not allow_marker and COMPOSITE_MARK in value:
-        raise InvalidArgument(f"{what}={value!r} must not contain {COMPOSITE_MARK!r}")
+        raise InvalidArgument(f"{what}={shown(value)} must not contain "
+                              f"{COMPOSITE_MARK!r}")
     return value
 
 
 def text(what: str, value) -> str:
     """Any string, "" included (an ID that may be left to its default)."""
     if not isinstance(value, str):
-        raise InvalidArgument(f"{what}={value!r} is not a string")
+        raise InvalidArgument(f"{what}={shown(value)} is not a string")
     return value
 
 
 def flag(what: str, value) -> bool:
     if not isinstance(value, (bool, np.bool_)):
-        raise InvalidArgument(f"{what}={value!r} is not a bool")
+        raise InvalidArgument(f"{what}={shown(value)} is not a bool")
     return bool(value)
 
 
 def count(what: str, value, low: int = 1) -> int:
     """An integer >= low (a bool is not one)."""
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
-        raise InvalidArgument(f"{what}={value!r} must be an integer >= {low}")
+        raise InvalidArgument(f"{what}={shown(value)} must be an integer >= {low}")
     return int(value)
 
 
@@ -107,39 +110,55 @@ def surface(what: str, value):
     unit."""
     from odin_common.specs import Surface
     if not isinstance(value, Surface):
-        raise InvalidArgument(f"{what}: {value!r} is not a Surface")
+        raise InvalidArgument(f"{what}: {shown(value)} is not a Surface")
     if value.friction is not None:
         mu = number(f"{what}: friction", value.friction, allow_inf=True)
         if mu < 0:
-            raise InvalidArgument(f"{what}: friction={mu!r} must be >= 0 (math.inf: infinite)")
+            raise InvalidArgument(f"{what}: friction={shown(mu)} must be >= 0 (math.inf: "
+                                  "infinite)")
     direction = value.friction_direction
     if value.friction2 is not None:
         if number(f"{what}: friction2", value.friction2) < 0:
-            raise InvalidArgument(f"{what}: friction2={value.friction2!r} must be >= 0")
+            raise InvalidArgument(f"{what}: friction2={shown(value.friction2)} must be >= 0")
         direction = tuple(axis(f"{what}: friction_direction", direction).tolist())
     if value.bounce is not None:
         e = number(f"{what}: bounce", value.bounce)
         if not 0 <= e <= 1:
-            raise InvalidArgument(f"{what}: bounce={e!r} must be in [0, 1]")
+            raise InvalidArgument(f"{what}: bounce={shown(e)} must be in [0, 1]")
         if number(f"{what}: bounce_velocity", value.bounce_velocity) < 0:
-            raise InvalidArgument(f"{what}: bounce_velocity={value.bounce_velocity!r} must be "
-                                  ">= 0")
+            raise InvalidArgument(f"{what}: bounce_velocity={shown(value.bounce_velocity)} "
+                                  "must be >= 0")
     if value.stiffness is not None:
         if number(f"{what}: stiffness", value.stiffness) <= 0:
-            raise InvalidArgument(f"{what}: stiffness={value.stiffness!r} must be > 0")
+            raise InvalidArgument(f"{what}: stiffness={shown(value.stiffness)} must be > 0")
         if number(f"{what}: damping", value.damping) < 0:
-            raise InvalidArgument(f"{what}: damping={value.damping!r} must be >= 0")
+            raise InvalidArgument(f"{what}: damping={shown(value.damping)} must be >= 0")
     return dataclasses.replace(value, friction_direction=direction)
 
 
 def mass(what: str, value: float) -> float:
     """A body's mass, kg, within odin_common.limits."""
     if value <= 0:
-        raise InvalidArgument(f"{what}: mass {value!r} must be positive")
+        raise InvalidArgument(f"{what}: mass {value:.6g} must be positive")
     if not limits.MIN_MASS <= value <= limits.MAX_MASS:
-        raise InvalidArgument(f"{what}: mass {value!r} kg is outside the limits "
+        raise InvalidArgument(f"{what}: mass {value:.6g} kg is outside the limits "
                               f"[{limits.MIN_MASS:g}, {limits.MAX_MASS:g}] kg")
     return value
+
+
+def ignored_mass(what: str, value: float) -> float:
+    """The mass of a geometry-only object, which has no body: 0 (the message's default) or a
+    mass a body could have; a negative or out-of-range one is refused, never ignored."""
+    return value if value == 0.0 else mass(what, value)
+
+
+def color(what: str, value) -> tuple:
+    """RGBA, each finite and in [0, 1] (all zero: the Viewer's default colour); what the
+    Viewer draws, so the world refuses what the Viewer would."""
+    rgba = vector(what, value, 4)
+    if np.any(rgba < 0.0) or np.any(rgba > 1.0):
+        raise InvalidArgument(f"{what}={shown(value)}: each of r, g, b, a must be in [0, 1]")
+    return tuple(rgba.tolist())
 
 
 def at_most(what: str, magnitude: float, limit: float, unit: str) -> None:
@@ -159,7 +178,7 @@ def step_count(count: int, what: str) -> int:
     """A number of steps for one call, at most limits.MAX_STEPS_PER_CALL; ``what`` names the
     request in the refusal."""
     if count > limits.MAX_STEPS_PER_CALL:
-        raise InvalidArgument(f"{what} asks for {count:.3g} steps; one call runs at most "
+        raise InvalidArgument(f"{what} asks for {float(count):.3g} steps; one call runs at most "
                               f"{limits.MAX_STEPS_PER_CALL:,} (ask in pieces)")
     return int(count)
 
@@ -169,6 +188,6 @@ def step_size(value) -> float:
     from odin_common.step_values import MAX_STEP
     value = number("step_size", value)
     if not limits.MIN_STEP <= value <= MAX_STEP:
-        raise InvalidArgument(f"step_size={value!r} s is outside [{limits.MIN_STEP:g}, "
+        raise InvalidArgument(f"step_size={value:.6g} s is outside [{limits.MIN_STEP:g}, "
                               f"{MAX_STEP:g}] s")
     return value

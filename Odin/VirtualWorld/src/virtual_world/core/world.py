@@ -22,7 +22,7 @@ from typing import Dict, List, Mapping, Optional, Sequence, Tuple
 import numpy as np
 
 from odin_common.interface import ForceKind, JointType, MotorKind, ServoDrive, Solver
-from odin_common.limits import ResourceLimits
+from odin_common.limits import ResourceLimits, shown, shown_list
 from odin_common.specs import CompositeSpec, EntitySpec, JointSpec, MotorSpec, ObjectSpec
 from odin_common.world_parameters import WorldParameters
 from virtual_world.core import (exemptions, forces, guard, joints, kinematic, motors, objects,
@@ -49,9 +49,9 @@ class Core:
         init_ode()
         parameters = WorldParameters() if parameters is None else parameters
         if not isinstance(parameters, WorldParameters):
-            raise InvalidArgument(f"parameters={parameters!r} is not a WorldParameters")
+            raise InvalidArgument(f"parameters={shown(parameters)} is not a WorldParameters")
         if not isinstance(resources, ResourceLimits):
-            raise InvalidArgument(f"resources={resources!r} is not a ResourceLimits")
+            raise InvalidArgument(f"resources={shown(resources)} is not a ResourceLimits")
         check.shared(parameters.validate)
         self._lock = threading.RLock()
         self.resources = resources
@@ -199,7 +199,7 @@ class Core:
         if len(motor_ids) == 0 and not object_id:
             raise InvalidArgument("nothing to set: give an object or motors")
         if object_id and linear is None and angular is None:
-            raise InvalidArgument(f"object {object_id!r} given without set_linear or "
+            raise InvalidArgument(f"object {shown(object_id)} given without set_linear or "
                                   "set_angular")
         scene = self._scene
         if object_id:
@@ -237,7 +237,7 @@ class Core:
         """(parameter, axis 1..3, value) triples on a joint or a motor, all or nothing (see
         joints.set_joint_parameters for the ranges); at least one."""
         if len(parameters) == 0:
-            raise InvalidArgument(f"no parameter to set on {joint_id!r}")
+            raise InvalidArgument(f"no parameter to set on {shown(joint_id)}")
         joints.set_joint_parameters(self._scene, joint_id, parameters)
 
     @changes_contents
@@ -385,7 +385,7 @@ class Core:
         name = check.name("snapshot name", name, allow_marker=True)
         held, limit = self._scene.snapshots, self.resources.max_snapshots
         if name not in held and len(held) >= limit:
-            raise InvalidArgument(f"snapshot {name!r}: the world holds {len(held)} snapshots, "
+            raise InvalidArgument(f"snapshot {shown(name)}: the world holds {len(held)} snapshots, "
                                   f"the limit (max_snapshots); remove one first")
         if self._scene.parameters.auto_disable:
             self._scene.c.restart_rest_counts()
@@ -397,7 +397,7 @@ class Core:
         results to stepping on from when it was saved. Refused when the scene's objects,
         joints or motors are no longer those it was saved with."""
         snapshot = self._snapshot(name)
-        snapshots.check_fits(self._scene, snapshot, f"snapshot {name!r}")
+        snapshots.check_fits(self._scene, snapshot, f"snapshot {shown(name)}")
         snapshots.put_back(self._scene, snapshot)
 
     @locked
@@ -412,7 +412,8 @@ class Core:
     def _snapshot(self, name: str):
         snapshot = self._scene.snapshots.get(name) if isinstance(name, str) else None
         if snapshot is None:
-            raise UnknownName(f"no snapshot {name!r} (saved: {sorted(self._scene.snapshots)})")
+            raise UnknownName(f"no snapshot {shown(name)} (saved: "
+                              f"{shown_list(sorted(self._scene.snapshots))})")
         return snapshot
 
     @locked
@@ -513,7 +514,7 @@ class Core:
         keep = check.flag("keep", keep)
         start_snapshot = self._snapshot(start) if start else None
         if start_snapshot is not None:
-            snapshots.check_fits(scene, start_snapshot, f"snapshot {start!r}")
+            snapshots.check_fits(scene, start_snapshot, f"snapshot {shown(start)}")
         if start_state is not None and len(start_state):
             if start_snapshot is not None:
                 raise InvalidArgument("give a start snapshot or a start state, not both")
@@ -600,7 +601,7 @@ class Core:
         Returns the pairs exempted (names, depth, points)."""
         min_depth = check.number("min_depth", min_depth)
         if min_depth < 0:
-            raise InvalidArgument(f"min_depth={min_depth!r} m must not be negative")
+            raise InvalidArgument(f"min_depth={shown(min_depth)} m must not be negative")
         return exemptions.exempt(self._scene, min_depth)
 
     @locked
@@ -632,8 +633,8 @@ class Core:
         recording), body forces, joint forces and motor goals, (Quick)Step, empty contacts."""
         step_size = check.step_size(step_size)
         if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
-            raise InvalidArgument(f"count={count!r} must be a positive integer")
-        count = check.step_count(count, f"count={count!r}")
+            raise InvalidArgument(f"count={shown(count)} must be a positive integer")
+        count = check.step_count(count, f"count={shown(count)}")
         scene = self._scene
         if not scene.parameters.contact_less:
             scene.carried = {}
@@ -738,13 +739,13 @@ def _state_vector_fault(vector: np.ndarray, index: int, exempt: int) -> InvalidA
     """The refusal of a body state vector whose value ``index`` cannot be put back (its last
     ``exempt`` values are exempt pairs' states)."""
     if index == 0:
-        return InvalidArgument(f"random generator state {float(vector[0])!r} is not a "
+        return InvalidArgument(f"random generator state {shown(float(vector[0]))} is not a "
                                "32-bit integer")
     if index >= vector.size - exempt:
         return InvalidArgument(f"an exempt pair's state is 0.0 or 1.0; value {index} is "
-                               f"{float(vector[index])!r}")
+                               f"{shown(float(vector[index]))}")
     return InvalidArgument(f"a body state vector's values are finite; value {index} is "
-                           f"{float(vector[index])!r}")
+                           f"{shown(float(vector[index]))}")
 
 
 def _checked_pushes(scene: Scene, pushes: Sequence[Tuple[str, Sequence[float]]]) -> list:
@@ -755,7 +756,7 @@ def _checked_pushes(scene: Scene, pushes: Sequence[Tuple[str, Sequence[float]]])
         try:
             object_id, vector = push
         except (TypeError, ValueError):
-            raise InvalidArgument(f"force {push!r} is not (object id, force vector)") from None
+            raise InvalidArgument(f"force {shown(push)} is not (object id, force vector)") from None
         checked.append((scene.body_object(object_id, "force").body.ptr,
                         forces.checked_vector(object_id, ForceKind.FORCE, vector)))
     return checked
@@ -778,9 +779,9 @@ def _checked_steps(duration: float, step_size: float) -> Tuple[float, int]:
     duration = check.number("duration", duration)
     step_size = check.step_size(step_size)
     if duration <= 0:
-        raise InvalidArgument(f"duration={duration!r} must be positive")
+        raise InvalidArgument(f"duration={shown(duration)} must be positive")
     return step_size, check.step_count(max(1, round(min(duration / step_size, 1e18))),
-                                       f"duration={duration!r} s at step {step_size!r} s")
+                                       f"duration={shown(duration)} s at step {shown(step_size)} s")
 
 
 __all__ = ["Core", "ForceKind", "JointType", "MotorKind"]

@@ -7,10 +7,12 @@ given. Arguments are already checked.
 """
 from __future__ import annotations
 
+import math
 from typing import List, Sequence, Tuple
 
 import numpy as np
 
+from odin_common import limits
 from odin_common.interface import JointParameter, JointType, MotorKind
 from virtual_world.ode.bindings import ffi, lib
 from virtual_world.ode.runtime import drains_ode_messages
@@ -199,9 +201,21 @@ def configure_motor(motor, kind: MotorKind, axes: Sequence[np.ndarray], frames: 
     for i, (axis, frame, force) in enumerate(zip(axes, frames, max_forces)):
         set_axis(motor, i, frame, *axis.tolist())
         set_motor_parameter(motor, kind, JointParameter.MAX_FORCE, i + 1,
-                            lib.dInfinity if force < 0 else force)
+                            unlimited_force(force))
         set_motor_parameter(motor, kind, JointParameter.VELOCITY, i + 1, 0.0)
 
 
 INFINITY = lib.dInfinity
-"""ODE's infinity (a motor's unlimited force, an open stop)."""
+"""ODE's infinity (an open stop)."""
+
+UNLIMITED_FORCE = limits.MAX_FORCE
+"""N or N m: the maximum force ODE is given for an axis whose force is unlimited (negative or
+infinite): the strongest force any request may set. Never ODE's infinity: on a powered axis
+that also rests on a stop ODE applies the whole maximum force to the bodies, and an infinite
+one made their velocities NaN and ended the process in ODE's quaternion normalisation."""
+
+
+def unlimited_force(force: float) -> float:
+    """The maximum force (N or N m) ODE is given for ``force``: UNLIMITED_FORCE when it is
+    negative or infinite ("unlimited"), else ``force``."""
+    return UNLIMITED_FORCE if force < 0 or math.isinf(force) else force

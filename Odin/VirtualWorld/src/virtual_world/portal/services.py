@@ -14,6 +14,7 @@ from geometry_msgs.msg import Vector3
 
 from odin_common import messages
 from odin_common.interface import SetJointAction
+from odin_common.limits import shown
 from odin_common.specs import EntitySpec, JointSpec, MotorSpec
 from odin_common.world_parameters import set_world_flags
 from virtual_world.core import Core, step_values
@@ -218,11 +219,11 @@ class WorldServices:
     def set_robot(self, request) -> dict:
         if request.remove:
             robot = self.mirror.remove_robot(request.robot.name)
-            return {"ros_namespace": robot.namespace, "message": f"forgot robot {robot.name!r}"}
+            return {"ros_namespace": robot.namespace, "message": f"forgot robot {shown(robot.name)}"}
         robot = robot_of(request.robot)
         self.mirror.set_robot(robot, {s.id: s.type for s in self.core.joint_states()})
         return {"ros_namespace": robot.namespace,
-                "message": f"robot {robot.name!r} in namespace /{robot.namespace}: "
+                "message": f"robot {shown(robot.name)} in namespace /{robot.namespace}: "
                            f"{len(robot.links)} links, {len(robot.joints)} joints"}
 
     def get_state(self, request) -> dict:
@@ -244,12 +245,12 @@ class WorldServices:
 
     def save_state(self, request) -> dict:
         self.core.save_state(request.name)
-        return {"message": f"saved {request.name!r} at {self.core.sim_time:g} s"}
+        return {"message": f"saved {shown(request.name)} at {self.core.sim_time:g} s"}
 
     def restore_state(self, request) -> dict:
         self.core.restore_state(request.name)
         self._sync_loop_time()
-        return {"sim_time": self.core.sim_time, "message": f"restored {request.name!r}"}
+        return {"sim_time": self.core.sim_time, "message": f"restored {shown(request.name)}"}
 
     def reset(self, request) -> dict:
         self.core.reset()

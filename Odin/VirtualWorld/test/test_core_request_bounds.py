@@ -1,0 +1,116 @@
+"""What a request may set and how a refusal reads: masses, colours and names are checked
+before anything is stored, and every refusal quotes a client's value cut short
+(odin_common.limits.shown), so a refusal is one short line however large the value."""
+import math
+
+import pytest
+
+from odin_common.limits import MAX_NAME_BYTES, MAX_SHOWN_CHARS
+from odin_common.specs import CompositeSpec, EntitySpec, JointSpec, MotorSpec, PartSpec
+from virtual_world.core import Core, ObjectSpec, step_values
+from virtual_world.errors import CoreError, InvalidArgument
+
+LONG = "w" * (MAX_NAME_BYTES + 1)
+
+
+@pytest.fixture
+def core():
+    c = Core()
+    c.build_object(ObjectSpec("base", [0.2], mass=1.0))
+    yield c
+    c.close()
+
+
+@pytest.mark.parametrize("mass", [-2.5, -0.0001, math.nan, -math.inf, math.inf, 1e300])
+def test_a_geometry_only_object_with_a_mass_no_body_has_is_refused(core, mass):
+    """Geometry only has no body, but its mass is 0 or one a body could have: a negative or
+    non-finite one is refused, never ignored; nothing is built."""
+    with pytest.raises(InvalidArgument, match="mass"):
+        core.build_object(ObjectSpec("wall", [1.0, 1.0, 0.1], mass=mass, geometry_only=True))
+    assert core.object_ids() == ["base"]
+
+
+@pytest.mark.parametrize("mass", [0.0, 2.0])
+def test_a_geometry_only_object_takes_no_mass_or_a_valid_one(core, mass):
+    core.build_object(ObjectSpec("wall", [1.0, 1.0, 0.1], mass=mass, geometry_only=True))
+    assert "wall" in core.object_ids()
+
+
+def test_a_mass_given_as_text_is_refused(core):
+    with pytest.raises(InvalidArgument, match="mass='3' is not a number"):
+        core.build_object(ObjectSpec("text", [0.1], mass="3"))
+
+
+@pytest.mark.parametrize("color", [(1.5, 0.0, 0.0, 1.0), (0.2, -0.1, 0.0, 1.0),
+                                   (0.2, 0.2, 0.2, 2.0), (math.nan, 0.0, 0.0, 1.0)])
+def test_a_colour_component_out_of_0_1_is_refused_for_objects_and_parts(core, color):
+    """The Viewer refuses such colours (the object would never be drawn): the world refuses
+    them first, for an object and for a composite's part alike."""
+    with pytest.raises(InvalidArgument, match="color"):
+        core.build_object(ObjectSpec("red", [0.1], color=color))
+    with pytest.raises(InvalidArgument, match="color"):
+        core.build_composite(CompositeSpec([PartSpec("p1", [0.1], color=color)]))
+    assert core.object_ids() == ["base"]
+
+
+NAMED = {
+    "object": lambda c, n: c.build_object(ObjectSpec(n, [0.1])),
+    "part": lambda c, n: c.build_composite(CompositeSpec([PartSpec(n, [0.1])])),
+    "entity": lambda c, n: c.build_entity(EntitySpec(n, [ObjectSpec("member", [0.1])])),
+    "joint": lambda c, n: c.add_joint(JointSpec(1, "base", "", id=n)),
+    "motor": lambda c, n: c.add_motor(MotorSpec(body1="base", axes=(0, 0, 1.0), id=n)),
+    "snapshot": lambda c, n: c.save_state(n),
+}
+
+
+@pytest.mark.parametrize("kind", sorted(NAMED))
+@pytest.mark.parametrize("name", [LONG, "tab\there", "line\nbreak", "nul\0"])
+def test_every_name_a_request_stores_follows_the_name_rule(core, kind, name):
+    """Objects, parts, entities, joints, motors and snapshots: longer than MAX_NAME_BYTES or
+    holding a control character is refused, with the name quoted short; nothing stored."""
+    before = (core.object_ids(), core.joint_ids(), core.motor_ids(), core.snapshot_names(),
+              core.entities())
+    with pytest.raises(InvalidArgument) as refused:
+        NAMED[kind](core, name)
+    assert len(str(refused.value)) < 300
+    assert (core.object_ids(), core.joint_ids(), core.motor_ids(), core.snapshot_names(),
+            core.entities()) == before
+
+
+def test_a_name_of_exactly_the_limit_is_taken(core):
+    core.build_object(ObjectSpec("n" * MAX_NAME_BYTES, [0.1]))
+
+
+@pytest.mark.parametrize("call", [
+    lambda c, v: c.remove_object(v), lambda c, v: c.restore_state(v),
+    lambda c, v: c.set_velocity(v, (0.0, 0.0, 0.0)),
+    lambda c, v: c.set_poses([(v, (0, 0, 0), (1, 0, 0, 0))]),
+    lambda c, v: c.add_body_force(v, 0, (0.0, 0.0, 1.0)),
+    lambda c, v: c.set_joint_parameters(v, [(0, 1, 0.1)]),
+    lambda c, v: c.build_object(ObjectSpec("big", [0.1], color=[0.5] * 200_000)),
+    lambda c, v: c.build_object(ObjectSpec("big", [0.1] * 100_001)),
+])
+def test_a_refusal_quotes_a_huge_value_short(core, call):
+    """A 1 MB unknown name, a 200,000-value colour, 100,001 parameters: the refusal names
+    them in a line of a few hundred characters, not a copy of the request."""
+    with pytest.raises(CoreError) as refused:
+        call(core, "x" * 2 ** 20)
+    assert len(str(refused.value)) < 4 * MAX_SHOWN_CHARS + 200
+
+
+def test_restore_states_refusal_lists_a_few_saved_names_and_counts_the_rest(core):
+    for k in range(40):
+        core.save_state(f"kept-{k:02d}-" + "s" * 200)
+    with pytest.raises(CoreError) as refused:
+        core.restore_state("never saved")
+    message = str(refused.value)
+    assert "30 more" in message and len(message) < 2500
+
+
+@pytest.mark.parametrize("step", [1e-300, 5e-324, 1e-8])
+def test_a_step_below_the_shortest_is_refused_in_a_short_line(step):
+    """Set Step 1e-300 printed the 298-digit count of steps in a cycle: it is below MIN_STEP
+    and is refused naming the range."""
+    with pytest.raises(InvalidArgument) as refused:
+        step_values.resolve(step_values.StepValues(), step=step)
+    assert "1e-07" in str(refused.value) and len(str(refused.value)) < 120
