@@ -157,7 +157,8 @@ def geometry_from_parameters(parameters: Sequence[float], indices: Sequence[int]
     ``shape`` (odin_common.interface.Shape; 0: by their count); see the module doc.
 
     Raises :class:`ViewerError` for a wrong parameter count, sizes not finite or outside
-    [MIN_SIZE, MAX_SIZE], mesh vertices beyond MAX_EXTENT, an empty mesh, an index count that is not a multiple of 3 or an index out of range.
+    [MIN_SIZE, MAX_SIZE], mesh vertices beyond MAX_EXTENT, an empty mesh, an index count that
+    is not a multiple of 3 or an index out of range.
     """
     params = np.asarray(parameters, dtype=float).reshape(-1)
     try:
