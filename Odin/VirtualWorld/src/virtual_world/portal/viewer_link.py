@@ -8,7 +8,12 @@ worker thread of this module sends. The Viewer may be absent, slow, or restarted
 * when a Viewer appears (or a new one replaces the old: its service address changes), the worker
   sends it the whole current scene: New Scene, then View Object for every geometry at its
   latest pose;
-* a call that fails marks the Viewer out of date, and the next check re-sends the scene.
+* a call that fails marks the Viewer out of date, and the next check re-sends the scene;
+* a call that outlasts CALL_TIMEOUT is given up on but not taken back: its request is on its
+  way and the Viewer may still apply it. Nothing more is sent to that Viewer until it has
+  answered (or its connection broke); only then is the scene re-sent, so a late removal or
+  New Scene can never land after the re-sent scene and take objects out of it. (It did: the
+  Viewer's mirror lost objects under churn and got them back only when it restarted.)
 
 Calls go over one persistent connection per service (a fresh one cost a lookup at the master,
 a TCP connection and a thread in each node, for every geometry of every load); the
@@ -22,7 +27,7 @@ import collections
 import logging
 import threading
 import time
-from typing import Callable, Sequence
+from typing import Callable, Optional, Sequence, Tuple
 
 import rosgraph
 import rospy
@@ -53,6 +58,10 @@ class ViewerLink:
         self._lock = threading.Condition()
         self._synced_uri: str | None = None
         self._proxies: dict = {}     # service name -> persistent rospy.ServiceProxy
+        # a call given up on (CALL_TIMEOUT) that may still land: (Viewer URI, the thread
+        # waiting for its answer, its proxy)
+        self._late: Optional[Tuple[str, threading.Thread, object]] = None
+        self._uri: Optional[str] = None   # the Viewer the calls under way go to
         self._stop = False
         self._thread = threading.Thread(target=self._work, name="viewer-link", daemon=True)
         self._thread.start()
@@ -115,6 +124,10 @@ class ViewerLink:
             self._synced_uri = None
             self._close_proxies()
             return
+        if self._awaiting_late_call(uri):
+            self._synced_uri = None
+            return  # the batch is in the scene the resync sends once the late call is in
+        self._uri = uri
         if uri != self._synced_uri:
             self._close_proxies()     # connected to the Viewer that was there before
             self._resync()
@@ -143,12 +156,33 @@ class ViewerLink:
         _log.info("Viewer at %s received the current scene (%d geometries)",
                   self._namespace, len(scene))
 
+    def _awaiting_late_call(self, uri: str) -> bool:
+        """Whether a call given up on may still land at the Viewer at ``uri`` (one at
+        another URI is another process's: it cannot touch this Viewer's scene)."""
+        if self._late is None:
+            return False
+        late_uri, thread, proxy = self._late
+        if late_uri == uri:
+            thread.join(CHECK_PERIOD)       # rather than ask the master again at once
+            if thread.is_alive():
+                return True
+        self._late = None
+        proxy.close()       # answered, or a Viewer that is gone: its connection is done with
+        return False
+
     def _call(self, name: str, service_class, *arguments) -> None:
         proxy = self._proxies.get(name)
         if proxy is None:
             proxy = self._proxies[name] = rospy.ServiceProxy(
                 f"{self._namespace}/{name}", service_class, persistent=True)
-        response = _with_timeout(lambda: proxy(*arguments), CALL_TIMEOUT)
+        try:
+            response = _with_timeout(lambda: proxy(*arguments), CALL_TIMEOUT)
+        except _LateCall as late:
+            # its connection stays open and is closed when it is in: closing it now would
+            # end the wait here, not the request on its way to the Viewer
+            del self._proxies[name]
+            self._late = (self._uri, late.thread, proxy)
+            raise
         if not response.success:
             # The Viewer refused: its scene is still consistent, only this geometry is missing.
             _log.warning("Viewer %s refused %s: %s", self._namespace, name, response.message)
@@ -166,9 +200,18 @@ class ViewerLink:
             return None
 
 
+class _LateCall(TimeoutError):
+    """A call not answered in time; ``thread`` still waits for its answer."""
+
+    def __init__(self, message: str, thread: threading.Thread) -> None:
+        super().__init__(message)
+        self.thread = thread
+
+
 def _with_timeout(function: Callable, timeout: float):
     """Runs ``function`` on a helper thread and gives up waiting after ``timeout`` seconds
-    (rospy's service calls have no timeout of their own)."""
+    (rospy's service calls have no timeout of their own): raises _LateCall, whose thread
+    ends when the call does."""
     outcome: dict = {}
 
     def target():
@@ -182,7 +225,7 @@ def _with_timeout(function: Callable, timeout: float):
     thread.start()
     thread.join(timeout)
     if thread.is_alive():
-        raise TimeoutError(f"no answer after {time.monotonic() - started:.1f} s")
+        raise _LateCall(f"no answer after {time.monotonic() - started:.1f} s", thread)
     if "error" in outcome:
         raise outcome["error"]
     return outcome["value"]
