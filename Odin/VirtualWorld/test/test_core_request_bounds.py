@@ -114,3 +114,58 @@ def test_a_step_below_the_shortest_is_refused_in_a_short_line(step):
     with pytest.raises(InvalidArgument) as refused:
         step_values.resolve(step_values.StepValues(), step=step)
     assert "1e-07" in str(refused.value) and len(str(refused.value)) < 120
+
+
+def _strip_mesh(columns: int):
+    """A flat strip of 2 x ``columns`` vertices (m) and its 2 (columns - 1) triangles."""
+    import numpy as np
+    x = np.repeat(np.arange(columns, dtype=float) * 1e-3, 2)
+    vertices = np.stack([x, np.tile([0.0, 1e-3], columns), np.zeros(2 * columns)], axis=1)
+    k = np.arange(columns - 1) * 2
+    triangles = np.concatenate([np.stack([k, k + 2, k + 1], 1), np.stack([k + 1, k + 2, k + 3],
+                                                                          1)])
+    return vertices.reshape(-1), triangles.reshape(-1).astype(np.uint32)
+
+
+def test_a_refused_mesh_leaves_the_worlds_memory_where_it_was(core):
+    """A 14 MB mesh that passes its own checks but is refused (a vertex beyond the world's
+    extent) is not kept by any cache: the memory the world holds afterwards grows by far less
+    than the mesh (the mesh cache had kept its bytes as a key and its arrays, twice its size)."""
+    import tracemalloc
+    vertices, triangles = _strip_mesh(300_000)
+    vertices[-3] = 2e4            # beyond world_extent (1e4 m)
+    tracemalloc.start()
+    try:
+        before = tracemalloc.get_traced_memory()[0]
+        with pytest.raises(InvalidArgument, match="world_extent"):
+            core.build_object(ObjectSpec("far", vertices, triangles, geometry_only=True))
+        grown = tracemalloc.get_traced_memory()[0] - before
+    finally:
+        tracemalloc.stop()
+    assert grown < 2 * 2 ** 20, f"{grown / 2 ** 20:.1f} MB kept after a refusal"
+
+
+def test_a_mesh_of_too_many_triangles_is_refused_before_it_is_checked():
+    """max_mesh_triangles is checked first: a refusal of 3 million triangles takes no time
+    to check or convert them."""
+    import time
+    import numpy as np
+    from odin_common.limits import ResourceLimits
+    with Core(resources=ResourceLimits(max_mesh_triangles=1000)) as small:
+        started = time.perf_counter()
+        with pytest.raises(InvalidArgument, match="max_mesh_triangles"):
+            small.build_object(ObjectSpec("many", np.zeros(9), np.zeros(9_000_000, np.uint32)))
+        assert time.perf_counter() - started < 0.5
+
+
+def test_a_refused_name_of_a_megabyte_costs_no_memory(core):
+    import tracemalloc
+    name = "n" * 2 ** 20
+    tracemalloc.start()
+    try:
+        with pytest.raises(InvalidArgument, match="MAX_NAME_BYTES"):
+            core.build_object(ObjectSpec(name, [0.1]))
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 3 * 2 ** 20

@@ -17,9 +17,10 @@ The result is expressed in the mesh's own frame.
 """
 from __future__ import annotations
 
+import hashlib
 import sys
 import threading
-from typing import TYPE_CHECKING, Dict, NamedTuple, Optional, Tuple
+from typing import TYPE_CHECKING, Dict, NamedTuple, Optional
 
 import numpy as np
 
@@ -113,13 +114,24 @@ def mesh_mass(vertices: np.ndarray, triangles: np.ndarray, mass: float) -> MeshM
     return MeshMass(mass, (low + high) / 2.0, inertia, "bounding box")
 
 
-_MESH_MASS_CACHE: Dict[Tuple[bytes, bytes], MeshMass] = {}
-"""LRU of unit-mass mesh properties (the same robot's meshes come back on every New Scene)."""
+_MESH_MASS_CACHE: Dict[bytes, MeshMass] = {}
+"""LRU of unit-mass mesh properties (the same robot's meshes come back on every New Scene),
+keyed by a digest of the mesh's bytes: an entry costs ~200 bytes however large the mesh (keyed
+by the bytes themselves, a refused 50 MB mesh had stayed in memory)."""
 _MESH_MASS_CACHE_SIZE = 256
 
 
+def mesh_digest(vertices: np.ndarray, triangles: np.ndarray) -> bytes:
+    """A 32-byte digest of a mesh's exact vertices and triangles (their dtypes' bytes)."""
+    digest = hashlib.blake2b(digest_size=32)
+    digest.update(np.ascontiguousarray(vertices).view(np.uint8).reshape(-1))
+    digest.update(b"|")
+    digest.update(np.ascontiguousarray(triangles).view(np.uint8).reshape(-1))
+    return digest.digest()
+
+
 def _unit_mesh_mass(what: str, shape: Shape) -> MeshMass:
-    key = (shape.vertices.tobytes(), shape.triangles.tobytes())
+    key = mesh_digest(shape.vertices, shape.triangles)
     unit = _MESH_MASS_CACHE.pop(key, None)
     if unit is None:  # mass properties of a unit mass scale linearly with the mass
         unit = mesh_mass(shape.vertices, shape.triangles, 1.0)

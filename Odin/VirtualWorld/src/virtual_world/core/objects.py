@@ -11,7 +11,7 @@ from __future__ import annotations
 import collections
 import threading
 from dataclasses import dataclass
-from typing import Dict, List, Sequence, Set, Tuple
+from typing import Dict, List, Optional, Sequence, Set, Tuple
 
 import numpy as np
 
@@ -23,7 +23,7 @@ from odin_common.specs import CompositeSpec, EntitySpec, ObjectSpec, PartSpec
 from virtual_world.core import (exemptions, forces, guard, joints, motors, readout,
                                 validation as check)
 from virtual_world.core.arrays import float64_array, uint32_array
-from virtual_world.core.mass import check_mass, shape_mass
+from virtual_world.core.mass import check_mass, mesh_digest, shape_mass
 from virtual_world.core.records import (Built, BuiltEntity, BuiltGeometry, GeometryRecord,
                                         ObjectRecord, Removed)
 from virtual_world.core.scene import Scene
@@ -49,6 +49,7 @@ class _Part:
     indices: Sequence[int]
     shape_asked: int
     surface: object   # odin_common.specs.Surface
+    cache_key: Optional[Tuple[bytes, int]] = None    # a new mesh's _MESH_SHAPES key
 
 
 @dataclass(eq=False)
@@ -68,9 +69,16 @@ class _Prepared:
 
 # ---------------------------------------------------------------------------------- checks
 
-def _part(what: str, given, mass: float, position, orientation) -> _Part:
-    """The checked geometry of an ObjectSpec or PartSpec ``given``."""
-    shape = _shape(what, given)
+def _part(what: str, given, mass: float, position, orientation,
+          max_triangles: int = limits.MAX_MESH_TRIANGLES) -> _Part:
+    """The checked geometry of an ObjectSpec or PartSpec ``given``; a mesh of more than
+    ``max_triangles`` is refused before anything is converted, checked or cached."""
+    try:
+        triangles = len(given.indices) // 3
+    except TypeError:
+        triangles = 0       # prepare_shape names what is wrong with them
+    check.at_most(f"{what}: mesh (max_mesh_triangles)", triangles, max_triangles, "triangles")
+    shape, cache_key = _shape(what, given)
     surface = check.surface(what, given.surface)
     if shape.kind == "plane" and surface.friction2 is not None:
         raise InvalidArgument(f"{what}: anisotropic friction (friction2) on a plane is not "
@@ -78,50 +86,55 @@ def _part(what: str, given, mass: float, position, orientation) -> _Part:
     return _Part(given.name, shape, mass, check.vector(f"{what}: position", position),
                  check.quaternion(f"{what}: orientation", orientation),
                  check.color(f"{what}: color", given.color),
-                 given.parameters, given.indices, int(given.shape), surface)
+                 given.parameters, given.indices, int(given.shape), surface, cache_key)
 
 
-_MESH_SHAPES: "collections.OrderedDict[Tuple[bytes, bytes, int], Shape]" = \
-    collections.OrderedDict()
-"""Meshes checked lately, by their exact parameters (float64 bytes), indices (uint32 bytes) and
-shape asked: checking a mesh (its indices in range, not every triangle degenerate) and
-converting a message's tuples took ~0.13 s of the TX90 + hand's Build Entity, and the same
-robot comes back after every New Scene. Only meshes that passed are kept (a refusal is checked
-again, with its message); their arrays are read-only, shared by every geometry built over
-them."""
+_MESH_SHAPES: "collections.OrderedDict[Tuple[bytes, int], Shape]" = collections.OrderedDict()
+"""Meshes checked lately, by a digest of their exact parameters (float64 bytes) and indices
+(uint32 bytes) and the shape asked: checking a mesh (its indices in range, not every triangle
+degenerate) and converting a message's tuples took ~0.13 s of the TX90 + hand's Build Entity,
+and the same robot comes back after every New Scene. Only meshes of objects that were built
+are kept (``remember_shapes``): a refused request leaves the cache as it was; their arrays are
+read-only, shared by every geometry built over them."""
 _MESH_SHAPES_LOCK = threading.Lock()     # two Cores may build at once
-#: bytes of parameters and indices the cache of checked meshes keeps at most (the TX90 +
-#: hand + cans: ~4.5 MB of keys, as much again of arrays)
+#: bytes of vertex and triangle arrays the cache of checked meshes keeps at most (the TX90 +
+#: hand + cans: ~4.5 MB)
 MESH_SHAPE_BYTES = 64 * 2 ** 20
 
 
-def _shape(what: str, given) -> Shape:
+def _shape(what: str, given) -> Tuple[Shape, Optional[Tuple[bytes, int]]]:
     """prepare_shape of ``given``'s parameters, indices and shape, a mesh from _MESH_SHAPES
-    when the very same one passed before."""
+    when the very same one passed before; with the cache key to remember it by once built
+    (None: not a mesh, or already cached)."""
     values, indices = float64_array(given.parameters), uint32_array(given.indices)
     if (values is None or indices is None or not indices.size
             or not isinstance(given.shape, int) or not np.all(np.isfinite(values))):
-        return prepare_shape(what, given.parameters, given.indices, given.shape)
-    key = (values.tobytes(), indices.tobytes(), int(given.shape))
+        return prepare_shape(what, given.parameters, given.indices, given.shape), None
+    key = (mesh_digest(values, indices), int(given.shape))
     with _MESH_SHAPES_LOCK:
-        shape = _MESH_SHAPES.pop(key, None)
-    if shape is None:
-        shape = prepare_shape(what, values, indices, given.shape)
-        if shape.kind != "mesh":
-            return shape
-        shape.vertices.flags.writeable = False
-        shape.triangles.flags.writeable = False
-    with _MESH_SHAPES_LOCK:
-        _MESH_SHAPES[key] = shape     # most recently used last
-        _trim_mesh_shapes()
-    return shape
+        shape = _MESH_SHAPES.get(key)
+        if shape is not None:
+            _MESH_SHAPES.move_to_end(key)     # most recently used last
+            return shape, None
+    shape = prepare_shape(what, values, indices, given.shape)
+    if shape.kind != "mesh":
+        return shape, None
+    shape.vertices.flags.writeable = False
+    shape.triangles.flags.writeable = False
+    return shape, key
 
 
-def _trim_mesh_shapes() -> None:
-    held = sum(len(key[0]) + len(key[1]) for key in _MESH_SHAPES)
-    while len(_MESH_SHAPES) > 1 and held > MESH_SHAPE_BYTES:
-        key, _ = _MESH_SHAPES.popitem(last=False)
-        held -= len(key[0]) + len(key[1])
+def remember_shapes(prepared: Sequence["_Prepared"]) -> None:
+    """Keeps the meshes of objects just built in _MESH_SHAPES (never those of a refusal)."""
+    with _MESH_SHAPES_LOCK:
+        for p in prepared:
+            for part in p.parts:
+                if part.cache_key is not None:
+                    _MESH_SHAPES[part.cache_key] = part.shape
+        held = sum(s.vertices.nbytes + s.triangles.nbytes for s in _MESH_SHAPES.values())
+        while len(_MESH_SHAPES) > 1 and held > MESH_SHAPE_BYTES:
+            _, shape = _MESH_SHAPES.popitem(last=False)
+            held -= shape.vertices.nbytes + shape.triangles.nbytes
 
 
 def _given_mass(what: str, mass: float, inertia, center_of_mass):
@@ -170,7 +183,8 @@ def _check_given_inertia(what: str, dmass, com: np.ndarray, parts: Sequence[_Par
         raise InvalidArgument(f"{what}: inertia: {problem}")
 
 
-def prepare_object(spec: ObjectSpec) -> _Prepared:
+def prepare_object(spec: ObjectSpec,
+                   max_triangles: int = limits.MAX_MESH_TRIANGLES) -> _Prepared:
     if not isinstance(spec, ObjectSpec):
         raise InvalidArgument(f"{shown(spec)} is not an ObjectSpec")
     name = check.name("object name", spec.name)
@@ -182,7 +196,7 @@ def prepare_object(spec: ObjectSpec) -> _Prepared:
         check.ignored_mass(what, mass)
     else:
         check.mass(what, mass)
-    part = _part(what, spec, mass, (0.0, 0.0, 0.0), IDENTITY)
+    part = _part(what, spec, mass, (0.0, 0.0, 0.0), IDENTITY, max_triangles)
     if part.shape.kind == "plane" and not geometry_only:
         raise InvalidArgument(f"{what}: a plane is static: give geometry_only")
     position = check.vector(f"{what}: position", spec.position)
@@ -199,7 +213,8 @@ def prepare_object(spec: ObjectSpec) -> _Prepared:
                      no_collisions, dmass, com)
 
 
-def prepare_composite(spec: CompositeSpec) -> _Prepared:
+def prepare_composite(spec: CompositeSpec,
+                      max_triangles: int = limits.MAX_MESH_TRIANGLES) -> _Prepared:
     if not isinstance(spec, CompositeSpec):
         raise InvalidArgument(f"{shown(spec)} is not a CompositeSpec")
     if len(spec.parts) == 0:
@@ -211,7 +226,7 @@ def prepare_composite(spec: CompositeSpec) -> _Prepared:
         name = check.name("part name", given.name)
         what = f"part {shown(name)}"
         mass = check.mass(what, check.number(f"{what}: mass", given.mass))
-        part = _part(what, given, mass, given.position, given.orientation)
+        part = _part(what, given, mass, given.position, given.orientation, max_triangles)
         if part.shape.kind == "plane":
             raise InvalidArgument(f"{what}: a plane cannot be a part of a composite")
         parts.append(part)
@@ -372,17 +387,21 @@ def place_static(geom, position: np.ndarray, orientation: np.ndarray,
 
 
 def build_object(scene: Scene, spec: ObjectSpec) -> Built:
-    prepared = prepare_object(spec)
+    prepared = prepare_object(spec, scene.resources.max_mesh_triangles)
     check_ranges(scene, [prepared])
     check_new_names(scene, [prepared])
-    return build(scene, prepared)
+    built = build(scene, prepared)
+    remember_shapes([prepared])
+    return built
 
 
 def build_composite(scene: Scene, spec: CompositeSpec) -> Built:
-    prepared = prepare_composite(spec)
+    prepared = prepare_composite(spec, scene.resources.max_mesh_triangles)
     check_ranges(scene, [prepared])
     check_new_names(scene, [prepared])
-    return build(scene, prepared)
+    built = build(scene, prepared)
+    remember_shapes([prepared])
+    return built
 
 
 def build_entity(scene: Scene, spec: EntitySpec) -> BuiltEntity:
@@ -395,8 +414,14 @@ def build_entity(scene: Scene, spec: EntitySpec) -> BuiltEntity:
         _free_entity_name(scene)
     if name in scene.entities:
         raise DuplicateName(f"entity {shown(name)} already exists")
-    prepared = [prepare_object(s) for s in spec.objects]
-    prepared += [prepare_composite(s) for s in spec.composites]
+    count = len(spec.objects) + len(spec.composites)     # before preparing any of them
+    if len(scene.objects) + count > scene.resources.max_objects:
+        raise InvalidArgument(f"entity {shown(name)}: {count:,} more object(s) would exceed the "
+                              f"world's limit of {scene.resources.max_objects:,} objects "
+                              "(max_objects)")
+    most = scene.resources.max_mesh_triangles
+    prepared = [prepare_object(s, most) for s in spec.objects]
+    prepared += [prepare_composite(s, most) for s in spec.composites]
     if not prepared:
         raise InvalidArgument(f"entity {shown(name)} has no objects")
     check_ranges(scene, prepared)
@@ -413,6 +438,7 @@ def build_entity(scene: Scene, spec: EntitySpec) -> BuiltEntity:
         for member in members:
             remove_object(scene, member.id)
         raise
+    remember_shapes(prepared)
     for member in members:
         scene.objects[member.id].entity = name
     scene.entities[name] = [member.id for member in members]
