@@ -167,10 +167,18 @@ def view_fields(marker: MarkerView) -> Optional[Tuple[str, tuple, tuple, int, tu
 
 
 class MarkerIntake:
-    """Which geometries came from markers; turns a MarkerArray into scene changes."""
+    """Which geometries came from markers (and still do: a View Object, Remove Object or New
+    Scene of the same ID makes it the services' again, ``forget``); turns a MarkerArray into
+    scene changes."""
 
     def __init__(self) -> None:
         self.added: set = set()
+
+    def forget(self, object_ids) -> None:
+        """The services now own these IDs: a later DELETE or DELETEALL leaves them alone (a
+        marker's DELETE, taken MARKER_GRACE s late, removed the world's object built again
+        meanwhile under the same ID)."""
+        self.added.difference_update(object_ids)
 
     def changes(self, markers: List[MarkerView], held) -> Tuple[list, list]:
         """(views to add: (ID, parameters, indices, shape, colour), IDs to remove) for a

@@ -143,11 +143,11 @@ class Portal:
                                on_frame=self._on_frame, wanted=self._frames_wanted)
         self.loop.start()
 
+        self._marker_intake = MarkerIntake()
         self._serve()
         rospy.Subscriber(f"{world}/world_update", SpaceDistribution, self._world_update,
                          queue_size=10)
         rospy.Subscriber(f"{world}/collided", Collided, self._collided, queue_size=1000)
-        self._marker_intake = MarkerIntake()
         rospy.Subscriber(f"{world}/markers", RawMarkerArray, self._markers, queue_size=10)
         rospy.loginfo("viewer: rendering %dx%d at %.1f Hz, world %s, snapshots in %s",
                       camera.width, camera.height, rate, world, self.snapshot_dir)
@@ -233,18 +233,25 @@ class Portal:
         request = prepare_view(req.id, req.parameters, req.indices, req.position,
                                req.orientation, req.color, req.shape,
                                self.geometries)   # on this thread
-        replaced = self.loop.call(lambda scene, _: scene.view(request))
+        replaced = self.loop.call(lambda scene, _: self._owned(scene.view(request), [req.id]))
         return {"message": f"replaced {req.id!r}" if replaced else f"added {req.id!r}"}
 
     def remove_object(self, req) -> dict:
         """Removes the object; an unknown ID is refused."""
-        self.loop.call(lambda scene, _: scene.remove_object(req.id))
+        self.loop.call(lambda scene, _: self._owned(scene.remove_object(req.id), [req.id]))
         return {"message": f"removed {req.id!r}"}
 
     def new_scene(self, req) -> dict:
         """Empties the scene (the camera stays)."""
-        self.loop.call(lambda scene, _: scene.new_scene())
+        self.loop.call(lambda scene, _: self._owned(scene.new_scene(),
+                                                    list(self._marker_intake.added)))
         return {}
+
+    def _owned(self, result, object_ids):
+        """``result``, once the markers' intake has forgotten ``object_ids`` (on the render
+        thread, which alone touches it): what the services changed, markers no longer do."""
+        self._marker_intake.forget(object_ids)
+        return result
 
     def save_snapshot(self, req) -> dict:
         """Renders now and writes ``<~snapshot_dir>/<name>.png``; answers the path written and
