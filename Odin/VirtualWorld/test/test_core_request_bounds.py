@@ -169,3 +169,23 @@ def test_a_refused_name_of_a_megabyte_costs_no_memory(core):
     finally:
         tracemalloc.stop()
     assert peak < 3 * 2 ** 20
+
+
+def test_more_poses_than_objects_are_refused_before_any_is_read(core):
+    """Set Position of 100,000 unknown names had cost 65 MB: a request naming more entries
+    than the world has objects is refused before any is read (the items here would raise if
+    read), and one naming an unknown object at that object."""
+    class Unreadable:
+        def __len__(self):
+            return 100_000
+
+        def __iter__(self):
+            raise AssertionError("read")
+
+        def __getitem__(self, index):
+            raise AssertionError("read")
+
+    with pytest.raises(InvalidArgument, match="100,000 poses given; the world holds 1"):
+        core.set_poses(Unreadable())
+    with pytest.raises(InvalidArgument, match="100,000 poses"):
+        core.check_collision(Unreadable())

@@ -6,6 +6,7 @@ through unchanged: SI units, world frame, quaternions (w, x, y, z) on both sides
 """
 from __future__ import annotations
 
+import collections.abc
 from typing import Sequence, Tuple
 
 import numpy as np
@@ -139,9 +140,27 @@ def situation_messages(poses) -> list:
             for name, position, orientation in poses]
 
 
-def situation_poses(messages) -> list:
-    """Messages/Situation -> (name, position, quaternion)."""
-    return [(m.name, tuple(m.position), tuple(m.orientation)) for m in messages]
+class _SituationPoses(collections.abc.Sequence):
+    """Messages/Situation -> (name, position, quaternion), each converted when it is read: a
+    request of 100,000 situations naming unknown objects is refused at the first one (and
+    its count at once) without a copy of them all."""
+
+    def __init__(self, messages):
+        self._messages = messages
+
+    def __len__(self) -> int:
+        return len(self._messages)
+
+    def __getitem__(self, index):
+        if isinstance(index, slice):
+            return [self[k] for k in range(*index.indices(len(self)))]
+        m = self._messages[index]
+        return (m.name, tuple(m.position), tuple(m.orientation))
+
+
+def situation_poses(messages) -> Sequence:
+    """Messages/Situation -> a sequence of (name, position, quaternion), converted lazily."""
+    return _SituationPoses(messages)
 
 
 def world_parameters_message(parameters: world_parameters.WorldParameters) -> WorldParameters:

@@ -489,7 +489,16 @@ def remove_object(scene: Scene, object_id: str) -> Removed:
 
 def check_poses(scene: Scene, poses) -> list:
     """[(object record, position (3,), orientation (4,))] of (object id, position m world,
-    orientation wxyz) items, each checked."""
+    orientation wxyz) items, each checked. More items than the scene has objects are refused
+    before any is read, an unknown object at the first: a request's work is bounded by the
+    world's size, not by what the request holds."""
+    try:
+        count = len(poses)
+    except TypeError:
+        raise InvalidArgument(f"poses={shown(poses)} is not a sequence") from None
+    if count > len(scene.objects):
+        raise InvalidArgument(f"{count:,} poses given; the world holds {len(scene.objects):,} "
+                              "objects (each object at most once)")
     checked = []
     for item in poses:
         try:
