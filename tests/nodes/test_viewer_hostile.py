@@ -106,3 +106,15 @@ def test_frames_on_a_full_disk_leave_no_empty_file_warn_once_and_resume(ros_mast
     _wait_for(lambda: "written again" in log_text())
     _wait_for(lambda: len(set(p.name for p in tiny_tmpfs.glob("frame_*.png")) - set(kept)) > 0)
     assert all(p.stat().st_size > 0 for p in tiny_tmpfs.glob("frame_*.png"))
+
+
+def test_a_snapshot_folder_that_cannot_be_made_stops_the_node_with_one_line(ros_master,
+                                                                             tmp_path):
+    in_the_way = tmp_path / "a_file"
+    in_the_way.write_text("not a folder")
+    node = ros_master.rosrun("Viewer", "viewer", f"_snapshot_dir:={in_the_way / 'snaps'}")
+    assert node.wait(timeout=60) == 1
+    log = ros_master.log_text(node)
+    assert "Traceback" not in log, log[-2000:]
+    fatal = [line for line in log.splitlines() if "~snapshot_dir" in line]
+    assert fatal and "cannot make the folder: Not a directory" in fatal[0], log[-2000:]

@@ -130,7 +130,11 @@ class Portal:
                                                             DEFAULTS["background"]))
         self.snapshot_dir = pathlib.Path(os.path.expanduser(
             rospy.get_param("~snapshot_dir", str(default_snapshot_dir())))).resolve()
-        self.snapshot_dir.mkdir(parents=True, exist_ok=True)
+        try:
+            self.snapshot_dir.mkdir(parents=True, exist_ok=True)
+        except OSError as error:      # a file in the way, no permission, a full disk
+            raise ViewerError(f"~snapshot_dir {self.snapshot_dir}: cannot make the folder: "
+                              f"{error.strerror or error}") from None
         self.snapshot_every = int(rospy.get_param("~snapshot_every", DEFAULTS["snapshot_every"]))
         self.frame_writer = FrameWriter(self.snapshot_dir) if self.snapshot_every > 0 else None
         self.geometries = GeometryCache()   # a world re-sends the same meshes on every load
