@@ -105,3 +105,11 @@ def test_a_real_full_disk_leaves_no_corrupt_bag_under_the_name(tiny_tmpfs):
     recorder = _record(path, 2000)
     assert recorder.failed and "No space left on device" in recorder.failed
     assert path.read_bytes() == before and _bag_entries(path) == 3
+
+
+def test_a_recording_folder_that_cannot_be_made_is_one_start_up_error(tmp_path):
+    from virtual_world.portal.recorder import RecordError
+    in_the_way = tmp_path / "a_file"
+    in_the_way.write_text("not a folder")
+    with pytest.raises(RecordError, match=r"^cannot record to .*a_file.*: Not a directory$"):
+        _record(in_the_way / "sub" / "run.bag", 1)
