@@ -89,6 +89,26 @@ MAX_STEPS_PER_CALL = 1_000_000
 meanwhile, so a longer run is asked for in pieces (at 1 ms steps, 1,000 s of simulated time)."""
 
 
+MAX_BODY_STEPS_PER_CALL = 10_000_000
+"""Body-steps (steps times the bodies that step) one call may ask for: a Propagate, a Step
+Once of several cycles. The node answers nothing else meanwhile, and a step's work grows with
+the bodies: 1,000 s of 1 ms steps over 200 bodies (2e8 body-steps) held a world for more
+than ten minutes (~3 us a body-step on a 2-core host); 1e7 is about half a minute there.
+A longer run is asked for in pieces."""
+
+
+def check_work(what: str, steps: int, bodies: int) -> int:
+    """``steps`` if ``steps`` x ``bodies`` (at least 1) is within MAX_BODY_STEPS_PER_CALL,
+    else InvalidArgument naming ``what`` and both numbers."""
+    work = int(steps) * max(int(bodies), 1)
+    if work > MAX_BODY_STEPS_PER_CALL:
+        raise InvalidArgument(f"{what}: {float(steps):.3g} steps x {bodies:,} bodies = "
+                              f"{float(work):.3g} body-steps; one call runs at most "
+                              f"{MAX_BODY_STEPS_PER_CALL:.3g} (MAX_BODY_STEPS_PER_CALL): ask "
+                              "in pieces")
+    return int(steps)
+
+
 def shown(value, limit: int = MAX_SHOWN_CHARS) -> str:
     """``repr(value)`` cut to ``limit`` characters (saying how long it was), for error messages
     that quote what a request or file gave."""

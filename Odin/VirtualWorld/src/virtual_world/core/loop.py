@@ -26,6 +26,9 @@ import threading
 import time
 from typing import Any, Callable
 
+from odin_common import limits
+from odin_common.errors import InvalidArgument as CommonInvalidArgument
+from odin_common.limits import shown
 from virtual_world.core.step_values import StepValues
 from virtual_world.errors import InvalidArgument
 
@@ -86,7 +89,10 @@ class WorldLoop:
     def __init__(self, advance: Callable[[float, int], float],
                  publish: Callable[[CycleReport], None],
                  step_values: StepValues = StepValues(), simulate: bool = False,
-                 free_run: bool = False):
+                 free_run: bool = False, bodies: Callable[[], int] = lambda: 1):
+        """``bodies()``: how many bodies a step advances (Core.body_count), which bounds a
+        Step Once's work (odin_common.limits.MAX_BODY_STEPS_PER_CALL)."""
+        self._bodies = bodies
         self._advance = advance
         self._publish = publish
         self.step_values = step_values
@@ -132,7 +138,13 @@ class WorldLoop:
             raise InvalidArgument("the simulation is running: pause it (Start false) to step once")
         cycles = cycles or 1
         if cycles > MAX_STEP_ONCE_CYCLES:
-            raise InvalidArgument(f"cycles must be at most {MAX_STEP_ONCE_CYCLES}, got {cycles}")
+            raise InvalidArgument(f"cycles must be at most {MAX_STEP_ONCE_CYCLES}, got "
+                                  f"{shown(cycles)}")
+        try:
+            limits.check_work(f"Step Once of {cycles:,} cycles",
+                              cycles * self.step_values.steps_per_cycle, self._bodies())
+        except CommonInvalidArgument as error:
+            raise InvalidArgument(str(error)) from None
         for _ in range(cycles):
             self.advance_cycle()
         return self.sim_time

@@ -21,6 +21,7 @@ from typing import Dict, List, Mapping, Optional, Sequence, Tuple
 
 import numpy as np
 
+from odin_common import limits
 from odin_common.interface import ForceKind, JointType, MotorKind, ServoDrive, Solver
 from odin_common.limits import ResourceLimits, shown, shown_list
 from odin_common.specs import CompositeSpec, EntitySpec, JointSpec, MotorSpec, ObjectSpec
@@ -511,6 +512,8 @@ class Core:
         vector alone). Everything is checked before anything changes."""
         scene = self._scene
         step_size, steps = _steps_of(duration, step_size)
+        check.shared(limits.check_work, f"propagate {duration:.6g} s at {step_size:g} s",
+                     steps, scene.body_array().count)
         keep = check.flag("keep", keep)
         start_snapshot = self._snapshot(start) if start else None
         if start_snapshot is not None:
@@ -641,6 +644,13 @@ class Core:
         taken = scene.c.step(step_size, int(count))
         scene.sim_time += step_size * taken
         guard.collect(scene, step_size)
+
+    @property
+    def body_count(self) -> int:
+        """Bodies that step (objects with a body): what a step's work grows with."""
+        with self._lock:
+            scene = self._scene
+            return 0 if scene is None else scene.body_array().count
 
     @locked
     def take_divergences(self) -> List[Divergence]:

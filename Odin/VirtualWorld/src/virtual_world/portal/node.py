@@ -94,7 +94,8 @@ class Portal:
             self.core.set_world_parameters(**initial)
         self.loop = WorldLoop(self.core_advance, self._publish, values,
                               simulate=bool(rospy.get_param("~simulate", DEFAULTS["simulate"])),
-                              free_run=bool(rospy.get_param("~free_run", DEFAULTS["free_run"])))
+                              free_run=bool(rospy.get_param("~free_run", DEFAULTS["free_run"])),
+                              bodies=lambda: self.core.body_count)
         self._rtf = RealTimeFactor()
         self._poses_for_viewer: tuple = ()
         self._poses_lock = threading.Lock()
