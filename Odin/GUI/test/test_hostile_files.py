@@ -292,3 +292,144 @@ def test_path_and_control_files_larger_than_the_limit_are_refused_unread(tmp_pat
         read_path(huge)
     with pytest.raises(PathFileError, match="larger than the"):
         read_control_path(huge, 2)
+
+
+# ------------------------------------------------------------------ scales and lengths
+
+def strict_json(text: str):
+    """JSON with no NaN or Infinity (which JSON does not have)."""
+    def refuse(name):
+        raise AssertionError(f"{name} in problem_info's JSON")
+    return json.loads(text, parse_constant=refuse)
+
+
+CRATE = ('<robot name="crate"><link name="body"><inertial><mass value="{mass}"/>'
+         '<inertia ixx="{ixx}" iyy="0.1" izz="0.1"/></inertial><collision>'
+         '<origin xyz="{xyz}"/><geometry>{geometry}</geometry></collision></link></robot>\n')
+TETRA = ("#Inventor V2.1 ascii\nSeparator { Coordinate3 { point [0 0 0, {far} 0 0, 0 1 0, "
+         "0 0 1] } IndexedFaceSet { coordIndex [0, 2, 1, -1, 0, 1, 3, -1, 0, 3, 2, -1, "
+         "1, 2, 3, -1] } }\n")
+
+
+def _scene(folder, obstacle="crate.urdf", scale="1", home='X="0"', mass="2", ixx="0.1",
+           xyz="0 0 0", geometry='<box size="0.3 0.2 0.1"/>', far="1", rob=None):
+    folder.mkdir()
+    (folder / "crate.urdf").write_text(CRATE.format(mass=mass, ixx=ixx, xyz=xyz,
+                                                    geometry=geometry))
+    (folder / "tetra.iv").write_text(TETRA.replace("{far}", far))
+    (folder / "tetra.stl").write_text(
+        f"solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex {far} 0 0\n"
+        "vertex 0 1 0\nendloop\nendfacet\nendsolid t\n")
+    if rob is not None:
+        (folder / "arm.rob").write_text(rob)
+    problem = folder / "p.xml"
+    problem.write_text(f'<Problem><Obstacle obstacle="{obstacle}" scale="{scale}">'
+                       f'<Home {home}/></Obstacle></Problem>\n')
+    return problem
+
+
+ROB = ('<Robot name="arm" DHType="Standard"><Joints><Joint name="base" ivFile="tetra.iv"/>'
+       '<Joint name="j1" ivFile="tetra.iv"><DHPars a="{a}" d="0" alpha="0" theta="0"/>'
+       '<Limits Low="-90" Hi="90"/>'
+       '</Joint></Joints></Robot>\n')
+
+ABSURD = {     # what the problem or its files say -> what the one error line must quote
+    "problem scale 1e308": (dict(scale="1e308"), "scale='1e308'"),
+    "problem scale 1e-300": (dict(scale="1e-300"), "scale='1e-300'"),
+    "problem scale -2": (dict(scale="-2"), "scale='-2'"),
+    "problem scale 0": (dict(scale="0"), "scale='0'"),
+    "home X 1e300": (dict(home='X="1e300"'), "<Home> X Y Z"),
+    "mesh scale 1e308": (dict(geometry='<mesh filename="tetra.iv" scale="1e308 1e308 1e308"/>'),
+                         "scale='1e308 1e308 1e308'"),
+    "uneven mesh scale 1e200": (dict(geometry='<mesh filename="tetra.stl" scale="1e200 1 1"/>'),
+                                "scale='1e200 1 1'"),
+    "mesh scale times problem scale": (dict(scale="1e10", geometry='<mesh filename="tetra.iv" '
+                                            'scale="1e10 1e10 1e10"/>'), "tetra.iv"),
+    "origin 1e300": (dict(xyz="1e300 0 0"), "<origin xyz='1e300 0 0'>"),
+    "box of 1e9 m": (dict(geometry='<box size="1e9 1 1"/>'), "<box> size"),
+    "mass 1e300": (dict(mass="1e300"), "<mass value='1e300'>"),
+    "inertia 1e300": (dict(ixx="1e300"), "<inertia>"),
+    "inertia 1e20 at scale 1e10": (dict(ixx="1e20", scale="1e10"), "<inertia>"),
+    "VRML vertex 1e30": (dict(obstacle="tetra.iv", far="1e30"), "a vertex reaches"),
+    "STL vertex 1e300": (dict(obstacle="tetra.stl", far="1e300"), "a vertex reaches"),
+    "rob DH a 1e305": (dict(obstacle="arm.rob", rob=ROB.format(a="1e305")), "<DHPars a d>"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(ABSURD))
+def test_an_absurd_scale_or_scaled_length_is_one_error_naming_file_and_value(case, tmp_path):
+    settings, quoted = ABSURD[case]
+    problem = _scene(tmp_path / "scene", **settings)
+    shapes._CACHE.clear()
+    status, out, err = problem_info(problem)
+    assert status == 2 and out == "", (out, err)
+    line = one_error_line(err)
+    assert quoted in line and str(tmp_path / "scene") in line, line
+
+
+def test_large_but_possible_scales_print_finite_json(tmp_path):
+    rob = ROB.format(a="500")
+    for k, settings in enumerate([dict(scale="1000"), dict(scale="1e-3"),
+                                  dict(obstacle="tetra.iv", scale="1e6"),
+                                  dict(geometry='<mesh filename="tetra.stl" scale="1e4 1 1"/>'),
+                                  dict(obstacle="arm.rob", rob=rob, scale="100")]):
+        problem = _scene(tmp_path / f"scene{k}", **settings)
+        shapes._CACHE.clear()
+        status, out, err = problem_info(problem)
+        assert status == 0, (settings, err)
+        strict_json(out)
+
+
+# ------------------------------------------------------------------ XML of absurd shape
+
+def _rss_of_problem_info(problem, tmp_path) -> tuple:
+    """problem_info on ``problem`` in a child process under a 2 GB address-space limit (an
+    unbounded parse fails there, not on the host): its status, stderr and peak RSS (MB)."""
+    import subprocess
+    script = ("import resource, sys\n"
+              "resource.setrlimit(resource.RLIMIT_AS, (2 * 2 ** 30, 2 * 2 ** 30))\n"
+              "from gui.cli import problem_info_main\n"
+              "status = problem_info_main([sys.argv[1]])\n"
+              "print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss // 1024, "
+              "file=sys.stderr)\n"
+              "sys.exit(status)\n")
+    run = subprocess.run([sys.executable, "-c", script, str(problem)], capture_output=True,
+                         text=True, timeout=120)
+    lines = run.stderr.strip().splitlines()
+    peak = int(lines[-1]) if lines and lines[-1].isdigit() else None
+    return run.returncode, "\n".join(lines[:-1]), peak
+
+
+@pytest.mark.timeout(120)
+def test_a_problem_of_millions_of_empty_elements_is_refused_in_bounded_memory(tmp_path):
+    import time
+    from odin_common.limits import MAX_XML_ELEMENTS
+    problem = tmp_path / "empty.xml"
+    with open(problem, "wb") as f:           # 60 MB: 15 million <a/>
+        f.write(b"<Problem>")
+        f.write(b"<a/>" * (15 * 10 ** 6))
+        f.write(b"</Problem>")
+    started = time.monotonic()
+    status, err, peak = _rss_of_problem_info(problem, tmp_path)
+    assert status == 2 and "Traceback" not in err, err
+    assert f"holds more than {MAX_XML_ELEMENTS:,} elements" in err and str(problem) in err
+    assert peak is not None and peak < 800, f"peak RSS {peak} MB"
+    assert time.monotonic() - started < 60
+
+
+def test_deep_wide_and_texty_xml_is_refused_or_read_quickly(tmp_path):
+    import time
+    from odin_common.limits import MAX_XML_ATTRIBUTES, MAX_XML_DEPTH
+    deep = tmp_path / "deep.xml"
+    deep.write_text("<Problem>" + "<a>" * 100_000 + "</a>" * 100_000 + "</Problem>")
+    with pytest.raises(ProblemError, match=f"more than {MAX_XML_DEPTH:,} levels"):
+        read_xml(deep)
+    wide = tmp_path / "wide.urdf"
+    wide.write_text("<robot " + " ".join(f'a{k}="1"' for k in range(5_000)) + "/>")
+    with pytest.raises(ProblemError, match=f"more than {MAX_XML_ATTRIBUTES:,} attributes"):
+        read_xml(wide)
+    texty = tmp_path / "texty.xml"           # 5 million pieces of text in one element
+    texty.write_text("<Problem>" + "&amp;" * 5_000_000 + "</Problem>")
+    started = time.monotonic()
+    assert len(read_xml(texty).text) == 5_000_000
+    assert time.monotonic() - started < 30

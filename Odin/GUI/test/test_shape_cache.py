@@ -3,6 +3,7 @@ blindly (corrupt and concurrent entries, files that name other files, --no-cache
 from __future__ import annotations
 
 import multiprocessing
+import os
 import subprocess
 import sys
 
@@ -170,3 +171,84 @@ def test_problem_info_no_cache_gives_the_same_answer(cache, kautham_dir):
     assert all(run.returncode == 0 for run in runs), runs[0].stderr
     assert runs[0].stdout == runs[1].stdout == runs[2].stdout
     assert len(list(cache.glob("*.shape"))) == 16       # the distinct geometry files it reads
+
+
+def _rewritten(whole: bytes, edit=None, payload=None) -> bytes:
+    """An entry with its JSON header passed through ``edit`` (a function changing the parsed
+    header in place) and/or its arrays replaced by ``payload``."""
+    import json
+    import struct
+    magic = shape_cache._MAGIC
+    (size,) = struct.unpack_from("<Q", whole, len(magic))
+    start = len(magic) + 8
+    header = json.loads(whole[start:start + size])
+    if edit is not None:
+        edit(header)
+    text = json.dumps(header).encode()     # NaN and Infinity written as JSON cannot
+    rest = whole[start + size:] if payload is None else payload(whole[start + size:])
+    return magic + struct.pack("<Q", len(text)) + text + rest
+
+
+def _set(path, value):
+    def edit(header):
+        target = header
+        for key in path[:-1]:
+            target = target[key]
+        target[path[-1]] = value
+    return edit
+
+
+def _vertex(value):
+    return lambda arrays: np.array([value], "<f8").tobytes() + arrays[8:]
+
+
+DAMAGED = {
+    "colour NaN": _set(("mesh", "color", 0), float("nan")),
+    "colour 7": _set(("mesh", "color", 1), 7.0),
+    "radius negative": _set(("primitives", 0, "parameters", 0), -2.0),
+    "radius Infinity": _set(("primitives", 0, "parameters", 0), float("inf")),
+    "radius a string": _set(("primitives", 0, "parameters", 0), "2"),
+    "two radii": _set(("primitives", 0, "parameters"), [1.0, 2.0]),
+    "a teapot": _set(("primitives", 0, "kind"), "teapot"),
+    "a pose scaled": _set(("primitives", 0, "pose", 0), 2.0),
+    "a pose of 15 values": lambda h: h["primitives"][0]["pose"].pop(),
+    "a pose at 1e300": _set(("primitives", 0, "pose", 3), 1e300),
+    "sizes as strings": _set(("mesh", "sizes"), ["4", "4"]),
+    "sizes true": lambda h: h["mesh"]["sizes"].__setitem__(1, True),
+    "sizes not matching": lambda h: h["mesh"]["sizes"].__setitem__(0, 3),
+    "empty": lambda h: h.update(mesh=None, primitives=[]),
+    "a list": None,
+}
+
+
+@pytest.mark.timeout(60)
+def test_a_damaged_entry_is_verified_dropped_and_the_file_read_again(cache, tmp_path, caplog):
+    model = tmp_path / "model.iv"
+    model.write_text(SCENE)
+    first = _read(model)
+    (entry,) = cache.glob("*.shape")
+    whole = entry.read_bytes()
+    variants = {name: _rewritten(whole, edit) for name, edit in DAMAGED.items() if edit}
+    variants["a list"] = whole.replace(b'{"mesh"', b'[{"mesh"', 1)
+    variants["a vertex NaN"] = _rewritten(whole, payload=_vertex(float("nan")))
+    variants["a vertex Infinity"] = _rewritten(whole, payload=_vertex(float("inf")))
+    variants["a vertex at 1e300"] = _rewritten(whole, payload=_vertex(1e300))
+    with caplog.at_level("INFO", logger="gui.core"):
+        for name, damaged in variants.items():
+            entry.write_bytes(damaged)
+            _same(_read(model), first)
+            assert entry.read_bytes() == whole, name          # written whole again
+    assert [r.getMessage() for r in caplog.records if r.levelname != "DEBUG"] == []
+    for planted in ("fifo", "directory", "zero"):              # never opened, never waited on
+        entry.unlink()
+        if planted == "fifo":
+            os.mkfifo(entry)
+        elif planted == "directory":
+            entry.mkdir()
+        else:
+            entry.symlink_to("/dev/zero")
+        _same(_read(model), first)
+        if planted == "directory":
+            entry.rmdir()
+            _read(model)
+        assert entry.is_file() and entry.read_bytes() == whole, planted

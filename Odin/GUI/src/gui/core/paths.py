@@ -23,9 +23,9 @@ from typing import Optional
 
 import numpy as np
 
-from gui.core.sizes import check_file_size
+from gui.core.sizes import read_input_file
 from gui.errors import PathFileError
-from gui.core.kautham.xmlfile import read_xml
+from gui.core.kautham.xmlfile import parse_xml_bytes
 from gui.core.model import PRISMATIC
 
 DEGREES, RADIANS = "degrees", "radians"
@@ -40,16 +40,16 @@ def read_path(path: os.PathLike | str, n_values: Optional[int] = None) -> np.nda
 
 
 def read_rows(path: os.PathLike | str, n_values: Optional[int] = None,
-              meaning: str = "one per movable joint") -> tuple:
+              meaning: str = "one per movable joint", data: Optional[bytes] = None) -> tuple:
     """``read_path``'s rows and the line each came from; ``meaning`` says what a row holds
-    (for the error of a row of the wrong length)."""
+    (for the error of a row of the wrong length). ``data``: the file's bytes when the caller
+    has read them (``gui.core.sizes.read_input_file``), else the file is read here."""
     p = pathlib.Path(path)
-    if not p.is_file():
-        raise PathFileError("path file not found", p)
-    check_file_size(p, "path file", PathFileError)
-    text = p.read_text(errors="replace")
+    if data is None:
+        data = read_input_file(p, "path file", PathFileError)
+    text = data.decode(errors="replace")
     if text.lstrip().startswith("<"):
-        root = read_xml(p, "task file")
+        root = parse_xml_bytes(data, str(p))
         lines = [(c.line, c.text) for c in _iter(root) if c.tag == "Conf"]
     else:
         lines = list(enumerate(text.splitlines(), start=1))

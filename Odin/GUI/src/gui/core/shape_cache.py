@@ -14,8 +14,12 @@ planted file can only fail to load.
 
 Safe against corrupt and concurrent entries: an entry is written to a temporary file in the
 cache folder and renamed into place (atomic on one file system), so a reader sees a whole
-entry or none; an entry that does not load or does not hold what a shape needs is removed and
-the file is read again. A cache folder that cannot be written only costs the speed.
+entry or none. An entry is read as any input file is (``gui.core.sizes.read_input_file``:
+a regular file, bounded) and verified field by field before it is used (``_decode``: sizes
+that match the bytes, finite vertices within the world's reach, triangles naming vertices the
+mesh has, primitives of a known kind with positive finite sizes and rigid poses, colours in
+[0, 1]); one that fails any check is removed (one debug line) and the file is read again.
+A cache folder that cannot be written only costs the speed.
 Files that name other files (VRML ``Inline``, Inventor ``File`` nodes) are never cached: their
 content alone does not say what they hold.
 
@@ -35,6 +39,8 @@ import tempfile
 from typing import Callable, Optional
 
 import numpy as np
+
+from odin_common.limits import shown
 
 log = logging.getLogger(__name__)
 
@@ -77,22 +83,18 @@ def cache_dir() -> pathlib.Path:
     return pathlib.Path(root) / "shapes"
 
 
-def cached(path: pathlib.Path, reading: str, read: Callable[[], "Shape"]) -> "Shape":
-    """The shape of ``path`` read as ``reading`` says (a text naming scale and defaults):
-    from the cache when an entry for its content exists, else ``read()``, stored for next time.
-    Errors of ``read`` (ShapeError) pass through and are not cached."""
-    if not enabled():
-        return read()
-    try:
-        content = path.read_bytes()
-    except OSError:
-        return read()                       # the reader says what is wrong with the file
-    if _names_other_files(content):
+def cached(content: bytes, source: str, reading: str, read: Callable[[], "Shape"]) -> "Shape":
+    """The shape of a geometry file's ``content`` (its bytes, as read once by
+    ``gui.core.sizes.read_input_file``; ``source`` names the file) read as ``reading`` says (a
+    text naming scale and defaults): from the cache when an entry for that content exists,
+    else ``read()``, stored for next time. Errors of ``read`` (ShapeError) pass through and are
+    not cached."""
+    if not enabled() or _names_other_files(content):
         return read()
     digest = hashlib.sha256(content)
     digest.update(f"\0{reading}\0{FORMAT_VERSION}\0{_readers_version()}".encode())
     entry = cache_dir() / f"{digest.hexdigest()}{ENTRY_SUFFIX}"
-    shape = _load(entry, str(path))
+    shape = _load(entry, source)
     if shape is None:
         shape = read()
         _store(entry, shape)
@@ -122,17 +124,21 @@ def _readers_version() -> str:
 
 
 def _load(entry: pathlib.Path, source: str):
-    try:
-        data = entry.read_bytes()
-    except FileNotFoundError:
+    from gui.core.sizes import read_input_file
+    from gui.errors import ProblemError
+    if not os.path.lexists(entry):
         return None
-    except OSError as error:
-        log.warning("shape cache: cannot read entry %s (%s)", entry, error)
+    try:
+        data = read_input_file(entry, "shape cache entry")
+    except ProblemError as error:   # planted, or removed meanwhile: read the file again
+        log.debug("shape cache: %s", error)
+        _remove(entry)
         return None
     try:
         shape = _decode(data, source)
-    except Exception as error:   # corrupt, truncated, of another layout: read the file again
-        log.warning("shape cache: dropping unreadable entry %s (%s)", entry, error)
+    except (ValueError, KeyError, TypeError, IndexError, AttributeError, OverflowError) \
+            as error:    # corrupt, truncated, of another layout: read the file again
+        log.debug("shape cache: dropping entry %s (%s)", entry, shown(str(error)))
         _remove(entry)
         return None
     try:
@@ -142,42 +148,102 @@ def _load(entry: pathlib.Path, source: str):
     return shape
 
 
+def _refuse_constant(name: str):
+    raise ValueError(f"{name} in the header")
+
+
 def _decode(data: bytes, source: str):
-    """The Shape an entry's bytes hold; raises ValueError (or a KeyError, TypeError) for
-    bytes that are not a whole entry of this format."""
-    from gui.core.shapes import Mesh, Primitive, Shape
-    if not data.startswith(_MAGIC):
+    """The Shape an entry's bytes hold, every field verified (module docstring); raises
+    ValueError (or a KeyError, TypeError...) for bytes that are not a whole, sound entry."""
+    from gui.core.shapes import Shape
+    if not data.startswith(_MAGIC) or len(data) < len(_MAGIC) + _HEADER_SIZE.size:
         raise ValueError("not an entry of this format")
     at = len(_MAGIC) + _HEADER_SIZE.size
     (header_size,) = _HEADER_SIZE.unpack_from(data, len(_MAGIC))
-    header = json.loads(data[at:at + header_size].decode("utf-8"))
+    if at + header_size > len(data):
+        raise ValueError(f"a header of {header_size} bytes in {len(data)}")
+    header = json.loads(data[at:at + header_size].decode("utf-8"),
+                        parse_constant=_refuse_constant)
+    if not isinstance(header, dict) or not isinstance(header["primitives"], list):
+        raise ValueError("the header is not a shape's")
     at += header_size
     mesh = None
     if header["mesh"] is not None:
-        n_vertices, n_triangles = (int(v) for v in header["mesh"]["sizes"])
-        if min(n_vertices, n_triangles) < 0:
-            raise ValueError(f"negative mesh sizes {n_vertices}, {n_triangles}")
-        vertex_bytes, triangle_bytes = 24 * n_vertices, 12 * n_triangles
-        if len(data) != at + vertex_bytes + triangle_bytes:
-            raise ValueError(f"{len(data)} bytes, expected {at + vertex_bytes + triangle_bytes}")
-        vertices = np.frombuffer(data, "<f8", 3 * n_vertices, at).reshape(-1, 3)
-        triangles = np.frombuffer(data, "<u4", 3 * n_triangles,
-                                  at + vertex_bytes).reshape(-1, 3)
-        if n_triangles and int(triangles.max()) >= n_vertices:
-            raise ValueError("a triangle names a vertex the mesh does not have")
-        mesh = Mesh(vertices.astype(np.float64), triangles.astype(np.uint32),
-                    _color(header["mesh"]["color"]))
+        mesh = _decode_mesh(header["mesh"], data, at)
     elif len(data) != at:
         raise ValueError(f"{len(data) - at} bytes after the header of a shape without a mesh")
-    primitives = tuple(
-        Primitive(str(p["kind"]), tuple(float(v) for v in p["parameters"]),
-                  np.array(p["pose"], dtype=np.float64).reshape(4, 4), _color(p["color"]))
-        for p in header["primitives"])
+    primitives = tuple(_decode_primitive(p) for p in header["primitives"])
+    if mesh is None and not primitives:
+        raise ValueError("an empty shape")
     return Shape(source, mesh, primitives)
 
 
+def _whole(value) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+        raise ValueError(f"{shown(value)} is not a count")
+    return value
+
+
+def _decode_mesh(header, data: bytes, at: int):
+    from gui.core.kautham.units import lengths_problem
+    from gui.core.shapes import Mesh
+    sizes = header["sizes"]
+    if not isinstance(sizes, list) or len(sizes) != 2:
+        raise ValueError(f"mesh sizes {shown(sizes)}")
+    n_vertices, n_triangles = (_whole(v) for v in sizes)
+    if n_vertices < 3 or n_triangles < 1:
+        raise ValueError(f"a mesh of {n_vertices} vertices and {n_triangles} triangles")
+    vertex_bytes, triangle_bytes = 24 * n_vertices, 12 * n_triangles
+    if len(data) != at + vertex_bytes + triangle_bytes:
+        raise ValueError(f"{len(data)} bytes, expected {at + vertex_bytes + triangle_bytes}")
+    vertices = np.frombuffer(data, "<f8", 3 * n_vertices, at).reshape(-1, 3)
+    triangles = np.frombuffer(data, "<u4", 3 * n_triangles, at + vertex_bytes).reshape(-1, 3)
+    problem = lengths_problem(vertices)
+    if problem is not None:
+        raise ValueError(f"a vertex {problem}")
+    if int(triangles.max()) >= n_vertices:
+        raise ValueError("a triangle names a vertex the mesh does not have")
+    return Mesh(vertices.astype(np.float64), triangles.astype(np.uint32),
+                _color(header["color"]))
+
+
+_PARAMETER_COUNTS = {"sphere": 1, "cylinder": 2, "box": 3}
+
+
+def _decode_primitive(p):
+    from gui.core.kautham.units import lengths_problem
+    from gui.core.shapes import Primitive
+    kind = p["kind"]
+    if kind not in _PARAMETER_COUNTS:
+        raise ValueError(f"a primitive of kind {shown(kind)}")
+    parameters = tuple(_finite(v) for v in p["parameters"])
+    if len(parameters) != _PARAMETER_COUNTS[kind] or min(parameters) <= 0.0 \
+            or lengths_problem(parameters) is not None:
+        raise ValueError(f"{kind} parameters {shown(parameters)}")
+    values = [_finite(v) for v in p["pose"]]
+    if len(values) != 16:
+        raise ValueError(f"a pose of {len(values)} values")
+    pose = np.array(values, dtype=np.float64).reshape(4, 4)
+    rotation = pose[:3, :3]
+    if not (np.array_equal(pose[3], [0.0, 0.0, 0.0, 1.0])
+            and np.allclose(rotation @ rotation.T, np.eye(3), atol=1e-6)
+            and np.linalg.det(rotation) > 0.0 and lengths_problem(pose[:3, 3]) is None):
+        raise ValueError("a primitive's pose is not a rigid pose within the world")
+    return Primitive(kind, parameters, pose, _color(p["color"]))
+
+
+def _finite(value) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) \
+            or not np.isfinite(value):
+        raise ValueError(f"{shown(value)} is not a finite number")
+    return float(value)
+
+
 def _color(values) -> tuple:
-    return tuple(float(v) for v in values)
+    color = tuple(_finite(v) for v in values)
+    if len(color) != 4 or not all(0.0 <= c <= 1.0 for c in color):
+        raise ValueError(f"colour {shown(color)}")
+    return color
 
 
 def _encode(shape) -> bytes:

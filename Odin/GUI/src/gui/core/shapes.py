@@ -33,6 +33,7 @@ import os
 import pathlib
 import re
 import tempfile
+import warnings
 from dataclasses import dataclass, field, replace
 from typing import Optional
 
@@ -40,8 +41,9 @@ import numpy as np
 
 from gui.core import shape_cache
 from gui.errors import ShapeError
+from gui.core.kautham.units import lengths_problem, scale_problem
 from gui.core.kinematics import rot_x
-from gui.core.sizes import check_file_size
+from gui.core.sizes import check_input_path, read_input_file
 from odin_common.limits import MAX_MESH_TRIANGLES
 
 COIN_SUFFIXES = (".wrl", ".iv", ".vrml")
@@ -113,16 +115,24 @@ class Shape:
         counter-clockwise seen from outside. A sphere, cylinder or box cannot stretch unevenly:
         factors of different sizes are a ``ShapeError`` when the shape has one."""
         f = np.asarray(factors, dtype=float)
-        if not np.all(np.isfinite(f)) or np.any(f == 0.0):
-            raise ShapeError(f"scale {tuple(f)} must be finite and non-zero", self.source)
+        for factor in f:
+            problem = scale_problem(abs(float(factor)))
+            if problem is not None:
+                raise ShapeError(f"scale {tuple(float(v) for v in f)}: each factor's size "
+                                 f"{problem}", self.source)
         mesh = self.mesh
         if mesh is not None:
+            check_lengths(mesh.vertices, f"a vertex scaled by {tuple(float(v) for v in f)}",
+                          self.source, float(np.max(np.abs(f))))
             triangles = mesh.triangles if np.prod(f) > 0 else mesh.triangles[:, ::-1].copy()
             mesh = replace(mesh, vertices=mesh.vertices * f, triangles=triangles)
         size = float(abs(f[0]))
         if self.primitives and not np.allclose(np.abs(f), size, rtol=1e-9, atol=0.0):
             raise ShapeError(f"a sphere, cylinder or box cannot be scaled by {tuple(f)} "
                              "(factors of different sizes)", self.source)
+        for p in self.primitives:
+            check_lengths(np.append(p.parameters, p.pose[:3, 3]), "a sphere, cylinder or "
+                          f"box scaled by {size:g}", self.source, size)
         return replace(self, mesh=mesh,
                        primitives=tuple(_mirrored(p, np.sign(f), size) for p in self.primitives))
 
@@ -204,14 +214,18 @@ def read_shape(path: os.PathLike | str, scale: float = 1.0,
     """Reads a geometry file and returns its ``Shape`` with coordinates multiplied by
     ``scale`` (the file unit in metres times the problem's scale: 0.001 for a millimetre file
     at scale 1). Reading is cached in this process by (file, scale): the SAH hand uses each
-    finger file four times; and on disk by the file's content (gui.core.shape_cache)."""
+    finger file four times; and on disk by the file's content (gui.core.shape_cache). The file
+    is read once, by ``gui.core.sizes.read_input_file`` (a regular file of bounded size), and
+    every reader parses those bytes: none opens the path itself."""
     p = pathlib.Path(path)
-    key = (str(p.resolve()) if p.exists() else str(p), float(scale), defaults)
+    key = (os.path.realpath(p), float(scale), defaults)
     shape = _CACHE.get(key)
     if shape is None:
-        shape = shape_cache.cached(p, f"scale={float(scale)!r} {defaults!r}",
-                                   lambda: _finish(_read_raw(p, defaults), scale, defaults,
-                                                   str(p)))
+        check_scale(scale, p)
+        data = read_input_file(p, "geometry file", ShapeError)
+        shape = shape_cache.cached(data, str(p), f"scale={float(scale)!r} {defaults!r}",
+                                   lambda: _finish(_read_raw(p, data, defaults), scale,
+                                                   defaults, str(p)))
         _CACHE[key] = shape
     return shape
 
@@ -224,7 +238,29 @@ class _Raw:
     shape_nodes: int = 0                 # VRML/Inventor shape nodes traversed
 
 
+def check_scale(scale: float, source) -> None:
+    """A ShapeError naming ``source`` unless ``scale`` is a valid scale factor
+    (gui.core.kautham.units.scale_problem)."""
+    problem = scale_problem(float(scale))
+    if problem is not None:
+        raise ShapeError(f"scale {float(scale)!r} {problem}", source)
+
+
+def check_lengths(values, what: str, source, scale: float = 1.0) -> None:
+    """A ShapeError naming ``source`` and ``what`` unless ``values`` times ``scale`` are
+    lengths a model may hold (gui.core.kautham.units.lengths_problem)."""
+    problem = lengths_problem(values, scale)
+    if problem is not None:
+        raise ShapeError(f"{what} {problem}", source)
+
+
 def _finish(raw: _Raw, scale: float, defaults: ShapeDefaults, source: str) -> Shape:
+    """The Shape of a file's raw triangles and primitives at ``scale`` (m per file unit),
+    every scaled length checked (check_lengths)."""
+    check_lengths(raw.corners, "a vertex", source, scale)
+    for _kind, dims, pose, _color in raw.primitives:
+        check_lengths(dims, "a sphere, cylinder or cube's size", source, scale)
+        check_lengths(pose[:3, 3], "a sphere, cylinder or cube's position", source, scale)
     mesh = None
     if len(raw.corners):
         vertices, triangles = merge_vertices(raw.corners * scale, defaults.merge_tolerance)
@@ -244,15 +280,17 @@ def _finish(raw: _Raw, scale: float, defaults: ShapeDefaults, source: str) -> Sh
     return shape
 
 
-def _read_raw(p: pathlib.Path, defaults: ShapeDefaults) -> _Raw:
-    if not p.is_file():
-        raise ShapeError("geometry file not found", p)
-    check_file_size(p, "geometry file", ShapeError)
+def _read_raw(p: pathlib.Path, data: bytes, defaults: ShapeDefaults) -> _Raw:
+    """The triangles and primitives of a geometry file's bytes ``data`` (``p`` names it and
+    its suffix says its format)."""
     suffix = p.suffix.lower()
     max_triangles = defaults.max_triangles
     if suffix == ".stl":
-        _check_stl_count(p, max_triangles)
-    raw = _read_trimesh(p) if suffix in TRIMESH_SUFFIXES else _read_coin(p, defaults)
+        _check_stl_count(p, data, max_triangles)
+    if suffix in TRIMESH_SUFFIXES:
+        raw = _read_trimesh(p, data)
+    else:
+        raw = _read_coin(p, data, defaults)
     if raw.shape_nodes > defaults.max_shape_nodes:
         raise ShapeError(f"holds more than {defaults.max_shape_nodes:,} shape nodes (a "
                          f"model holds a handful; instancing can make billions)", p)
@@ -262,46 +300,73 @@ def _read_raw(p: pathlib.Path, defaults: ShapeDefaults) -> _Raw:
     return raw
 
 
-def _check_stl_count(p: pathlib.Path, max_triangles: int) -> None:
+def _check_stl_count(p: pathlib.Path, data: bytes, max_triangles: int) -> None:
     """A binary STL says its triangle count in bytes 80-84 and holds 50 bytes per triangle:
-    a count over the limit is refused before the file is loaded (an ASCII STL, or a file whose
-    size does not match its count, is bounded by the file size check)."""
-    with open(p, "rb") as f:
-        head = f.read(84)
-    if len(head) < 84:
+    a count over the limit is refused before the file is parsed (an ASCII STL, or a file whose
+    size does not match its count, is bounded by the file size limit)."""
+    if len(data) < 84:
         return
-    count = int.from_bytes(head[80:84], "little")
-    if count > max_triangles and p.stat().st_size == 84 + 50 * count:
+    count = int.from_bytes(data[80:84], "little")
+    if count > max_triangles and len(data) == 84 + 50 * count:
         raise ShapeError(f"holds {count:,} triangles, more than the {max_triangles:,} of one "
                          f"mesh", p)
 
 
-def _collada_surfaces(p: pathlib.Path) -> io.BytesIO:
+def _collada_surfaces(data: bytes) -> io.BytesIO:
     """A Collada file without its ``<lines>`` and ``<linestrips>``: they hold no surface
     (nothing collides with a line, and Kautham draws only faces), and pycollada refuses some
     that assimp, Kautham's reader, reads (an ``<input>`` without ``offset``, in the IOC lab's
     steel cupboard). The XML is read without entities or network access."""
     from lxml import etree
     parser = etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False)
-    root = etree.fromstring(p.read_bytes(), parser)
+    root = etree.fromstring(data, parser)
     for element in list(root.iter("{*}lines", "{*}linestrips", "lines", "linestrips")):
         element.getparent().remove(element)
     return io.BytesIO(etree.tostring(root))
 
 
-def _read_trimesh(p: pathlib.Path) -> _Raw:
-    """Triangles and the main colour of a mesh file read by trimesh (Collada through
+def _bounded_resolver(p: pathlib.Path):
+    """trimesh's resolver of the files a mesh names (an OBJ's materials, a glTF's buffers),
+    in the mesh's folder as trimesh's own, each read by ``read_input_file``."""
+    import trimesh.resolvers
+
+    class Bounded(trimesh.resolvers.FilePathResolver):
+        def get(self, name: str) -> bytes:
+            for candidate in (name.strip(), name.strip().lstrip("/"), os.path.split(name)[-1]):
+                try:
+                    path = self.absolute(candidate)
+                except ValueError:
+                    continue
+                if os.path.lexists(path):
+                    return read_input_file(path, f"file named by {p.name}", ShapeError)
+            self.absolute(name)          # a name outside the folder: trimesh's own error
+            raise FileNotFoundError(name)
+
+        def namespaced(self, namespace: str):
+            return Bounded(os.path.join(self.parent, namespace))
+
+    return Bounded(str(p))
+
+
+def _read_trimesh(p: pathlib.Path, data: bytes) -> _Raw:
+    """Triangles and the main colour of a mesh file's bytes read by trimesh (Collada through
     pycollada). A Collada file's ``<unit>`` and ``<up_axis>`` are not applied, as in Kautham:
     assimp puts them in the scene's root transform, which Kautham's import
     (``Assimp2Inventor``, src/problem/assimpImport.cpp) skips; URDFs scale such meshes
     themselves (``<mesh scale="0.0254 0.0254 0.0254">`` for an inch file)."""
     import trimesh  # slow to import: only when such a file is read
     try:
-        if p.suffix.lower() == ".dae":
-            loaded = trimesh.load(_collada_surfaces(p), file_type="dae", force="mesh",
-                                  process=False)
-        else:
-            loaded = trimesh.load(str(p), force="mesh", process=False)
+        with warnings.catch_warnings():     # numpy's overflow warnings on absurd
+            warnings.simplefilter("ignore", RuntimeWarning)  # coordinates: checked after
+            if p.suffix.lower() == ".dae":
+                loaded = trimesh.load(_collada_surfaces(data), file_type="dae", force="mesh",
+                                      process=False)
+            else:
+                loaded = trimesh.load(io.BytesIO(data), file_type=p.suffix.lower()[1:],
+                                      force="mesh", process=False,
+                                      resolver=_bounded_resolver(p))
+    except ShapeError:       # a file it names (an OBJ's material), refused by what it is
+        raise
     except Exception as error:  # trimesh raises many kinds; all mean "does not parse"
         raise ShapeError(f"does not parse as a mesh: {error}", p) from None
     corners = np.asarray(loaded.triangles, dtype=np.float64) if len(loaded.faces) else \
@@ -347,14 +412,43 @@ def _captured_stderr():
             captured["text"] = tmp.read().decode(errors="replace")
 
 
-def _read_coin(p: pathlib.Path, defaults: ShapeDefaults) -> _Raw:
+_NAMED_FILES = re.compile(rb'\b(?:url|name|filename)\s*\[?\s*((?:"[^"]*"\s*,?\s*)+)')
+_QUOTED = re.compile(rb'"([^"]*)"')
+
+
+def _check_named_files(p: pathlib.Path, data: bytes) -> None:
+    """Every file a VRML or Inventor file names (``Inline``/``WWWInline`` url, ``File``
+    name, texture filename or url) that Coin would open itself, where Coin looks for it (the
+    file's folder, the current folder, or the path as written): it must be a regular file
+    within the size limit (``gui.core.sizes.check_input_path``), so that a name leading to a
+    FIFO or ``/dev/zero`` is refused instead of read for ever. Coin opens these by path, after
+    this check: what this cannot see is a file swapped in between."""
+    if b'"' not in data:
+        return
+    for match in _NAMED_FILES.finditer(data):
+        for quoted in _QUOTED.findall(match.group(1)):
+            name = os.fsdecode(quoted).strip()
+            if name.startswith("file://"):
+                name = name[len("file://"):]
+            if not name or "://" in name:
+                continue
+            for candidate in (p.parent / name, pathlib.Path(name)):
+                if os.path.lexists(candidate):
+                    check_input_path(candidate, f"file named by {p.name}", ShapeError)
+
+
+def _read_coin(p: pathlib.Path, data: bytes, defaults: ShapeDefaults) -> _Raw:
+    """The triangles and primitives of VRML or Inventor bytes, parsed by Coin from memory
+    (``SoInput.setBuffer``); the file's folder is searched first for the files its ``Inline``
+    and ``File`` nodes name, as when Coin opens the file itself, each checked first
+    (``_check_named_files``)."""
+    _check_named_files(p, data)
     coin = _coin_module()
     inp = coin.SoInput()
+    inp.addDirectoryFirst(str(p.parent))
     with _captured_stderr() as err:
-        opened = inp.openFile(str(p))
-        root = coin.SoDB.readAll(inp) if opened else None
-        if opened:
-            inp.closeFile()
+        inp.setBuffer(data)                  # ``data`` outlives the read: Coin does not copy
+        root = coin.SoDB.readAll(inp)
     if root is None:
         text = err["text"]
         match = re.search(r"line\s+(\d+)", text)

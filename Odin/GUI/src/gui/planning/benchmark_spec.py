@@ -28,7 +28,7 @@ from dataclasses import dataclass, replace
 from typing import Optional, Sequence, Tuple
 
 from gui.core.kautham.xmlfile import Node, parse_xml_bytes
-from gui.core.sizes import check_file_size
+from gui.core.sizes import read_input_file
 from gui.errors import PlanningError, ProblemError
 
 OMPL_PLANNER_OF = {
@@ -99,14 +99,7 @@ def read_benchmark_file(path: str) -> Tuple[Experiment, ...]:
     """The experiments of Kautham's benchmark file ``path``. A ``ProblemError`` names the file
     and line of anything wrong (no ``<Benchmark>``, no ``<Problem>``, a row without ``File``,
     an unknown or valueless ``<Parameter>``, a bad number)."""
-    check_file_size(path, "benchmark file", ProblemError)
-    try:
-        with open(path, "rb") as f:
-            data = f.read()
-    except FileNotFoundError:
-        raise ProblemError("benchmark file not found", path) from None
-    except OSError as error:
-        raise ProblemError(f"benchmark file cannot be read: {error.strerror}", path) from None
+    data = read_input_file(path, "benchmark file", ProblemError)
     # Several <Benchmark> elements side by side, as pugixml reads them: one synthetic root
     # around them, on the first line, so that every line keeps its number.
     data = _XML_DECLARATION.sub(b"", data, count=1)

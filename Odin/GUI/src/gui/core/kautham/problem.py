@@ -51,7 +51,7 @@ import numpy as np
 from gui.core.kautham.controls import (BASE_DOFS, LEGACY_OFFSET_DEFAULT, control_map,
                                        free_flyer_control_set, read_cntr)
 from gui.core.kautham.robot_rob import read_dh_robot, read_shape_robot
-from gui.core.kautham.units import LEGACY, SI, Units
+from gui.core.kautham.units import LEGACY, SI, Units, scale_problem
 from gui.core.kautham.urdf import read_urdf
 from gui.core.kautham.xmlfile import Node, parse_number, read_xml
 from gui.core.kinematics import pose_from_axis_angle
@@ -60,6 +60,7 @@ from gui.core.model import (CAR, FIXED_BASE, FREE_BODY, MOBILE, REVOLUTE, Attach
                             PlannerSearch, Problem, RobotModel, warn_once)
 from gui.core.shapes import COIN_SUFFIXES, TRIMESH_SUFFIXES
 from gui.errors import ProblemError
+from odin_common.limits import shown
 
 log = logging.getLogger("gui.core.kautham")
 
@@ -521,8 +522,8 @@ def _resolve(rel: str, node: Node, problem: pathlib.Path, current: bool) -> path
             candidates.append(folder / "models" / rel)
     candidates.append(problem.parent / rel)
     for c in candidates:
-        if c.is_file():
-            return c
+        if os.path.lexists(c):    # the first there, whatever it is: its reader says if it
+            return c              # is not a file (a FIFO, a device, a link loop)
     raise node.error(f"file \"{rel}\" not found (looked in: "
                      + ", ".join(str(c.parent) for c in candidates[:3])
                      + (", ..." if len(candidates) > 3 else "") + ")")
@@ -538,7 +539,8 @@ def _pose(node: Optional[Node], units: Units, ignored: List[Ignored]) -> np.ndar
     ``ignored`` (it says nothing)."""
     if node is None:
         return np.eye(4)
-    position = [node.number(c, 0.0) * units.length for c in ("X", "Y", "Z")]
+    position = node.scaled_lengths(f"<{node.tag}> X Y Z",
+                                   [node.number(c, 0.0) for c in ("X", "Y", "Z")], units.length)
     axis = [node.number(c, 0.0) for c in ("WX", "WY", "WZ")]
     angle = node.number("TH", 0.0) * units.angle
     if angle != 0.0 and not any(axis):
@@ -551,8 +553,9 @@ def _pose(node: Optional[Node], units: Units, ignored: List[Ignored]) -> np.ndar
 
 def _scale(node: Node) -> float:
     scale = node.number("scale", 1.0)
-    if scale <= 0:
-        raise node.error(f"scale=\"{node.get('scale')}\" must be positive")
+    problem = scale_problem(scale)
+    if problem is not None:
+        raise node.error(f"<{node.tag} scale={shown(node.get('scale'))}> {problem}")
     return scale
 
 

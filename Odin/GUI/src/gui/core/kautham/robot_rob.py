@@ -36,7 +36,7 @@ import numpy as np
 
 from gui.errors import ProblemError
 from gui.core.kautham.controls import parse_control_set
-from gui.core.kautham.units import LEGACY, SI, Units
+from gui.core.kautham.units import LEGACY, SI, Units, scale_problem
 from gui.core.kautham.xmlfile import Node, read_xml
 from gui.core.kinematics import pose_from_axis_angle, rot_x, rot_z, translation
 from gui.core.model import FIXED, PRISMATIC, REVOLUTE, Ignored, LinkModel, RobotModel
@@ -53,6 +53,9 @@ def read_dh_robot(path: pathlib.Path, scale: float = 1.0) -> RobotModel:
     """Reads a .rob/.dh file with its link geometry; everything in SI."""
     units = units_of(path)
     root = read_xml(path, "robot file")
+    problem = scale_problem(scale)
+    if problem is not None:
+        raise root.error(f"scale {scale!r} {problem}")
     if root.tag != "Robot":
         raise root.error(f"expected a <Robot> element, found <{root.tag}>")
     name = root.get("name") or path.stem
@@ -121,16 +124,17 @@ def _read_link(joint: Node, k: int, links: list, index: dict, dh_type: str, unit
     dh = joint.find("DHPars")
     if dh is not None:
         alpha = dh.number("alpha", 0.0) * units.angle
-        a = dh.number("a", 0.0) * length
         theta = dh.number("theta", 0.0) * units.angle
-        d = dh.number("d", 0.0) * length
+        a, d = (float(v) for v in dh.scaled_lengths(
+            "<DHPars a d>", (dh.number("a", 0.0), dh.number("d", 0.0)), length))
     else:
         alpha = a = theta = d = 0.0
     pre_trans = np.eye(4)
     pt = joint.find("PreTrans")
     if pt is not None:
         pre_trans = pose_from_axis_angle(
-            [pt.number(c, 0.0) * length for c in ("X", "Y", "Z")],
+            pt.scaled_lengths("<PreTrans X Y Z>",
+                              [pt.number(c, 0.0) for c in ("X", "Y", "Z")], length),
             [pt.number(c, 0.0) for c in ("WX", "WY", "WZ")],
             pt.number("TH", 0.0) * units.angle)
     if dh_type == "Standard":
@@ -148,6 +152,9 @@ def _read_link(joint: Node, k: int, links: list, index: dict, dh_type: str, unit
     if lim is not None and kind != FIXED:
         factor = units.angle if kind == REVOLUTE else length
         low, high = lim.number("Low") * factor, lim.number("Hi") * factor
+        if kind == PRISMATIC:     # lengths: bounded as every scaled length is
+            low, high = (float(v) for v in lim.scaled_lengths(
+                "<Limits Low Hi>", (lim.number("Low"), lim.number("Hi")), factor))
         if low > high:
             raise lim.error(f"Low={lim.get('Low')} is above Hi={lim.get('Hi')}")
         limits = (low, high)

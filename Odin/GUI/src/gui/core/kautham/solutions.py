@@ -45,10 +45,10 @@ from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from gui.core.kautham.xmlfile import Node, read_xml
+from gui.core.kautham.xmlfile import Node, parse_xml_bytes
 from gui.core.model import Instance, Problem
 from gui.core.paths import DEGREES, RADIANS, read_rows, to_si
-from gui.core.sizes import check_file_size
+from gui.core.sizes import read_input_file
 from gui.errors import PathFileError, ProblemError
 from odin_common.rotations import quaternion_to_matrix
 
@@ -116,14 +116,12 @@ def read_solution(path: os.PathLike | str, problem: Problem, robot: Optional[str
     drive (default: the first); ``units``: DEGREES or RADIANS for raw rows (default: degrees
     for 2012 problems, radians otherwise)."""
     p = pathlib.Path(path)
-    if not p.is_file():
-        raise PathFileError("path file not found", p)
     if not problem.robots:
         raise PathFileError(f"problem {problem.source} has no robot to move", p)
-    check_file_size(p, "path file", PathFileError)
-    text = p.read_text(errors="replace")
+    data = read_input_file(p, "path file", PathFileError)
+    text = data.decode(errors="replace")
     if text.lstrip().startswith("<"):
-        root = _read_xml(p)
+        root = _parse_xml(p, data)
         if root.tag == "Planner" or root.find("SampleSet") is not None:
             return _read_kps(p, root, problem)
         if root.tag == "Task":
@@ -131,12 +129,12 @@ def read_solution(path: os.PathLike | str, problem: Problem, robot: Optional[str
         raise PathFileError(f"root element <{root.tag}> is neither a Kautham solution "
                             "(<Planner> with <SampleSet>) nor a task file (<Task>)", p,
                             root.line)
-    return _read_plain_rows(p, problem, robot, units)
+    return _read_plain_rows(p, data, problem, robot, units)
 
 
-def _read_xml(p: pathlib.Path) -> Node:
+def _parse_xml(p: pathlib.Path, data: bytes) -> Node:
     try:
-        return read_xml(p, "path file")
+        return parse_xml_bytes(data, str(p))
     except PathFileError:
         raise
     except ProblemError as error:
@@ -432,20 +430,21 @@ def _check_limits(p: pathlib.Path, instance: Instance, rows: Sequence[np.ndarray
 
 
 # -- plain rows ----------------------------------------------------------------------------------
-def _read_plain_rows(p: pathlib.Path, problem: Problem, robot: Optional[str],
+def _read_plain_rows(p: pathlib.Path, data: bytes, problem: Problem, robot: Optional[str],
                      units: Optional[str]) -> Solution:
     instance = _robot(p, problem, robot)
     movable = len(instance.model.movable_links())
     if problem.format == "2012":
-        raw, lines = read_rows(p, movable)
+        raw, lines = read_rows(p, movable, data=data)
     else:
         layout = RowLayout.of(problem)
-        first, _ = read_rows(p, None)
+        first, _ = read_rows(p, None, data=data)
         if first.shape[1] in (layout.size, RowLayout.of(problem, movable_only=True).size) \
                 and robot is None:
-            raw, lines = read_rows(p, first.shape[1], f"a configuration: {layout.describe()}")
+            raw, lines = read_rows(p, first.shape[1], f"a configuration: {layout.describe()}",
+                                   data)
             return Solution(str(p), OMPL, layout.split(p, raw.tolist(), lines))
-        raw, lines = read_rows(p, movable, f"one per movable joint of {instance.name}")
+        raw, lines = read_rows(p, movable, f"one per movable joint of {instance.name}", data)
     unit = units or (DEGREES if problem.format == "2012" else RADIANS)
     kinds = [instance.model.links[i].joint for i in instance.model.movable_links()]
     joints = to_si(raw, kinds, unit)

@@ -28,17 +28,20 @@ from typing import List, Optional
 
 import numpy as np
 
+from gui.core.kautham.units import inertia_problem, mass_problem, scale_problem
 from gui.core.kautham.xmlfile import LenientNumber, Node, parse_number, read_xml
 from gui.core.kinematics import rpy_matrix
 from gui.core.model import FIXED, PRISMATIC, REVOLUTE, Ignored, Inertial, LinkModel, RobotModel
 from gui.core.shapes import Primitive, Shape, read_shape
 from gui.errors import ShapeError
+from odin_common.limits import shown
 from odin_common.specs import WORLD_SURFACE, Surface
 
 _JOINT_KINDS = {"revolute": REVOLUTE, "continuous": REVOLUTE, "prismatic": PRISMATIC,
                 "fixed": FIXED}
 _GAZEBO_SURFACE = ("mu1", "mu2", "fdir1", "kp", "kd")
 _ROBOT_CHILDREN_USED = ("link", "joint", "material", "gazebo")
+_PRIMITIVE_SIZES = {"box": ("size",), "sphere": ("radius",), "cylinder": ("radius", "length")}
 
 
 def _origin(node: Optional[Node], scale: float) -> np.ndarray:
@@ -51,7 +54,7 @@ def _origin(node: Optional[Node], scale: float) -> np.ndarray:
     xyz = o.numbers("xyz", 3, (0.0, 0.0, 0.0))
     rpy = o.numbers("rpy", 3, (0.0, 0.0, 0.0))
     T[:3, :3] = rpy_matrix(*rpy)
-    T[:3, 3] = np.asarray(xyz) * scale
+    T[:3, 3] = o.scaled_lengths(f"<origin xyz={shown(o.get('xyz'))}>", xyz, scale)
     return T
 
 
@@ -75,30 +78,44 @@ def _geometry(owner: Node, scale: float, urdf: pathlib.Path) -> Optional[Shape]:
     for child in geom.children:
         tag = child.tag.lower()
         if tag == "mesh":
-            filename = child.require("filename")
-            if filename.startswith("package://"):
-                filename = filename[len("package://"):].split("/", 1)[-1]
-            elif filename.startswith("file://"):
-                filename = filename[len("file://"):]
-            factors = child.numbers("scale", 3, (1.0, 1.0, 1.0))
-            if factors[0] > 0 and max(factors) - min(factors) <= 1e-9 * factors[0]:
-                return read_shape(urdf.parent / filename, factors[0] * scale).transformed(pose)
-            mesh = read_shape(urdf.parent / filename, scale)
-            try:       # uneven or mirroring factors (TIAGo's arm meshes: "1 -1 -1")
-                return mesh.scaled(factors).transformed(pose)
-            except ShapeError as error:
-                raise child.error(f"{filename}: {error.reason}") from None
-        if tag == "box":
-            dims = tuple(v * scale for v in child.numbers("size", 3))
-            return Shape(str(urdf), None, (Primitive("box", dims, pose),))
-        if tag == "sphere":
+            return _mesh(child, scale, urdf).transformed(pose)
+        if tag in _PRIMITIVE_SIZES:
+            sizes = _PRIMITIVE_SIZES[tag]
+            raw = child.numbers(sizes[0], 3) if tag == "box" else \
+                tuple(child.number(name) for name in sizes)
+            dims = child.scaled_lengths(f"<{tag}> {' '.join(sizes)}", raw, scale)
             return Shape(str(urdf), None,
-                         (Primitive("sphere", (child.number("radius") * scale,), pose),))
-        if tag == "cylinder":
-            dims = (child.number("radius") * scale, child.number("length") * scale)
-            return Shape(str(urdf), None, (Primitive("cylinder", dims, pose),))
+                         (Primitive(tag, tuple(float(v) for v in dims), pose),))
         raise child.error(f"unknown URDF geometry <{child.tag}>")
     raise geom.error("<geometry> is empty")
+
+
+def mesh_file(uri: str, urdf: pathlib.Path) -> pathlib.Path:
+    """The file a ``<mesh filename>`` names: ``package://pkg/rest`` is ``rest`` and
+    ``file://path`` is ``path``, both beside the URDF unless absolute (as Kautham finds them)."""
+    if uri.startswith("package://"):
+        uri = uri[len("package://"):].split("/", 1)[-1]
+    elif uri.startswith("file://"):
+        uri = uri[len("file://"):]
+    return urdf.parent / uri
+
+
+def _mesh(node: Node, scale: float, urdf: pathlib.Path) -> Shape:
+    """A ``<mesh filename scale>``'s shape, scaled; an error of its file names the URI as
+    written, where it was looked for and what is wrong there."""
+    uri = node.require("filename")
+    file = mesh_file(uri, urdf)
+    factors = node.numbers("scale", 3, (1.0, 1.0, 1.0))
+    try:
+        if factors[0] > 0 and max(factors) - min(factors) <= 1e-9 * factors[0]:
+            return read_shape(file, factors[0] * scale)
+        # uneven or mirroring factors (TIAGo's arm meshes: "1 -1 -1")
+        return read_shape(file, scale).scaled(factors)
+    except ShapeError as error:
+        scaled = "" if node.get("scale") is None else f" scale={shown(node.get('scale'))}"
+        raise ShapeError(f"<mesh filename={shown(uri)}{scaled}>: {error.path or file}"
+                         f"{f':{error.line}' if error.line else ''}: {error.reason}",
+                         node.path, node.line) from None
 
 
 def _link_shape(link: Node, scale: float, urdf: pathlib.Path, materials: dict
@@ -121,15 +138,22 @@ def _inertial(link: Node, scale: float) -> Optional[Inertial]:
     node = link.find("inertial")
     if node is None or node.find("mass") is None:
         return None
-    mass = node.find("mass").number("value")
+    mass_node = node.find("mass")
+    mass = mass_node.number("value")
     if mass <= 0:
         return None
+    problem = mass_problem(mass)
+    if problem is not None:
+        raise mass_node.error(f"<mass value={shown(mass_node.get('value'))}>: {problem}")
     tensor = None
     inertia = node.find("inertia")
     if inertia is not None:
         i = {k: inertia.number(k, 0.0) for k in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")}
         matrix = np.array([[i["ixx"], i["ixy"], i["ixz"]], [i["ixy"], i["iyy"], i["iyz"]],
-                           [i["ixz"], i["iyz"], i["izz"]]]) * scale ** 2
+                           [i["ixz"], i["iyz"], i["izz"]]]) * (scale * scale)
+        problem = inertia_problem(matrix)
+        if problem is not None:
+            raise inertia.error(f"<inertia> times the scale {scale:g} squared: {problem}")
         tensor = matrix if np.any(matrix != 0.0) else None
     return Inertial(mass, _origin(node, scale), tensor)
 
@@ -207,7 +231,9 @@ def _joint_limits(joint: Node, kind: str, scale: float) -> tuple:
         return None, None, None
     factor = scale if kind == PRISMATIC else 1.0
     effort = lim.number("effort", 0.0)
-    velocity = lim.number("velocity", 0.0) * factor
+    velocity = lim.number("velocity", 0.0)
+    if kind == PRISMATIC:       # m/s: a length per second, scaled
+        velocity = float(lim.scaled_lengths("<limit velocity>", velocity, factor))
     if effort < 0 or velocity < 0:
         raise lim.error("effort and velocity limits cannot be negative")
     limits = None
@@ -219,7 +245,10 @@ def _joint_limits(joint: Node, kind: str, scale: float) -> tuple:
             where = soft
         else:
             low, high, where = lim.number("lower", 0.0), lim.number("upper", 0.0), lim
-        limits = (low * factor, high * factor)
+        if kind == PRISMATIC:   # m: scaled lengths
+            low, high = (float(v) for v in where.scaled_lengths("lower and upper",
+                                                                (low, high), factor))
+        limits = (low, high)
         if limits[0] > limits[1]:
             raise where.error("lower is above upper")
     return limits, effort or None, velocity or None
@@ -249,6 +278,9 @@ def read_urdf(path: pathlib.Path, scale: float = 1.0) -> RobotModel:
 
 def _read_urdf(path: pathlib.Path, scale: float, lenient: list) -> RobotModel:
     root = read_xml(path, "URDF file", lenient)
+    problem = scale_problem(scale)
+    if problem is not None:
+        raise root.error(f"scale {scale!r} {problem}")
     if root.tag != "robot":
         raise root.error(f"expected a <robot> element, found <{root.tag}>")
     name = root.get("name") or path.stem

@@ -8,8 +8,13 @@ Every XML file the GUI reads (problems, robots, URDF, control and path files) co
 here, and any of them may come from someone else, so the parser is hardened as defusedxml
 hardens expat: a DTD may not declare entities (a "billion laughs" file expands a few lines
 into gigabytes; Kautham's files declare none), external entities and parameter entities are
-never resolved (an external entity would read another file, or a URL, into the problem), and
-a file larger than odin_common.limits.MAX_INPUT_FILE_MB is refused before it is read.
+never resolved (an external entity would read another file, or a URL, into the problem), a
+file is read by ``gui.core.sizes.read_input_file`` (a regular file of at most
+odin_common.limits.MAX_INPUT_FILE_MB, opened once), and the tree is bounded while it is built:
+at most MAX_XML_ELEMENTS elements, MAX_XML_DEPTH deep, MAX_XML_ATTRIBUTES attributes on one
+element (odin_common.limits). A node of the tree costs a few hundred bytes, so 200 MB of empty
+elements would need gigabytes: the parse stops at the first element past a bound, having built
+a bounded tree.
 
 Numbers: a malformed number is an error naming the file and line, except in a tree read with
 ``lenient`` (URDF files): there a value that starts with a number ("0.46 5") is read as that
@@ -28,8 +33,12 @@ import xml.parsers.expat
 from dataclasses import dataclass, field
 from typing import Iterator, Optional
 
-from gui.core.sizes import check_file_size
+import numpy as np
+
+from gui.core.kautham.units import lengths_problem
+from gui.core.sizes import read_input_file
 from gui.errors import ProblemError
+from odin_common.limits import MAX_XML_ATTRIBUTES, MAX_XML_DEPTH, MAX_XML_ELEMENTS
 
 
 _LEADING_NUMBER = re.compile(r"\s*[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
@@ -106,6 +115,15 @@ class Node:
         self.lenient.append(LenientNumber(self.path, self.line, what, value))
         return value
 
+    def scaled_lengths(self, what: str, values, scale: float = 1.0) -> np.ndarray:
+        """``values`` (file units) times ``scale`` (m per file unit) as an array of lengths
+        in m, or an error naming ``what`` (the attribute as written) when one is not finite
+        or reaches past the largest world (gui.core.kautham.units.lengths_problem)."""
+        problem = lengths_problem(values, scale)
+        if problem is not None:
+            raise self.error(f"{what} times the scale {scale:g} {problem}")
+        return np.asarray(values, dtype=float) * scale
+
     def flag(self, name: str, default: bool) -> bool:
         raw = self.get(name)
         if raw is None:
@@ -143,18 +161,11 @@ def parse_number(raw: str, what: str, path: Optional[str], line: Optional[int]) 
 
 def read_xml(path: os.PathLike | str, what: str = "file",
              lenient: Optional[list] = None) -> Node:
-    """Parses ``path`` into a ``Node`` tree; a missing or malformed file is a ``ProblemError``
-    naming the file and (for malformed XML) the line. ``lenient``: a list to record
-    ``LenientNumber`` readings in (module docstring); None: numbers are strict."""
+    """Parses ``path`` into a ``Node`` tree; a missing, unreadable or malformed file is a
+    ``ProblemError`` naming the file and (for malformed XML) the line. ``lenient``: a list to
+    record ``LenientNumber`` readings in (module docstring); None: numbers are strict."""
     p = pathlib.Path(path)
-    check_file_size(p, what, ProblemError)
-    try:
-        data = p.read_bytes()
-    except FileNotFoundError:
-        raise ProblemError(f"{what} not found", p) from None
-    except OSError as error:
-        raise ProblemError(f"{what} cannot be read: {error.strerror}", p) from None
-    return parse_xml_bytes(data, str(p), lenient)
+    return parse_xml_bytes(read_input_file(p, what, ProblemError), str(p), lenient)
 
 
 class _Refused(Exception):
@@ -186,26 +197,45 @@ def _harden(parser) -> None:
     parser.ExternalEntityRefHandler = external_reference
 
 
+def _bounds(parser, depth: int, elements: int, attributes: int) -> None:
+    """Raises _Refused when an element opened at ``depth`` (1: the root), the ``elements``-th
+    of the file, with ``attributes`` attributes, goes past a bound of the tree."""
+    for value, bound, name, what in (
+            (elements, MAX_XML_ELEMENTS, "MAX_XML_ELEMENTS", "elements"),
+            (depth, MAX_XML_DEPTH, "MAX_XML_DEPTH", "levels of nested elements"),
+            (attributes, MAX_XML_ATTRIBUTES, "MAX_XML_ATTRIBUTES", "attributes on one element")):
+        if value > bound:
+            raise _Refused(f"holds more than {bound:,} {what} (odin_common.limits.{name})",
+                           parser.CurrentLineNumber)
+
+
 def parse_xml_bytes(data: bytes, path: str, lenient: Optional[list] = None) -> Node:
+    """Parses an XML file's bytes (``path`` names it in errors) into a bounded ``Node`` tree
+    (module docstring); raises ``ProblemError`` naming the file and line."""
     parser = xml.parsers.expat.ParserCreate()
     _harden(parser)
     stack: list[Node] = []
+    texts: list[list] = []          # per open element, its text's pieces (joined at its end)
     root: list[Node] = []
+    count = [0]
 
     def start(tag, attrib):
+        count[0] += 1
+        _bounds(parser, len(stack) + 1, count[0], len(attrib))
         node = Node(tag, dict(attrib), parser.CurrentLineNumber, path, lenient=lenient)
         if stack:
             stack[-1].children.append(node)
         else:
             root.append(node)
         stack.append(node)
+        texts.append([])
 
     def end(tag):
-        stack.pop()
+        stack.pop().text = "".join(texts.pop())
 
     def text(data_):
-        if stack:
-            stack[-1].text += data_
+        if texts:
+            texts[-1].append(data_)
 
     parser.StartElementHandler = start
     parser.EndElementHandler = end
