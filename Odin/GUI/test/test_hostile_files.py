@@ -184,7 +184,8 @@ def mutate(data: bytes, rng: random.Random) -> bytes:
     if not numbers:
         return data[:len(data) // 2]
     m = rng.choice(numbers)
-    absurd = rng.choice([b"nan", b"1e400", b"-1", b"0", b"1e30", b"abc", b""])
+    absurd = rng.choice([b"nan", b"1e400", b"-1", b"0", b"1e30", b"abc", b"", b"1e308",
+                         b"-1e308", b"1e-308"])
     return data[:m.start()] + absurd + data[m.end():]
 
 
@@ -228,10 +229,43 @@ def fuzz(copy, mutations: int, rng: random.Random, each_file_once: bool) -> int:
                 runs += 1
                 check_problem_info(problem, target)
             target.write_bytes(original)
+        for target in [problem] + dependencies:
+            if each_file_once and (target, "replaced") in done:
+                continue
+            done.add((target, "replaced"))
+            for how in REPLACEMENTS:
+                with replaced(target, how):
+                    runs += 1
+                    line = check_problem_info(problem, target)
+                assert line is not None and str(target) in line, (how, target, line)
     return runs
 
 
-def check_problem_info(problem, target) -> None:
+REPLACEMENTS = ("fifo", "zero", "loop")
+"""What a file a problem names is replaced with, once each: a FIFO (an open would block for
+ever), /dev/zero (endless), a symbolic link loop: each refused naming it."""
+
+
+@contextlib.contextmanager
+def replaced(target, how: str):
+    aside = target.with_name(target.name + ".aside")
+    target.rename(aside)
+    try:
+        if how == "fifo":
+            os.mkfifo(target)
+        elif how == "zero":
+            target.symlink_to("/dev/zero")
+        else:
+            target.symlink_to(target.name)
+        yield
+    finally:
+        target.unlink()
+        aside.rename(target)
+
+
+def check_problem_info(problem, target):
+    """problem_info's error line on ``problem`` (``target`` mutated), None for a plan (its
+    JSON strict: no NaN or Infinity)."""
     shapes._CACHE.clear()
     try:
         with time_limit(60):
@@ -242,10 +276,10 @@ def check_problem_info(problem, target) -> None:
         pytest.fail(f"{type(error).__name__} escaped problem_info on {problem} "
                     f"with {target} mutated: {error}")
     if status == 0:
-        json.loads(out)
-    else:
-        assert status == 2, err
-        one_error_line(err)
+        strict_json(out)
+        return None
+    assert status == 2, err
+    return one_error_line(err)
 
 
 @pytest.mark.forked

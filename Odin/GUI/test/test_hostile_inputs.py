@@ -261,3 +261,19 @@ def test_each_file_is_opened_once(tmp_path, monkeypatch):
     mine = [p for p in opened if p.startswith(str(tmp_path)) and "/cache/" not in p]
     assert sorted(mine) == sorted(str(tmp_path / n) for n in
                                   ("problem.xml", "arm.urdf", "meshy.urdf", "tri.stl")), mine
+
+
+@pytest.mark.timeout(120)
+def test_the_problem_info_tool_refuses_devices_and_fifos_in_one_line(tmp_path):
+    """The installed tool, as a user runs it: exit 2 and one line, at once."""
+    import subprocess
+    import sys
+    fifo = tmp_path / "problem.xml"
+    os.mkfifo(fifo)
+    script = pathlib.Path(shapes.__file__).parents[3] / "scripts" / "problem_info"
+    for target, said in (("/dev/zero", "is a character device, not a file"),
+                         (str(fifo), "is a FIFO (named pipe), not a file")):
+        run = subprocess.run([sys.executable, str(script), target], capture_output=True,
+                             text=True, timeout=60)
+        assert run.returncode == 2 and run.stdout == "", run.stderr
+        assert run.stderr == f"problem_info: error: {target}: problem file {said}\n"
