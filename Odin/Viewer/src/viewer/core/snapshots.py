@@ -1,6 +1,7 @@
 """Rendered frames encoded: PNG files, always inside one folder (ROS 1 has no authentication,
-so a caller must not be able to write anywhere else), and JPEG bytes for the compressed image
-topic."""
+so a caller must not be able to write anywhere else) and each written whole or not at all (a
+full disk leaves an older file of the name as it was: :func:`write_file`), and JPEG bytes for
+the compressed image topic."""
 from __future__ import annotations
 
 import io
