@@ -467,3 +467,20 @@ def test_deep_wide_and_texty_xml_is_refused_or_read_quickly(tmp_path):
     started = time.monotonic()
     assert len(read_xml(texty).text) == 5_000_000
     assert time.monotonic() - started < 30
+
+
+def test_a_megabyte_value_in_a_file_makes_a_short_error_line(tmp_path):
+    huge = "9" * 1_000_000
+    (tmp_path / "shell.iv").write_text("#Inventor V2.1 ascii\nSeparator { Sphere { radius 1 } }\n")
+    (tmp_path / "m.urdf").write_text(f'<robot name="m"><link name="s"><visual><geometry><mesh '
+                                     f'filename="package://kit/{huge}.stl"/></geometry>'
+                                     f'</visual></link></robot>')
+    for k, element in enumerate([f'<Robot robot="{huge}.urdf"/>',
+                                 f'<Obstacle obstacle="shell.iv" scale="{huge}"/>',
+                                 f'<Obstacle obstacle="shell.iv"><Home X="1 {huge}"/></Obstacle>',
+                                 '<Obstacle obstacle="m.urdf"/>']):
+        problem = tmp_path / f"p{k}.xml"
+        problem.write_text(f"<Problem>{element}</Problem>")
+        status, out, err = problem_info(problem)
+        line = one_error_line(err)
+        assert status == 2 and str(problem.parent) in line and len(line) < 2_000, line[:300]

@@ -15,22 +15,39 @@ class GuiError(OdinError):
     """Root of everything the GUI raises on purpose."""
 
 
+MAX_REASON_CHARS = 1000
+"""Characters of a ProblemError's reason (and of its path) kept: a message that quotes what a
+file gave (a 10 MB attribute, a file name of a megabyte) keeps its head and its tail, which
+say what and why, and a note of how long it was, so that a hostile file never makes a huge
+error line. Readers quote values through ``odin_common.limits.shown`` (80 characters); this
+is the bound for whatever else a message holds."""
+
+
+def bounded(text: str, limit: int = MAX_REASON_CHARS) -> str:
+    """``text`` itself when at most ``limit`` characters, else its head and tail around a
+    note of its length."""
+    if len(text) <= limit:
+        return text
+    tail = limit // 4
+    return f"{text[:limit - tail]} … ({len(text):,} characters) … {text[-tail:]}"
+
+
 class ProblemError(GuiError):
     """A problem, robot, control or path file that cannot be read or does not make sense.
 
     ``path`` and ``line`` (1-based, ``None`` when unknown) say where; ``str(error)`` is
-    ``"path:line: reason"``.
+    ``"path:line: reason"``; reason and path are ``bounded``.
     """
 
     def __init__(self, reason: str, path: Optional[os.PathLike | str] = None,
                  line: Optional[int] = None):
-        self.reason = reason
-        self.path = None if path is None else str(path)
+        self.reason = bounded(str(reason))
+        self.path = None if path is None else bounded(str(path))
         self.line = line
         where = ""
         if self.path is not None:
             where = f"{self.path}:{line}: " if line else f"{self.path}: "
-        super().__init__(f"{where}{reason}")
+        super().__init__(f"{where}{self.reason}")
 
 
 class ShapeError(ProblemError):

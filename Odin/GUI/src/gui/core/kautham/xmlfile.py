@@ -38,7 +38,8 @@ import numpy as np
 from gui.core.kautham.units import lengths_problem
 from gui.core.sizes import read_input_file
 from gui.errors import ProblemError
-from odin_common.limits import MAX_XML_ATTRIBUTES, MAX_XML_DEPTH, MAX_XML_ELEMENTS
+from odin_common.limits import (MAX_SHOWN_CHARS, MAX_XML_ATTRIBUTES, MAX_XML_DEPTH,
+                                MAX_XML_ELEMENTS, shown)
 
 
 _LEADING_NUMBER = re.compile(r"\s*[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
@@ -104,7 +105,7 @@ class Node:
             if default is None:
                 raise self.error(f"<{self.tag}> has no attribute {name}=")
             return default
-        what = f"<{self.tag} {name}=\"{raw}\">"
+        what = f"<{self.tag} {name}=\"{cut(raw)}\">"
         try:
             return parse_number(raw, what, self.path, self.line)
         except ProblemError:
@@ -133,7 +134,7 @@ class Node:
             return True
         if low in ("false", "0", "no"):
             return False
-        raise self.error(f"<{self.tag} {name}=\"{raw}\"> is not true or false")
+        raise self.error(f"<{self.tag} {name}=\"{cut(raw)}\"> is not true or false")
 
     def numbers(self, name: str, count: int, default: Optional[tuple] = None) -> tuple:
         """A space-separated vector attribute (URDF's xyz="0 0 1")."""
@@ -144,18 +145,27 @@ class Node:
             return default
         parts = raw.split()
         if len(parts) != count:
-            raise self.error(f"<{self.tag} {name}=\"{raw}\"> needs {count} numbers")
-        return tuple(parse_number(p, f"<{self.tag} {name}=\"{raw}\">", self.path, self.line)
-                     for p in parts)
+            raise self.error(f"<{self.tag} {name}=\"{cut(raw)}\"> needs {count} numbers")
+        return tuple(parse_number(p, f"<{self.tag} {name}=\"{cut(raw)}\">", self.path,
+                                  self.line) for p in parts)
+
+
+def cut(raw: str) -> str:
+    """An attribute's text as written, for an error message: cut to MAX_SHOWN_CHARS (saying
+    how long it was), so that a huge value never makes a huge message."""
+    if len(raw) <= MAX_SHOWN_CHARS:
+        return raw
+    return f"{raw[:MAX_SHOWN_CHARS - 1]}… ({len(raw):,} characters)"
 
 
 def parse_number(raw: str, what: str, path: Optional[str], line: Optional[int]) -> float:
     try:
         value = float(raw.strip())
     except ValueError:
-        raise ProblemError(f"{what}: {raw.strip()!r} is not a number", path, line) from None
+        raise ProblemError(f"{what}: {shown(raw.strip())} is not a number", path,
+                           line) from None
     if not math.isfinite(value):
-        raise ProblemError(f"{what}: {raw.strip()!r} is not finite", path, line)
+        raise ProblemError(f"{what}: {shown(raw.strip())} is not finite", path, line)
     return value
 
 
