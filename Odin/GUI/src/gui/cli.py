@@ -19,6 +19,8 @@ from typing import Callable, Optional, Sequence
 
 import numpy as np
 
+from gui.cli_boundary import (ToolParser, count, fail, hertz, one_line_errors, reading,
+                              seconds)
 from gui.errors import GuiError, PlanningError
 from odin_common.errors import OdinError
 from odin_common.tool import stop_on_ctrl_c
@@ -42,10 +44,8 @@ def without_teardown(main: Callable[[], Optional[int]]) -> Callable[[], int]:
     return ended
 
 
-def _fail(tool: str, error: Exception) -> int:
-    text = " ".join(str(error).split())
-    print(f"{tool}: error: {text}", file=sys.stderr)
-    return 2
+MAX_INDENT = 16
+"""problem_info --indent: the most spaces per level of the JSON (each level's lines carry them)."""
 
 
 def _check_output(option: str, path: Optional[str]) -> None:
@@ -154,22 +154,25 @@ def _plan(args):
         shape_cache.set_enabled(False)
     defaults = BuildDefaults(ground=args.ground, start_at_query=args.start_at_query,
                              inertia=args.inertia)
-    return plan_problem(load_problem(args.problem), defaults)
+    with reading("problem", args.problem):
+        return plan_problem(load_problem(args.problem), defaults)
 
 
+@one_line_errors("problem_info")
 def problem_info_main(argv: Optional[Sequence[str]] = None) -> int:
-    parser = argparse.ArgumentParser(
+    parser = ToolParser(
         prog="problem_info", description="Describe a Kautham problem as Odin would build it "
         "(JSON on stdout; no ROS needed).")
     parser.add_argument("problem", help="problem XML file")
-    parser.add_argument("--indent", type=int, default=1, help="JSON indentation (0: compact)")
+    parser.add_argument("--indent", type=count(0, MAX_INDENT), default=1,
+                        help="JSON indentation (0: compact)")
     _build_options(parser)
     args = parser.parse_args(argv)
     _warnings_to_stderr("problem_info")
     try:
         plan = _plan(args)
     except GuiError as error:
-        return _fail("problem_info", error)
+        return fail("problem_info", error)
     json.dump(describe(plan), sys.stdout, indent=args.indent or None)
     sys.stdout.write("\n")
     return 0
@@ -206,8 +209,9 @@ class _WorldConnection:
         return self._client
 
 
+@one_line_errors("load_problem")
 def load_problem_main(argv: Optional[Sequence[str]] = None) -> int:
-    parser = argparse.ArgumentParser(
+    parser = ToolParser(
         prog="load_problem", description="Build a Kautham problem in a running VirtualWorld.")
     parser.add_argument("problem", help="problem XML file")
     parser.add_argument("--keep", action="store_true",
@@ -215,7 +219,7 @@ def load_problem_main(argv: Optional[Sequence[str]] = None) -> int:
                         "(the problem is first built alone, in the room the world has left, "
                         "in this process; a clash with what the world holds is refused by "
                         "the world, and what was built of the problem removed)")
-    parser.add_argument("--timeout", type=float, default=10.0,
+    parser.add_argument("--timeout", type=seconds, default=10.0,
                         help="seconds to wait for the ROS master, then for the world's "
                         "services [10]")
     _build_options(parser)
@@ -227,7 +231,7 @@ def load_problem_main(argv: Optional[Sequence[str]] = None) -> int:
         connection = _WorldConnection(args.timeout)
         plan = _plan(args)
     except OdinError as error:
-        return _fail("load_problem", error)
+        return fail("load_problem", error)
     total = len(plan.steps)
     print(f"loaded {args.problem} in {time.monotonic() - started:.2f} s: {total} requests",
           flush=True)
@@ -240,15 +244,16 @@ def load_problem_main(argv: Optional[Sequence[str]] = None) -> int:
 
         load_scene(client, plan, keep=args.keep, progress=progress)
     except OdinError as error:
-        return _fail("load_problem", error)
+        return fail("load_problem", error)
     print(f"built {args.problem} in {time.monotonic() - started:.2f} s; the world is paused "
           f"at its start (rosservice call {client.namespace}/start \"simulate: true\" runs "
           f"it)", flush=True)
     return 0
 
 
+@one_line_errors("run_path")
 def run_path_main(argv: Optional[Sequence[str]] = None) -> int:
-    parser = argparse.ArgumentParser(
+    parser = ToolParser(
         prog="run_path", description="Drive a robot built by load_problem with a path file.")
     parser.add_argument("problem", help="the problem XML file the scene was built from")
     kind = parser.add_mutually_exclusive_group(required=True)
@@ -289,14 +294,14 @@ def run_path_main(argv: Optional[Sequence[str]] = None) -> int:
     units.add_argument("--radians", action="store_true",
                        help="values in radians (m) [default for current problems]")
     parser.add_argument("--robot", help="robot name (default: the first robot)")
-    parser.add_argument("--double", type=int, default=0, metavar="N",
+    parser.add_argument("--double", type=count(0, MAX_DOUBLINGS), default=0, metavar="N",
                         help="double the path precision N times (position paths)")
-    parser.add_argument("--rate", type=float, default=0.0,
+    parser.add_argument("--rate", type=hertz, default=0.0,
                         help="rows per second (default: the world's publication rate)")
     parser.add_argument("--fast", action="store_true",
                         help="control and tracked paths: as fast as the world steps, not in "
                         "real time")
-    parser.add_argument("--timeout", type=float, default=10.0,
+    parser.add_argument("--timeout", type=seconds, default=10.0,
                         help="seconds to wait for the ROS master, then for the world's "
                         "services [10]")
     _build_options(parser)
@@ -319,9 +324,10 @@ def run_path_main(argv: Optional[Sequence[str]] = None) -> int:
         unit = DEGREES if args.degrees else RADIANS if args.radians else (
             DEGREES if plan.problem.format == "2012" else RADIANS)
         file = args.initial or args.position or args.velocity
-        rows = load_robot_path(file, handle, unit)
+        with reading("path file", file):
+            rows = load_robot_path(file, handle, unit)
         if args.position and args.double:
-            rows = refine(rows, args.double)
+            rows = refine(rows, _doublings(args.double, len(rows)))
         from gui.ros.client import WorldClient, run_position_path, run_velocity_path
         client = WorldClient(timeout=args.timeout)
         if args.initial:
@@ -352,8 +358,24 @@ def run_path_main(argv: Optional[Sequence[str]] = None) -> int:
                                     f"of {len(rows) / rate:.2f} s)")
         print(f"{handle.name}: {len(rows)} rows at {rate:g} Hz done")
     except OdinError as error:
-        return _fail("run_path", error)
+        return fail("run_path", error)
     return 0
+
+
+MAX_DOUBLINGS = 20
+"""run_path --double N: the most doublings of a path's precision asked (each doubles its rows)."""
+
+MAX_PATH_ROWS = 1_000_000
+"""Rows of a path after --double: 11 hours at 25 rows per second (memory grows with them)."""
+
+
+def _doublings(times: int, rows: int) -> int:
+    """``times`` if a path of ``rows`` rows doubled that many times has at most
+    MAX_PATH_ROWS rows, else GuiError."""
+    if rows * 2 ** times > MAX_PATH_ROWS:
+        raise GuiError(f"--double {times}: {rows:,} rows would become {rows * 2 ** times:,}, "
+                       f"more than {MAX_PATH_ROWS:,} (MAX_PATH_ROWS)")
+    return times
 
 
 class _Stopped(Exception):
@@ -374,7 +396,8 @@ def _run_tracked(args, plan) -> int:
     from gui.core.kautham.solutions import read_solution
     from gui.core.paths import DEGREES, RADIANS
     units = DEGREES if args.degrees else RADIANS if args.radians else None
-    solution = read_solution(args.tracked, plan.problem, args.robot, units)
+    with reading("plan", args.tracked):
+        solution = read_solution(args.tracked, plan.problem, args.robot, units)
     from gui.ros.client import WorldClient
     from odin_common.interface import Solver
     client = WorldClient(timeout=args.timeout)
@@ -459,7 +482,8 @@ def _run_controls(args, plan, handle) -> int:
     a query, its distance to the goal in the planner's metric (``_goal_meter``): the figure
     ``plan`` printed for the same path."""
     from gui.core.control_path import control_size, read_control_path, run_on_client
-    rows = read_control_path(args.controls, control_size(handle))
+    with reading("control path", args.controls):
+        rows = read_control_path(args.controls, control_size(handle))
     meter = _goal_meter(plan, handle)
     from gui.ros.client import WorldClient
     client = WorldClient(timeout=args.timeout)
@@ -507,25 +531,28 @@ def _goal_meter(plan, handle):
 
 # ------------------------------------------------------------------------------ plan (issue 17)
 
+@one_line_errors("plan")
 def plan_main(argv: Optional[Sequence[str]] = None) -> int:
     """``rosrun GUI plan PROBLEM --planner NAME --time S --out PATH``: plans the problem's
     query with one of OMPL's control planners through Odin's physics (gui.planning), writes
     the solution as a Kautham control path (``run_path --controls`` runs it), prints the
     search's statistics as JSON; exits 1 with one line when no solution was found in time,
     2 on bad input."""
-    from gui.planning.bridge import PLANNERS
-    parser = argparse.ArgumentParser(
+    from gui.planning.bridge import MAX_SEED, PLANNERS
+    from gui.planning.parallel import MAX_SEARCHES
+    from gui.planning.problem import MAX_CONTROL_STEPS
+    parser = ToolParser(
         prog="plan", description="Plan a Kautham physics problem's query with an OMPL control "
         "planner through Odin's world; write the solution as a control path.")
     parser.add_argument("problem", help="the problem XML file")
     parser.add_argument("--planner", default="KPIECE1",
                         help=f"OMPL control planner: {', '.join(PLANNERS)} [KPIECE1]")
-    parser.add_argument("--time", type=float, default=None, metavar="S",
+    parser.add_argument("--time", type=seconds, default=None, metavar="S",
                         help="wall-clock seconds the planner may search [the problem's "
                         "\"_Max Planning Time\", else 10]")
     parser.add_argument("--out", required=True, metavar="PATH",
                         help="control path file to write (rows: controls, duration s)")
-    parser.add_argument("--seed", type=int, default=None,
+    parser.add_argument("--seed", type=count(1, MAX_SEED), default=None,
                         help="OMPL's random seed [drawn at random, printed and written with "
                         "the path: --seed repeats a run]")
     parser.add_argument("--backend", choices=("core", "pool"), default="core",
@@ -533,17 +560,19 @@ def plan_main(argv: Optional[Sequence[str]] = None) -> int:
                         "nodes of --worlds over ROS (cleared and built from the problem)")
     parser.add_argument("--worlds", default="/virtual_world", metavar="NS[,NS...]",
                         help="--backend pool: the world nodes' namespaces [/virtual_world]")
-    parser.add_argument("--world-timeout", type=float, default=30.0, metavar="S",
+    parser.add_argument("--world-timeout", type=seconds, default=30.0, metavar="S",
                         help="--backend pool: how long to wait for each world [30]")
     parser.add_argument("--robot", help="robot name (default: the first robot)")
     parser.add_argument("--goal-tolerance", type=float, default=None, metavar="M",
                         help="goal region radius in the plane, m [0.25]")
-    parser.add_argument("--min-control-steps", type=int, default=None, metavar="N",
+    parser.add_argument("--min-control-steps", type=count(1, MAX_CONTROL_STEPS),
+                        default=None, metavar="N",
                         help="a control is held at least N propagation steps [the problem's "
                         "\"Min Control Steps\", else 2]")
-    parser.add_argument("--max-control-steps", type=int, default=None, metavar="N",
+    parser.add_argument("--max-control-steps", type=count(1, MAX_CONTROL_STEPS),
+                        default=None, metavar="N",
                         help="and at most N [the problem's \"Max Control Steps\", else 30]")
-    parser.add_argument("--parallel", type=int, default=1, metavar="N",
+    parser.add_argument("--parallel", type=count(1, MAX_SEARCHES), default=1, metavar="N",
                         help="N independent searches at once, seeds SEED..SEED+N-1, each in a "
                         "process with a back end of its own (pool: its share of --worlds); "
                         "the first solution wins [1]")
@@ -555,7 +584,7 @@ def plan_main(argv: Optional[Sequence[str]] = None) -> int:
         with stop_on_ctrl_c() as stop:
             result, time_limit, seed = _search(args, stop)
         if not result.solved:
-            return _fail("plan", GuiError(
+            return fail("plan", GuiError(
                 f"{args.problem}: no solution within {time_limit:g} s ({args.planner}, seed "
                 f"{seed}{_searches(args)}): the closest plan ends {result.goal_distance:.3f} m "
                 "from the goal")) - 1
@@ -567,7 +596,7 @@ def plan_main(argv: Optional[Sequence[str]] = None) -> int:
             "each row: the robot's controls in [0, 1], then the duration (s)"))
         print(f"plan: {len(result.rows)} rows ({result.duration:.3f} s) written to {args.out}")
     except (OdinError, OSError) as error:
-        return _fail("plan", error)
+        return fail("plan", error)
     return 0
 
 

@@ -13,21 +13,23 @@ import sys
 import time
 from typing import Optional, Sequence
 
+from gui.cli_boundary import ToolParser, count, one_line_errors, reading, seconds
 from gui.errors import GuiError
 from gui.planning.benchmark import SCHEDULER_TIMEOUT_S
-from odin_common.errors import OdinError
 from odin_common.tool import stop_on_ctrl_c
 
 TOOL = "benchmark"
 
 
-def _fail(error: Exception) -> int:
-    print(f"{TOOL}: error: {' '.join(str(error).split())}", file=sys.stderr)
-    return 2
+MAX_RUNS = 1_000_000
+"""Runs per planner one benchmark may ask (each is a search of up to its time limit)."""
 
 
 def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    from gui.planning.bridge import MAX_SEED
+    from gui.planning.parallel import MAX_SEARCHES
+    from gui.planning.problem import MAX_CONTROL_STEPS
+    parser = ToolParser(
         prog=TOOL, description="Benchmark OMPL control planners on Kautham physics problems "
         "through Odin's world: a Kautham <Benchmark> file, or --problem ... --planners ...; "
         "OMPL benchmark logs, summary.json and plots in --out.")
@@ -36,16 +38,16 @@ def _parser() -> argparse.ArgumentParser:
                         help="a problem file instead of a benchmark file (repeatable)")
     parser.add_argument("--planners", metavar="A,B", help="OMPL control planners for every "
                         "problem (KPIECE1, RRT, EST) [each problem's own <Planner>]")
-    parser.add_argument("--runs", type=int, metavar="N", help="runs per planner [the file's "
-                        "runCount; 10 with --problem]")
-    parser.add_argument("--time", type=float, metavar="S", help="wall-clock seconds per run "
+    parser.add_argument("--runs", type=count(1, MAX_RUNS), metavar="N",
+                        help="runs per planner [the file's runCount; 10 with --problem]")
+    parser.add_argument("--time", type=seconds, metavar="S", help="wall-clock seconds per run "
                         "[the file's maxTime; with --problem each problem's "
                         "\"_Max Planning Time\", else 10]")
     parser.add_argument("--max-mem", type=float, metavar="MB", help="MB a run's process may "
                         "grow by during its search; the search ends there, as at its time "
                         "limit (OMPL's maxMem) [the file's maxMem, else 4096]")
-    parser.add_argument("--seed", type=int, default=1, help="run k of every planner has seed "
-                        "SEED+k [1]")
+    parser.add_argument("--seed", type=count(1, MAX_SEED), default=1,
+                        help="run k of every planner has seed SEED+k [1]")
     parser.add_argument("--out", default="benchmark", metavar="DIR",
                         help="folder for the logs, runs.jsonl, summary.json and plots "
                         "[./benchmark]")
@@ -54,18 +56,19 @@ def _parser() -> argparse.ArgumentParser:
     where = parser.add_mutually_exclusive_group()
     where.add_argument("--scheduler", metavar="tcp://HOST:8786",
                        help="run on this Dask cluster [a local one]")
-    where.add_argument("--workers", type=int, metavar="N",
+    where.add_argument("--workers", type=count(0, MAX_SEARCHES), metavar="N",
                        help="local Dask worker processes [one per core]; 0: no Dask, one run "
                        "after another in this process")
-    parser.add_argument("--scheduler-timeout", type=float, metavar="S",
+    parser.add_argument("--scheduler-timeout", type=seconds, metavar="S",
                         help="s to wait for --scheduler to answer, then for its first worker "
                         f"[{SCHEDULER_TIMEOUT_S:g}]")
     parser.add_argument("--no-plots", action="store_true", help="no PNG figures")
     search = parser.add_argument_group(
         "search settings", "change every problem's own (as rosrun GUI plan's options do)")
-    search.add_argument("--min-control-steps", type=int, metavar="N",
+    search.add_argument("--min-control-steps", type=count(1, MAX_CONTROL_STEPS), metavar="N",
                         help="a control is held at least N propagation steps")
-    search.add_argument("--max-control-steps", type=int, metavar="N", help="and at most N")
+    search.add_argument("--max-control-steps", type=count(1, MAX_CONTROL_STEPS), metavar="N",
+                        help="and at most N")
     search.add_argument("--goal-bias", type=float, metavar="F",
                         help="KPIECE1's and RRT's fraction of expansions aimed at the goal")
     search.add_argument("--goal-tolerance", type=float, metavar="M",
@@ -90,14 +93,12 @@ def _overrides(args) -> dict:
     return given
 
 
+@one_line_errors(TOOL)
 def benchmark_main(argv: Optional[Sequence[str]] = None) -> int:
     args = _parser().parse_args(argv)
     logging.getLogger("gui.core").setLevel(logging.ERROR)   # problem_info lists what is unused
-    try:
-        prepared, out = _prepare(args)
-        return _run(args, prepared, out)
-    except (OdinError, OSError) as error:
-        return _fail(error)
+    prepared, out = _prepare(args)
+    return _run(args, prepared, out)
 
 
 def _experiments(args):
@@ -116,9 +117,11 @@ def _experiments(args):
     if args.planners is not None and not planners:
         raise GuiError(f"--planners {args.planners!r}: no planner named")
     if args.problem:
-        return spec.command_line_experiments(args.problem, planners, args.runs or 10, args.time,
-                                             args.max_mem)
-    experiments = spec.read_benchmark_file(args.file)
+        with reading("problem", ", ".join(args.problem)):
+            return spec.command_line_experiments(args.problem, planners, args.runs or 10,
+                                                 args.time, args.max_mem)
+    with reading("benchmark file", args.file):
+        experiments = spec.read_benchmark_file(args.file)
     if planners:
         experiments = spec.with_planners(experiments, planners)
     return tuple(replace(e, request=replace(

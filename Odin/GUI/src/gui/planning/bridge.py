@@ -253,11 +253,15 @@ def _planner(oc, si, name: str, goal_bias: float):
     return planner
 
 
+MAX_SEED = 2 ** 32 - 1
+"""The largest seed OMPL takes (its generators' seed is a 32-bit unsigned integer)."""
+
+
 def seed_ompl(seed: int) -> None:
     """Seeds OMPL's random generators; effective for a process's first search only (OMPL
     seeds each generator from one master it makes once)."""
     _, _, ou = _ompl()
-    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 < seed < 2 ** 32:
+    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 < seed <= MAX_SEED:
         raise PlanningError(f"seed {seed!r} must be an integer in [1, 2^32)")
     ou.RNG.setSeed(seed)
 

@@ -27,6 +27,11 @@ from gui.planning.bridge import PlanResult, plan
 START_GRACE_S = 60.0
 """s: how long a child may take to build its back end before its search starts."""
 
+MAX_SEARCHES = 64
+"""Searches (processes) one parallel run may start: each is a process of its own with a world
+of its own (~150 MB), and a search cannot use more than one core; more than the host has
+cores only share them."""
+
 
 @dataclass(frozen=True)
 class SearchOutcome:
@@ -67,8 +72,9 @@ def plan_in_parallel(make_backend: Callable[[int], object], count: int, planner:
     every search failed. ``stop()`` true (asked every 0.1 s; each child asks its own copy,
     which its own Ctrl-C sets: a terminal's Ctrl-C reaches the whole process group) ends
     every search, waits for the children to be gone and raises KeyboardInterrupt."""
-    if isinstance(count, bool) or not isinstance(count, int) or count < 1:
-        raise PlanningError(f"parallel searches {count!r}: need a whole number >= 1")
+    if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= MAX_SEARCHES:
+        raise PlanningError(f"parallel searches {count!r}: need a whole number in [1, "
+                            f"{MAX_SEARCHES}] (MAX_SEARCHES)")
     if isinstance(seed, bool) or not isinstance(seed, int) or not 0 < seed < 2 ** 32 - count:
         raise PlanningError(f"seed {seed!r} must be an integer in [1, 2^32 - {count})")
     context = multiprocessing.get_context("fork")

@@ -47,7 +47,14 @@ from gui.core.model import CAR, FREE_BODY, MOBILE
 from gui.core.plan import BuildPlan, RobotHandle
 from gui.core.translate import GROUND
 from gui.errors import PlanningError
+from odin_common.limits import shown
 from odin_common.rotations import quaternion_to_matrix
+
+MAX_CONTROL_STEPS = 10_000
+"""Propagation steps a planner may hold one control (Kautham's planners: 2 to 30): each step
+is a world step the search waits for (10,000 of Kautham's 0.03 s steps is 300 s of simulated
+time for one motion); OMPL takes it as an unsigned int."""
+
 
 @dataclass(frozen=True)
 class SearchSettings:
@@ -84,9 +91,12 @@ class SearchSettings:
     def check(self) -> None:
         if self.step is not None and not (math.isfinite(self.step) and self.step > 0):
             raise PlanningError(f"step {self.step!r} s must be positive")
-        if not 1 <= self.min_control_steps <= self.max_control_steps:
-            raise PlanningError(f"control steps {self.min_control_steps}..."
-                                f"{self.max_control_steps}: need 1 <= min <= max")
+        steps = (self.min_control_steps, self.max_control_steps)
+        if any(isinstance(n, bool) or not isinstance(n, int) for n in steps) or \
+                not 1 <= steps[0] <= steps[1] <= MAX_CONTROL_STEPS:
+            raise PlanningError(f"control steps {shown(steps[0])}...{shown(steps[1])}: need "
+                                f"whole numbers 1 <= min <= max <= {MAX_CONTROL_STEPS:,} "
+                                "(MAX_CONTROL_STEPS)")
         for name in ("goal_tolerance", "max_speed"):
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0):
