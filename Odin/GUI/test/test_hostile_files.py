@@ -484,3 +484,41 @@ def test_a_megabyte_value_in_a_file_makes_a_short_error_line(tmp_path):
         status, out, err = problem_info(problem)
         line = one_error_line(err)
         assert status == 2 and str(problem.parent) in line and len(line) < 2_000, line[:300]
+
+
+ARM = ('<robot name="arm"><link name="base"><collision><geometry><box size="0.2 0.2 0.1"/>'
+       '</geometry></collision></link><link name="upper"><collision><geometry>'
+       '<cylinder radius="0.03" length="0.4"/></geometry></collision></link>'
+       '<joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/>'
+       '<axis xyz="0 0 1"/><limit lower="{low}" upper="{high}" effort="5" velocity="1"/>'
+       '</joint></robot>\n')
+CNTR = ('<ControlSet><Control name="c1" eigValue="{eig}"><DOF name="arm/upper" value="{value}"/>'
+        '</Control><Control name="c2"><DOF name="arm/X" value="1"/></Control></ControlSet>\n')
+QUERY_PROBLEM = ('<Problem><Robot robot="arm.urdf"><Home X="0" Y="0" Z="0" WX="0" WY="0" WZ="1" '
+                 'TH="0"/><Limits name="X" min="{xmin}" max="{xmax}"/></Robot>'
+                 '<Controls robot="arm.cntr"/><Planner><Parameters><Name>omplRRTConnect</Name>'
+                 '</Parameters><Queries><Query><Init>0.5 0.5</Init><Goal>0.7 0.3</Goal>'
+                 '</Query></Queries></Planner></Problem>\n')
+
+
+@pytest.mark.parametrize("absurd, quoted", [
+    (dict(low="-1e308", high="1e308"), "arm.urdf:1: lower and upper"),
+    (dict(eig="1e308"), "arm.cntr:1: <Control eigValue=\"1e308\">"),
+    (dict(value="-1e300"), "arm.cntr:1: <DOF value=\"-1e300\">"),
+    (dict(xmin="-1e308", xmax="1e308"), "p.xml:1: <Limits name=\"X\"> min max")])
+def test_limits_and_control_weights_that_overflow_a_query_are_refused(absurd, quoted, tmp_path):
+    """A query maps controls through limits (low + p (high - low)) and weights (offset +
+    eigValue value (c - 0.5)): values near 1e308 made them infinite or NaN in the JSON."""
+    values = {**dict(low="-2", high="2", eig="1", value="1", xmin="-1", xmax="1"), **absurd}
+    (tmp_path / "arm.urdf").write_text(ARM.format(**values))
+    (tmp_path / "arm.cntr").write_text(CNTR.format(**values))
+    problem = tmp_path / "p.xml"
+    problem.write_text(QUERY_PROBLEM.format(**values))
+    status, out, err = problem_info(problem)
+    assert status == 2 and quoted in one_error_line(err), (out[:300], err)
+    values = dict(low="-2", high="2", eig="1", value="1", xmin="-1", xmax="1")
+    for name, text in (("arm.urdf", ARM), ("arm.cntr", CNTR), ("p.xml", QUERY_PROBLEM)):
+        (tmp_path / name).write_text(text.format(**values))
+    status, out, err = problem_info(problem)
+    assert status == 0, err
+    strict_json(out)

@@ -36,7 +36,7 @@ from typing import Optional, Sequence, Tuple
 
 import numpy as np
 
-from gui.core.kautham.xmlfile import Node, read_xml
+from gui.core.kautham.xmlfile import Node, cut, read_xml
 from gui.core.kinematics import translation
 from gui.core.model import Configuration, Control, ControlSet, Instance
 from gui.errors import ProblemError
@@ -52,17 +52,32 @@ CONTINUOUS_LIMITS = (-2.0 * math.pi, 2.0 * math.pi)
 """rad: the range Kautham gives a URDF continuous joint."""
 
 
+MAX_CONTROL_WEIGHT = 1e6
+"""An offset, eigValue or DOF value of a control set, in size (Kautham's files: within 2).
+A weight past it would only saturate the clamp of p to [0, 1], and weights near 1e308 make
+their products infinite and p NaN (infinity times a control of 0.5 minus 0.5)."""
+
+
+def _weight(node: Node, name: str, default: Optional[float] = None) -> float:
+    """A control set's number, refused past MAX_CONTROL_WEIGHT."""
+    value = node.number(name, default)
+    if abs(value) > MAX_CONTROL_WEIGHT:
+        raise node.error(f"<{node.tag} {name}=\"{cut(node.get(name))}\"> is beyond "
+                         f"{MAX_CONTROL_WEIGHT:g} in size (MAX_CONTROL_WEIGHT)")
+    return value
+
+
 def parse_control_set(node: Node) -> ControlSet:
     offset = {}
     off = node.find("Offset")
     if off is not None:
         for dof in off.findall("DOF"):
-            offset[dof.require("name").strip()] = dof.number("value")
+            offset[dof.require("name").strip()] = _weight(dof, "value")
     controls = []
     for control in node.findall("Control"):
-        values = {dof.require("name").strip(): dof.number("value")
+        values = {dof.require("name").strip(): _weight(dof, "value")
                   for dof in control.findall("DOF")}
-        controls.append(Control(control.get("name", ""), control.number("eigValue", 1.0),
+        controls.append(Control(control.get("name", ""), _weight(control, "eigValue", 1.0),
                                 values, control.line))
     return ControlSet(offset=offset, controls=controls, source=node.path, line=node.line)
 

@@ -219,8 +219,9 @@ class _Loader:
         for lim in node.findall("Limits"):
             name = (lim.get("name") or "").strip()
             if name in ("X", "Y", "Z"):
-                low = lim.number("min") * self.units.length
-                high = lim.number("max") * self.units.length
+                low, high = (float(v) for v in lim.scaled_lengths(
+                    f"<Limits name=\"{name}\"> min max", (lim.number("min"), lim.number("max")),
+                    self.units.length))
                 if low > high:
                     raise lim.error(f"min={lim.get('min')} is above max={lim.get('max')}")
                 out[name] = (low, high)

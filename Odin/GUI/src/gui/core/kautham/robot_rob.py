@@ -151,10 +151,9 @@ def _read_link(joint: Node, k: int, links: list, index: dict, dh_type: str, unit
     lim = joint.find("Limits")
     if lim is not None and kind != FIXED:
         factor = units.angle if kind == REVOLUTE else length
-        low, high = lim.number("Low") * factor, lim.number("Hi") * factor
-        if kind == PRISMATIC:     # lengths: bounded as every scaled length is
-            low, high = (float(v) for v in lim.scaled_lengths(
-                "<Limits Low Hi>", (lim.number("Low"), lim.number("Hi")), factor))
+        low, high = (float(v) for v in lim.scaled_lengths(
+            "<Limits Low Hi>", (lim.number("Low"), lim.number("Hi")), factor,
+            "rad" if kind == REVOLUTE else "m"))
         if low > high:
             raise lim.error(f"Low={lim.get('Low')} is above Hi={lim.get('Hi')}")
         limits = (low, high)

@@ -51,17 +51,19 @@ def scale_problem(value: float) -> Optional[str]:
     return None
 
 
-def lengths_problem(values, scale: float = 1.0) -> Optional[str]:
-    """Why lengths ``values`` (any shape, file units) times ``scale`` (m per file unit)
-    cannot be a model's (not finite, or past MAX_LENGTH m), or None."""
+def lengths_problem(values, scale: float = 1.0, unit: str = "m") -> Optional[str]:
+    """Why lengths ``values`` (any shape, file units) times ``scale`` (``unit`` per file unit)
+    cannot be a model's (not finite, or past MAX_LENGTH), or None. Joint limits in rad are
+    held to the same bound (``unit="rad"``): a control maps [0, 1] onto high - low, which must
+    stay finite."""
     array = np.asarray(values, dtype=float)
     if array.size == 0:
         return None
     with np.errstate(over="ignore", invalid="ignore"):
         largest = float(np.max(np.abs(array))) * abs(scale)
     if not math.isfinite(largest) or largest > MAX_LENGTH:
-        return (f"reaches {largest:.3g} m, farther than the {MAX_LENGTH:g} m of the largest "
-                f"world (world_extent)")
+        where = "of the largest world (world_extent)" if unit == "m" else "a model may hold"
+        return f"reaches {largest:.3g} {unit}, beyond the {MAX_LENGTH:g} {unit} {where}"
     return None
 
 

@@ -245,9 +245,8 @@ def _joint_limits(joint: Node, kind: str, scale: float) -> tuple:
             where = soft
         else:
             low, high, where = lim.number("lower", 0.0), lim.number("upper", 0.0), lim
-        if kind == PRISMATIC:   # m: scaled lengths
-            low, high = (float(v) for v in where.scaled_lengths("lower and upper",
-                                                                (low, high), factor))
+        low, high = (float(v) for v in where.scaled_lengths(
+            "lower and upper", (low, high), factor, "m" if kind == PRISMATIC else "rad"))
         limits = (low, high)
         if limits[0] > limits[1]:
             raise where.error("lower is above upper")

@@ -116,11 +116,12 @@ class Node:
         self.lenient.append(LenientNumber(self.path, self.line, what, value))
         return value
 
-    def scaled_lengths(self, what: str, values, scale: float = 1.0) -> np.ndarray:
-        """``values`` (file units) times ``scale`` (m per file unit) as an array of lengths
-        in m, or an error naming ``what`` (the attribute as written) when one is not finite
-        or reaches past the largest world (gui.core.kautham.units.lengths_problem)."""
-        problem = lengths_problem(values, scale)
+    def scaled_lengths(self, what: str, values, scale: float = 1.0,
+                       unit: str = "m") -> np.ndarray:
+        """``values`` (file units) times ``scale`` (``unit`` per file unit) as an array, or
+        an error naming ``what`` (the attributes) when one is not finite or reaches past the
+        largest world (gui.core.kautham.units.lengths_problem)."""
+        problem = lengths_problem(values, scale, unit)
         if problem is not None:
             raise self.error(f"{what} times the scale {scale:g} {problem}")
         return np.asarray(values, dtype=float) * scale
