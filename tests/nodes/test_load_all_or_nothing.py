@@ -114,3 +114,20 @@ def test_the_window_refuses_a_problem_beyond_the_world_extent_and_keeps_its_scen
         client.close()
     finally:
         window.shutdown()
+
+
+def test_keep_with_a_clash_only_the_world_sees_is_undone(world, arm_and_box):
+    """--keep rehearses the problem alone: that its names are taken in the world is found by
+    the world only, midway; what the load set and built is then undone, the scene as it was
+    (its world parameters included), and the line names the step."""
+    from gui.ros.client import WorldClient
+    problem = arm_and_box("twice.xml", 800)
+    assert _load(world, problem).returncode == 0
+    client = WorldClient()
+    client.set_world(gravity=(0.0, 0.0, -1.62))     # the problem sets Earth's: undone too
+    before = _scene(client)
+    refused = _load(world, problem, "--keep")
+    assert _scene(client) == before
+    line = _refused_in_one_line(refused, "twice.xml", "the world refused step")
+    assert "the scene is as it was" in line, line
+    client.close()
