@@ -131,3 +131,50 @@ def test_keep_with_a_clash_only_the_world_sees_is_undone(world, arm_and_box):
     line = _refused_in_one_line(refused, "twice.xml", "the world refused step")
     assert "the scene is as it was" in line, line
     client.close()
+
+
+def _grid_stl(path: pathlib.Path, side: int) -> pathlib.Path:
+    """A binary STL of a rippled square, side x side vertices 1 mm apart (2 (side-1)^2
+    triangles)."""
+    import struct
+    x, y = np.meshgrid(np.arange(side, dtype=float), np.arange(side, dtype=float))
+    z = 0.1 * np.sin(x / 3.0) * np.cos(y / 5.0)
+    points = np.stack([x, y, z], axis=-1)
+    corners = [points[:-1, :-1], points[1:, :-1], points[1:, 1:], points[:-1, 1:]]
+    triangles = np.concatenate([np.stack(corners[:3], axis=2).reshape(-1, 3, 3),
+                                np.stack([corners[0], corners[2], corners[3]],
+                                         axis=2).reshape(-1, 3, 3)])
+    records = np.zeros(len(triangles), dtype=[("normal", "<f4", 3), ("vertices", "<f4", (3, 3)),
+                                              ("attributes", "<u2")])
+    records["vertices"] = triangles
+    path.write_bytes(b"\0" * 80 + struct.pack("<I", len(triangles)) + records.tobytes())
+    return path
+
+
+@pytest.fixture
+def capped_world(ros_master):
+    """A world node that reads no message over 1 MB."""
+    node = ros_master.rosrun("VirtualWorld", "virtualWorld", "_max_request_mb:=1")
+    ros_master.wait_for_service("/virtual_world/set_servo")
+    yield ros_master
+    assert node.poll() is None, "virtualWorld died:\n" + ros_master.log_text(node)[-3000:]
+
+
+def test_a_mesh_over_the_nodes_message_limit_leaves_the_scene_built_before(capped_world,
+                                                                           arm_and_box):
+    """The node's ~max_request_mb is a limit its Core does not know: the rehearsal checks a
+    step's mesh arrays against it (a 2 MB mesh in a world that reads 1 MB)."""
+    from gui.ros.client import WorldClient
+    good = arm_and_box("small.xml", 600)
+    _grid_stl(good.with_name("grid.stl"), 200)
+    big = good.with_name("big.xml")
+    big.write_text('<?xml version="1.0"?>\n<Problem>\n<Robot robot="arm.rob"/>\n'
+                   '<Scene scene="grid.stl" scale="1.0"><Location X="700" Y="0" Z="300" '
+                   'WX="0" WY="0" WZ="1" TH="0"/></Scene>\n</Problem>\n')
+    assert _load(capped_world, good).returncode == 0
+    client = WorldClient()
+    before = _scene(client)
+    refused = _load(capped_world, big)
+    assert _scene(client) == before
+    _refused_in_one_line(refused, "big.xml", "max_request_mb", "unchanged")
+    client.close()

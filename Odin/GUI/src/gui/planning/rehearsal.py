@@ -26,6 +26,8 @@ from __future__ import annotations
 import dataclasses
 from typing import Callable, Optional
 
+import numpy as np
+
 from gui.core.plan import BuildPlan, BuiltIds
 from gui.errors import GuiError
 from gui.planning.backend import CoreWorld
@@ -61,12 +63,28 @@ def rehearse(plan: BuildPlan, parameters: WorldParameters, step_values: StepValu
         ids = BuiltIds()
         for k, step in enumerate(plan.steps, start=1):
             try:
+                _check_request_size(step, resources)
                 step.send(world, ids)
             except OdinError as error:
                 raise GuiError(f"step {k}/{len(plan.steps)} ({step.label()}) would be "
                                f"refused: {_one_line(error)}") from None
     finally:
         world.close()
+
+
+def _check_request_size(step, resources: ResourceLimits) -> None:
+    """The node reads no message over its ``max_request_mb`` (it drops the connection, which
+    a Core never sees): a step whose bodies' mesh arrays alone (float64 parameters, uint32
+    indices: the bulk of its request) are larger is refused here. What the rest of a request
+    adds (names, poses: bytes per body) can still tip one just under it over: the node then
+    refuses it, and load_scene undoes the load."""
+    size = sum(8 * np.size(shape.parameters) + 4 * np.size(shape.indices)
+               for body in step.bodies for shape in getattr(body, "parts", (body,)))
+    limit = resources.max_request_mb * 2 ** 20
+    if size > limit:
+        raise GuiError(f"its request holds {size:,} bytes of mesh arrays, more than the "
+                       f"world reads in one message ({limit:,} bytes: max_request_mb "
+                       f"{resources.max_request_mb})")
 
 
 def load_scene(client, plan: BuildPlan, keep: bool = False,
