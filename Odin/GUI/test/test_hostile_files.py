@@ -462,6 +462,12 @@ def test_deep_wide_and_texty_xml_is_refused_or_read_quickly(tmp_path):
     wide.write_text("<robot " + " ".join(f'a{k}="1"' for k in range(5_000)) + "/>")
     with pytest.raises(ProblemError, match=f"more than {MAX_XML_ATTRIBUTES:,} attributes"):
         read_xml(wide)
+    for named in ("<Problem><%s/></Problem>" % ("T" * 100_000),
+                  '<Problem><Obstacle %s="1"/></Problem>' % ("a" * 300)):
+        (tmp_path / "named.xml").write_text(named)
+        with pytest.raises(ProblemError, match="longer than 256 bytes") as refused:
+            read_xml(tmp_path / "named.xml")
+        assert len(str(refused.value)) < 300
     texty = tmp_path / "texty.xml"           # 5 million pieces of text in one element
     texty.write_text("<Problem>" + "&amp;" * 5_000_000 + "</Problem>")
     started = time.monotonic()

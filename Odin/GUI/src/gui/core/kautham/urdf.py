@@ -149,8 +149,9 @@ def _inertial(link: Node, scale: float) -> Optional[Inertial]:
     inertia = node.find("inertia")
     if inertia is not None:
         i = {k: inertia.number(k, 0.0) for k in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")}
-        matrix = np.array([[i["ixx"], i["ixy"], i["ixz"]], [i["ixy"], i["iyy"], i["iyz"]],
-                           [i["ixz"], i["iyz"], i["izz"]]]) * (scale * scale)
+        with np.errstate(over="ignore"):      # an overflow is refused just below
+            matrix = np.array([[i["ixx"], i["ixy"], i["ixz"]], [i["ixy"], i["iyy"], i["iyz"]],
+                               [i["ixz"], i["iyz"], i["izz"]]]) * (scale * scale)
         problem = inertia_problem(matrix)
         if problem is not None:
             raise inertia.error(f"<inertia> times the scale {scale:g} squared: {problem}")

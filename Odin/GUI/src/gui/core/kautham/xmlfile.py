@@ -12,9 +12,9 @@ never resolved (an external entity would read another file, or a URL, into the p
 file is read by ``gui.core.sizes.read_input_file`` (a regular file of at most
 odin_common.limits.MAX_INPUT_FILE_MB, opened once), and the tree is bounded while it is built:
 at most MAX_XML_ELEMENTS elements, MAX_XML_DEPTH deep, MAX_XML_ATTRIBUTES attributes on one
-element (odin_common.limits). A node of the tree costs a few hundred bytes, so 200 MB of empty
-elements would need gigabytes: the parse stops at the first element past a bound, having built
-a bounded tree.
+element, names of at most MAX_NAME_BYTES (odin_common.limits). A node of the tree costs a few
+hundred bytes, so 200 MB of empty elements would need gigabytes: the parse stops at the first
+element past a bound, having built a bounded tree.
 
 Numbers: a malformed number is an error naming the file and line, except in a tree read with
 ``lenient`` (URDF files): there a value that starts with a number ("0.46 5") is read as that
@@ -38,8 +38,8 @@ import numpy as np
 from gui.core.kautham.units import lengths_problem
 from gui.core.sizes import read_input_file
 from gui.errors import ProblemError
-from odin_common.limits import (MAX_SHOWN_CHARS, MAX_XML_ATTRIBUTES, MAX_XML_DEPTH,
-                                MAX_XML_ELEMENTS, shown)
+from odin_common.limits import (MAX_NAME_BYTES, MAX_SHOWN_CHARS, MAX_XML_ATTRIBUTES,
+                                MAX_XML_DEPTH, MAX_XML_ELEMENTS, shown)
 
 
 _LEADING_NUMBER = re.compile(r"\s*[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
@@ -220,6 +220,16 @@ def _bounds(parser, depth: int, elements: int, attributes: int) -> None:
                            parser.CurrentLineNumber)
 
 
+def _check_names(parser, tag: str, attrib: dict) -> None:
+    """Raises _Refused for an element or attribute name longer than MAX_NAME_BYTES: names
+    are quoted in warnings and in what the tools print (Kautham's: a few dozen bytes)."""
+    for name in (tag, *attrib):
+        if len(name) > MAX_NAME_BYTES // 4 and len(name.encode("utf-8")) > MAX_NAME_BYTES:
+            raise _Refused(f"has an element or attribute name of {len(name):,} characters "
+                           f"{shown(name)}, longer than {MAX_NAME_BYTES} bytes "
+                           f"(odin_common.limits.MAX_NAME_BYTES)", parser.CurrentLineNumber)
+
+
 def parse_xml_bytes(data: bytes, path: str, lenient: Optional[list] = None) -> Node:
     """Parses an XML file's bytes (``path`` names it in errors) into a bounded ``Node`` tree
     (module docstring); raises ``ProblemError`` naming the file and line."""
@@ -233,6 +243,7 @@ def parse_xml_bytes(data: bytes, path: str, lenient: Optional[list] = None) -> N
     def start(tag, attrib):
         count[0] += 1
         _bounds(parser, len(stack) + 1, count[0], len(attrib))
+        _check_names(parser, tag, attrib)
         node = Node(tag, dict(attrib), parser.CurrentLineNumber, path, lenient=lenient)
         if stack:
             stack[-1].children.append(node)
