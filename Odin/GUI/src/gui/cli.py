@@ -236,7 +236,8 @@ def load_problem_main(argv: Optional[Sequence[str]] = None) -> int:
     print(f"loaded {args.problem} in {time.monotonic() - started:.2f} s: {total} requests",
           flush=True)
     try:
-        from gui.planning.rehearsal import load_scene
+        from gui.planning.rehearsal import load_scene, warm_up
+        warm_up()           # while the world is still being found (its thread imports nothing)
         client = connection.client()
 
         def progress(k: int, step, answer_id: str) -> None:

@@ -87,6 +87,13 @@ def _check_request_size(step, resources: ResourceLimits) -> None:
                        f"{resources.max_request_mb})")
 
 
+def warm_up() -> None:
+    """Imports what a rehearsal's Core imports when it first meets a mesh (trimesh, for its
+    mass: 0.5 s), so that a tool can do it while it waits for something else."""
+    import trimesh  # noqa: F401
+    import virtual_world.core  # noqa: F401
+
+
 def load_scene(client, plan: BuildPlan, keep: bool = False,
                progress: Optional[Progress] = None) -> dict:
     """Builds ``plan`` in the world of ``client`` (a WorldClient) whole, after New Scene
@@ -165,4 +172,4 @@ def _one_line(error: BaseException) -> str:
     return " ".join(str(error).split())
 
 
-__all__ = ["load_scene", "rehearse"]
+__all__ = ["load_scene", "rehearse", "warm_up"]
