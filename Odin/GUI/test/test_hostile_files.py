@@ -435,18 +435,24 @@ def _rss_of_problem_info(problem, tmp_path) -> tuple:
 
 
 @pytest.mark.timeout(120)
-def test_a_problem_of_millions_of_empty_elements_is_refused_in_bounded_memory(tmp_path):
+@pytest.mark.parametrize("kind", ["problem", "Collada mesh"])
+def test_a_file_of_millions_of_empty_elements_is_refused_in_bounded_memory(kind, tmp_path):
     import time
     from odin_common.limits import MAX_XML_ELEMENTS
-    problem = tmp_path / "empty.xml"
-    with open(problem, "wb") as f:           # 60 MB: 15 million <a/>
-        f.write(b"<Problem>")
+    bomb = tmp_path / ("empty.xml" if kind == "problem" else "empty.dae")
+    root = b"Problem" if kind == "problem" else b"COLLADA"
+    with open(bomb, "wb") as f:           # 60 MB: 15 million <a/>
+        f.write(b"<" + root + b">")
         f.write(b"<a/>" * (15 * 10 ** 6))
-        f.write(b"</Problem>")
+        f.write(b"</" + root + b">")
+    problem = bomb
+    if kind != "problem":
+        problem = tmp_path / "p.xml"
+        problem.write_text('<Problem><Obstacle obstacle="empty.dae"/></Problem>')
     started = time.monotonic()
     status, err, peak = _rss_of_problem_info(problem, tmp_path)
     assert status == 2 and "Traceback" not in err, err
-    assert f"holds more than {MAX_XML_ELEMENTS:,} elements" in err and str(problem) in err
+    assert f"holds more than {MAX_XML_ELEMENTS:,} elements" in err and str(bomb) in err, err
     assert peak is not None and peak < 800, f"peak RSS {peak} MB"
     assert time.monotonic() - started < 60
 

@@ -312,12 +312,16 @@ def _check_stl_count(p: pathlib.Path, data: bytes, max_triangles: int) -> None:
                          f"mesh", p)
 
 
-def _collada_surfaces(data: bytes) -> io.BytesIO:
+def _collada_surfaces(p: pathlib.Path, data: bytes) -> io.BytesIO:
     """A Collada file without its ``<lines>`` and ``<linestrips>``: they hold no surface
     (nothing collides with a line, and Kautham draws only faces), and pycollada refuses some
     that assimp, Kautham's reader, reads (an ``<input>`` without ``offset``, in the IOC lab's
-    steel cupboard). The XML is read without entities or network access."""
+    steel cupboard). The XML is read without entities or network access, and only once
+    within the bounds every XML file the GUI reads has (``xmlfile.check_xml_bounds``: lxml
+    would build a tree of any size)."""
+    from gui.core.kautham.xmlfile import check_xml_bounds
     from lxml import etree
+    check_xml_bounds(data, str(p), ShapeError)
     parser = etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False)
     root = etree.fromstring(data, parser)
     for element in list(root.iter("{*}lines", "{*}linestrips", "lines", "linestrips")):
@@ -359,8 +363,8 @@ def _read_trimesh(p: pathlib.Path, data: bytes) -> _Raw:
         with warnings.catch_warnings():     # numpy's overflow warnings on absurd
             warnings.simplefilter("ignore", RuntimeWarning)  # coordinates: checked after
             if p.suffix.lower() == ".dae":
-                loaded = trimesh.load(_collada_surfaces(data), file_type="dae", force="mesh",
-                                      process=False)
+                loaded = trimesh.load(_collada_surfaces(p, data), file_type="dae",
+                                      force="mesh", process=False)
             else:
                 loaded = trimesh.load(io.BytesIO(data), file_type=p.suffix.lower()[1:],
                                       force="mesh", process=False,

@@ -262,6 +262,39 @@ def parse_xml_bytes(data: bytes, path: str, lenient: Optional[list] = None) -> N
     parser.StartElementHandler = start
     parser.EndElementHandler = end
     parser.CharacterDataHandler = text
+    _parse(parser, data, path)
+    if not root:
+        raise ProblemError("no XML element", path)
+    return root[0]
+
+
+def check_xml_bounds(data: bytes, path: str, error=ProblemError) -> None:
+    """Raises ``error`` (a ProblemError class) naming ``path`` unless an XML file another
+    library will parse (Collada, by lxml) is within the bounds of the module docstring and
+    declares no entity; nothing is built (expat counts elements as they start)."""
+    parser = xml.parsers.expat.ParserCreate()
+    _harden(parser)
+    depth, count = [0], [0]
+
+    def start(tag, attrib):
+        count[0] += 1
+        depth[0] += 1
+        _bounds(parser, depth[0], count[0], len(attrib))
+        _check_names(parser, tag, attrib)
+
+    def end(_tag):
+        depth[0] -= 1
+
+    parser.StartElementHandler = start
+    parser.EndElementHandler = end
+    try:
+        _parse(parser, data, path)
+    except ProblemError as refused:
+        raise error(refused.reason, path, refused.line) from None
+
+
+def _parse(parser, data: bytes, path: str) -> None:
+    """Runs ``parser`` over ``data``: its errors as ProblemErrors naming ``path``."""
     try:
         parser.Parse(data, True)
     except xml.parsers.expat.ExpatError as error:
@@ -272,6 +305,3 @@ def parse_xml_bytes(data: bytes, path: str, lenient: Optional[list] = None) -> N
         raise ProblemError(refused.reason, path, refused.line) from None
     except (LookupError, ValueError) as error:   # an unknown or wrong encoding="..."
         raise ProblemError(f"malformed XML: {error}", path, parser.CurrentLineNumber) from None
-    if not root:
-        raise ProblemError("no XML element", path)
-    return root[0]
