@@ -534,3 +534,39 @@ def test_limits_and_control_weights_that_overflow_a_query_are_refused(absurd, qu
     status, out, err = problem_info(problem)
     assert status == 0, err
     strict_json(out)
+
+
+MESH_TEXTS = {
+    ".obj": lambda n: "v 0 0 0\nv 1 0 0\nv 0 1 0\n" + "f 1 2 3\n" * n,
+    ".ply": lambda n: ("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty "
+                       "float y\nproperty float z\nelement face %d\nproperty list uchar int "
+                       "vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n" % n
+                       + "3 0 1 2\n" * n),
+    ".off": lambda n: "OFF\n3 %d 0\n0 0 0\n1 0 0\n0 1 0\n" % n + "3 0 1 2\n" * n,
+}
+
+
+@pytest.mark.parametrize("suffix", sorted(MESH_TEXTS))
+def test_a_text_mesh_listing_too_many_faces_is_refused_before_it_is_parsed(suffix, tmp_path,
+                                                                           monkeypatch):
+    small, big = tmp_path / f"small{suffix}", tmp_path / f"big{suffix}"
+    small.write_text(MESH_TEXTS[suffix](10))
+    big.write_text(MESH_TEXTS[suffix](1_500))
+    limits = ShapeDefaults(max_triangles=1_000)
+    shapes._CACHE.clear()
+    assert read_shape(small, defaults=limits).mesh is not None
+    monkeypatch.setattr(shapes, "_read_trimesh", lambda *a: pytest.fail("parsed"))
+    with pytest.raises(ShapeError, match="holds 1,500 faces and 3 vertices, more than the "
+                                         "1,000 triangles"):
+        read_shape(big, defaults=limits)
+
+
+@pytest.mark.timeout(120)
+def test_a_60_mb_obj_of_faces_is_refused_in_bounded_memory(tmp_path):
+    with open(tmp_path / "faces.obj", "wb") as f:       # 7.5 million faces
+        f.write(b"v 0 0 0\nv 1 0 0\nv 0 1 0\n" + b"f 1 2 3\n" * (75 * 10 ** 5))
+    problem = tmp_path / "p.xml"
+    problem.write_text('<Problem><Obstacle obstacle="faces.obj"/></Problem>')
+    status, err, peak = _rss_of_problem_info(problem, tmp_path)
+    assert status == 2 and "holds 7,500,000 faces" in err, err
+    assert peak is not None and peak < 500, f"peak RSS {peak} MB"
