@@ -40,3 +40,55 @@ def test_hostile_requests_are_refused_in_a_line_and_the_world_steps_on(ros_maste
     world.ok("step_once", cycles=5)
     assert world.ok("get_world").objects == ["ball"] + [f"m{k}" for k in range(30)]
     assert node.poll() is None
+
+
+CALL_AND_GO = """
+import rospy
+from Services.srv import Propagate
+rospy.init_node("odin_impatient_client", anonymous=True, disable_signals=True)
+print("calling", flush=True)
+rospy.ServiceProxy("/virtual_world/propagate", Propagate)(duration=20.0, step=0.001)
+"""
+
+
+def test_a_long_propagate_stops_when_its_caller_has_gone(ros_master):
+    """A Propagate of ~1,000 s of work (10 spheres resting on the ground under QuickStep at
+    100,000 iterations, ~50 ms a step, 20,000 steps: far within MAX_BODY_STEPS_PER_CALL)
+    whose client gives up after a second and exits: the world notices the closed
+    connection between pieces, puts the state back and answers Get World within seconds,
+    its simulated time as before the call."""
+    import subprocess
+    import sys
+    import threading
+    import time
+
+    import rospy
+    from world_client import WorldClient, box, sphere
+
+    node = ros_master.rosrun("VirtualWorld", "virtualWorld")
+    ros_master.wait_for_service("/virtual_world/propagate")
+    rospy.init_node("odin_test_client", anonymous=True, disable_signals=True)
+    world = WorldClient()
+    world.ok("set_world", set_solver=True, solver=0, quickstep_iterations=100_000)
+    world.ok("build_object", object=box("ground", (20, 20, 0.2), (0, 0, -0.1),
+                                        geometry_only=True))
+    for k in range(10):
+        world.ok("build_object", object=sphere(f"p{k}", 0.1, (k * 0.5, 0, 0.1)))
+    client = subprocess.Popen([sys.executable, "-c", CALL_AND_GO], env=ros_master.env,
+                              stdout=subprocess.PIPE, text=True)
+    try:
+        assert client.stdout.readline().strip() == "calling"
+        time.sleep(1.5)                     # the call is under way: the world is busy
+    finally:
+        client.kill()                       # gone: its connection closes
+        client.wait(10)
+    answered = {}
+    asked = time.monotonic()
+    thread = threading.Thread(target=lambda: answered.update(world=world("get_world")),
+                              daemon=True)
+    thread.start()
+    thread.join(15.0)
+    assert "world" in answered, "the world still runs the propagation of a caller gone"
+    assert time.monotonic() - asked < 10.0
+    assert answered["world"].success and answered["world"].sim_time == 0.0
+    assert node.poll() is None

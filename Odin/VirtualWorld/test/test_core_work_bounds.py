@@ -51,3 +51,53 @@ def test_a_step_once_beyond_the_body_step_bound_is_refused_before_a_cycle():
     assert advanced == []
     loop.step_cycles(2)
     assert advanced == [1000, 1000]
+
+
+def _pile() -> Core:
+    """40 spheres falling onto a ground box and each other: contacts in every step."""
+    core = Core()
+    core.build_object(ObjectSpec("ground", [20.0, 20.0, 0.2], position=(0, 0, -0.1),
+                                 geometry_only=True))
+    for k in range(40):
+        core.build_object(ObjectSpec(f"p{k}", [0.1], position=(
+            (k % 4) * 0.15, (k // 4 % 3) * 0.15, 0.3 + 0.25 * (k // 12))))
+    return core
+
+
+def test_a_propagation_run_in_pieces_is_bit_for_bit_the_one_run_at_once():
+    """12,000 steps over 40 bodies run in pieces between looks at ``cancelled`` (from one
+    step, growing): the state, the steps and the collisions (with their first times) are
+    those of one run."""
+    looks = []
+    with _pile() as once, _pile() as pieces:
+        whole = once.propagate(12.0, 0.001, keep=True)
+        split = pieces.propagate(12.0, 0.001, keep=True,
+                                 cancelled=lambda: looks.append(1) and False)
+        assert len(looks) >= 3
+        assert split.steps == whole.steps == 12_000
+        assert split.state.tobytes() == whole.state.tobytes()
+        assert split.collisions == whole.collisions and whole.collisions
+        assert pieces.sim_time == once.sim_time
+
+
+def test_a_cancelled_propagation_leaves_the_world_as_it_was_even_when_kept():
+    """The caller gone after the second piece: Cancelled, and the world is in the state it
+    had before the call (a Propagate is all or nothing), its simulated time too."""
+    from virtual_world.core.long_calls import Cancelled
+    with _pile() as core:
+        core.step(0.001, 10)
+        before, time_before = core.body_state_vector(), core.sim_time
+        looks = []
+        with pytest.raises(Cancelled, match="the caller has gone"):
+            core.propagate(60.0, 0.001, keep=True,
+                           cancelled=lambda: looks.append(1) or len(looks) > 2)
+        assert core.body_state_vector().tobytes() == before.tobytes()
+        assert core.sim_time == time_before
+
+
+def test_a_step_once_whose_caller_has_gone_stops_between_cycles():
+    advanced = []
+    loop = WorldLoop(lambda step, count: advanced.append(count) or 0.0, lambda report: None,
+                     StepValues(0.001, 10))
+    loop.step_cycles(50, cancelled=lambda: len(advanced) >= 3)
+    assert advanced == [10, 10, 10]

@@ -97,6 +97,13 @@ than ten minutes (~3 us a body-step on a 2-core host); 1e7 is about half a minut
 A longer run is asked for in pieces."""
 
 
+MAX_CALL_SECONDS = 60.0
+"""s of wall time a long call (a Propagate, a Step Once of many cycles) of the world node may
+run before it is stopped as if its caller had gone: MAX_BODY_STEPS_PER_CALL bounds the work
+in body-steps, but a body-step's cost spans orders of magnitude (0.3 us in a scattering pile
+under QuickStep, 1.4 ms in a stack of 99 boxes under the exact solver)."""
+
+
 def check_work(what: str, steps: int, bodies: int) -> int:
     """``steps`` if ``steps`` x ``bodies`` (at least 1) is within MAX_BODY_STEPS_PER_CALL,
     else InvalidArgument naming ``what`` and both numbers."""

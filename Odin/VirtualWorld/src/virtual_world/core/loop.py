@@ -131,9 +131,11 @@ class WorldLoop:
         self.sim_time = self._advance(values.step, values.steps_per_cycle)
         return self._finish_cycle(stepped=True, force_publish=True)
 
-    def step_cycles(self, cycles: int) -> float:
+    def step_cycles(self, cycles: int, cancelled: Callable[[], object] = lambda: None) -> float:
         """Step Once: ``cycles`` whole cycles (0 means 1) of a paused world, each published;
-        returns the simulated time after them."""
+        returns the simulated time after them. ``cancelled()`` is asked before each cycle:
+        when the caller has gone the cycles done so far stand (each was published), as if
+        it had asked for fewer, and the rest are not run."""
         if self.simulate:
             raise InvalidArgument("the simulation is running: pause it (Start false) to step once")
         cycles = cycles or 1
@@ -145,7 +147,12 @@ class WorldLoop:
                               cycles * self.step_values.steps_per_cycle, self._bodies())
         except CommonInvalidArgument as error:
             raise InvalidArgument(str(error)) from None
-        for _ in range(cycles):
+        for done in range(cycles):
+            why = cancelled()
+            if why:
+                _log.info("Step Once stopped, %d cycle(s) not run: %s", cycles - done,
+                          why if isinstance(why, str) else "the caller has gone")
+                break
             self.advance_cycle()
         return self.sim_time
 

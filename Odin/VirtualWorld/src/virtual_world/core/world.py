@@ -17,7 +17,7 @@ import functools
 import math
 import threading
 import time
-from typing import Dict, List, Mapping, Optional, Sequence, Tuple
+from typing import Callable, Dict, List, Mapping, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -26,8 +26,8 @@ from odin_common.interface import ForceKind, JointType, MotorKind, ServoDrive, S
 from odin_common.limits import ResourceLimits, shown, shown_list
 from odin_common.specs import CompositeSpec, EntitySpec, JointSpec, MotorSpec, ObjectSpec
 from odin_common.world_parameters import WorldParameters
-from virtual_world.core import (exemptions, forces, guard, joints, kinematic, motors, objects,
-                                readout, snapshots, validation as check)
+from virtual_world.core import (exemptions, forces, guard, joints, kinematic, long_calls,
+                                motors, objects, readout, snapshots, validation as check)
 from virtual_world.core.requests import changes_contents, changes_state, disturbs, locked
 from virtual_world.core.records import (BodyState, Built, BuiltEntity, Collision, Divergence,
                                         JointReaction, JointState, MotorState, ObjectState,
@@ -501,7 +501,8 @@ class Core:
                   body_forces: Sequence[Mapping] = (), start: str = "",
                   keep: bool = False,
                   start_state: Optional[Sequence[float]] = None,
-                  read_states: bool = True) -> Propagation:
+                  read_states: bool = True,
+                  cancelled: Optional[long_calls.Cancel] = None) -> Propagation:
         """Runs the world for ``duration`` s in steps of ``step_size`` s, as fast as it goes:
         from the snapshot ``start``, or from the body state vector ``start_state``
         (``body_state_vector``'s; the rest of the state as it is now), or from now; under ``motor_goals`` ({motor id: goal
@@ -509,7 +510,10 @@ class Core:
         every pair that collides on the way. Then the world goes back to the state it had
         before the call, unless ``keep``; the forces act during the propagation only.
         ``read_states`` False leaves the answer's ``states`` empty (a planner reads the state
-        vector alone). Everything is checked before anything changes."""
+        vector alone). Everything is checked before anything changes. ``cancelled``
+        (core.long_calls): asked between pieces of the run; when it says the caller has gone
+        the world goes back to the state before the call, as after a refusal, kept or not,
+        and long_calls.Cancelled is raised."""
         scene = self._scene
         step_size, steps = _steps_of(duration, step_size)
         check.shared(limits.check_work, f"propagate {duration:.6g} s at {step_size:g} s",
@@ -534,7 +538,7 @@ class Core:
             if motor_goals:
                 motors.set_velocities(scene, motor_goals)
             added = [forces.add_body_force(scene, **dict(f)) for f in body_forces]
-            result = self._run(steps, step_size, read_states)
+            result = self._run(steps, step_size, read_states, cancelled)
             for force_id in added:
                 forces.remove_body_force(scene, force_id)
         except Exception:
@@ -571,7 +575,8 @@ class Core:
         guard.collect(scene, step_size)
         return StatePropagation(state, scene.pair_names(pairs), steps)
 
-    def _run(self, steps: int, step_size: float, read_states: bool = True) -> Propagation:
+    def _run(self, steps: int, step_size: float, read_states: bool = True,
+             cancelled: Optional[long_calls.Cancel] = None) -> Propagation:
         """Steps with every step's collisions recorded; what a propagation answers."""
         scene = self._scene
         readout.carry_collisions(scene, set())
@@ -579,11 +584,9 @@ class Core:
         start_time, start_step = scene.sim_time, scene.c.step_count
         scene.c.record_every_step = True
         try:
-            steps = scene.c.step(step_size, steps)
+            steps = long_calls.run_steps(scene, step_size, steps, cancelled)
         finally:
             scene.c.record_every_step = False
-        scene.sim_time += step_size * steps
-        guard.collect(scene, step_size)
         collisions = tuple(sorted(
             c._replace(first_time=start_time + (step - start_step) * step_size)
             for c, step in readout.named_records(scene)))

@@ -68,7 +68,7 @@ from odin_common.node import MasterWatch, init_ros_node, numpy_requests, stop_on
 from odin_common.world_parameters import PARAMETERS
 from virtual_world.core import Core, mass, step_values
 from virtual_world.core.loop import CycleReport, RealTimeFactor, WorldLoop
-from virtual_world.portal import conversions, message_cap, publish_queue
+from virtual_world.portal import caller, conversions, message_cap, publish_queue
 from virtual_world.portal.interaction import InteractiveObjects
 from virtual_world.portal.mirror import WorldMirror
 from virtual_world.portal.parameters import DEFAULTS, RESOURCE_PARAMETERS
@@ -149,7 +149,8 @@ class Portal:
             service_class = getattr(srv, type_name)
             self._answers[name] = self._guarded(service_class, self._handler(name))
             served = numpy_requests(service_class) if name in NUMPY_REQUESTS else service_class
-            self.servers.append(rospy.Service(f"~{name}", served, self._answers[name]))
+            self.servers.append(caller.WatchedService(f"~{name}", served,
+                                                      self._answers[name]))
 
     def serve(self, name: str, request):
         """Answers ``request`` as the service ``name`` does over ROS (any thread)."""
@@ -180,8 +181,21 @@ class Portal:
         in_force = {srv.SetWorld: lambda: self.core.world_parameters.as_dict(),
                     srv.SetStep: self.services.step_fields}.get(service_class, dict)
         return replies.guarded(service_class,
-                               lambda request: self.loop.call(lambda: handler(request)),
+                               lambda request: self.loop.call(self._watched(handler, request)),
                                in_force)
+
+    def _watched(self, handler: Callable, request) -> Callable[[], dict]:
+        """``handler(request)`` for the loop thread, with the services told how to ask whether
+        this call's caller has gone (portal.caller; watched from rospy's thread, here)."""
+        gone = caller.watch()
+
+        def run() -> dict:
+            self.services.cancelled = gone
+            try:
+                return handler(request)
+            finally:
+                self.services.cancelled = caller.never
+        return run
 
     # -- running ------------------------------------------------------------------------------
     def run(self) -> None:

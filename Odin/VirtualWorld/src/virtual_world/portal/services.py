@@ -17,7 +17,7 @@ from odin_common.interface import SetJointAction
 from odin_common.limits import shown
 from odin_common.specs import EntitySpec, JointSpec, MotorSpec
 from odin_common.world_parameters import set_world_flags
-from virtual_world.core import Core, step_values
+from virtual_world.core import Core, long_calls, step_values
 from virtual_world.errors import InvalidArgument
 from virtual_world.portal import conversions
 from virtual_world.portal.mirror import WorldMirror
@@ -58,6 +58,9 @@ class WorldServices:
         self.loop = loop
         self.viewer = viewer
         self.mirror = WorldMirror() if mirror is None else mirror
+        #: whether the caller of the call being served has gone (the Portal sets it around
+        #: each call: portal.caller); long calls stop then (core.long_calls)
+        self.cancelled: long_calls.Cancel = long_calls.never
 
     def _built(self, *built) -> None:
         """Objects the Core built (core.Built each): to the Viewer and the mirror."""
@@ -94,7 +97,7 @@ class WorldServices:
         return dict(self.step_fields(), message=note)
 
     def step_once(self, request) -> dict:
-        sim_time = self.loop.step_cycles(request.cycles)
+        sim_time = self.loop.step_cycles(request.cycles, self.cancelled)
         return {"sim_time": sim_time, "message": f"{request.cycles or 1} cycle(s)"}
 
     def start(self, request) -> dict:
@@ -267,7 +270,8 @@ class WorldServices:
         result = self.core.propagate(
             request.duration, step, motor_goals=goals,
             body_forces=[messages.body_force_arguments(f) for f in request.forces],
-            start=request.start, keep=request.keep, start_state=request.start_state)
+            start=request.start, keep=request.keep, start_state=request.start_state,
+            cancelled=self.cancelled)
         if result.kept:
             self._sync_loop_time()
         return {"start_time": result.start_time, "step": result.step_size,
