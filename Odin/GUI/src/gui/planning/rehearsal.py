@@ -142,8 +142,9 @@ def _room(resources: ResourceLimits, before, keep: bool) -> ResourceLimits:
 
 def _undo(client, plan: BuildPlan, before, ids: BuiltIds, keep: bool) -> str:
     """Removes what a refused load built (everything, after its New Scene; its bodies, with
-    their joints and motors, and its robots, with ``keep``) and sets the world parameters and
-    step values of ``before`` (Get World before the load) again; says what it did."""
+    their joints and motors, and its robots, with ``keep``), sets the world parameters and
+    step values of ``before`` (Get World before the load) again and, if it was running,
+    starts the world again; says what it did."""
     try:
         if keep:
             held = set(client.world().objects)
@@ -161,6 +162,8 @@ def _undo(client, plan: BuildPlan, before, ids: BuiltIds, keep: bool) -> str:
         values = before.step_values
         client.set_step(step=values.step, steps_per_cycle=values.steps_per_cycle,
                         rate=values.rate)
+        if before.simulating:       # a plan's first step pauses the world
+            client.start()
     except OdinError as error:
         return f"undoing what it built failed too: {_one_line(error)}"
     if keep:
