@@ -189,3 +189,32 @@ def test_more_poses_than_objects_are_refused_before_any_is_read(core):
         core.set_poses(Unreadable())
     with pytest.raises(InvalidArgument, match="100,000 poses"):
         core.check_collision(Unreadable())
+
+
+def test_a_body_or_joint_holds_at_most_max_forces_per_owner(core):
+    """Each persistent force is applied at every step and adding one walks those held: the
+    17th on one body (or joint) is refused, and a Propagate's forces count too."""
+    from odin_common.limits import MAX_FORCES_PER_OWNER
+    for _ in range(MAX_FORCES_PER_OWNER):
+        core.add_body_force("base", 0, (0.0, 0.0, 1.0))
+    with pytest.raises(InvalidArgument, match="MAX_FORCES_PER_OWNER"):
+        core.add_body_force("base", 1, (0.0, 0.0, 1.0))
+    assert len(core.body_force_ids()) == MAX_FORCES_PER_OWNER
+    core.build_object(ObjectSpec("free", [0.1], position=(1.0, 0.0, 0.0)))
+    push = {"object_id": "free", "kind": 0, "vector": (1.0, 0.0, 0.0)}
+    with pytest.raises(InvalidArgument, match="MAX_FORCES_PER_OWNER"):
+        core.propagate(0.01, 0.001, body_forces=[push] * (MAX_FORCES_PER_OWNER + 1))
+    assert len(core.body_force_ids()) == MAX_FORCES_PER_OWNER
+    joint = core.create_joint(1, "free", "", axis1=(0.0, 0.0, 1.0))
+    for _ in range(MAX_FORCES_PER_OWNER):
+        core.add_joint_force(joint, [0.1])
+    with pytest.raises(InvalidArgument, match="MAX_FORCES_PER_OWNER"):
+        core.add_joint_force(joint, [0.1])
+
+
+def test_get_state_of_more_names_than_the_world_holds_is_refused_before_reading(core):
+    """One name repeated 100,000 times would answer 100,000 states: refused at once."""
+    for kwargs in ({"objects": ["base"] * 100_000}, {"joints": ["j"] * 2},
+                   {"motors": ["m"] * 3}):
+        with pytest.raises(InvalidArgument, match="asked for; the world holds"):
+            core.state(**kwargs)

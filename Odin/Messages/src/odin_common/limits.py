@@ -16,6 +16,11 @@ from odin_common.errors import InvalidArgument
 MAX_FORCE = 1e7
 """N (forces) or N m (torques): a persistent body or joint force, a motor's maximum force."""
 
+MAX_FORCES_PER_OWNER = 16
+"""Persistent forces and torques (Set External Force, Set Joint Force, a Propagate's forces)
+one body or one joint may hold at a time: each is applied at every step, and adding one
+walks those held, so their number bounds a step's and a request's work."""
+
 MIN_MASS = 1e-9
 """kg: the lightest body."""
 MAX_MASS = 1e9

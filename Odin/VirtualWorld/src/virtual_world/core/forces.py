@@ -149,9 +149,14 @@ _JOINT = _Kind("joint force", lambda scene: scene.joint_forces, lambda scene: sc
 def _keep(scene: Scene, kind: _Kind, prefix: str, record) -> str:
     """Keeps ``record`` under "<prefix>:<n>", n the first free number; returns that ID."""
     records = kind.records(scene)
+    owner = kind.owners(scene)[kind.owner_id(record)]
+    if len(owner.forces) >= limits.MAX_FORCES_PER_OWNER:
+        raise InvalidArgument(f"{shown(kind.owner_id(record))} holds {len(owner.forces)} "
+                              f"forces, the most one may (MAX_FORCES_PER_OWNER): remove one "
+                              "first")
     force_id = _free_id(records, prefix)
     records[force_id] = record
-    kind.owners(scene)[kind.owner_id(record)].forces.add(force_id)
+    owner.forces.add(force_id)
     kind.to_c(scene)
     return force_id
 

@@ -729,8 +729,15 @@ class Core:
         """Get State: for the objects, joints and motors named (each list empty: all of them),
         their states: poses, velocities, mass and inertia; joint positions, rates and the
         force and torque each joint applied to its bodies in the last step; motor goals and
-        maximum forces. Unknown names raise before anything is read."""
+        maximum forces. Unknown names raise before anything is read, and a list longer than
+        what the world holds before any name is (the answer may not outgrow the world)."""
         scene = self._scene
+        for what, names, held in (("objects", objects, len(scene.objects)),
+                                  ("joints", joints, len(scene.joints)),
+                                  ("motors", motors, len(scene.motors))):
+            if len(names) > held:
+                raise InvalidArgument(f"{len(names):,} {what} asked for; the world holds "
+                                      f"{held:,} (each at most once)")
         for object_id in objects:
             scene.body_object(object_id, "state")
         for joint_id in joints:
