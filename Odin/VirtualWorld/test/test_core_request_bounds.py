@@ -218,3 +218,22 @@ def test_get_state_of_more_names_than_the_world_holds_is_refused_before_reading(
                    {"motors": ["m"] * 3}):
         with pytest.raises(InvalidArgument, match="asked for; the world holds"):
             core.state(**kwargs)
+
+
+def test_saved_states_are_bounded_in_memory_not_only_in_count(core, monkeypatch):
+    """A snapshot grows with the scene: with MAX_SNAPSHOT_MB made small, Save State beyond it
+    is refused naming the bound (max_snapshots alone would allow 10,000 of any size), and
+    saving again under a name held replaces it within the bound."""
+    from odin_common import limits
+    from virtual_world.core import snapshots
+    for k in range(200):
+        core.build_object(ObjectSpec(f"b{k}", [0.05], position=(0.2 * k, 2.0, 0.0)))
+    core.save_state("first")
+    one = snapshots.size_bytes(core._scene.snapshots["first"])
+    assert one > 200 * 200
+    monkeypatch.setattr(limits, "MAX_SNAPSHOT_MB", 2.5 * one / 2 ** 20)
+    core.save_state("second")
+    with pytest.raises(InvalidArgument, match="MAX_SNAPSHOT_MB"):
+        core.save_state("third")
+    core.save_state("second")
+    assert core.snapshot_names() == ["first", "second"]

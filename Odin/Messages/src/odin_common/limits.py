@@ -61,6 +61,11 @@ MIN_STEP = 1e-7
 MAX_GRAVITY = 1e4
 """m/s^2: each component of gravity."""
 
+MAX_SNAPSHOT_MB = 1024
+"""MB (estimated) all of a world's saved states (Save State) may hold together: a snapshot
+grows with the scene (~0.3 kB a body), so max_snapshots of a 100,000-body scene would be
+hundreds of GB; Save State beyond it is refused, naming both."""
+
 MAX_MESH_TRIANGLES = 2_000_000
 """Triangles of one mesh, by default (ResourceLimits.max_mesh_triangles)."""
 

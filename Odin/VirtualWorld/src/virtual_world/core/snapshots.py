@@ -55,6 +55,24 @@ class Snapshot:
     exempt_live: np.ndarray                     # exempt pairs' states (core.exemptions)
 
 
+_ITEM_BYTES = 100
+"""Bytes a snapshot's Python item (a tuple, a dict entry, an ID) is counted as: an estimate
+of CPython's object and container overhead."""
+
+
+def size_bytes(snapshot: Snapshot) -> int:
+    """What ``snapshot`` holds in memory, estimated (bytes): its arrays, and _ITEM_BYTES per
+    item of its tuples and dicts."""
+    arrays = (snapshot.body_states.nbytes + snapshot.static_poses.nbytes
+              + snapshot.exempt_live.nbytes)
+    items = sum(len(part) for part in (
+        *snapshot.contents, snapshot.body_ids, snapshot.static_names,
+        snapshot.joint_parameters, snapshot.motor_parameters, snapshot.motor_goals,
+        snapshot.servos, snapshot.body_forces, snapshot.joint_forces, snapshot.carried,
+        snapshot.parked, snapshot.kinematic))
+    return arrays + _ITEM_BYTES * items
+
+
 def contents(scene: Scene) -> Contents:
     return tuple(scene.objects), tuple(scene.joints), tuple(scene.motors), scene.exempt_pairs
 
