@@ -20,8 +20,9 @@ from typing import Dict, Tuple
 
 import numpy as np
 
+from odin_common import limits
 from odin_common.interface import JOINT_PARAMETER_AXES, JOINT_PARAMETERS, MOTOR_PARAMETERS
-from odin_common.limits import shown_list
+from odin_common.limits import shown, shown_list
 from virtual_world.core import exemptions, forces, guard, kinematic, motors, readout
 from virtual_world.core.records import BodyForceRecord, Collision, JointForceRecord
 from virtual_world.core.scene import Scene
@@ -71,6 +72,18 @@ def size_bytes(snapshot: Snapshot) -> int:
         snapshot.servos, snapshot.body_forces, snapshot.joint_forces, snapshot.carried,
         snapshot.parked, snapshot.kinematic))
     return arrays + _ITEM_BYTES * items
+
+
+def check_room(held: Dict[str, Snapshot], name: str, snapshot: Snapshot) -> None:
+    """InvalidArgument when keeping ``snapshot`` under ``name`` (replacing one so named) would
+    make the saved states ``held`` hold more than limits.MAX_SNAPSHOT_MB."""
+    size = size_bytes(snapshot)
+    others = sum(size_bytes(s) for n, s in held.items() if n != name)
+    if others + size > limits.MAX_SNAPSHOT_MB * 2 ** 20:
+        raise InvalidArgument(f"snapshot {shown(name)}: {size / 2 ** 20:.3g} MB more than the "
+                              f"{others / 2 ** 20:.4g} MB of saved states held exceeds "
+                              f"{limits.MAX_SNAPSHOT_MB:,} MB (MAX_SNAPSHOT_MB); remove some "
+                              "first")
 
 
 def contents(scene: Scene) -> Contents:

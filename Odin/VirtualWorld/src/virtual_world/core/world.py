@@ -389,13 +389,7 @@ class Core:
             raise InvalidArgument(f"snapshot {shown(name)}: the world holds {len(held)} snapshots, "
                                   f"the limit (max_snapshots); remove one first")
         snapshot = snapshots.take(self._scene)
-        size = snapshots.size_bytes(snapshot)
-        others = sum(snapshots.size_bytes(s) for n, s in held.items() if n != name)
-        if others + size > limits.MAX_SNAPSHOT_MB * 2 ** 20:
-            raise InvalidArgument(f"snapshot {shown(name)}: {size / 2 ** 20:.3g} MB more than "
-                                  f"the {others / 2 ** 20:.4g} MB of saved states held "
-                                  f"exceeds {limits.MAX_SNAPSHOT_MB:,} MB (MAX_SNAPSHOT_MB); "
-                                  "remove some first")
+        snapshots.check_room(held, name, snapshot)
         if self._scene.parameters.auto_disable:    # (no snapshot holds ODE's rest counts)
             self._scene.c.restart_rest_counts()
         held[name] = snapshot
