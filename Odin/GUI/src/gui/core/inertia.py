@@ -21,7 +21,7 @@ import numpy as np
 
 from gui.core.model import Ignored, LinkModel
 from gui.core.shapes import Shape
-from odin_common.limits import primitive_corners, thin_inertia
+from odin_common.limits import inertia_problem, primitive_corners
 
 AUTO, FILE, SHAPE = "auto", "file", "shape"
 INERTIA_MODES = (AUTO, FILE, SHAPE)
@@ -143,11 +143,12 @@ def choose(link: LinkModel, owner: str, mass: float, offset: np.ndarray, mode: s
 
 
 def _thin(link: LinkModel, tensor: np.ndarray, mass: float) -> Optional[str]:
-    """Why the world would refuse ``tensor`` as too light in rotation for the link's shape
-    (odin_common.limits.thin_inertia), in the inertial frame; None when it would not."""
+    """Why the world would refuse ``tensor`` for the link's shape, too light or too heavy in
+    rotation (odin_common.limits.inertia_problem), in the inertial frame; None when it would
+    not."""
     to_inertial = np.linalg.inv(link.inertial.origin)
     points = shape_points(link.shape) @ to_inertial[:3, :3].T + to_inertial[:3, 3]
-    return thin_inertia(tensor, mass, points)
+    return inertia_problem(tensor, mass, points)
 
 
 __all__ = ["shape_points", "AUTO", "FILE", "SHAPE", "INERTIA_MODES", "BodyInertia",

@@ -26,7 +26,9 @@ NODE_PARAMETERS: Tuple[NodeParameter, ...] = (
     NodeParameter("viewer", VIEWER_NAMESPACE, "-", "namespace of the Viewer's services"),
     NodeParameter("record", "", "-", "a rosbag file to record every state-changing request "
                   "and every advance into (`rosrun VirtualWorld replay FILE` re-runs it); "
-                  "empty: no recording"),
+                  "empty: no recording. Written as FILE.active and renamed onto FILE when "
+                  "the node closes it; a full disk stops the recording and leaves FILE as it "
+                  "was"),
     NodeParameter("push_speed", 0.5, "m/s", "velocity an interactive marker's Push adds to an "
                   "object (RViz, docs/ROS.md)"),
     NodeParameter("max_objects", _RESOURCES.max_objects, "-",

@@ -79,11 +79,20 @@ How a problem maps to the world:
   is a rigid body's and plausible for the link's shape, the shape's at uniform density
   otherwise. The world refuses a given inertia far too light in rotation for the body's
   geometry (a principal radius of gyration under ``odin_common.limits.MIN_GYRATION_FRACTION``
-  of the geometry's reach from that axis: ODE's solver would abort the process), so such a
+  of the geometry's reach from that axis: ODE's solver would abort the process) or far too
+  heavy (over ``MAX_GYRATION_MULTIPLE`` times that reach, or over ``MAX_INERTIA``), so such a
   tensor is set aside for the shape's too. Contact surfaces: the link's (URDF contact coefficients) on its object or parts.
 - Names (thesis 8.3): links are "robot/link" (Kautham's own .cntr naming), one-link instances
   keep the instance name; instance names come from the robot's name or the obstacle's file
   name, numbered "_2", "_3"... on collision; composite parts are "name#k".
+- All or nothing (``gui.planning.rehearsal.load_scene``): load_problem and the window's Open
+  build the whole plan first in a Core of their own process, started as the world is (its
+  parameters, step values and its node's ``~max_objects``, ``~max_mesh_triangles``,
+  ``~max_snapshots``, ``~max_request_mb``), and send it only when every request was taken
+  there; otherwise one line names the step and the world is unchanged. A step the world still
+  refuses (another client in between, a clash with what ``--keep`` keeps) is undone: what the
+  load built is removed, the parameters and step values it set are put back, and a running
+  world is started again.
 """
 from gui.core.translate.planner import GROUND, BuildDefaults, plan_problem
 
