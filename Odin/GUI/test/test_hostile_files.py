@@ -570,3 +570,21 @@ def test_a_60_mb_obj_of_faces_is_refused_in_bounded_memory(tmp_path):
     status, err, peak = _rss_of_problem_info(problem, tmp_path)
     assert status == 2 and "holds 7,500,000 faces" in err, err
     assert peak is not None and peak < 500, f"peak RSS {peak} MB"
+
+
+@pytest.mark.timeout(120)
+def test_a_vrml_mesh_over_the_triangle_limit_is_refused_before_its_triangles_are_collected(
+        tmp_path, monkeypatch):
+    """Coin hands triangles to Python one callback each (~0.1 ms): 2.1 million in one face
+    set took minutes before the limit refused them. They are counted first, in C++."""
+    import time
+    big = tmp_path / "big.iv"
+    big.write_bytes(b"#Inventor V2.1 ascii\nSeparator { Coordinate3 { point [0 0 0, 1 0 0, "
+                    b"0 1 0] } IndexedFaceSet { coordIndex [" + b"0,1,2,-1," * 2_100_000
+                    + b"] } }\n")
+    shapes._CACHE.clear()
+    monkeypatch.setattr(shapes, "_collect", lambda *a: pytest.fail("collected triangles"))
+    started = time.monotonic()
+    with pytest.raises(ShapeError, match=r"more than 2,000,000 triangles \(2,100,000;"):
+        read_shape(big)
+    assert time.monotonic() - started < 30
