@@ -191,3 +191,35 @@ def test_an_unlimited_motor_force_on_an_axis_past_its_stop_steps(where):
     assert "stepped" in done.stdout
     if where == "motor":
         assert "max_forces=(inf,)" in done.stdout
+
+
+def test_an_unlimited_force_is_odes_infinity_until_its_axis_has_a_stop():
+    """Where no stop can be met, ODE keeps its own infinity (the unbounded solver row every
+    scene without stops has always stepped: the thesis's grasp and pile experiments moved
+    when it was replaced by a finite force everywhere); a finite stop, set before or after,
+    makes it UNLIMITED_FORCE, and the stop taken away makes it ODE's infinity again. A client
+    reads infinity throughout."""
+    import math
+    from odin_common.interface import JointParameter as P, JointType as J
+    from virtual_world.core import Core, ObjectSpec
+    from virtual_world.ode import joints as ode_joints
+    with Core() as core:
+        core.build_object(ObjectSpec("arm", [0.2, 0.3], mass=0.5, position=(0.3, 0.0, 0.0)))
+        core.build_object(ObjectSpec("hub", [0.3], mass=4.0, position=(-0.3, 0.0, 0.0)))
+        motor = core.create_motor(body1="arm", body2="hub", axes=[0.0, 0.0, 1.0])
+        record = core._scene.motors[motor]
+
+        def held() -> float:
+            return ode_joints.motor_parameter(record.owner.ptr, record.kind, P.MAX_FORCE, 1)
+        assert held() == math.inf
+        core.set_joint_parameters(motor, [(P.HI_STOP, 1, 0.5)])
+        assert held() == ode_joints.UNLIMITED_FORCE
+        assert math.isfinite(held()) and held() > 1e7
+        core.set_joint_parameters(motor, [(P.HI_STOP, 1, math.inf)])
+        assert held() == math.inf
+        core.set_joint_parameters(motor, [(P.MAX_FORCE, 1, 1e7)])
+        core.set_joint_parameters(motor, [(P.LO_STOP, 1, -0.5)])
+        assert held() == 1e7        # a limited force is what was asked, stop or none
+        core.set_joint_parameters(motor, [(P.MAX_FORCE, 1, -1.0)])
+        assert held() == ode_joints.UNLIMITED_FORCE
+        assert core.state()[2][0].max_forces == (math.inf,)

@@ -107,7 +107,7 @@ def _checked_parameters(kind: JointType, joint_id: str, parameters) -> list:
 
 def _check_parameters(parameters, allowed, axes: int, kind: str, joint_id: str) -> list:
     """[(JointParameter, axis, value)] with values in range; MAX_FORCE < 0 (unlimited) ->
-    ode.joints.UNLIMITED_FORCE."""
+    math.inf (what ODE is given for it: ode.joints.set_joint_parameter)."""
     checked = []
     for item in parameters:
         try:

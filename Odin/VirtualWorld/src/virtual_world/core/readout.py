@@ -140,6 +140,7 @@ def motor_states(scene: Scene, motor_ids) -> List[MotorState]:
 
 
 def _reported_force(fmax: float) -> float:
-    """A motor's maximum force as ODE holds it -> as a client reads it: ODE is given
-    ode.joints.UNLIMITED_FORCE for an unlimited one, which reads as math.inf again."""
+    """A motor's maximum force as ODE holds it -> as a client reads it: ODE holds its
+    infinity for an unlimited one, or ode.joints.UNLIMITED_FORCE on an axis with a stop:
+    both read as math.inf."""
     return math.inf if fmax >= ode_joints.UNLIMITED_FORCE else fmax

@@ -62,11 +62,13 @@ def flat_vector(what: str, value) -> np.ndarray:
 def axis(what: str, value) -> np.ndarray:
     """(3,) unit vector."""
     a = vector(what, value)
-    largest = float(np.max(np.abs(a)))
-    if largest < 1e-9:
+    norm = float(np.linalg.norm(a))
+    if math.isinf(norm):    # (1e200, 0, 1e200): brought to ~1 first. Only then: dividing
+        a = a / float(np.max(np.abs(a)))    # every axis by its largest first would change
+        norm = float(np.linalg.norm(a))     # the last bit of ordinary ones, and so motions
+    if norm < 1e-9:
         raise InvalidArgument(f"{what}={shown(value)} is a zero axis")
-    a = a / largest     # first to ~1: the norm of (1e200, 0, 1e200) would overflow to inf
-    return a / float(np.linalg.norm(a))
+    return a / norm
 
 
 def quaternion(what: str, value) -> np.ndarray:

@@ -142,13 +142,46 @@ def ode_parameter(parameter: JointParameter, axis: int) -> int:
 @drains_ode_messages
 def set_joint_parameter(joint, kind: JointType, parameter: JointParameter, axis: int,
                         value: float) -> None:
-    _SET_PARAMETER[kind](joint, ode_parameter(parameter, axis), value)
+    """Sets ``parameter`` of ``axis`` (1..3) on a joint; an unlimited MAX_FORCE as
+    ``_set_parameter`` says."""
+    _set_parameter(_SET_PARAMETER[kind], _GET_PARAMETER[kind], joint, parameter, axis, value)
 
 
 @drains_ode_messages
 def set_motor_parameter(motor, kind: MotorKind, parameter: JointParameter, axis: int,
                         value: float) -> None:
-    _SET_MOTOR_PARAMETER[kind](motor, ode_parameter(parameter, axis), value)
+    """Sets ``parameter`` of ``axis`` (1..3) on a motor; an unlimited MAX_FORCE as
+    ``_set_parameter`` says."""
+    _set_parameter(_SET_MOTOR_PARAMETER[kind], _GET_MOTOR_PARAMETER[kind], motor, parameter,
+                   axis, value)
+
+
+_STOPS = (JointParameter.LO_STOP, JointParameter.HI_STOP)
+
+
+def _set_parameter(set_, get, handle, parameter: JointParameter, axis: int,
+                   value: float) -> None:
+    """Sets a parameter so that ODE never holds an infinite maximum force on an axis with a
+    stop: there, on a powered axis resting on the stop, ODE applies the whole maximum force
+    to the bodies, and an infinite one made their velocities NaN and ended the process in its
+    quaternion normalisation. An unlimited force (negative, infinite, or UNLIMITED_FORCE read
+    back) is ODE's infinity on an axis without stops, as it always was (an unbounded row of
+    the solver: what every scene without stops steps, bit for bit), and UNLIMITED_FORCE on an
+    axis with a finite stop; a stop set later moves an unlimited force from one to the
+    other."""
+    max_force = ode_parameter(JointParameter.MAX_FORCE, axis)
+    if parameter == JointParameter.MAX_FORCE and (value < 0 or value >= UNLIMITED_FORCE):
+        value = _unlimited_for(get, handle, axis)
+    set_(handle, ode_parameter(parameter, axis), value)
+    if parameter in _STOPS and float(get(handle, max_force)) >= UNLIMITED_FORCE:
+        set_(handle, max_force, _unlimited_for(get, handle, axis))
+
+
+def _unlimited_for(get, handle, axis: int) -> float:
+    """What ODE is given for an unlimited force on ``axis``: its infinity unless a stop of the
+    axis is finite, else UNLIMITED_FORCE."""
+    stops = [float(get(handle, ode_parameter(stop, axis))) for stop in _STOPS]
+    return UNLIMITED_FORCE if any(math.isfinite(stop) for stop in stops) else INFINITY
 
 
 def reactions(joint_owner) -> Tuple[Tuple[float, ...], ...]:
@@ -208,14 +241,14 @@ def configure_motor(motor, kind: MotorKind, axes: Sequence[np.ndarray], frames: 
 INFINITY = lib.dInfinity
 """ODE's infinity (an open stop)."""
 
-UNLIMITED_FORCE = limits.MAX_FORCE
-"""N or N m: the maximum force ODE is given for an axis whose force is unlimited (negative or
-infinite): the strongest force any request may set. Never ODE's infinity: on a powered axis
-that also rests on a stop ODE applies the whole maximum force to the bodies, and an infinite
-one made their velocities NaN and ended the process in ODE's quaternion normalisation."""
+UNLIMITED_FORCE = math.nextafter(limits.MAX_FORCE, math.inf)
+"""N or N m: what ODE holds for an unlimited force (negative or infinite) on an axis with a
+finite stop (``_set_parameter``), never its infinity there; just above the strongest force a
+request may set (limits.MAX_FORCE), so that it reads back as infinite again and nothing else
+does."""
 
 
 def unlimited_force(force: float) -> float:
-    """The maximum force (N or N m) ODE is given for ``force``: UNLIMITED_FORCE when it is
-    negative or infinite ("unlimited"), else ``force``."""
-    return UNLIMITED_FORCE if force < 0 or math.isinf(force) else force
+    """``force`` (N or N m) as the setters take it: math.inf when it is negative or infinite
+    ("unlimited"; ``_set_parameter`` decides what ODE is given), else ``force``."""
+    return math.inf if force < 0 or math.isinf(force) else force
