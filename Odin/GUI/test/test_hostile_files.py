@@ -473,7 +473,9 @@ def test_deep_wide_and_texty_xml_is_refused_or_read_quickly(tmp_path):
         (tmp_path / "named.xml").write_text(named)
         with pytest.raises(ProblemError, match="longer than 256 bytes") as refused:
             read_xml(tmp_path / "named.xml")
-        assert len(str(refused.value)) < 300
+        # short whatever the name's length: the message less the file's path (which depends
+        # on where pytest put it) is a line
+        assert len(str(refused.value)) - len(str(tmp_path / "named.xml")) < 250
     texty = tmp_path / "texty.xml"           # 5 million pieces of text in one element
     texty.write_text("<Problem>" + "&amp;" * 5_000_000 + "</Problem>")
     started = time.monotonic()
