@@ -277,3 +277,26 @@ def test_the_problem_info_tool_refuses_devices_and_fifos_in_one_line(tmp_path):
                              text=True, timeout=60)
         assert run.returncode == 2 and run.stdout == "", run.stderr
         assert run.stderr == f"problem_info: error: {target}: problem file {said}\n"
+
+
+def test_a_urdf_link_without_geometry_is_named_not_an_internal_error(tmp_path):
+    """A link with neither <collision> nor <visual> (a tool frame, base_footprint) between
+    two links with shapes: every link is built as a body with a shape, so the link is named
+    in one line instead of "internal error: AttributeError"."""
+    (tmp_path / "frames.urdf").write_text(
+        '<robot name="frames">'
+        '<link name="foot"><collision><geometry><sphere radius="0.1"/></geometry></collision>'
+        '</link><link name="tool0"/>'
+        '<link name="finger"><visual><geometry><box size="0.02 0.02 0.1"/></geometry></visual>'
+        '</link>'
+        '<joint name="a" type="prismatic"><parent link="foot"/><child link="tool0"/>'
+        '<origin xyz="0 0 0.3"/><limit lower="0" upper="0.2" effort="5" velocity="1"/></joint>'
+        '<joint name="b" type="fixed"><parent link="tool0"/><child link="finger"/></joint>'
+        '</robot>')
+    problem = tmp_path / "frames.xml"
+    problem.write_text('<?xml version="1.0"?><Problem><Robot robot="frames.urdf" scale="1">'
+                       '<Home X="0" Y="0" Z="0" WX="0" WY="0" WZ="1" TH="0"/></Robot>'
+                       '</Problem>')
+    line = _tool_error(problem)
+    assert "link 'tool0' of 'frames' has no geometry" in line and "frames.urdf" in line
+    assert "internal error" not in line

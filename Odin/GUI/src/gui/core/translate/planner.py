@@ -23,6 +23,7 @@ from gui.core.translate import car, chain
 from gui.core.translate.joints import (fixed_joint, joint_motors, link_drive, link_joint,
                                        motor_kind)
 from gui.core.world_settings import default_world, kautham_world
+from gui.errors import ProblemError
 from odin_common.interface import (SERVO_MAX_SPEED, MotorKind, Shape as ShapeKind,
                                    default_motor_id)
 from odin_common.specs import (CompositeSpec, EntitySpec, JointSpec, ObjectSpec, Surface,
@@ -185,6 +186,11 @@ class _Planner:
         specs, bodies = [], []
         for link, pose in zip(model.links, model.link_poses(base_pose, built_at)):
             name = inst.name if single else f"{inst.name}/{link.name}"
+            if link.shape is None:
+                raise ProblemError(f"link {link.name!r} of {inst.name!r} has no geometry (no "
+                                   "<collision> or <visual> shape): Odin builds every link as "
+                                   "a body with a shape; give it one (a small sphere will do)",
+                                   link.source or None)
             mass = link.mass if link.mass is not None else self._default_mass(inst, link)
             spec, offset = shape_to_body(name, link.shape, pose, mass, static)
             if not static:
