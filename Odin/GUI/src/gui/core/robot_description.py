@@ -41,9 +41,10 @@ from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from gui.core.kautham.xmlfile import read_xml
+from gui.core.kautham.xmlfile import parse_xml_bytes, read_xml
 from gui.core.kinematics import pose_to_position_quaternion
 from gui.core.model import FIXED, PRISMATIC, REVOLUTE, LinkModel, RobotModel
+from gui.core.sizes import read_input_file
 from gui.errors import ProblemError
 from odin_common.interface import DEFAULT_COLOR, SERVO_MAX_SPEED, name_segment, unique_frame
 
@@ -154,9 +155,14 @@ def _given_urdf(model: RobotModel) -> Tuple[str, List[str], Dict[int, str]]:
         resolved = (folder / filename).resolve()
         return f"{match.group(1)}{match.group(2)}file://{resolved}{match.group(2)}"
 
-    text = _MESH.sub(absolute, path.read_text(encoding="utf-8"))
+    data = read_input_file(path, "URDF file")   # once, bounded: read_input_file's checks
+    try:
+        text = _MESH.sub(absolute, data.decode("utf-8"))
+    except UnicodeDecodeError as error:
+        raise ProblemError(f"URDF file is not UTF-8 text ({error.reason} at byte "
+                           f"{error.start})", path) from None
     names = {}
-    for joint in read_xml(path, "URDF file").findall("joint"):
+    for joint in parse_xml_bytes(data, str(path)).findall("joint"):
         child = joint.find("child")
         if child is not None:
             names[child.get("link")] = joint.get("name", "")

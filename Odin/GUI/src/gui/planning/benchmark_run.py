@@ -160,6 +160,7 @@ def problem_bundle(load: Callable[[], object], problem: str
         sys.addaudithook(_record_open)
         _hook_installed = True
     from gui.core import shapes
+    from gui.core.sizes import read_input_file
     cached = shapes._CACHE
     shapes._CACHE = {}      # this process's shapes read again: their files opened, and seen
     _recording = set()
@@ -174,8 +175,7 @@ def problem_bundle(load: Callable[[], object], problem: str
     root = os.path.commonpath([os.path.dirname(p) for p in opened])
     files = []
     for path in sorted(opened):
-        with open(path, "rb") as f:
-            files.append((os.path.relpath(path, root), f.read()))
+        files.append((os.path.relpath(path, root), read_input_file(path, "problem's file")))
     return os.path.relpath(problem, root), tuple(files)
 
 
