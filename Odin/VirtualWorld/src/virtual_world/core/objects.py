@@ -147,8 +147,8 @@ def _given_mass(what: str, mass: float, inertia, center_of_mass):
         return None
     i = check.vector(f"{what}: inertia", inertia, 6)
     # before ODE forms its matrix: sums of such values would overflow to inf
-    check.at_most(f"{what}: inertia", float(np.max(np.abs(i))), limits.MAX_INERTIA,
-                  "kg m^2 (MAX_INERTIA)")
+    check.at_most(f"{what}: inertia (MAX_INERTIA)", float(np.max(np.abs(i))),
+                  limits.MAX_INERTIA, "kg m^2")
     center = check.vector(f"{what}: center_of_mass", center_of_mass) \
         if len(center_of_mass) else np.zeros(3)
     matrix = np.array([[i[0], i[3], i[4]], [i[3], i[1], i[5]], [i[4], i[5], i[2]]])
