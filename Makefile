@@ -42,8 +42,11 @@ bench: setup bench-setup
 experiments: setup
 	@$(ENV) python tools/experiments/run.py
 
+# catkin_lint over the packages' manifests and CMake files, then ruff over the Python
+# (ruff.toml: pyflakes and 100-column lines); both always run, either failing fails the target
 lint: setup
-	@$(ENV) catkin_lint --strict -W2 Odin
+	@$(ENV) failed=0; catkin_lint --strict -W2 Odin || failed=1; \
+	  ruff check || failed=1; exit $$failed
 
 # mutation testing of the Core (C step code and Python), not part of `make test`: writes
 # out/mutants/report.json and report.md, prints the survivors, exits 0 (docs/MUTANTS.md)
