@@ -36,11 +36,16 @@ import pathlib
 import re
 import struct
 import tempfile
-from typing import Callable, Optional
+from typing import TYPE_CHECKING, Callable, Optional
 
 import numpy as np
 
 from odin_common.limits import shown
+
+if TYPE_CHECKING:
+    # only a type: shapes imports this module at its top, so at run time the functions below
+    # import what they build from shapes when they run, never at import
+    from gui.core.shapes import Shape
 
 log = logging.getLogger(__name__)
 
