@@ -15,7 +15,7 @@ import pytest
 from gui.core.plan import EntityStep, JointStep
 from gui.core.translate import BuildDefaults, plan_problem
 from odin_common.specs import CompositeSpec
-from gui.errors import GuiError, ProblemError, ShapeError
+from gui.errors import ProblemError, ShapeError
 from gui.core.kautham.corpus import corpus_dir
 from gui.core.kautham.problem import load_problem
 from gui.core.kautham.robot_rob import read_dh_robot
@@ -122,7 +122,7 @@ def test_tx90_link_poses_match_the_dh_table_at_home_and_elsewhere():
 def test_hand_tree_with_pretrans_matches_the_table():
     problem = load_problem(LEGACY / "TX90_RHand_ICRA10_5PMD_TwoCan.xml")
     model = problem.robots[0].model
-    names = [l.name for l in model.links]
+    names = [link.name for link in model.links]
     home = model.home()
     poses = model.link_poses(np.eye(4))
     tcp = tx90_poses(np.eye(4), [0.0] * 6)[-1]
@@ -173,7 +173,7 @@ def test_urdf_tx90_follows_its_joint_origins():
         expected.append(T)
     for got, exp in zip(robot.model.link_poses(robot.base_pose, q), expected):
         np.testing.assert_allclose(got, exp, atol=1e-9)
-    assert [l.mass for l in robot.model.links][0] == pytest.approx(10.733459)
+    assert [link.mass for link in robot.model.links][0] == pytest.approx(10.733459)
 
 
 # -- scene placement --------------------------------------------------------------------------

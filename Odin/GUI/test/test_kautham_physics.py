@@ -138,7 +138,8 @@ def test_problem_info_lists_what_odin_does_not_use_and_warns_once_each():
     assert not any('"Goal Bias"' in w for w in whats)       # the planning bridge uses it
     assert any("Constraint Force Mixing" in w for w in whats)
     assert any("<inertial>" in w for w in whats)             # the placeholder inertias
-    warnings = [l for l in result.stderr.splitlines() if l.startswith("problem_info: warning:")]
+    warnings = [line for line in result.stderr.splitlines()
+                if line.startswith("problem_info: warning:")]
     assert len(warnings) == len(set(warnings)) == len(info["ignored"])
     robot = info["robots"][0]
     assert robot["kind"] == "free body" and robot["start"]["controls"] == [0.544, 0.433, 0.4]

@@ -21,7 +21,6 @@ from odin_common.step_values import StepValues
 from Services import srv
 from visualization_msgs.msg import Marker
 from virtual_world.core import Core
-from virtual_world.portal import conversions
 from virtual_world.portal.mirror import WorldMirror
 from virtual_world.portal.services import WorldServices
 

@@ -73,7 +73,8 @@ def _problem_of_chess_size(tmp_path, robots: int = 2) -> pathlib.Path:
     robots_xml = "".join(f'<Robot robot="arm.urdf" name="arm{k}"><Home TH="0" WZ="1" WY="0" '
                          f'WX="0" Z="0" Y="{k}" X="0"/></Robot>' for k in range(robots))
     movable = [i for i in range(1, 21) if i not in (7, 9, 12)]
-    controls = "".join(f'<Control name="c{k}{i}" eigValue="1"><DOF name="{("arm", "arm_2")[k]}/l{i}" '
+    controls = "".join(f'<Control name="c{k}{i}" eigValue="1">'
+                       f'<DOF name="{("arm", "arm_2")[k]}/l{i}" '
                        'value="1"/></Control>' for k in range(robots) for i in movable)
     (tmp_path / "arm.cntr").write_text(f"<ControlSet>{controls}</ControlSet>")
     problem = tmp_path / "problem.xml"

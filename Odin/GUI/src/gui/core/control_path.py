@@ -14,7 +14,6 @@ world (paused) for its duration, kept, as Kautham's propagation steps its ODE wo
 """
 from __future__ import annotations
 
-import math
 import os
 import pathlib
 import time
@@ -37,13 +36,13 @@ seconds (`rosrun GUI run_path PROBLEM --controls FILE`, the Motion tab's "Contro
 Each row maps to the robot as Kautham maps a control sample (`Robot::control2Parameters`,
 `parameter2Pose`): normalised DOF values p = offset + sum_k eigValue_k map_k (c_k - 0.5) from
 the control file (`.cntr`, or the `.rob`'s `<ControlSet>`; a DOF it does not list has offset 0.5,
-0 in a 2012 `.rob`'s own set, and no map), each clamped to [0, 1], then through the robot's limits: a joint's value
-q = low + p (high - low) (a continuous joint's range is [-2 pi, 2 pi]); the base's position
-low + p (high - low) per axis of the problem's `<Limits>` box taken into the Home frame, and
-its orientation from X1, X2, X3 by Kuffner's uniform quaternion (w = sqrt(1 - p1) cos(pi p3),
-x = sqrt(p1) sin(2 pi p2), y = sqrt(p1) cos(2 pi p2), z = sqrt(1 - p1) sin(pi p3)), both in the
-Home frame. The query's `<Init>` and `<Goal>` map the same way to the start the problem is built
-at and the goal.
+0 in a 2012 `.rob`'s own set, and no map), each clamped to [0, 1], then through the robot's
+limits: a joint's value q = low + p (high - low) (a continuous joint's range is
+[-2 pi, 2 pi]); the base's position low + p (high - low) per axis of the problem's `<Limits>`
+box taken into the Home frame, and its orientation from X1, X2, X3 by Kuffner's uniform
+quaternion (w = sqrt(1 - p1) cos(pi p3), x = sqrt(p1) sin(2 pi p2), y = sqrt(p1) cos(2 pi p2),
+z = sqrt(1 - p1) sin(pi p3)), both in the Home frame. The query's `<Init>` and `<Goal>` map the
+same way to the start the problem is built at and the goal.
 
 For the row's duration the robot is then driven the way Kautham's ODE environment drives that
 kind of robot:

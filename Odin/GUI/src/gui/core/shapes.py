@@ -5,7 +5,8 @@ Readers:
   headers over Coin's VRML node names and .wrl files that are Inventor) through Coin3D (pivy):
   ``SoDB.readAll`` then a ``SoCallbackAction`` whose triangle callback receives each shape's
   triangles in that shape's *object* space (contrary to what one might expect); the shape's
-  model matrix, taken in a pre-callback, is applied afterwards with numpy, one shape at a time. Spheres, cylinders and cubes are *not* triangulated: Coin tessellates them as open
+  model matrix, taken in a pre-callback, is applied afterwards with numpy, one shape at a time.
+  Spheres, cylinders and cubes are *not* triangulated: Coin tessellates them as open
   meshes, so they stay ODE primitives (a pre-callback records them with their model matrix and
   prunes them).
 - STL, OBJ, PLY, OFF, GLB... through trimesh (imported only when such a file is read); Collada

@@ -7,8 +7,8 @@ The OMPL problem (``gui.planning.problem`` says what each part means):
   planners measure distances and cells here) and the whole world's body state vector
   (``Core.body_state_vector``, weight 0: carried, never measured) with one value appended,
   1 when the step into the state touched an obstacle the robot must not;
-- control space: [0, 1]^k, the robot's `.cntr` controls (those searched); a control lasts ``min_control_steps``
-  to ``max_control_steps`` propagation steps of ``step`` s;
+- control space: [0, 1]^k, the robot's `.cntr` controls (those searched); a control lasts
+  ``min_control_steps`` to ``max_control_steps`` propagation steps of ``step`` s;
 - propagator: the back end's (restore, apply the row, step, read);
 - validity: the tracked link in bounds and no forbidden contact on the way in;
 - goal region: the tracked link within ``goal_tolerance`` of where the query's goal puts it,

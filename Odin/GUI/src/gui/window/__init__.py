@@ -2,10 +2,10 @@
 
 Modules: ``main_window`` (the window, message log, connection state), one module per tab
 (``simulation_tab``, ``settings_tab``, ``objects_tab``, ``motion_tab``, ``joints_tab``),
-``plot_panel`` (joint positions and speeds from the world's ~joint_states), ``viewer_panel`` (the Viewer's
-image), ``worker`` (service calls on a QThread, never the GUI thread), ``ros_link`` (topics ->
-Qt signals), ``scene`` (what the window knows of the scene), ``fields`` (input limits),
-``display`` (on-screen or off-screen, decided at start-up).
+``plot_panel`` (joint positions and speeds from the world's ~joint_states), ``viewer_panel``
+(the Viewer's image), ``worker`` (service calls on a QThread, never the GUI thread),
+``ros_link`` (topics -> Qt signals), ``scene`` (what the window knows of the scene), ``fields``
+(input limits), ``display`` (on-screen or off-screen, decided at start-up).
 
     rosrun GUI gui [--master-timeout S] [_world:=/virtual_world] [_viewer:=/viewer]
 

@@ -1,4 +1,5 @@
-"""Past the thesis: chosen joints' positions and speeds over time, from the world's ``~joint_states``.
+"""Past the thesis: chosen joints' positions and speeds over time, from the world's
+``~joint_states``.
 
 Samples go into one bounded deque per joint axis (``history`` seconds of simulated time); the
 plot is repainted by a timer at ``fps`` (never per message), with QPainter: positions on top,

@@ -15,8 +15,9 @@ The mapping (Kautham's ``Robot::control2Parameters``, ``Robot::parameter2Pose``,
 
 with offset 0.5 for every DOF the file does not list (current Kautham's
 ``Problem::setRobotControls``), 0 in a 2012 robot's own ``<ControlSet>`` (Kautham 2012's
-``Robot::Robot`` zeroes its offset matrix before reading ``<Offset>``); each p is then clamped to [0, 1] (the
-controls are within bounds when no clamp was needed). Then, through the robot's limits:
+``Robot::Robot`` zeroes its offset matrix before reading ``<Offset>``); each p is then clamped
+to [0, 1] (the controls are within bounds when no clamp was needed). Then, through the
+robot's limits:
 
 - a joint: q = low + p (high - low) (continuous joints: [-2 pi, 2 pi], Kautham's);
 - the base, only when the control set names one of X..X3 for the robot (otherwise the base

@@ -29,12 +29,10 @@ never stops a load. ``robType="Freeflying"`` gives the robot a free base
 """
 from __future__ import annotations
 
-import math
 import pathlib
 
 import numpy as np
 
-from gui.errors import ProblemError
 from gui.core.kautham.controls import parse_control_set
 from gui.core.kautham.units import LEGACY, SI, Units, scale_problem
 from gui.core.kautham.xmlfile import Node, read_xml

@@ -28,7 +28,8 @@ How a problem maps to the world:
   (steering about the base's up, opposite for the wheels ahead of its centre and the others;
   both reversed like a hinge's, so that a positive steering turns left and a positive wheel
   speed rolls the car along its +x). Then one Set Motor per movable joint
-  (angular for hinges and hinge-2s, linear for sliders; zero speed; the joint's effort limit as its force limit, infinite without one; the chain of
+  (angular for hinges and hinge-2s, linear for sliders; zero speed; the joint's effort limit
+  as its force limit, infinite without one; the chain of
   Kautham's chain planner gets PlanarChainEnvironment's 7 N m and 1 rad/s for every joint
   instead, whatever its URDF says), id "motor:" + joint id; a joint with friction gets a second
   motor at zero speed whose force limit is the friction ("friction:" + joint id), a joint
@@ -74,14 +75,16 @@ How a problem maps to the world:
   Kautham, which no body can be) its shape's volume at ``BuildDefaults.massless_density``
   (water's, at least ``LIGHTEST_LINK``: 1 kg fingertips sagged the Allegro hands' 1 N m
   joints); else ``BuildDefaults.link_mass`` (1 kg, what Kautham's ODE environment gives an
-  obstacle without a mass; a .rob ``<Weight>`` is a planner weight, not a mass); a composite's mass is shared among its parts in proportion to their
+  obstacle without a mass; a .rob ``<Weight>`` is a planner weight, not a mass); a
+  composite's mass is shared among its parts in proportion to their
   volumes. Inertia (``gui.core.inertia``): the URDF's tensor about its centre of mass where it
   is a rigid body's and plausible for the link's shape, the shape's at uniform density
   otherwise. The world refuses a given inertia far too light in rotation for the body's
   geometry (a principal radius of gyration under ``odin_common.limits.MIN_GYRATION_FRACTION``
   of the geometry's reach from that axis: ODE's solver would abort the process) or far too
   heavy (over ``MAX_GYRATION_MULTIPLE`` times that reach, or over ``MAX_INERTIA``), so such a
-  tensor is set aside for the shape's too. Contact surfaces: the link's (URDF contact coefficients) on its object or parts.
+  tensor is set aside for the shape's too. Contact surfaces: the link's (URDF contact
+  coefficients) on its object or parts.
 - Names (thesis 8.3): links are "robot/link" (Kautham's own .cntr naming), one-link instances
   keep the instance name; instance names come from the robot's name or the obstacle's file
   name, numbered "_2", "_3"... on collision; composite parts are "name#k".
