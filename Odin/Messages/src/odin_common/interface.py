@@ -433,7 +433,8 @@ WORLD_SERVICES: Dict[str, str] = {
     "remove_object": "RemoveObject", "set_joint": "SetJoint", "set_motor": "SetMotor",
     "set_position": "SetPosition", "set_velocity": "SetVelocity",
     "set_external_force": "SetExternalForce", "set_joint_force": "SetJointForce",
-    "get_world": "GetWorld", "get_state": "GetState", "save_state": "SaveState", "restore_state": "RestoreState",
+    "get_world": "GetWorld", "get_state": "GetState", "save_state": "SaveState",
+    "restore_state": "RestoreState",
     "reset": "Reset", "propagate": "Propagate", "check_collision": "CheckCollision",
     "set_surface": "SetSurface", "set_servo": "SetServo", "set_robot": "SetRobot",
     "exempt_overlaps": "ExemptOverlaps",
@@ -457,14 +458,16 @@ class NodeParameter(NamedTuple):
     what: str
 
 
-__all__ = ["NodeParameter", "SERVO_GAIN", "SERVO_MAX_SPEED", "JointType", "JointParameter", "SetJointAction", "MotorKind", "AxisFrame", "ServoDrive",
-           "ForceKind", "Solver", "DivergencePolicy", "AUTO_SOLVER_MAX_ROWS", "AUTO_SOLVER_ARTICULATION_ROWS", "AUTO_SOLVER_MAX_ISLAND_ROWS", "JOINT_AXES_USED", "JOINT_USES_ANCHOR",
-           "JOINT_NEEDS_TWO_BODIES", "JOINT_AXIS2_ON_BODY2", "JOINT_FORCE_MAGNITUDES", "JOINT_STATE_AXES", "JOINT_PARAMETERS",
-           "JOINT_PARAMETER_AXES", "MOTOR_PARAMETERS", "UNIT_PARAMETERS",
-           "NON_NEGATIVE_PARAMETERS", "joint_type", "default_joint_id", "MOTOR_PREFIX", "default_motor_id", "motor_joint",
-           "Shape", "SHAPE_BY_PARAMETER_COUNT", "SHAPE_PARAMETERS", "shape_of",
-           "shape_kind", "COMPOSITE_MARK", "composite_id",
+__all__ = ["NodeParameter", "SERVO_GAIN", "SERVO_MAX_SPEED", "JointType", "JointParameter",
+           "SetJointAction", "MotorKind", "AxisFrame", "ServoDrive", "ForceKind", "Solver",
+           "DivergencePolicy", "AUTO_SOLVER_MAX_ROWS", "AUTO_SOLVER_ARTICULATION_ROWS",
+           "AUTO_SOLVER_MAX_ISLAND_ROWS", "JOINT_AXES_USED", "JOINT_USES_ANCHOR",
+           "JOINT_NEEDS_TWO_BODIES", "JOINT_AXIS2_ON_BODY2", "JOINT_FORCE_MAGNITUDES",
+           "JOINT_STATE_AXES", "JOINT_PARAMETERS", "JOINT_PARAMETER_AXES", "MOTOR_PARAMETERS",
+           "UNIT_PARAMETERS", "NON_NEGATIVE_PARAMETERS", "joint_type", "default_joint_id",
+           "MOTOR_PREFIX", "default_motor_id", "motor_joint", "Shape", "SHAPE_BY_PARAMETER_COUNT",
+           "SHAPE_PARAMETERS", "shape_of", "shape_kind", "COMPOSITE_MARK", "composite_id",
            "is_composite_id", "WORLD_NAMESPACE", "VIEWER_NAMESPACE", "WORLD_SERVICES",
-           "VIEWER_SERVICES", "WORLD_FRAME", "frame_id", "unique_frame", "name_segment", "robot_namespace",
-           "robot_link_frame", "DEFAULT_COLOR", "COLLIDING_COLOR", "PLANE_DRAWN_SIZE",
-           "PLANE_DRAWN_THICKNESS"]
+           "VIEWER_SERVICES", "WORLD_FRAME", "frame_id", "unique_frame", "name_segment",
+           "robot_namespace", "robot_link_frame", "DEFAULT_COLOR", "COLLIDING_COLOR",
+           "PLANE_DRAWN_SIZE", "PLANE_DRAWN_THICKNESS"]

@@ -196,7 +196,7 @@ def body_force_message(object_id: str, kind: int, vector, vector_in_body_frame: 
                      point=_floats(point), point_in_body_frame=bool(point_in_body_frame))
 
 
-__all__ = ["surface_message", "surface_of", "world_parameters_message", "world_parameters_of", "body_state_message",
-           "body_force_arguments", "body_force_message", "object_message", "object_spec", "part_message", "part_spec", "composite_message",
-           "composite_spec", "parameter_messages", "parameter_triples", "situation_messages",
-           "situation_poses"]
+__all__ = ["surface_message", "surface_of", "world_parameters_message", "world_parameters_of",
+           "body_state_message", "body_force_arguments", "body_force_message", "object_message",
+           "object_spec", "part_message", "part_spec", "composite_message", "composite_spec",
+           "parameter_messages", "parameter_triples", "situation_messages", "situation_poses"]

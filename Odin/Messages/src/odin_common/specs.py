@@ -202,5 +202,5 @@ class MotorSpec:
         return self.id or default_motor_id(self.joint, self.body1, self.body2)
 
 
-__all__ = ["Surface", "WORLD_SURFACE", "NO_COLOR", "ObjectSpec", "PartSpec", "CompositeSpec", "EntitySpec", "JointSpec",
-           "MotorSpec"]
+__all__ = ["Surface", "WORLD_SURFACE", "NO_COLOR", "ObjectSpec", "PartSpec", "CompositeSpec",
+           "EntitySpec", "JointSpec", "MotorSpec"]

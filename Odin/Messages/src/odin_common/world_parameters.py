@@ -113,11 +113,12 @@ PARAMETERS: Tuple[ParameterInfo, ...] = (
                   "set_bounce", 0, label="Bounce velocity", group=_CONTACTS),
     ParameterInfo("solver", "int", "-",
                   "0 QuickStep (iterative, handles piles), 1 dWorldStep (the thesis's exact "
-                  "solver, cubic in each island's constraints), 2 auto (each step: dWorldStep while "
-                  "the whole step has at most odin_common.interface.AUTO_SOLVER_MAX_ROWS "
+                  "solver, cubic in each island's constraints), 2 auto (each step: dWorldStep "
+                  "while the whole step has at most odin_common.interface.AUTO_SOLVER_MAX_ROWS "
                   "constraint rows, or an island is articulated (joints, motors) and the largest "
                   "island has at most odin_common.interface.AUTO_SOLVER_MAX_ISLAND_ROWS, "
-                  "QuickStep otherwise: piles, many bodies at rest, a larger island)", "set_solver", 0, 2,
+                  "QuickStep otherwise: piles, many bodies at rest, a larger island)",
+                  "set_solver", 0, 2,
                   label="Solver", group=_SOLVER, choices=("QuickStep", "WorldStep", "auto")),
     ParameterInfo("quickstep_iterations", "int", "-", "iterations of QuickStep", "set_solver",
                   1, 100000, label="QuickStep iterations", group=_SOLVER),
