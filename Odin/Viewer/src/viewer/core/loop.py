@@ -3,11 +3,11 @@
 Other threads (rospy's service and subscriber threads) never touch the scene or GL: they hand
 work to the loop. :meth:`RenderLoop.call` runs a function on the render thread between frames
 and returns its result (or raises its exception) in the caller's thread; :meth:`RenderLoop.post`
-queues one without waiting, :meth:`RenderLoop.post_later` one to run once a delay has passed. Work is done in the order it arrived, as soon as the thread is free,
-and a frame is rendered every 1/rate seconds whatever arrives, then handed to ``on_frame`` --
-while someone wants frames (``wanted``): a Viewer nobody watches renders nothing and costs
-no CPU beyond keeping its scene up to date (a frame of the TX90 scene is tens of ms of a core).
-ROS-free: the Portal wires it to topics and services.
+queues one without waiting, :meth:`RenderLoop.post_later` one to run once a delay has passed. Work
+is done in the order it arrived, as soon as the thread is free, and a frame is rendered every 1/rate
+seconds whatever arrives, then handed to ``on_frame`` -- while someone wants frames (``wanted``): a
+Viewer nobody watches renders nothing and costs no CPU beyond keeping its scene up to date (a frame
+of the TX90 scene is tens of ms of a core). ROS-free: the Portal wires it to topics and services.
 """
 from __future__ import annotations
 

@@ -5,10 +5,10 @@ Primitive shapes are tessellated and uploaded once (unit sphere, cylinder and bo
 object); each mesh is uploaded once as vertex and index buffers when first drawn, and freed once its
 geometry has left the scene. A large mesh is drawn at the level of detail its size on screen
 needs (viewer.core.geometry.MeshLevels): the coarsest whose grid is at most ``LOD_PIXELS`` of a
-pixel where the mesh comes nearest the camera; each level drawn is uploaded once. Lighting: two white directional lights fixed to the camera and an
-ambient term, so faces turned to the viewer are bright and the hue of every object is kept.
-Closed outward shapes are drawn with back faces culled; open or inverted meshes (many Kautham
-meshes) with both sides lit. A grid on the
+pixel where the mesh comes nearest the camera; each level drawn is uploaded once. Lighting: two
+white directional lights fixed to the camera and an ambient term, so faces turned to the viewer are
+bright and the hue of every object is kept. Closed outward shapes are drawn with back faces culled;
+open or inverted meshes (many Kautham meshes) with both sides lit. A grid on the
 world's z = 0 plane shows the floor.
 """
 from __future__ import annotations

@@ -7,7 +7,8 @@ plane as a CUBE of PLANE_DRAWN_SIZE x PLANE_DRAWN_SIZE x PLANE_DRAWN_THICKNESS, 
 capsule as a TRIANGLE_LIST of its triangles in the geometry's frame. A geometry the Viewer does
 not hold is added from its marker (at the origin: the next world_update places it); one it
 already holds (from View Object) is left alone; a DELETE or DELETEALL removes only what markers
-added. Markers are taken MARKER_GRACE s after they arrive, in the order they arrived. Colours are the marker's, which are the Viewer's own colours.
+added. Markers are taken MARKER_GRACE s after they arrive, in the order they arrived. Colours are
+the marker's, which are the Viewer's own colours.
 
 The markers are read from the message's bytes (:class:`RawMarkerArray`, :func:`read_markers`):
 genpy makes a Python object per point, ~1 s of CPU for the TX90 grasp scene's triangles, on

@@ -8,7 +8,8 @@ from odin_common.interface import WORLD_NAMESPACE, NodeParameter
 from viewer.core.scene import DEFAULT_BACKGROUND
 
 NODE_PARAMETERS: Tuple[NodeParameter, ...] = (
-    NodeParameter("rate", 25.0, "Hz", "frames per second, rendered while an image topic has a subscriber"),
+    NodeParameter("rate", 25.0, "Hz",
+                  "frames per second, rendered while an image topic has a subscriber"),
     NodeParameter("width", 640, "px", "image width (16..4096)"),
     NodeParameter("height", 480, "px", "image height (16..4096)"),
     NodeParameter("fov_y", 0.8, "rad", "vertical field of view"),
