@@ -1,7 +1,6 @@
 """virtual_world.core.arrays: a message's tuples as numpy arrays, the same bits as numpy's own
 conversion, or None for what is not a flat sequence of plain numbers."""
 import numpy as np
-import pytest
 
 from virtual_world.core import arrays
 from virtual_world.core.arrays import flat_float64, float64_array, uint32_array

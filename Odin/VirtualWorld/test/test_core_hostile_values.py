@@ -200,7 +200,7 @@ def test_an_unlimited_force_is_odes_infinity_until_its_axis_has_a_stop():
     makes it UNLIMITED_FORCE, and the stop taken away makes it ODE's infinity again. A client
     reads infinity throughout."""
     import math
-    from odin_common.interface import JointParameter as P, JointType as J
+    from odin_common.interface import JointParameter as P
     from virtual_world.core import Core, ObjectSpec
     from virtual_world.ode import joints as ode_joints
     with Core() as core:

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from odin_common.interface import SERVO_GAIN, SERVO_MAX_SPEED
+from odin_common.interface import SERVO_MAX_SPEED
 from virtual_world.core import (HINGE, HINGE2, SLIDER, UNIVERSAL, Core, ObjectSpec,
                                 WorldParameters)
 from virtual_world.errors import InvalidArgument, Unsupported

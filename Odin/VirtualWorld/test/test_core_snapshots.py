@@ -375,7 +375,8 @@ def test_a_bad_propagation_is_refused_and_changes_nothing(core):
         with pytest.raises(OdinError):
             core.propagate(**{"duration": 0.1, "step_size": H, **kwargs})
         assert state_bytes(core) == before, kwargs
-        assert core.body_force_ids() == ["force:l2:0"] and core.motor_goals()["motor:1:&l0"] == [0.4]
+        assert core.body_force_ids() == ["force:l2:0"]
+        assert core.motor_goals()["motor:1:&l0"] == [0.4]
 
 
 @pytest.mark.parametrize("build,pushed", [(pile, "s4"), (arm, "l2")], ids=["pile", "arm"])

@@ -8,7 +8,7 @@ import pytest
 
 from odin_common.interface import Shape
 from odin_common.specs import Surface
-from virtual_world.core import (Core, CompositeSpec, FORCE, ObjectSpec, PartSpec,
+from virtual_world.core import (Core, CompositeSpec, ObjectSpec, PartSpec,
                                 WorldParameters)
 from virtual_world.errors import InvalidArgument
 

@@ -171,7 +171,8 @@ class WorldLoop:
                                                   self.step_values.steps_per_cycle)
                 self._finish_cycle(stepped=self.simulate, force_publish=not self.free_run)
                 now = time.monotonic()
-                next_tick = now if (self.free_run and self.simulate) else max(next_tick + period, now)
+                next_tick = (now if (self.free_run and self.simulate)
+                             else max(next_tick + period, now))
         finally:
             self._fail_queued_calls()
 

@@ -14,10 +14,9 @@ moved by forces or contacts, infinite mass for them.
 from __future__ import annotations
 
 import functools
-import math
 import threading
 import time
-from typing import Callable, Dict, List, Mapping, Optional, Sequence, Tuple
+from typing import Dict, List, Mapping, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -507,11 +506,11 @@ class Core:
                   cancelled: Optional[long_calls.Cancel] = None) -> Propagation:
         """Runs the world for ``duration`` s in steps of ``step_size`` s, as fast as it goes:
         from the snapshot ``start``, or from the body state vector ``start_state``
-        (``body_state_vector``'s; the rest of the state as it is now), or from now; under ``motor_goals`` ({motor id: goal
-        speeds}) and ``body_forces`` (each the keyword arguments of add_body_force), recording
-        every pair that collides on the way. Then the world goes back to the state it had
-        before the call, unless ``keep``; the forces act during the propagation only.
-        ``read_states`` False leaves the answer's ``states`` empty (a planner reads the state
+        (``body_state_vector``'s; the rest of the state as it is now), or from now; under
+        ``motor_goals`` ({motor id: goal speeds}) and ``body_forces`` (each the keyword arguments of
+        add_body_force), recording every pair that collides on the way. Then the world goes back to
+        the state it had before the call, unless ``keep``; the forces act during the propagation
+        only. ``read_states`` False leaves the answer's ``states`` empty (a planner reads the state
         vector alone). Everything is checked before anything changes. ``cancelled``
         (core.long_calls): asked between pieces of the run; when it says the caller has gone
         the world goes back to the state before the call, as after a refusal, kept or not,

@@ -105,8 +105,8 @@ class CWorld:
     @property
     def last_island_rows(self) -> tuple:
         """The auto solver's measure of the last step (0, 0 under an explicit solver, when the
-        small-system clause held or with nothing articulated): the largest island's constraint rows and the most rows of
-        non-contact joints in one island (odin_step.c measure_islands)."""
+        small-system clause held or with nothing articulated): the largest island's constraint rows
+        and the most rows of non-contact joints in one island (odin_step.c measure_islands)."""
         return int(self.struct.island_rows), int(self.struct.articulated_rows)
 
     @drains_ode_messages

@@ -173,4 +173,5 @@ class _PreSerialised(SpaceDistribution):
 
 
 __all__ = ["view_requests", "collision_pairs", "collided_message", "divergence_diagnostics",
-           "servo_states_message", "wrench", "joint_data", "joint_state_message", "SpaceDistributionWriter"]
+           "servo_states_message", "wrench", "joint_data", "joint_state_message",
+           "SpaceDistributionWriter"]

@@ -23,7 +23,6 @@ import time
 from typing import Callable, Dict, Tuple
 
 import numpy as np
-import rospy
 from geometry_msgs.msg import Pose
 from interactive_markers.interactive_marker_server import InteractiveMarkerServer
 from interactive_markers.menu_handler import MenuHandler

@@ -23,7 +23,8 @@ _ROSPY_WRITE_DATA = QueuedConnection.write_data
 
 
 def _write_data(self, data) -> bool:
-    """rospy's ``QueuedConnection.write_data`` (python3-rospy 1.15) without its ``time.sleep(0)``."""
+    """rospy's ``QueuedConnection.write_data`` (python3-rospy 1.15) without its
+    ``time.sleep(0)``."""
     with self._lock:
         if self._error:         # an error of the sending thread is raised here, as rospy does
             error, self._error = self._error, None

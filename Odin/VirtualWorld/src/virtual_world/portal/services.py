@@ -145,8 +145,8 @@ class WorldServices:
             removed = self.core.remove_joint(request.id)
             self.mirror.removed(joint_ids=[request.id, *removed.joints])
             also = [*removed.motors, *removed.forces]
-            return {"id": request.id,
-                    "message": f"removed {request.id}" + (f" and {', '.join(also)}" if also else "")}
+            return {"id": request.id, "message": f"removed {request.id}"
+                    + (f" and {', '.join(also)}" if also else "")}
         raise InvalidArgument(f"unknown action {request.action} ("
                               + ", ".join(f"{a.name}={a.value}" for a in SetJointAction) + ")")
 
@@ -222,7 +222,8 @@ class WorldServices:
     def set_robot(self, request) -> dict:
         if request.remove:
             robot = self.mirror.remove_robot(request.robot.name)
-            return {"ros_namespace": robot.namespace, "message": f"forgot robot {shown(robot.name)}"}
+            return {"ros_namespace": robot.namespace,
+                    "message": f"forgot robot {shown(robot.name)}"}
         robot = robot_of(request.robot)
         self.mirror.set_robot(robot, {s.id: s.type for s in self.core.joint_states()})
         return {"ros_namespace": robot.namespace,
