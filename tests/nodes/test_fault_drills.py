@@ -108,7 +108,8 @@ def test_a_client_killed_mid_call_costs_the_world_nothing(ros_master):
     rospy.init_node("odin_test_client", anonymous=True, disable_signals=True)
     world = WorldClient()
     for k in range(30):
-        world.ok("build_object", object=sphere(f"s{k}", position=(0.3 * (k % 6), 0.3 * (k // 6), 1)))
+        world.ok("build_object",
+                 object=sphere(f"s{k}", position=(0.3 * (k % 6), 0.3 * (k // 6), 1)))
     client = subprocess.Popen([sys.executable, "-c", CLIENT], env=ros_master.env,
                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
     assert client.stdout.readline().strip() == b"sent"    # the world has the long call

@@ -2,8 +2,6 @@
 from __future__ import annotations
 
 import json
-import math
-import os
 import pathlib
 import time
 
@@ -32,11 +30,13 @@ def test_load_problem_builds_the_hand_and_prints_progress(world, legacy):
     assert lines[-1].startswith("built ")
     # the whole world first (every parameter at its default: a 2012 problem sets none), the
     # robot last held by its 24 servos
-    assert any(l.startswith("[1/56] world: all 23 parameters at their defaults") for l in lines)
-    assert any(l.startswith("[2/56] step 0.001 s, 40 per cycle, 25 Hz") for l in lines)
-    assert any("[3/56] entity TX90 SAHand Right: 25 bodies" in l for l in lines)
-    assert sum(" motor on " in l for l in lines) == 24
-    assert any("[56/56] hold TX90 SAHand Right: 24 servos at the built pose" in l for l in lines)
+    assert any(line.startswith("[1/56] world: all 23 parameters at their defaults")
+               for line in lines)
+    assert any(line.startswith("[2/56] step 0.001 s, 40 per cycle, 25 Hz") for line in lines)
+    assert any("[3/56] entity TX90 SAHand Right: 25 bodies" in line for line in lines)
+    assert sum(" motor on " in line for line in lines) == 24
+    assert any("[56/56] hold TX90 SAHand Right: 24 servos at the built pose" in line
+               for line in lines)
 
 
 def test_load_problem_error_builds_nothing(world, tmp_path):
@@ -159,8 +159,8 @@ def test_a_control_path_drives_the_sphere_demo_to_its_goal(world, kautham_dir, t
     goal = np.array([-5 + 10 * 0.426, -5 + 10 * 0.578])     # sp3.cntr and <Limits>: x, y
     start = np.array([-5 + 10 * 0.544, -5 + 10 * 0.433])
     # "[k/12] t=... s SphereDE at [x, y, z], d m from the goal"
-    where = [np.array(json.loads("[" + l.split(" SphereDE at [")[1].split("]")[0] + "]"))[:2]
-             for l in lines[:-1]]
+    where = [np.array(json.loads("[" + line.split(" SphereDE at [")[1].split("]")[0] + "]"))[:2]
+             for line in lines[:-1]]
     assert len(where) == 12
     assert np.linalg.norm(where[0] - goal) < np.linalg.norm(start - goal) - 0.2
     assert np.linalg.norm(where[-1] - goal) < 0.02
@@ -173,7 +173,8 @@ def test_a_control_path_drives_the_sphere_demo_to_its_goal(world, kautham_dir, t
     result = world.run(["rosrun", "GUI", "run_path", str(problem), "--controls", str(bad)],
                        check=False, timeout=60)
     # the loader's warnings (what Odin does not use), then ONE line: the error, file and line
-    errors = [l for l in result.stderr.splitlines() if not l.startswith("run_path: warning:")]
+    errors = [line for line in result.stderr.splitlines()
+              if not line.startswith("run_path: warning:")]
     assert result.returncode != 0 and len(errors) == 1 and f"{bad}:2:" in errors[0]
 
 
@@ -189,7 +190,7 @@ def test_load_problem_warns_of_parts_the_problem_builds_inside_each_other(world,
     problem = arm_and_box
     inside = problem("inside.xml", 50.0)
     result = world.run(["rosrun", "GUI", "load_problem", str(inside)], timeout=120)
-    warnings = [l for l in result.stderr.splitlines() if "inside each other" in l]
+    warnings = [line for line in result.stderr.splitlines() if "inside each other" in line]
     assert len(warnings) == 1, result.stderr
     assert warnings[0].startswith(f"load_problem: warning: {inside}: built with parts inside "
                                   "each other, where the problem places them: arm/J1 in ")

@@ -25,7 +25,7 @@ def _interrupt_after(world, args, line: str) -> tuple[int, str, str, float]:
                             start_new_session=True)
     try:
         said = ""
-        while not any(l.startswith(line) for l in said.splitlines()):
+        while not any(said_line.startswith(line) for said_line in said.splitlines()):
             out = tool.stdout.readline()
             assert out, f"run_path ended before {line!r}: {said}{tool.stderr.read()}"
             said += out

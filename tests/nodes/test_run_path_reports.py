@@ -90,7 +90,8 @@ def test_a_kps_run_backwards_is_refused_away_from_its_start_and_moved_there_when
     result = world.run(["rosrun", "GUI", "run_path", str(problem), "--at-start", "--tracked",
                         str(solution), "--fast", "--solver", "worldstep"], check=False,
                        timeout=120)
-    errors = [l for l in result.stderr.splitlines() if not l.startswith("run_path: warning:")]
+    errors = [line for line in result.stderr.splitlines()
+              if not line.startswith("run_path: warning:")]
     assert result.returncode == 2 and errors == [
         "run_path: error: the robot is 1.8 rad from the path's start (2D-Robot/link2); "
         "--from-here to move it there first"], result.stderr
@@ -121,8 +122,9 @@ def test_the_readme_s_position_path_runs_word_for_word(world, kautham_dir):
     import os
     import pathlib
     readme = pathlib.Path(os.environ["ODIN_ROOT"], "README.md").read_text().splitlines()
-    lines = [l for l in readme if l.startswith("rosrun GUI ")
-             and "Kuka_two_columns.xml" in l and ("load_problem" in l or "--position" in l)]
+    lines = [line for line in readme if line.startswith("rosrun GUI ")
+             and "Kuka_two_columns.xml" in line
+             and ("load_problem" in line or "--position" in line)]
     assert len(lines) == 2 and "load_problem" in lines[0], lines
     for line in lines:
         result = world.run(["bash", "-c", line], timeout=180)

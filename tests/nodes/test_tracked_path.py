@@ -71,6 +71,7 @@ def test_a_mismatched_plan_is_one_error_line_and_runs_nothing(world, kautham_dir
                    '  <Sample>0.5 0.5 0.5</Sample>\n </SampleSet>\n</Planner>\n')
     result = world.run(["rosrun", "GUI", "run_path", str(problem), "--tracked", str(bad)],
                        check=False, timeout=60)
-    errors = [l for l in result.stderr.splitlines() if not l.startswith("run_path: warning:")]
+    errors = [line for line in result.stderr.splitlines()
+              if not line.startswith("run_path: warning:")]
     assert result.returncode != 0 and len(errors) == 1 and f"{bad}:10:" in errors[0]
     assert "3 values" in errors[0]

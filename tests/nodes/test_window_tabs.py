@@ -90,7 +90,8 @@ def test_settings_tab_step_values_and_world_parameters(window):
     from gui.window.testing import click, screenshot, type_into, wait_for
     tab = window.settings
     window.tabs.setCurrentWidget(tab)
-    wait_for(lambda: tab.in_force_labels["rate"].text() != "?", 5, "values in force: " + window.last_error)
+    wait_for(lambda: tab.in_force_labels["rate"].text() != "?", 5,
+             "values in force: " + window.last_error)
     assert tab.in_force["steps_per_cycle"] == 40
     # only the step is given: the world keeps the cycle time and recomputes steps per cycle
     check, box = tab.step_fields["step"]

@@ -24,7 +24,6 @@ def _viewer_camera():
 
 def test_the_viewer_panel_frames_orbits_and_zooms(ros_master):
     os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
-    import rospy
     from PyQt5.QtCore import QEvent, QPoint, QPointF, Qt
     from PyQt5.QtGui import QMouseEvent
     from PyQt5.QtWidgets import QApplication

@@ -111,7 +111,7 @@ def test_time_never_goes_back_across_new_scenes_for_tf_and_sim_time_nodes(ros_ma
     assert rospy.get_param("/use_sim_time") is True
     stamps = _Stamps()
     buffer = tf2_ros.Buffer(cache_time=rospy.Duration(600))
-    listener = tf2_ros.TransformListener(buffer)
+    listener = tf2_ros.TransformListener(buffer)  # noqa: F841 - held: it fills buffer while it lives
 
     # a use_sim_time node: sleeps on /clock the whole time; rospy raises if time goes back
     sleeper_errors, slept, stop = [], [], threading.Event()
