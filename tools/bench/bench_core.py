@@ -5,8 +5,9 @@ ratios; the two runs of a round are measured back to back, under the same load o
 machine, native first in even rounds and Odin first in odd ones):
   core_spheres100_ratio  100 spheres (r 0.1) dropped on a plane (a static box), Odin's
                          broad phase (sweep and prune), 3 contacts per pair made in serial
-                         order as Odin makes them (native/ordered_contacts.h), mu 1, QuickStep, 2000 steps of 1 ms;
-                         native_time / odin_time (goal >= 0.95).
+                         order as Odin makes them (native/ordered_contacts.h), mu 1,
+                         QuickStep, 2000 steps of 1 ms; native_time / odin_time
+                         (goal >= 0.95).
   core_pile_ratio        the same inside four walls so they pile up (~230 contacts a step).
   core_forces_ratio      the pile plus 100 persistent forces and 20 motors (goal >= 0.90).
   core_newscene_leak_kb  resident memory growth (kB) over 1000 New Scene cycles of a

@@ -16,10 +16,11 @@ The benchmark files are written at run time into out/bench/ode_demos/ (``benchma
 Sphere demos live in the Kautham corpus ($ODIN_KAUTHAM_DIR), the car and the chain in
 tools/kautham/ode_demos, so their ``File`` attributes are absolute paths. The logs and runs land in
 physics/ and car/ there, the summary of both and the plots (success_rate.png,
-time_to_solution.png, propagations_per_s.png) in ode_demos/; docs/PLANNING.md shows them. ``ODIN_BENCH_DEMO_RUNS`` and ``ODIN_BENCH_DEMO_TIME`` (s) shorten
-the benchmark for development (the figures then measure that shorter benchmark), and
-``ODIN_BENCH_DEMO_WORKERS`` sets the local Dask workers (default: one per core). A ``make
-bench`` stopped in the middle of it goes on from the runs it finished (``_benchmark``).
+time_to_solution.png, propagations_per_s.png) in ode_demos/; docs/PLANNING.md shows them.
+``ODIN_BENCH_DEMO_RUNS`` and ``ODIN_BENCH_DEMO_TIME`` (s) shorten the benchmark for development (the
+figures then measure that shorter benchmark), and ``ODIN_BENCH_DEMO_WORKERS`` sets the local Dask
+workers (default: one per core). A ``make bench`` stopped in the middle of it goes on from the runs
+it finished (``_benchmark``).
 """
 import json
 import os

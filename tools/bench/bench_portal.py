@@ -70,7 +70,6 @@ def _start_world(master: RosMaster, *params: str):
 # -- calls under load ----------------------------------------------------------------------
 def _client(index: int, count: int, results) -> None:
     """One load client: mixed calls, each with the answer it must get."""
-    import rospy
     from world_client import WorldClient, sphere
     from Messages.msg import Situation
 

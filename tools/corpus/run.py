@@ -5,15 +5,16 @@ would run it, with a report (issue 31). Not part of `make test` (about an hour h
                                [--no-readme]
 
 The corpus is what ``tools/get_kautham.sh --all`` lays out (``$ODIN_KAUTHAM_ALL_DIR``, else
-``../shared/kautham_all`` beside the clone: ``gui.core.kautham.corpus``). Its problem files are the XML files that mention
-``<Problem`` (Kautham's benchmark and task-planning configuration files do too).
+``../shared/kautham_all`` beside the clone: ``gui.core.kautham.corpus``). Its problem files
+are the XML files that mention ``<Problem`` (Kautham's benchmark and task-planning configuration
+files do too).
 
 1. problem_info on each (``rosrun GUI problem_info FILE``'s main, in a process forked for it
-   from one that imported it once: a rosrun each costs seconds of imports): ok (exit 0, JSON), refused (exit 2 and one line
-   ``problem_info: error: ...``) or failed (anything else: a traceback, another status, more
-   than one error line, a hang of more than ``PROBLEM_INFO_TIMEOUT`` s). A refusal is expected
-   when the file is not a problem (``<Benchmark>``, ``<Config>``) or names a file the
-   repository does not hold at that commit (absent from the tree, or listed in the corpus's
+   from one that imported it once: a rosrun each costs seconds of imports): ok (exit 0, JSON),
+   refused (exit 2 and one line ``problem_info: error: ...``) or failed (anything else: a traceback,
+   another status, more than one error line, a hang of more than ``PROBLEM_INFO_TIMEOUT`` s). A
+   refusal is expected when the file is not a problem (``<Benchmark>``, ``<Config>``) or names a
+   file the repository does not hold at that commit (absent from the tree, or listed in the corpus's
    SKIPPED.md); any other refusal is unexpected.
 2. Each problem problem_info accepts is loaded into a VirtualWorld (with a Viewer beside it,
    both started by rosrun against a roscore of the run's own) as ``rosrun GUI load_problem``

@@ -31,7 +31,6 @@ import math
 import os
 import pathlib
 import shutil
-import sys
 import threading
 import time
 from dataclasses import dataclass, field

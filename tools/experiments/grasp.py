@@ -45,7 +45,6 @@ from __future__ import annotations
 
 import os
 import pathlib
-import time
 
 import numpy as np
 

@@ -243,8 +243,9 @@ def run(scratch: pathlib.Path, jobs: int, fresh: bool, say: Callable[[str], None
             if verdict["status"] != ERROR:
                 cache[cache_key(common, m)] = verdict
                 cache_file.write_text(json.dumps(cache, indent=1))
+            shown_detail = verdict["status"] in (SURVIVED, ERROR, COMPILE_ERROR)
             say(f"c: [{done[0]}/{len(todo)}] {m.path}/{m.name}: {verdict['status']} "
-                f"({verdict['seconds']} s){' ' + verdict['detail'] if verdict['status'] in (SURVIVED, ERROR, COMPILE_ERROR) else ''}")
+                f"({verdict['seconds']} s){' ' + verdict['detail'] if shown_detail else ''}")
         return m.name, dict(entry, **verdict, cached=False)
 
     with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:

@@ -51,8 +51,7 @@ class Sim:
 
     def _arm(self, scene: str) -> None:
         c = self.client
-        masses, shapes, positions, orientations, inertial, parents, types, axes = \
-            [], [], [], [], [], [], [], []
+        masses, shapes, positions, inertial, parents, types, axes = [], [], [], [], [], [], []
         previous = (0.0, 0.0, 0.0)
         for k, (anchor, axis, start, end, mass) in enumerate(scenes.links()):
             vertical = abs(end[2] - start[2]) > 1e-9
