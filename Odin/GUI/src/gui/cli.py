@@ -237,13 +237,16 @@ def load_problem_main(argv: Optional[Sequence[str]] = None) -> int:
           flush=True)
     try:
         from gui.planning.rehearsal import load_scene, warm_up
-        warm_up()           # while the world is still being found (its thread imports nothing)
+        from gui.planning.rehearsal_cache import plan_digest, seen
+        plan_key = plan_digest(plan)
+        if not seen(plan_key):  # a rehearsal to come: its imports while the world is found
+            warm_up()           # (the connecting thread imports nothing)
         client = connection.client()
 
         def progress(k: int, step, answer_id: str) -> None:
             print(f"[{k}/{total}] {step.label()} -> {answer_id}", flush=True)
 
-        load_scene(client, plan, keep=args.keep, progress=progress)
+        load_scene(client, plan, keep=args.keep, progress=progress, plan_key=plan_key)
     except OdinError as error:
         return fail("load_problem", error)
     print(f"built {args.problem} in {time.monotonic() - started:.2f} s; the world is paused "

@@ -30,6 +30,7 @@ import numpy as np
 
 from gui.core.plan import BuildPlan, BuiltIds
 from gui.errors import GuiError
+from gui.planning import rehearsal_cache
 from gui.planning.backend import CoreWorld
 from odin_common.errors import OdinError
 from odin_common.limits import ResourceLimits
@@ -72,6 +73,17 @@ def rehearse(plan: BuildPlan, parameters: WorldParameters, step_values: StepValu
         world.close()
 
 
+def _rehearse_once(plan: BuildPlan, parameters: WorldParameters, step_values: StepValues,
+                   resources: ResourceLimits, plan_key: Optional[str]) -> None:
+    """``rehearse``, unless the same plan was taken before by a Core that started as this
+    world (``rehearsal_cache``); a plan taken is remembered."""
+    world_key = rehearsal_cache.world_digest(parameters, step_values, resources)
+    if rehearsal_cache.taken(plan_key, world_key):
+        return
+    rehearse(plan, parameters, step_values, resources)
+    rehearsal_cache.remember(plan_key, world_key)
+
+
 def _check_request_size(step, resources: ResourceLimits) -> None:
     """The node reads no message over its ``max_request_mb`` (it drops the connection, which
     a Core never sees): a step whose bodies' mesh arrays alone (float64 parameters, uint32
@@ -95,17 +107,20 @@ def warm_up() -> None:
 
 
 def load_scene(client, plan: BuildPlan, keep: bool = False,
-               progress: Optional[Progress] = None) -> dict:
+               progress: Optional[Progress] = None, plan_key: Optional[str] = None) -> dict:
     """Builds ``plan`` in the world of ``client`` (a WorldClient) whole, after New Scene
-    unless ``keep``, or changes nothing: rehearsed first (``rehearse``), sent only if every
-    step was taken; a step the world still refuses is undone (``_undo``). Returns
-    ``client.execute``'s answer (the world's IDs, robots, overlaps); raises GuiError, one
-    line naming the problem and the step."""
+    unless ``keep``, or changes nothing: rehearsed first (``rehearse``, unless the same plan
+    was taken by a Core that started as this world: ``rehearsal_cache``; ``plan_key``: its
+    ``plan_digest`` when the caller has it), sent only if every step was taken; a step the
+    world still refuses is undone (``_undo``). Returns ``client.execute``'s answer (the
+    world's IDs, robots, overlaps); raises GuiError, one line naming the problem and the
+    step."""
     before = client.world()
     source = plan.problem.source
     try:
-        rehearse(plan, before.parameters, before.step_values,
-                 _room(client.resource_limits(), before, keep))
+        _rehearse_once(plan, before.parameters, before.step_values,
+                       _room(client.resource_limits(), before, keep),
+                       plan_key or rehearsal_cache.plan_digest(plan))
     except OdinError as error:
         raise GuiError(f"{source}: {_one_line(error)}; nothing was sent: the world is "
                        "unchanged") from None
