@@ -95,7 +95,9 @@ How a problem maps to the world:
   there; otherwise one line names the step and the world is unchanged. A step the world still
   refuses (another client in between, a clash with what ``--keep`` keeps) is undone: what the
   load built is removed, the parameters and step values it set are put back, and a running
-  world is started again.
+  world is started again. A plan a Core took is not rehearsed again for a world that starts
+  the same (``gui.planning.rehearsal_cache``: a digest of the plan's values, the world and
+  the Core's code, kept beside the shape cache; ``--no-cache`` turns it off).
 """
 from gui.core.translate.planner import GROUND, BuildDefaults, plan_problem
 
