@@ -403,6 +403,11 @@ def unit_box() -> tuple:
 #: detail): several problems' worth of meshes (the TX90 grasp scene has ~200,000)
 GEOMETRY_CACHE_TRIANGLES = 2_000_000
 
+#: geometries a :class:`GeometryCache` keeps at most, whatever their triangles: each costs
+#: ~1 KB beyond its triangles, so many small distinct meshes (a client sending shapes of
+#: random sizes) stay within ~4 MB; the largest scenes hold a few hundred
+GEOMETRY_CACHE_ENTRIES = 4096
+
 
 class GeometryCache:
     """Geometries built before, by content: the same parameters, indices and shape give the
@@ -410,12 +415,18 @@ class GeometryCache:
     clustering cost ~20 ms per 10,000 triangles). A world re-sends its whole scene on every
     problem load and on every Viewer restart; so does a bag of markers played in a loop.
 
-    Least recently used geometries go first once more than ``max_triangles`` are kept.
-    Thread-safe: service threads and the render thread share one. A Geometry is immutable
-    (its levels of detail are made on the render thread only), so objects may share one."""
+    Only meshes are kept (capsules are meshes too): a primitive (sphere, cylinder, box,
+    plane) costs microseconds to build and saves nothing, and every size sent would stay
+    (a soak's thousands of random spheres and boxes grew the Viewer by ~0.8 KB each).
+    Least recently used geometries go first once more than ``max_triangles`` or more than
+    ``max_entries`` are kept. Thread-safe: service threads and the render thread share one.
+    A Geometry is immutable (its levels of detail are made on the render thread only), so
+    objects may share one."""
 
-    def __init__(self, max_triangles: int = GEOMETRY_CACHE_TRIANGLES) -> None:
+    def __init__(self, max_triangles: int = GEOMETRY_CACHE_TRIANGLES,
+                 max_entries: int = GEOMETRY_CACHE_ENTRIES) -> None:
         self.max_triangles = max_triangles
+        self.max_entries = max_entries
         self._geometries: "collections.OrderedDict[bytes, Geometry]" = collections.OrderedDict()
         self._triangles = 0
         self._lock = threading.Lock()
@@ -439,6 +450,8 @@ class GeometryCache:
         built = geometry_from_parameters(parameters, indices, shape)
         with self._lock:
             self.misses += 1
+            if built.kind != "mesh":
+                return built                # nothing to save by keeping it
             if key not in self._geometries:
                 self._geometries[key] = built
                 self._triangles += built.triangle_count
@@ -446,7 +459,8 @@ class GeometryCache:
             return self._geometries[key]
 
     def _evict(self) -> None:
-        while self._triangles > self.max_triangles and len(self._geometries) > 1:
+        while len(self._geometries) > 1 and (self._triangles > self.max_triangles
+                                             or len(self._geometries) > self.max_entries):
             _, oldest = self._geometries.popitem(last=False)
             self._triangles -= oldest.triangle_count
 

@@ -32,8 +32,8 @@ Services (odin_common.interface.VIEWER_SERVICES, each answered by the Portal's m
 same name)
     ``~view_object`` (Services/ViewObject): add an object, or replace the one with that ID (the
         world may re-send its scene to a Viewer that started late, and does on every problem
-        load: geometries are kept by content, viewer.core.geometry.GeometryCache, so the same
-        shape sent again is not built again). Checked whole before the scene or the camera
+        load: meshes are kept by content, viewer.core.geometry.GeometryCache, so the same
+        mesh sent again is not built again). Checked whole before the scene or the camera
         changes (a refusal changes nothing): refused are an ID that is no name
         (odin_common.limits.check_name: empty, over 256 bytes, NUL, newline...), a parameter
         count that is no shape, sizes outside [MIN_SIZE, MAX_SIZE], an empty mesh, an index
