@@ -6,6 +6,7 @@ import json
 import os
 import pathlib
 import signal
+import subprocess
 import sys
 import tempfile
 
@@ -124,6 +125,44 @@ def arm_and_box(tmp_path):
             'WX="0" WY="0" WZ="1" TH="0"/></Scene>\n</Problem>\n')
         return path
     return problem
+
+
+@pytest.fixture(scope="session")
+def plan_of():
+    """``plan_of(problem_file)``: the build plan of a Kautham problem with gui.core.translate's
+    defaults, the loader's warnings silenced."""
+    import logging
+
+    def plan(problem_file):
+        from gui.core.kautham.problem import load_problem
+        from gui.core.translate import plan_problem
+        logging.disable(logging.WARNING)
+        try:
+            return plan_problem(load_problem(problem_file))
+        finally:
+            logging.disable(logging.NOTSET)
+    return plan
+
+
+@pytest.fixture
+def tmpfs(tmp_path):
+    """``mount(kib)``: a tmpfs of ``kib`` KiB at a new folder under tmp_path (a disk that fills
+    up, for the tests of files written whole or not at all), unmounted at the end; the test is
+    skipped where mounting is not allowed."""
+    mounted = []
+
+    def mount(kib: int) -> pathlib.Path:
+        mount_point = tmp_path / f"tmpfs{len(mounted)}"
+        mount_point.mkdir()
+        done = subprocess.run(["mount", "-t", "tmpfs", "-o", f"size={kib}k", "tmpfs",
+                               str(mount_point)], capture_output=True, text=True)
+        if done.returncode != 0:
+            pytest.skip(f"cannot mount a tmpfs here: {done.stderr.strip() or done.returncode}")
+        mounted.append(mount_point)
+        return mount_point
+    yield mount
+    for mount_point in mounted:
+        subprocess.run(["umount", "-l", str(mount_point)], check=False)
 
 
 def pytest_collection_modifyitems(items):

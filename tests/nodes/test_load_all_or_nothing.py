@@ -10,6 +10,8 @@ import pathlib
 import numpy as np
 import pytest
 
+from world_client import running_world
+
 pytestmark = pytest.mark.forked
 
 
@@ -48,10 +50,7 @@ def _refused_in_one_line(result, *words: str) -> str:
 @pytest.fixture
 def small_world(ros_master):
     """A world node that holds at most 6 objects."""
-    node = ros_master.rosrun("VirtualWorld", "virtualWorld", "_max_objects:=6")
-    ros_master.wait_for_service("/virtual_world/set_servo")
-    yield ros_master
-    assert node.poll() is None, "virtualWorld died:\n" + ros_master.log_text(node)[-3000:]
+    yield from running_world(ros_master, "_max_objects:=6")
 
 
 def test_a_problem_beyond_the_world_extent_leaves_the_scene_built_before(world, arm_and_box):
@@ -157,10 +156,7 @@ def _grid_stl(path: pathlib.Path, side: int) -> pathlib.Path:
 @pytest.fixture
 def capped_world(ros_master):
     """A world node that reads no message over 1 MB."""
-    node = ros_master.rosrun("VirtualWorld", "virtualWorld", "_max_request_mb:=1")
-    ros_master.wait_for_service("/virtual_world/set_servo")
-    yield ros_master
-    assert node.poll() is None, "virtualWorld died:\n" + ros_master.log_text(node)[-3000:]
+    yield from running_world(ros_master, "_max_request_mb:=1")
 
 
 def test_a_mesh_over_the_nodes_message_limit_leaves_the_scene_built_before(capped_world,

@@ -4,7 +4,6 @@ request works."""
 from __future__ import annotations
 
 import pathlib
-import subprocess
 import time
 
 import numpy as np
@@ -60,19 +59,9 @@ def test_hostile_views_and_snapshot_names_are_refused_by_name_and_change_nothing
 
 
 @pytest.fixture
-def tiny_tmpfs(tmp_path):
-    """A 48 KiB tmpfs at tmp_path/tiny, unmounted at the end (skipped where mounting is not
-    allowed)."""
-    mount_point = tmp_path / "tiny"
-    mount_point.mkdir()
-    done = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=48k", "tmpfs",
-                           str(mount_point)], capture_output=True, text=True)
-    if done.returncode != 0:
-        pytest.skip(f"cannot mount a tmpfs here: {done.stderr.strip() or done.returncode}")
-    try:
-        yield mount_point
-    finally:
-        subprocess.run(["umount", "-l", str(mount_point)], check=False)
+def tiny_tmpfs(tmpfs):
+    """A 48 KiB tmpfs (the root conftest's ``tmpfs``)."""
+    return tmpfs(48)
 
 
 def _wait_for(predicate, timeout: float = 20.0):

@@ -7,7 +7,6 @@ import errno
 import io
 import logging
 import os
-import subprocess
 
 import numpy as np
 import pytest
@@ -83,19 +82,9 @@ def test_a_symbolic_link_at_the_name_is_refused_at_start(tmp_path):
 
 
 @pytest.fixture
-def tiny_tmpfs(tmp_path):
-    """A 256 KiB tmpfs at tmp_path/tiny, unmounted at the end (skipped where mounting is not
-    allowed)."""
-    mount_point = tmp_path / "tiny"
-    mount_point.mkdir()
-    done = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=256k", "tmpfs",
-                           str(mount_point)], capture_output=True, text=True)
-    if done.returncode != 0:
-        pytest.skip(f"cannot mount a tmpfs here: {done.stderr.strip() or done.returncode}")
-    try:
-        yield mount_point
-    finally:
-        subprocess.run(["umount", "-l", str(mount_point)], check=False)
+def tiny_tmpfs(tmpfs):
+    """A 256 KiB tmpfs (the root conftest's ``tmpfs``)."""
+    return tmpfs(256)
 
 
 def test_a_real_full_disk_leaves_no_corrupt_bag_under_the_name(tiny_tmpfs):

@@ -58,3 +58,13 @@ def wait_until(predicate, timeout: float = 10.0, period: float = 0.05):
             return value
         time.sleep(period)
     raise TimeoutError("condition not met in time")
+
+
+def running_world(ros_master, *parameters: str):
+    """The body of a world fixture: a VirtualWorld node started with ``parameters``
+    ("_max_objects:=6"), up to its servo service; yields the master, then checks that the node
+    lived."""
+    node = ros_master.rosrun("VirtualWorld", "virtualWorld", *parameters)
+    ros_master.wait_for_service("/virtual_world/set_servo")
+    yield ros_master
+    assert node.poll() is None, "virtualWorld died:\n" + ros_master.log_text(node)[-3000:]

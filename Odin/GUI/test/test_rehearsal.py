@@ -4,7 +4,6 @@ named, and the plan is left as it was (its predicted IDs, which the real load re
 from __future__ import annotations
 
 import dataclasses
-import logging
 
 import pytest
 
@@ -15,43 +14,34 @@ from odin_common.step_values import StepValues
 from odin_common.world_parameters import WorldParameters
 
 
-def _plan(path):
-    from gui.core.kautham.problem import load_problem
-    from gui.core.translate import plan_problem
-    logging.disable(logging.WARNING)
-    try:
-        return plan_problem(load_problem(path))
-    finally:
-        logging.disable(logging.NOTSET)
-
 
 def _ids(plan) -> list:
     return [(h.motor_ids, h.joint_ids, [b.body_id for b in h.bodies]) for h in plan.robots]
 
 
-def test_a_plan_the_world_takes_is_taken_and_left_as_it_was(arm_and_box):
-    plan = _plan(arm_and_box("fine.xml", 700))
+def test_a_plan_the_world_takes_is_taken_and_left_as_it_was(arm_and_box, plan_of):
+    plan = plan_of(arm_and_box("fine.xml", 700))
     predicted = _ids(plan)
     rehearse(plan, WorldParameters(), StepValues(), ResourceLimits())
     assert _ids(plan) == predicted
 
 
-def test_the_first_step_the_core_refuses_is_named(arm_and_box):
-    plan = _plan(arm_and_box("away.xml", -4e7))         # 40 km: beyond the 10 km extent
+def test_the_first_step_the_core_refuses_is_named(arm_and_box, plan_of):
+    plan = plan_of(arm_and_box("away.xml", -4e7))         # 40 km: beyond the 10 km extent
     with pytest.raises(GuiError, match=r"^step \d+/\d+ \(object cube.*\) would be refused: "
                                        r".*world_extent"):
         rehearse(plan, WorldParameters(), StepValues(), ResourceLimits())
 
 
-def test_the_worlds_limits_are_the_rehearsals(arm_and_box):
-    plan = _plan(arm_and_box("three.xml", 700))         # 2 links and a box
+def test_the_worlds_limits_are_the_rehearsals(arm_and_box, plan_of):
+    plan = plan_of(arm_and_box("three.xml", 700))         # 2 links and a box
     with pytest.raises(GuiError, match="max_objects"):
         rehearse(plan, WorldParameters(), StepValues(), ResourceLimits(max_objects=2))
     rehearse(plan, WorldParameters(), StepValues(), ResourceLimits(max_objects=3))
 
 
-def test_a_step_over_the_nodes_message_limit_is_refused(arm_and_box):
-    plan = _plan(arm_and_box("mesh.xml", 700))
+def test_a_step_over_the_nodes_message_limit_is_refused(arm_and_box, plan_of):
+    plan = plan_of(arm_and_box("mesh.xml", 700))
     step = next(s for s in plan.steps if s.bodies and s.owner is None)
     spec = step.spec
     heavy = dataclasses.replace(spec, parameters=tuple(spec.parameters) * 100_000)

@@ -5,7 +5,6 @@ are never kept; --no-cache turns it off."""
 from __future__ import annotations
 
 import dataclasses
-import logging
 
 import numpy as np
 import pytest
@@ -41,19 +40,10 @@ def rehearsals(monkeypatch):
     return built
 
 
-def _plan(path):
-    from gui.core.kautham.problem import load_problem
-    from gui.core.translate import plan_problem
-    logging.disable(logging.WARNING)
-    try:
-        return plan_problem(load_problem(path))
-    finally:
-        logging.disable(logging.NOTSET)
 
-
-def test_the_same_problem_read_twice_has_one_digest_and_another_value_another(arm_and_box):
+def test_the_same_problem_read_twice_has_one_digest_and_another_value_another(arm_and_box, plan_of):
     path = arm_and_box("same.xml", 700)
-    first, again = _plan(path), _plan(path)
+    first, again = plan_of(path), plan_of(path)
     assert cache.plan_digest(first) == cache.plan_digest(again) is not None
     step = next(s for s in again.steps if s.bodies and s.owner is None)
     moved = np.array(step.spec.position, dtype=float)
@@ -62,8 +52,8 @@ def test_the_same_problem_read_twice_has_one_digest_and_another_value_another(ar
     assert cache.plan_digest(again) != cache.plan_digest(first)
 
 
-def test_a_plan_taken_is_not_rehearsed_again_for_that_world_only(arm_and_box, rehearsals):
-    plan = _plan(arm_and_box("taken.xml", 700))
+def test_a_plan_taken_is_not_rehearsed_again_for_that_world_only(arm_and_box, plan_of, rehearsals):
+    plan = plan_of(arm_and_box("taken.xml", 700))
     key = cache.plan_digest(plan)
     assert not cache.seen(key)
     for _ in range(2):
@@ -74,8 +64,8 @@ def test_a_plan_taken_is_not_rehearsed_again_for_that_world_only(arm_and_box, re
     assert len(rehearsals) == 2
 
 
-def test_a_refusal_is_never_kept(arm_and_box, rehearsals):
-    plan = _plan(arm_and_box("three.xml", 700))         # 2 links and a box
+def test_a_refusal_is_never_kept(arm_and_box, plan_of, rehearsals):
+    plan = plan_of(arm_and_box("three.xml", 700))         # 2 links and a box
     key, small = cache.plan_digest(plan), ResourceLimits(max_objects=2)
     for _ in range(2):
         with pytest.raises(GuiError, match="max_objects"):
@@ -83,8 +73,8 @@ def test_a_refusal_is_never_kept(arm_and_box, rehearsals):
     assert len(rehearsals) == 2 and not cache.seen(key)
 
 
-def test_no_cache_rehearses_every_time(arm_and_box, rehearsals):
-    plan = _plan(arm_and_box("nocache.xml", 700))
+def test_no_cache_rehearses_every_time(arm_and_box, plan_of, rehearsals):
+    plan = plan_of(arm_and_box("nocache.xml", 700))
     key = cache.plan_digest(plan)
     shape_cache.set_enabled(False)
     for _ in range(2):
@@ -92,8 +82,8 @@ def test_no_cache_rehearses_every_time(arm_and_box, rehearsals):
     assert len(rehearsals) == 2 and not cache.seen(key)
 
 
-def test_a_value_the_digest_cannot_encode_exactly_keeps_nothing(arm_and_box, rehearsals):
-    plan = _plan(arm_and_box("odd.xml", 700))
+def test_a_value_the_digest_cannot_encode_exactly_keeps_nothing(arm_and_box, plan_of, rehearsals):
+    plan = plan_of(arm_and_box("odd.xml", 700))
     plan.steps.append(object())                        # no exact encoding: not kept
     assert cache.plan_digest(plan) is None
     plan.steps.pop()
@@ -102,8 +92,8 @@ def test_a_value_the_digest_cannot_encode_exactly_keeps_nothing(arm_and_box, reh
     assert len(rehearsals) == 2
 
 
-def test_the_cores_code_is_part_of_the_digest(arm_and_box, monkeypatch):
-    plan = _plan(arm_and_box("code.xml", 700))
+def test_the_cores_code_is_part_of_the_digest(arm_and_box, plan_of, monkeypatch):
+    plan = plan_of(arm_and_box("code.xml", 700))
     before = cache.plan_digest(plan)
     monkeypatch.setattr(cache, "_code_digest", "another Core")
     assert cache.plan_digest(plan) != before

@@ -3,7 +3,6 @@ written whole or not at all (a full disk leaves the old one as it was)."""
 import errno
 import logging
 import os
-import subprocess
 import time
 
 import numpy as np
@@ -143,18 +142,9 @@ def test_the_longest_file_name_is_written(tmp_path):
 
 
 @pytest.fixture
-def tiny_tmpfs(tmp_path):
-    """A 64 KiB tmpfs at tmp_path/tiny (skipped where mounting is not allowed)."""
-    mount_point = tmp_path / "tiny"
-    mount_point.mkdir()
-    done = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs",
-                           str(mount_point)], capture_output=True, text=True)
-    if done.returncode != 0:
-        pytest.skip(f"cannot mount a tmpfs here: {done.stderr.strip() or done.returncode}")
-    try:
-        yield mount_point
-    finally:
-        subprocess.run(["umount", "-l", str(mount_point)], check=False)
+def tiny_tmpfs(tmpfs):
+    """A 64 KiB tmpfs (the root conftest's ``tmpfs``)."""
+    return tmpfs(64)
 
 
 def test_a_real_full_disk_keeps_the_old_snapshot(tiny_tmpfs):
