@@ -3,19 +3,14 @@ line the user reads."""
 from __future__ import annotations
 
 from gui.core.overlaps import BUILT_OVERLAP, Overlap, built_overlaps, overlap_warning
-from gui.core.kautham.corpus import corpus_dir
 from gui.core.kautham.problem import load_problem
 from gui.core.translate import plan_problem
 
-TWO_COLUMNS = corpus_dir() / "legacy_2012" / "examples" / "Staubli_R6_two_columns.xml"
+TWO_COLUMNS = ("legacy_2012", "examples", "Staubli_R6_two_columns.xml")
 
 
-def _plan():
-    return plan_problem(load_problem(TWO_COLUMNS))
-
-
-def test_deep_pairs_with_a_part_that_moves_count_deepest_first():
-    plan = _plan()
+def test_deep_pairs_with_a_part_that_moves_count_deepest_first(kautham_dir):
+    plan = plan_problem(load_problem(kautham_dir.joinpath(*TWO_COLUMNS)))
     statics = [p.name for b in plan.bodies() if b.geometry_only for p in b.parts]
     assert len(statics) >= 2              # the columns: one composite of static parts
     pairs = [("TX90/Elbow", statics[0], 0.0045),
