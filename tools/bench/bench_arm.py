@@ -51,7 +51,7 @@ def _hold(solver: int) -> dict:
         core = world.core
         core.set_world_parameters(solver=solver, gravity=(0.0, 0.0, -9.81))
         robot = plan.robot()
-        core.set_servos({motor: {"targets": [0.0]} for motor in robot.motor_ids})
+        core.set_servo(robot.motor_ids, [0.0] * len(robot.motor_ids))
         tip = robot.bodies[-1].body_id
         z0, worst, stepping = world.position(tip)[2], 0.0, 0.0
         for _ in range(round(SECONDS / STEP / CHUNK)):

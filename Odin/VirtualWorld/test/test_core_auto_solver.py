@@ -30,7 +30,7 @@ def arm(core, links=7):
     """``links`` capsules (seven by default) stretched along +x, hinged alternately about y
     and z, each held at 0 by a servo of 300 N m: the worst pose for gravity (the tip's lever is
     the whole arm). Returns the tip link's name."""
-    parent, servos = "", {}
+    parent, servos = "", []
     for k in range(links):
         core.build_object(ObjectSpec(f"link{k}", [0.04, LINK - 0.02], mass=LINK_MASS,
                                      position=((k + 0.5) * LINK, 0.0, ARM_Z),
@@ -38,9 +38,9 @@ def arm(core, links=7):
         axis = (0.0, 1.0, 0.0) if k % 2 == 0 else (0.0, 0.0, 1.0)
         joint = core.create_joint(JointType.HINGE, f"link{k}", parent,
                                   anchor=(k * LINK, 0.0, ARM_Z), axis1=axis)
-        servos[core.create_motor(joint=joint, max_forces=[300.0])] = {"targets": [0.0]}
+        servos.append(core.create_motor(joint=joint, max_forces=[300.0]))
         parent = f"link{k}"
-    core.set_servos(servos)
+    core.set_servo(servos, [0.0] * len(servos))
     return parent
 
 

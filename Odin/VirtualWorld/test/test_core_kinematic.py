@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from odin_common.interface import MotorKind, ServoDrive
+from odin_common.interface import SERVO_GAIN, SERVO_MAX_SPEED, MotorKind, ServoDrive
 from odin_common.rotations import quaternion_to_matrix
 from virtual_world.core import HINGE, SLIDER, UNIVERSAL, Core, ObjectSpec, WorldParameters
 from virtual_world.errors import InvalidArgument, Unsupported, UnknownName
@@ -86,8 +86,8 @@ def test_a_kinematic_servo_follows_its_law_with_no_force_limit():
     """The servo's law alone moves the joint: e(n) = e0 (1 - gain h)^n, exactly, though its
     motor's force limit (0.5 N m) could not even hold the arm up."""
     core, joints, motors = two_link_arm()
-    core.set_servos({motors[0]: {"targets": [0.3], "gains": [10.0], "max_speeds": [100.0]},
-                     motors[1]: {"targets": [0.0]}}, drive=ServoDrive.KINEMATIC)
+    core.set_servo(motors, [0.3, 0.0], gains=[10.0, SERVO_GAIN],
+                   max_speeds=[100.0, SERVO_MAX_SPEED], drive=ServoDrive.KINEMATIC)
     core.step(H, 100)
     shoulder, elbow = values(core, joints)
     assert 0.3 - shoulder == pytest.approx(0.3 * (1 - 10.0 * H) ** 100, rel=1e-9)
@@ -166,7 +166,7 @@ def test_bad_requests_are_refused_and_change_nothing(motor_ids, drive, error):
     core.set_motor_velocities({motors[0]: [0.5]})
     before = core.body_state_vector()
     with pytest.raises(error):
-        core.set_servos({m: {"targets": [0.1]} for m in motors + motor_ids}, drive=drive)
+        core.set_servo(motors + motor_ids, [0.1] * len(motors + motor_ids), drive=drive)
     assert core.kinematic_links() == {} and core.servo_states() == []
     assert core.motor_goals()[motors[0]] == [0.5]
     assert core.body_state_vector().tobytes() == before.tobytes()

@@ -116,7 +116,7 @@ class CoreRequests(RuleBasedStateMachine):
         if data.draw(st.booleans()):
             self.attempt(self.core.set_motor_velocities, {motor: values})
         else:
-            self.attempt(self.core.set_servos, {motor: {"targets": values}})
+            self.attempt(self.core.set_servo, [motor], values)
 
     @precondition(lambda self: self.core.joint_ids())
     @rule(data=st.data(), values=st.lists(MAGNITUDE, max_size=3))

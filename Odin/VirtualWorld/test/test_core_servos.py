@@ -10,7 +10,7 @@ import pytest
 from odin_common.interface import SERVO_MAX_SPEED
 from virtual_world.core import (HINGE, HINGE2, SLIDER, UNIVERSAL, Core, ObjectSpec,
                                 WorldParameters)
-from virtual_world.errors import InvalidArgument, Unsupported
+from virtual_world.errors import InvalidArgument, UnknownName, Unsupported
 
 H = 0.001
 
@@ -30,7 +30,7 @@ def angle(core, joint):
 
 def test_the_error_decays_as_exp_of_minus_gain_t():
     core, joint, motor = rotor()
-    core.set_servos({motor: {"targets": [0.3], "gains": [10.0], "max_speeds": [100.0]}})
+    core.set_servo([motor], [0.3], gains=[10.0], max_speeds=[100.0])
     core.step(H, 100)
     # the motor's speed follows the error step by step: e(n) = e0 (1 - gain h)^n
     assert 0.3 - angle(core, joint) == pytest.approx(0.3 * (1 - 10.0 * H) ** 100, rel=0.02)
@@ -45,7 +45,7 @@ def test_the_feed_forward_rate_moves_the_rest_point_by_rate_over_gain():
     """A servo told its target moves at 1 rad/s while the target stays at 0: the speed
     rate + gain (0 - q) is zero at q = rate / gain, where the joint settles."""
     core, joint, motor = rotor()
-    core.set_servos({motor: {"targets": [0.0], "rates": [1.0], "gains": [20.0]}})
+    core.set_servo([motor], [0.0], rates=[1.0], gains=[20.0])
     core.step(H, 1000)
     assert angle(core, joint) == pytest.approx(1.0 / 20.0, rel=1e-4)
     core.close()
@@ -55,7 +55,7 @@ def test_the_feed_forward_rate_moves_the_rest_point_by_rate_over_gain():
 def test_a_far_target_is_reached_at_the_speed_limit_with_the_defaults(target):
     """Either way: the bound holds above as well as below."""
     core, joint, motor = rotor()
-    core.set_servos({motor: {"targets": [target]}})
+    core.set_servo([motor], [target])
     core.step(H, 200)
     rate = {s.id: s for s in core.joint_states()}[joint].rates[0]
     assert rate == pytest.approx(math.copysign(SERVO_MAX_SPEED, target), rel=1e-6)
@@ -67,7 +67,7 @@ def test_a_far_target_is_reached_at_the_speed_limit_with_the_defaults(target):
 def test_a_servo_too_weak_for_its_load_gives_way_at_its_force_limit():
     torque, limit = 2.0, 1.5                      # N m: the load beats the servo by 0.5
     core, joint, motor = rotor(max_force=limit)
-    core.set_servos({motor: {"targets": [0.0]}})
+    core.set_servo([motor], [0.0])
     core.add_joint_force(joint, [torque])
     core.step(H, 500)
     # the servo pushes back with all it has: the rod turns at (torque - limit) / I about the
@@ -87,8 +87,9 @@ def test_a_slider_servo_and_a_universal_servo_reach_their_targets():
     universal = core.create_joint(UNIVERSAL, "head", "", anchor=(3, 0, 0), axis1=(1, 0, 0),
                                   axis2=(0, 1, 0))
     both = core.create_motor(joint=universal, max_forces=[100.0, 100.0])
-    core.set_servos({linear: {"targets": [0.4], "max_speeds": [1.0]},
-                     both: {"targets": [0.2, -0.3]}})
+    # the universal's servo keeps the default speed limit
+    core.set_servo([linear, both], [0.4, 0.2, -0.3],
+                   max_speeds=[1.0, SERVO_MAX_SPEED, SERVO_MAX_SPEED])
     core.step(H, 2000)
     states = {s.id: s for s in core.joint_states()}
     assert states[slider].positions[0] == pytest.approx(0.4, abs=1e-5)
@@ -104,7 +105,7 @@ def test_a_servo_on_a_hinge2s_second_axis_pulls_the_right_way():
     hinge2 = core.create_joint(HINGE2, "chassis", "wheel", anchor=(1, 0, 0), axis1=(0, 0, 1),
                                axis2=(0, 1, 0))
     motor = core.create_motor(joint=hinge2, max_forces=[50.0, 50.0])
-    core.set_servos({motor: {"targets": [0.1, 0.5]}})
+    core.set_servo([motor], [0.1, 0.5])
     core.step(H, 2000)
     state = {s.id: s for s in core.joint_states()}[hinge2]
     assert state.positions == pytest.approx((0.1, 0.5), abs=1e-4)
@@ -115,7 +116,7 @@ def test_a_servo_holds_its_joint_where_set_position_put_it():
     """Under gravity, a rod held at 0 by its servo is turned to 0.5 rad by Set Position: the
     servo now holds 0.5 rad (it does not pull the rod back to 0)."""
     core, joint, motor = rotor(gravity=(0.0, 0.0, -9.81))
-    core.set_servos({motor: {"targets": [0.0]}})
+    core.set_servo([motor], [0.0])
     core.step(H, 100)
     half = (math.cos(0.25), 0.0, math.sin(0.25), 0.0)      # 0.5 rad about +y
     core.set_poses([("rod", (0.25 * math.cos(0.5), 0.0, -0.25 * math.sin(0.5)), half)],
@@ -130,7 +131,7 @@ def test_a_servo_holds_its_joint_where_set_position_put_it():
 
 def test_a_goal_speed_takes_a_motor_out_of_servo_mode():
     core, joint, motor = rotor()
-    core.set_servos({motor: {"targets": [0.0]}})
+    core.set_servo([motor], [0.0])
     core.set_motor_velocities({motor: [1.0]})
     assert core.servo_states() == []
     core.step(H, 200)
@@ -140,7 +141,7 @@ def test_a_goal_speed_takes_a_motor_out_of_servo_mode():
 
 def test_a_released_servo_holds_still_and_a_snapshot_brings_the_servo_back():
     core, joint, motor = rotor(gravity=(0, 0, -9.81))
-    core.set_servos({motor: {"targets": [0.5]}})
+    core.set_servo([motor], [0.5])
     core.step(H, 50)
     core.save_state("tracking")
     core.step(H, 500)
@@ -155,19 +156,19 @@ def test_a_released_servo_holds_still_and_a_snapshot_brings_the_servo_back():
     core.close()
 
 
-@pytest.mark.parametrize("servos,error", [
-    ({"motor:1:rod&": {}}, InvalidArgument),
-    ({"motor:1:rod&": {"targets": [0.1, 0.2]}}, InvalidArgument),
-    ({"motor:1:rod&": {"targets": [0.1], "gains": [-1.0]}}, InvalidArgument),
-    ({"motor:1:rod&": {"targets": [0.1], "speed": [1.0]}}, InvalidArgument),
-    ({"motor:1:rod&": {"targets": [math.nan]}}, InvalidArgument),
-    ({"motor:rod&": {"targets": [0.1]}}, Unsupported),
-    ({"nope": {"targets": [0.1]}}, Exception),
+@pytest.mark.parametrize("motors,lists,error", [
+    (["motor:1:rod&"], dict(targets=[]), InvalidArgument),
+    (["motor:1:rod&"], dict(targets=[0.1, 0.2]), InvalidArgument),
+    (["motor:1:rod&"], dict(targets=[0.1], gains=[-1.0]), InvalidArgument),
+    (["motor:1:rod&"], dict(targets=[0.1], rates=[1.0, 2.0]), InvalidArgument),
+    (["motor:1:rod&"], dict(targets=[math.nan]), InvalidArgument),
+    (["motor:1:rod&", "motor:rod&"], dict(targets=[1.0, 0.1]), Unsupported),
+    (["motor:1:rod&", "nope"], dict(targets=[1.0, 0.1]), UnknownName),
 ])
-def test_bad_servo_requests_are_refused_and_change_nothing(servos, error):
+def test_bad_servo_requests_are_refused_and_change_nothing(motors, lists, error):
     core, joint, motor = rotor()
     core.create_motor(body1="rod", axes=[0, 0, 1])   # a motor without a joint
     with pytest.raises(error):
-        core.set_servos({motor: {"targets": [1.0]}, **servos})
+        core.set_servo(motors, **lists)
     assert core.servo_states() == []
     core.close()

@@ -43,7 +43,7 @@ class Sim:
         self.bodies = len(self.spheres)
 
     def _arm(self) -> None:
-        core, servos = self.core, {}
+        core, servos = self.core, []
         parent = ""
         for k, (anchor, axis, start, end, mass) in enumerate(scenes.links()):
             length = math.dist(start, end)
@@ -55,9 +55,9 @@ class Sim:
             joint = core.create_joint(JointType.HINGE, f"link{k}", parent, anchor=anchor,
                                       axis1=axis)
             motor = core.create_motor(joint=joint, max_forces=[scenes.MOTOR_MAX_TORQUE])
-            servos[motor] = {"targets": [0.0]}
+            servos.append(motor)
             parent = f"link{k}"
-        core.set_servos(servos)
+        core.set_servo(servos, [0.0] * len(servos))
         self.bodies = 7
         self._flange_local = (scenes.FLANGE[0] - centre[0], 0.0, 0.0)   # in link6's frame: x
         self._flange_local = rotate((Z_ONTO_X[0], 0, -Z_ONTO_X[2], 0), self._flange_local)

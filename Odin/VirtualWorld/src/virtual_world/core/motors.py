@@ -200,9 +200,10 @@ def set_servos(scene: Scene, servos: Mapping[str, Mapping]) -> None:
     """Servo mode for each motor: {motor id: {"targets": per axis (rad or m, the joint's
     reported units), optional "rates" (feed-forward, rad/s or m/s; 0), "gains" (1/s;
     interface.SERVO_GAIN), "max_speeds" (rad/s or m/s; interface.SERVO_MAX_SPEED),
-    "max_forces" (N m or N; the motor's as it is)}}. Before every step the motor's speed on
-    each axis becomes clamp(rate + gain (target - q), +-max_speed) with q the joint's value.
-    A servo drives a motor made on a joint with the joint's own axes. All checked first."""
+    "max_forces" (N m or N; the motor's as it is)}}, as core.actuation.split_servo_lists
+    gives them. Before every step the motor's speed on each axis becomes clamp(rate + gain
+    (target - q), +-max_speed) with q the joint's value. A servo drives a motor made on a joint
+    with the joint's own axes. All checked first."""
     checked = []
     for motor_id, fields in dict(servos).items():
         motor = scene.motor(motor_id)
@@ -211,10 +212,6 @@ def set_servos(scene: Scene, servos: Mapping[str, Mapping]) -> None:
             raise Unsupported(f"motor {shown(motor_id)} is no servo: a servo drives a motor made "
                               "on a joint with the joint's own axes")
         fields = dict(fields)
-        unknown = set(fields) - {"targets", "rates", "gains", "max_speeds", "max_forces"}
-        if unknown or "targets" not in fields:
-            raise InvalidArgument(f"servo of {shown(motor_id)}: give targets (and optionally "
-                                  f"rates, gains, max_speeds, max_forces); got {sorted(fields)}")
 
         def per_axis(name, default, low, high, unit):
             given = fields.get(name)

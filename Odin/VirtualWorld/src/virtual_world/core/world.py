@@ -25,7 +25,7 @@ from odin_common.interface import ForceKind, JointType, MotorKind, ServoDrive, S
 from odin_common.limits import ResourceLimits, shown, shown_list
 from odin_common.specs import CompositeSpec, EntitySpec, JointSpec, MotorSpec, ObjectSpec
 from odin_common.world_parameters import WorldParameters
-from virtual_world.core import (exemptions, forces, guard, joints, kinematic, long_calls,
+from virtual_world.core import (actuation, exemptions, forces, guard, joints, long_calls,
                                 motors, objects, readout, snapshots, validation as check)
 from virtual_world.core.requests import changes_contents, changes_state, disturbs, locked
 from virtual_world.core.records import (BodyState, Built, BuiltEntity, Collision, Divergence,
@@ -272,46 +272,39 @@ class Core:
         return motors.axis_counts(self._scene, motor_ids)
 
     @locked
-    def split_per_axis(self, motor_ids: Sequence[str], values: Sequence[float],
-                       what: str = "velocities") -> Dict[str, Tuple[float, ...]]:
-        """{motor id: its values} from one flat list (Set Velocity's, Propagate's and Set
-        Servo's requests: each motor takes as many values as it has axes, in order)."""
+    def split_per_axis(self, motor_ids: Sequence[str], values: Sequence[float]
+                       ) -> Dict[str, Tuple[float, ...]]:
+        """{motor id: its goal speeds} from one flat list (Propagate's request: each motor
+        takes as many values as it has axes, in order)."""
         if len(motor_ids) == 0 and len(values) == 0:
             return {}
-        return motors.split_per_axis(self._scene, motor_ids, values, what)
+        return motors.split_per_axis(self._scene, motor_ids, values)
 
     @disturbs
-    def set_servos(self, servos: Mapping[str, Mapping],
-                   drive: int = ServoDrive.UNCHANGED) -> None:
-        """Servo mode for motors, all checked first (core.motors.set_servos): each tracks a
-        position target on its joint's axes; ``drive`` (ServoDrive) for their joints
-        (core.kinematic: KINEMATIC, the links follow the servos' law exactly)."""
-        scene = self._scene
-        links = kinematic.plan(scene, list(servos), drive)
-        motors.set_servos(scene, servos)
-        if links is not None:
-            kinematic.install(scene, links)
+    def set_servo(self, motors: Sequence[str], targets: Sequence[float], rates=(), gains=(),
+                  max_speeds=(), max_forces=(), drive: int = ServoDrive.UNCHANGED) -> None:
+        """Set Servo: servo mode for ``motors``, each tracking a position target on its
+        joint's axes. The lists are flat, one value per motor axis in the motors' order:
+        ``targets`` (rad or m); optional, empty meaning not given: ``rates`` (feed-forward,
+        rad/s or m/s; 0), ``gains`` (1/s; interface.SERVO_GAIN), ``max_speeds`` (rad/s or
+        m/s; interface.SERVO_MAX_SPEED), ``max_forces`` (N m or N; the motor's as it is).
+        ``drive`` (ServoDrive) for their joints (core.kinematic: KINEMATIC, the links follow
+        the servos' law exactly). All checked before anything changes."""
+        actuation.set_servo(self._scene, motors, {
+            "targets": targets, "rates": rates, "gains": gains, "max_speeds": max_speeds,
+            "max_forces": max_forces}, drive)
 
     @disturbs
     def release_servos(self, motor_ids: Sequence[str],
                        drive: int = ServoDrive.UNCHANGED) -> None:
-        """Motors back from servo mode to speed goals, at zero; ``drive`` as set_servos'."""
-        scene = self._scene
-        for motor_id in motor_ids:
-            scene.motor(motor_id)
-        links = kinematic.plan(scene, motor_ids, drive)
-        motors.release_servos(scene, motor_ids)
-        if links is not None:
-            kinematic.install(scene, links)
+        """Motors back from servo mode to speed goals, at zero; ``drive`` as set_servo's."""
+        actuation.release_servos(self._scene, motor_ids, drive)
 
     @disturbs
     def set_drive(self, motor_ids: Sequence[str], drive: int) -> None:
         """The drive (ServoDrive) of the motors' joints alone, all or nothing: KINEMATIC, the
         links beyond them follow the motors' commanded speeds exactly (core.kinematic)."""
-        scene = self._scene
-        links = kinematic.plan(scene, motor_ids, drive)
-        if links is not None:
-            kinematic.install(scene, links)
+        actuation.set_drive(self._scene, motor_ids, drive)
 
     @locked
     def kinematic_links(self) -> Dict[str, str]:

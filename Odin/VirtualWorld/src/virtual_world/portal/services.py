@@ -18,6 +18,7 @@ from odin_common.limits import shown
 from odin_common.specs import EntitySpec, JointSpec, MotorSpec
 from odin_common.world_parameters import set_world_flags
 from virtual_world.core import Core, long_calls, step_values
+from virtual_world.core.actuation import SERVO_LISTS
 from virtual_world.errors import InvalidArgument
 from virtual_world.portal import conversions
 from virtual_world.portal.mirror import WorldMirror
@@ -30,10 +31,6 @@ WORLD_FIELDS = set_world_flags()
 READ_ONLY = frozenset({"get_world", "get_state", "check_collision"})
 #: services that drive the loop: a recording holds the advances they caused instead
 LOOP_CONTROL = frozenset({"start", "step_once"})
-
-
-#: Set Servo's per-axis lists
-SERVO_LISTS = ("targets", "rates", "gains", "max_speeds", "max_forces")
 
 
 class NoViewer:
@@ -192,14 +189,8 @@ class WorldServices:
         if request.drive and not any(len(getattr(request, name)) for name in SERVO_LISTS):
             self.core.set_drive(motor_ids, request.drive)
             return {"message": f"drive of {len(motor_ids)} motor(s) set"}
-        servos = {motor_id: {} for motor_id in motor_ids}
-        for name in SERVO_LISTS:
-            values = list(getattr(request, name))
-            if name == "targets" or values:
-                for motor_id, split in self.core.split_per_axis(motor_ids, values,
-                                                                name).items():
-                    servos[motor_id][name] = split
-        self.core.set_servos(servos, request.drive)
+        self.core.set_servo(motor_ids, request.targets, request.rates, request.gains,
+                            request.max_speeds, request.max_forces, request.drive)
         return {"message": f"{len(motor_ids)} servo(s) set"}
 
     def set_surface(self, request) -> dict:
