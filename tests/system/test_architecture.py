@@ -96,3 +96,31 @@ def test_module_imports_only_what_its_layer_may(name, path):
              if any(_matches(imported, prefix) for prefix in forbidden)
              and not any(_matches(imported, ok) for ok in allowed)]
     assert not wrong, f"{path.relative_to(ROOT)} imports {wrong}"
+
+
+# the roscore test harness (a private master per test, process groups, rosrun's search) is for
+# tests and tools: no node loads it when it starts, not even through odin_common's modules
+PORTALS = ("virtual_world.portal", "viewer.portal", "gui.ros")
+HARNESS = "odin_common.ros_master"
+_NAMED = {name: path for name, path in MODULES}
+
+
+def _loaded_with(name: str) -> set:
+    """The modules of the stack that importing ``name`` may load: its packages, what it
+    imports (lazily too) and so on, followed through every module read."""
+    loaded, frontier = set(), [name]
+    while frontier:
+        module = frontier.pop()
+        if module in loaded:
+            continue
+        loaded.add(module)
+        parts = module.split(".")
+        packages = [".".join(parts[:k]) for k in range(1, len(parts))]
+        imported = [i for i, _ in _imports(_NAMED[module])]
+        frontier += [m for m in packages + imported if m in _NAMED and m not in loaded]
+    return loaded
+
+
+@pytest.mark.parametrize("name", [n for n, _ in MODULES if n.startswith(PORTALS)])
+def test_no_portal_loads_the_test_harness(name):
+    assert HARNESS not in _loaded_with(name), f"{name} loads {HARNESS}"

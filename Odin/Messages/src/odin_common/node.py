@@ -27,7 +27,7 @@ from rospy.impl.registration import RegManager, get_service_manager, get_topic_m
 from rospy.numpy_msg import numpy_msg
 
 from odin_common.errors import NoMasterError
-from odin_common.ros_master import _TimeoutTransport
+from odin_common.master_link import MasterRefusal, call_master
 
 
 def init_ros_node(name: str, disable_signals: bool = False, poll: float = 0.5,
@@ -101,9 +101,9 @@ def wait_for_master(caller_id: str, poll: float = 0.5, timeout: Optional[float] 
     while True:
         left = None if deadline is None else max(0.05, deadline - time.monotonic())
         try:
-            _ask_master(uri, caller_id, left)
+            call_master(uri, caller_id, "getPid", timeout=left)
             return
-        except (OSError, xmlrpc.client.Error, rosgraph.MasterError):
+        except (OSError, xmlrpc.client.Error, MasterRefusal):
             if deadline is not None and time.monotonic() >= deadline:
                 raise NoMasterError(f"no ROS master answers at {uri} after {timeout:g} s "
                                     "(is roscore running? is ROS_MASTER_URI right?)") from None
@@ -113,17 +113,6 @@ def wait_for_master(caller_id: str, poll: float = 0.5, timeout: Optional[float] 
                 said = True
             time.sleep(poll if deadline is None else
                        max(0.0, min(poll, deadline - time.monotonic())))
-
-
-def _ask_master(uri: str, caller_id: str, timeout: Optional[float]) -> None:
-    """The master's getPid, within ``timeout`` s (None: the socket's default)."""
-    if timeout is None:
-        rosgraph.Master(caller_id, master_uri=uri).getPid()
-        return
-    proxy = xmlrpc.client.ServerProxy(uri, transport=_TimeoutTransport(timeout))
-    code, message, _ = proxy.getPid(caller_id)
-    if code != 1:
-        raise rosgraph.MasterError(message)
 
 
 #: MasterWatch's mark for a master that answered with an error (it knows nothing of the node)

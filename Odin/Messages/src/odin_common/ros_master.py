@@ -39,6 +39,7 @@ import uuid
 import xmlrpc.client
 from typing import Any, Sequence
 
+from odin_common.master_link import MasterRefusal, call_master
 
 # Masters listen below the kernel's ephemeral range (net.ipv4.ip_local_port_range starts at
 # 32768 on Debian): a port handed out by bind(0) can be taken again by any node's XML-RPC
@@ -159,12 +160,10 @@ class RosMaster:
         """The value of one ROS Master API call (``lookupService``, ``getParam``, ...) made as
         caller /odin_test, or None when the master does not answer in ``timeout`` s or answers
         with an error code (whatever holds a taken port may accept and never answer)."""
-        proxy = xmlrpc.client.ServerProxy(self.uri, transport=_TimeoutTransport(timeout))
         try:
-            code, _, value = getattr(proxy, method)("/odin_test", *args)
-        except (OSError, xmlrpc.client.Error):
+            return call_master(self.uri, "/odin_test", method, *args, timeout=timeout)
+        except (OSError, xmlrpc.client.Error, MasterRefusal):
             return None
-        return value if code == 1 else None
 
     def _use_port(self, port: int) -> None:
         self.port = port
@@ -366,19 +365,6 @@ def _executables_named(name: str, folders: list, package_folder: str) -> list:
 def _unique_in_order(paths: list) -> list:
     """``uniq``: adjacent repeats once."""
     return [p for k, p in enumerate(paths) if k == 0 or paths[k - 1] != p]
-
-
-class _TimeoutTransport(xmlrpc.client.Transport):
-    """XML-RPC over HTTP that gives up after ``timeout`` s (the standard one waits forever)."""
-
-    def __init__(self, timeout: float):
-        super().__init__()
-        self._timeout = timeout
-
-    def make_connection(self, host):
-        connection = super().make_connection(host)
-        connection.timeout = self._timeout
-        return connection
 
 
 def _stop_groups(processes: Sequence[subprocess.Popen],

@@ -23,6 +23,7 @@ import xmlrpc.client
 from typing import Dict, Iterator, Mapping, Type
 
 from gui.errors import ServiceError
+from odin_common.master_link import TimeoutTransport
 
 PING_TIMEOUT = 2.0      # s: a node that does not answer its pid in this long is absent
 
@@ -173,16 +174,9 @@ def node_answers(service: str, caller_id: str = "/gui") -> bool:
         if not providers:
             return False
         api = master.lookupNode(providers[0])
-        xmlrpc.client.ServerProxy(api, transport=_QuickTransport()).getPid(master.caller_id)
+        xmlrpc.client.ServerProxy(api, transport=TimeoutTransport(PING_TIMEOUT)).getPid(
+            master.caller_id)
         return True
     except Exception:  # master down, service not registered, node gone or not answering
         return False
 
-
-class _QuickTransport(xmlrpc.client.Transport):
-    """XML-RPC over HTTP that gives up after PING_TIMEOUT s."""
-
-    def make_connection(self, host):
-        connection = super().make_connection(host)
-        connection.timeout = PING_TIMEOUT
-        return connection
