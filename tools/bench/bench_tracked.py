@@ -33,7 +33,6 @@ def _2drr(solver: int) -> dict:
     from gui.core.kautham.problem import load_problem
     from gui.core.kautham.solutions import read_solution
     from gui_core_world import CoreWorld
-    from tracking_port import CoreTrackingPort
     tro = corpus_dir() / "legacy_2012" / "examples" / "TRO"
     problem = load_problem(tro / "2DRR_obstacle.xml")
     plan = plan_problem(problem, BuildDefaults(start_at_query=True))
@@ -41,7 +40,7 @@ def _2drr(solver: int) -> dict:
     try:
         world.execute(plan)
         world.core.set_world_parameters(solver=solver)
-        report = execute_tracked(CoreTrackingPort(world), plan,
+        report = execute_tracked(world, plan,
                                  read_solution(tro / "2DRR_obstacle_sol.kps", problem))
     finally:
         world.close()

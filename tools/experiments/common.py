@@ -399,24 +399,28 @@ class Session:
 
 # -- tracked execution, cycle by cycle ---------------------------------------------------------
 def session_tracking_port(session: Session, frame_every: int = 0):
-    """A ``gui.core.execution.TrackingPort`` that advances ``session`` one Step Once per Portal
-    cycle (so the world publishes every cycle and the Viewer's frames keep their numbering:
-    one every ``frame_every`` cycles, none at 0): the servos are updated once per cycle, the
-    period being the cycle's simulated time. Collisions are the pairs of ``~contacts``
-    (contact policy: ``Session(contacts=True)``), first time and deepest depth per cycle."""
-    from gui.core.execution import ClientTrackingPort
+    """A ``gui.core.world_port.WorldPort`` (the world node's, gui.ros.world_port) that advances
+    ``session`` one Step Once per Portal cycle (so the world publishes every cycle and the
+    Viewer's frames keep their numbering: one every ``frame_every`` cycles, none at 0): a
+    tracked run's servos are updated once per cycle, its step being the cycle's simulated time.
+    Collisions are the pairs of ``~contacts`` (contact policy: ``Session(contacts=True)``),
+    first time and deepest depth per cycle."""
+    from gui.core.world_port import Collision
+    from gui.ros.world_port import ClientWorldPort
+    from odin_common.step_values import StepValues
 
-    class SessionPort(ClientTrackingPort):
-        def step(self) -> float:
-            if self._step is None:
-                self._step = session.client.step_values().cycle_time
-            return self._step
+    class SessionPort(ClientWorldPort):
+        def step_values(self) -> StepValues:
+            if self._step_values is None:
+                values = session.client.step_values()
+                self._step_values = StepValues(values.cycle_time, 1, values.rate)
+            return self._step_values
 
-        def advance(self, duration: float, forces) -> list:
+        def advance(self, duration: float, forces=()) -> list:
             if forces:
                 raise ExperimentError("a session's tracked run drives no free-flying base")
             started = session.sim_time
-            cycles = max(1, int(round(duration / self.step())))
+            cycles = max(1, int(round(duration / self.step_values().step)))
             stamps = []
             for _ in range(cycles):
                 if frame_every and (session.cycles + 1) % frame_every == 0:
@@ -429,7 +433,7 @@ def session_tracking_port(session: Session, frame_every: int = 0):
                 return []
             session.wait_for_contacts()
             with session.record.lock:
-                return [(a, b, depth, t - started) for t in stamps
+                return [Collision(a, b, depth, t - started) for t in stamps
                         for a, b, depth in session.record.contact_depths.get(t, [])]
 
     return SessionPort(session.client)

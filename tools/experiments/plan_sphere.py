@@ -11,7 +11,7 @@ KPIECE1 with a fixed OMPL seed and a wall-clock limit searches the sphere's x an
 region (0.25 m of the query's ``<Goal>`` in the plane), every motion simulated from the whole
 world's state. The solution is written as a Kautham control path (``plan.path``, one row per
 step), read back, and run as ``rosrun GUI run_path --controls`` runs it (one kept Propagate per
-row, ``gui.core.control_path.ClientPort``) in a world node that was only built from the
+row, ``gui.ros.world_port.ClientWorldPort``) in a world node that was only built from the
 problem, with a Viewer frame every ``frame_every_rows`` rows.
 
 Outcome (summary.json): the planner's statistics; where the executed plan leaves the sphere
@@ -43,7 +43,7 @@ STILL_M = 0.005
 
 
 class FramedClient:
-    """The WorldClient a ``ClientPort`` drives, seen through: each Propagate's collisions are
+    """The WorldClient a ``ClientWorldPort`` drives, seen through: each Propagate's collisions are
     kept, the Session's simulated time follows the world's, and every ``frame_every`` rows the
     Viewer's picture is saved."""
 
@@ -121,8 +121,9 @@ def plan_and_run(name: str, problem_file, parameters: dict, camera: "common.Came
     reads it back and runs it in a world node only built from the problem, with a Viewer frame
     every ``frame_every_rows`` rows; ``outcome(session, Executed)`` makes the facts written
     to summary.json, which are returned."""
-    from gui.core.control_path import (ClientPort, control_size, read_control_path,
-                                       run_control_path, write_control_path)
+    from gui.core.control_path import (control_size, read_control_path, run_control_path,
+                                       write_control_path)
+    from gui.ros.world_port import ClientWorldPort
     p = dict(parameters)
     _, searched = common.load_plan(problem_file)
     problem, result = search(searched, p)
@@ -142,7 +143,7 @@ def plan_and_run(name: str, problem_file, parameters: dict, camera: "common.Came
         before = _states(s.client, bodies)
         s.frame()
         client = FramedClient(s, p["frame_every_rows"])
-        port = ClientPort(client, real_time=False)
+        port = ClientWorldPort(client)
         results = run_control_path(port, handle, rows)
         if len(rows) % p["frame_every_rows"]:
             s.frame()

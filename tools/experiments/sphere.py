@@ -28,7 +28,6 @@ how far the blocks and walls moved.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -93,37 +92,36 @@ def resting_height(body) -> float:
     return float(shape[0]) if len(shape) == 1 else float(shape[2]) / 2
 
 
-@dataclass
-class CyclePort:
-    """gui.core.control_path's ControlPort through a Session: a row's forces are persistent
-    Set External Forces for its duration, the world advanced by Step Once, a frame every
-    ``frame_every`` cycles; body states by Get State."""
-    session: "common.Session"
-    cycle_s: float
-    frame_every: int
+def cycle_port(session: "common.Session", cycle_s: float, frame_every: int):
+    """The world node's WorldPort (gui.ros.world_port) through a Session: a control row's
+    forces are persistent Set External Forces for its duration, the world advanced by Step
+    Once, a frame every ``frame_every`` cycles."""
+    from gui.ros.world_port import ClientWorldPort
+    from odin_common.interface import ForceKind
 
-    def body_state(self, body_id: str):
-        body = self.session.client.call("get_state", objects=[body_id]).bodies[0]
-        return np.array(body.position), np.array(body.orientation), np.array(body.linear)
+    class CyclePort(ClientWorldPort):
+        def set_servo(self, command) -> None:
+            raise common.ExperimentError("the sphere has no joints to servo")
 
-    def set_servo(self, command) -> None:
-        raise common.ExperimentError("the sphere has no joints to servo")
+        def advance(self, duration: float, forces=()) -> list:
+            cycles = round(duration / cycle_s)
+            if cycles < 1 or abs(cycles * cycle_s - duration) > 1e-6:
+                raise common.ExperimentError(f"a row of {duration} s is not a whole number "
+                                             f"of {cycle_s} s cycles")
+            client = session.client
+            ids = [client.add_body_force(body, ForceKind.FORCE, vector)
+                   for body, vector in forces]
+            for _ in range(cycles):
+                if (session.cycles + 1) % frame_every == 0:
+                    session.cycle_and_frame()
+                else:
+                    session.cycle(1)
+            for force_id in ids:
+                client.remove_body_force(force_id)
+            self._states.clear()            # bodies are read again (Get State)
+            return []
 
-    def advance(self, duration: float, forces) -> None:
-        from odin_common.interface import ForceKind
-        cycles = round(duration / self.cycle_s)
-        if cycles < 1 or abs(cycles * self.cycle_s - duration) > 1e-6:
-            raise common.ExperimentError(f"a row of {duration} s is not a whole number of "
-                                         f"{self.cycle_s} s cycles")
-        client = self.session.client
-        ids = [client.add_body_force(body, ForceKind.FORCE, vector) for body, vector in forces]
-        for _ in range(cycles):
-            if (self.session.cycles + 1) % self.frame_every == 0:
-                self.session.cycle_and_frame()
-            else:
-                self.session.cycle(1)
-        for force_id in ids:
-            client.remove_body_force(force_id)
+    return CyclePort(session.client)
 
 
 def _states(client, names) -> dict:
@@ -158,7 +156,7 @@ def run(frames: bool = True) -> dict:
         targets = route(start, p["route_corners_m"], goal, p["speed_m_s"] * p["row_s"])
         targets = np.vstack([targets, np.repeat(goal[None], p["hold_rows"], axis=0)])
         rows = control_rows(handle, targets, p)
-        results = run_control_path(CyclePort(s, cycle_s, every), handle, rows)
+        results = run_control_path(cycle_port(s, cycle_s, every), handle, rows)
         s.frame()
         s.finish()
         facts = analyse(s, p, bodies, handle, built, settled, targets, results, route_from)

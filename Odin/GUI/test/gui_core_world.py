@@ -1,8 +1,8 @@
-"""The VirtualWorld's Core standing in for the world node in GUI Core tests (no ROS): a
-client with the WorldClient methods build plans call, and a control port over it.
+"""The VirtualWorld's Core standing in for the world node in GUI Core tests (no ROS):
+gui.planning's CoreWorld (the WorldPort over a Core), with stepping and read-outs for the tests.
 
-The plan's steps call only these methods, as they do WorldClient's; the node tests and the
-experiments send the same plans through the real client."""
+The plan's steps, control paths and tracked paths ask only the WorldPort's methods; the node
+tests and the experiments run the same through the world node (gui.ros.world_port)."""
 from __future__ import annotations
 
 import logging
@@ -10,17 +10,17 @@ import logging
 import numpy as np
 
 from gui.core.translate import plan_problem
-from gui.planning import backend as planning_backend
+from gui.planning import core_world
 
 
-class CoreWorld(planning_backend.CoreWorld):
+class CoreWorld(core_world.CoreWorld):
     """gui.planning's in-process world (a Core behind WorldClient's build methods), with
     stepping and read-outs for the tests."""
 
     # -- stepping ------------------------------------------------------------------------------
     def run(self, seconds: float) -> None:
         """Steps the world ``seconds`` of simulated time at the step in force."""
-        h = self.step_values.step
+        h = self.step_values().step
         self.core.step(h, max(1, round(seconds / h)))
 
     def position(self, object_id: str) -> np.ndarray:
@@ -34,16 +34,13 @@ class CoreWorld(planning_backend.CoreWorld):
         its largest distance (mm) from where it was when called}."""
         start = {i: self.position(i) for i in object_ids}
         worst = dict.fromkeys(object_ids, 0.0)
-        h = self.step_values.step
+        h = self.step_values().step
         for _ in range(max(1, round(seconds / h / chunk))):
             self.core.step(h, chunk)
             for i in object_ids:
                 moved = 1000.0 * float(np.linalg.norm(self.position(i) - start[i]))
                 worst[i] = max(worst[i], moved)
         return worst
-
-
-CorePort = planning_backend.CorePort
 
 
 def quiet_plan(problem_file):

@@ -19,7 +19,7 @@ from gui.core.control_path import ControlRow, run_control_path
 from gui.core.kautham.problem import load_problem
 from gui.core.model import FIXED_BASE
 from gui.errors import ProblemError
-from gui_core_world import CorePort, CoreWorld
+from gui_core_world import CoreWorld
 from kautham_files import KINEMATIC, SHELF, default_parameters, plan_steps, write_problem
 from odin_common.interface import JointParameter, JointType, Shape
 
@@ -134,7 +134,7 @@ def test_kautham_s_chain_planner_drives_the_chain_as_its_environment_does(tmp_pa
     assert any(i.what == '<dynamics> of joint "upper"' for i in plan.ignored)
     # both joints 2 rad and more from their targets: each turns at the environment's speed
     world.execute(plan)
-    run_control_path(CorePort(world), handle, [ControlRow(handle.goal.controls, 0.01)] * 30)
+    run_control_path(world, handle, [ControlRow(handle.goal.controls, 0.01)] * 30)
     rates = {j.id: j.rates[0] for j in world.core.joint_states() if j.rates}
     assert [abs(rates[j]) for j in handle.joint_ids] == pytest.approx([1.0, 1.0], rel=0.02)
 
@@ -176,7 +176,7 @@ def test_a_control_row_servos_the_chain_to_its_configuration(tmp_path, world):
     plan = plan_problem(load_problem(_arm(tmp_path)))
     world.execute(plan)
     handle = plan.robot()
-    run_control_path(CorePort(world), handle, [ControlRow(handle.goal.controls, 0.5)] * 6)
+    run_control_path(world, handle, [ControlRow(handle.goal.controls, 0.5)] * 6)
     readings = {j.id: j.positions[0] for j in world.core.joint_states() if j.positions}
     reached = np.array([readings[j] for j in handle.joint_ids]) + handle.built_at
     np.testing.assert_allclose(reached, handle.goal.joints, atol=0.01)
@@ -198,7 +198,7 @@ def test_an_initially_attached_obstacle_rides_its_link(tmp_path, world):
     world.execute(plan)
     handle = plan.robot()
     fore_before, box_before = world.position("arm/fore"), world.position("box")
-    run_control_path(CorePort(world), handle, [ControlRow(handle.goal.controls, 0.5)] * 4)
+    run_control_path(world, handle, [ControlRow(handle.goal.controls, 0.5)] * 4)
     fore, box_now = world.position("arm/fore"), world.position("box")
     assert np.linalg.norm(box_now - box_before) > 0.2           # it moved with the arm
     assert np.linalg.norm(box_now - fore) == pytest.approx(

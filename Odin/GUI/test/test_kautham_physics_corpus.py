@@ -22,7 +22,7 @@ from gui.core.kautham.corpus import corpus_dir
 from gui.core.kautham.problem import load_problem
 from gui.core.model import FREE_BODY
 from gui.core.world_settings import with_values
-from gui_core_world import CorePort, CoreWorld
+from gui_core_world import CoreWorld
 from kautham_files import default_parameters, plan_steps
 from odin_common.interface import Shape
 
@@ -106,7 +106,7 @@ def test_a_control_row_pushes_the_sphere_toward_its_goal(world):
     handle = plan.robot()
     goal = handle.goal.base_pose[:2, 3]
     before = np.linalg.norm(world.position("SphereDE")[:2] - goal)
-    results = run_control_path(CorePort(world), handle,
+    results = run_control_path(world, handle,
                                [ControlRow(handle.goal.controls, 0.3)] * 12)
     distances = [np.linalg.norm(r.base_position[:2] - goal) for r in results]
     assert distances[0] < before - 0.2            # the first row already moves it toward it

@@ -20,7 +20,7 @@ from gui.core.control_path import ControlRow, read_control_path, run_control_pat
 from gui.core.kautham.problem import load_problem
 from gui.core.model import CAR, MOBILE
 from gui.errors import PathFileError
-from gui_core_world import CorePort, CoreWorld
+from gui_core_world import CoreWorld
 from kautham_files import KINEMATIC, SHELF, plan_steps, write_problem
 from odin_common.interface import JointParameter, JointType
 
@@ -102,7 +102,7 @@ def test_a_kautham_car_rolls_toward_world_minus_x_with_positive_wheel_speed(tmp_
     world.execute(plan)
     world.run(0.5)
     handle = plan.robot()
-    port = CorePort(world)
+    port = world
     # steering 0 (c = 0.5), wheel speed -5 + 15 x 0.6 = 4 rad/s: the chassis turns at 4 rad/s
     # about +y relative to its wheels, so they roll toward -x: 0.32 m/s on 0.08 m wheels
     straight = run_control_path(port, handle, [ControlRow((0.5, 0.6), 1.0)])
@@ -130,7 +130,7 @@ def test_a_car_outside_kauthams_car_planner_drives_forward_and_turns_left(tmp_pa
     world.execute(plan)
     world.run(0.5)
     handle = plan.robot()
-    port = CorePort(world)
+    port = world
     straight = run_control_path(port, handle, [ControlRow((0.5, 0.6), 1.0)])
     assert straight[0].base_position[0] == pytest.approx(0.32, abs=0.03)
     turn = run_control_path(port, handle, [ControlRow((1.0, 0.6), 0.5)] * 3)
@@ -192,7 +192,7 @@ def test_a_mobile_robot_has_a_free_base_its_controls_drive_with_its_arm(tmp_path
     world.execute(plan)
     world.run(0.5)
     handle = plan.robot()
-    results = run_control_path(CorePort(world), handle,
+    results = run_control_path(world, handle,
                                [ControlRow(handle.goal.controls, 0.5)] * 8)
     assert np.linalg.norm(results[-1].base_position[:2] - (1.0, -1.0)) < 0.03
     pan = {j.id: j.positions[0] for j in world.core.joint_states()}[handle.joint_ids[0]]
@@ -234,7 +234,7 @@ def test_without_kautham_physics_only_the_controls_and_attachments_move_anything
     # a control row moves the held base (its velocity) and servos the joint; it then stops
     handle = plan.robot()
     assert handle.base_held
-    results = run_control_path(CorePort(world), handle,
+    results = run_control_path(world, handle,
                                [ControlRow(handle.goal.controls, 0.5)] * 2)
     np.testing.assert_allclose(results[0].base_position[:2], (1.0, -1.0), atol=1e-6)
     world.run(1.0)

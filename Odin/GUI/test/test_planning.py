@@ -15,7 +15,7 @@ from gui.errors import PathFileError, PlanningError
 from gui.planning.backend import CoreBackend
 from gui.planning.bridge import PLANNERS, plan, replay
 from gui.planning.problem import SearchSettings, planning_problem
-from gui_core_world import CorePort, CoreWorld, quiet_plan
+from gui_core_world import CoreWorld, quiet_plan
 
 SPHERE = ("current_2025", "demos", "OMPL_ode_demos", "Sphere", "Sphere.xml")
 
@@ -101,7 +101,7 @@ def test_kpiece_solves_the_sphere_and_its_plan_replays_in_a_fresh_world(
     try:
         fresh = plan_problem(sphere_plan.problem)
         world.execute(fresh)
-        results = run_control_path(CorePort(world), fresh.robot(), rows)
+        results = run_control_path(world, fresh.robot(), rows)
         end = results[-1].base_position
     finally:
         world.close()

@@ -7,7 +7,8 @@ pairs and forbidden-contact verdicts, bit for bit."""
 import numpy as np
 import pytest
 
-from gui.planning.backend import CoreBackend, CorePort, CoreWorld, Outcome, step_actuation
+from gui.planning.backend import CoreBackend, Outcome, step_actuation
+from gui.planning.core_world import CoreWorld
 from gui.planning.problem import planning_problem
 from gui_core_world import quiet_plan
 
@@ -23,18 +24,17 @@ class GeneralPathBackend:
         self.problem = problem
         self.world = CoreWorld()
         self.world.execute(built)
-        self.port = CorePort(self.world)
 
     def propagate_one(self, state, control) -> Outcome:
         core, problem = self.world.core, self.problem
         core.set_body_state_vector(state)
-        act = step_actuation(problem, control, self.port.body_state(problem.base_body))
+        act = step_actuation(problem, control, self.world.body_state(problem.base_body))
         if act.servo is not None:
-            self.port.set_servo(act.servo)
-        result = self.port.advance(problem.step, act.forces)
+            self.world.set_servo(act.servo)
+        collisions = self.world.advance(problem.step, act.forces)
         position, quaternion, linear, _ = core.body_state(problem.tracked_body)
         return Outcome(core.body_state_vector(), problem.tracked_origin(position, quaternion),
-                       np.asarray(linear), tuple((c.first, c.second) for c in result.collisions))
+                       np.asarray(linear), tuple((c.first, c.second) for c in collisions))
 
     def close(self) -> None:
         self.world.close()

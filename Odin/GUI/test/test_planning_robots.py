@@ -12,7 +12,7 @@ from gui.core.control_path import ControlRow, run_control_path
 from gui.planning.backend import CoreBackend
 from gui.planning.bridge import plan, replay
 from gui.planning.problem import SearchSettings, planning_problem
-from gui_core_world import CorePort, CoreWorld, quiet_plan
+from gui_core_world import CoreWorld, quiet_plan
 
 CHAIN = ("demos", "OMPL_ode_demos", "Chain", "k-PMPChain.xml")
 CAR = ("demos", "OMPL_ode_demos", "Car", "k-PMPCar.xml")
@@ -111,7 +111,7 @@ def test_servo_propagations_restore_exactly_and_replay_in_a_fresh_world(
     try:
         fresh = plan_problem(built.problem)
         world.execute(fresh)
-        run_control_path(CorePort(world), fresh.robot(), rows)
+        run_control_path(world, fresh.robot(), rows)
         assert world.core.body_state_vector().tobytes() == state.tobytes()
     finally:
         world.close()

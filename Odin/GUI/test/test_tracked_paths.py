@@ -19,7 +19,6 @@ from gui.core.trajectory import BaseLimits, Profile, Trajectory
 from gui.errors import PathFileError
 from gui_core_world import CoreWorld
 from odin_common.interface import Solver
-from tracking_port import CoreTrackingPort
 
 KAUTHAM = corpus_dir() or pathlib.Path("/no-kautham-corpus")
 TRO = KAUTHAM / "legacy_2012" / "examples" / "TRO"
@@ -190,7 +189,7 @@ def test_the_2drr_solution_reaches_its_goal_on_the_core(kautham_dir, world):
     plan = plan_problem(problem, BuildDefaults(start_at_query=True))
     world.execute(plan)
     world.core.set_world_parameters(solver=Solver.WORLDSTEP)
-    report = execute_tracked(CoreTrackingPort(world), plan,
+    report = execute_tracked(world, plan,
                              read_solution(TRO / "2DRR_obstacle_sol.kps", problem))
     assert report.goal_error <= 0.01
     assert report.tracking_error_max < 0.01
@@ -212,7 +211,7 @@ def test_a_free_flying_sphere_follows_an_se3_task_path(kautham_dir, world, tmp_p
         f"<Conf> 0.2 -0.2 {z} 0 0 0.3826834 0.9238795 </Conf>\n"
         f"<Conf> -0.5 0.5 {z} 0 0 0.7071068 0.7071068 </Conf>\n"
         "</Transit>\n</Task>\n")
-    report = execute_tracked(CoreTrackingPort(world), plan, read_solution(task, problem),
+    report = execute_tracked(world, plan, read_solution(task, problem),
                              TrackingDefaults(settle=1.0), from_here=True)
     assert report.names == ["SphereDE/base x", "SphereDE/base y", "SphereDE/base z",
                             "SphereDE/base rotation"]
@@ -224,25 +223,28 @@ def test_a_free_flying_sphere_follows_an_se3_task_path(kautham_dir, world, tmp_p
     assert report.actuals[-1][:3] == pytest.approx([-0.5, 0.5, z], abs=0.01)
 
 
-class _RecordingPort(CoreTrackingPort):
-    """The Core port, recording when (simulated s) a fixed joint is made and removed."""
+class _RecordingPort:
+    """The Core's world port, recording when (simulated s) a fixed joint is made and
+    removed."""
 
     def __init__(self, world):
-        super().__init__(world)
-        self.now, self.calls = 0.0, []
+        self.world, self.now, self.calls = world, 0.0, []
+
+    def __getattr__(self, name):
+        return getattr(self.world, name)
 
     def advance(self, duration, forces):
-        collisions = super().advance(duration, forces)
+        collisions = self.world.advance(duration, forces)
         self.now += duration
         return collisions
 
     def attach(self, body1, body2):
-        joint = super().attach(body1, body2)
+        joint = self.world.attach(body1, body2)
         self.calls.append(("attach", round(self.now, 6), body1, body2, joint))
         return joint
 
     def detach(self, joint_id):
-        super().detach(joint_id)
+        self.world.detach(joint_id)
         self.calls.append(("detach", round(self.now, 6), joint_id))
 
 

@@ -16,7 +16,6 @@ from gui.core.translate import BuildDefaults, plan_problem
 from gui.errors import PathFileError
 from gui_core_world import CoreWorld
 from odin_common.interface import Solver
-from tracking_port import CoreTrackingPort
 
 
 @pytest.fixture
@@ -76,7 +75,7 @@ def _singularity_world(world, tro_singularity):
 def test_a_robot_away_from_the_path_s_start_is_refused_and_nothing_moves(tro_singularity,
                                                                          world):
     problem, plan, solution = _singularity_world(world, tro_singularity)
-    port = CoreTrackingPort(world)
+    port = world
     before = world.core.body_state_vector()
     with pytest.raises(AwayFromStart) as error:
         execute_tracked(port, plan, solution)
@@ -89,7 +88,7 @@ def test_a_robot_away_from_the_path_s_start_is_refused_and_nothing_moves(tro_sin
 
 def test_from_here_moves_it_to_the_start_first_as_a_reported_segment(tro_singularity, world):
     problem, plan, solution = _singularity_world(world, tro_singularity)
-    report = execute_tracked(CoreTrackingPort(world), plan, solution, from_here=True)
+    report = execute_tracked(world, plan, solution, from_here=True)
     move, path = report.segments[0], report.segments[1]
     assert move["what"] == "to the path's start" and move["channel"] == "2D-Robot/link2"
     assert move["distance"] == pytest.approx(1.803, abs=1e-3) and move["unit"] == "rad"
@@ -109,7 +108,7 @@ def test_a_robot_at_the_path_s_start_runs_with_a_move_of_nothing_reported(kautha
     problem = _load(tro / "2DRR_obstacle.xml")
     plan = plan_problem(problem, BuildDefaults(start_at_query=True))
     world.execute(plan)
-    report = execute_tracked(CoreTrackingPort(world), plan,
+    report = execute_tracked(world, plan,
                              read_solution(tro / "2DRR_obstacle_sol.kps", problem),
                              TrackingDefaults(settle=0.1))
     assert report.segments[0]["distance"] < TrackingDefaults().start_tolerance

@@ -396,7 +396,7 @@ def _interrupted(where: str) -> int:
 def _run_tracked(args, plan) -> int:
     """run_path --tracked: the plan read and checked whole, then executed in the running world
     (paused meanwhile); one line per simulated second, then the figures."""
-    from gui.core.execution import run_tracked_on_client
+    from gui.ros.world_port import run_tracked_on_client
     from gui.core.kautham.solutions import read_solution
     from gui.core.paths import DEGREES, RADIANS
     units = DEGREES if args.degrees else RADIANS if args.radians else None
@@ -450,9 +450,10 @@ def _run_tracked(args, plan) -> int:
 def _check_start(client, plan, solution, from_here: bool) -> None:
     """Unless ``from_here``: the robots are where the path starts (``gui.core.execution``'s
     rule), else one line saying how far they are and what would move them there."""
-    from gui.core.execution import AwayFromStart, ClientTrackingPort, plan_tracking
+    from gui.core.execution import AwayFromStart, plan_tracking
+    from gui.ros.world_port import ClientWorldPort
     try:
-        plan_tracking(ClientTrackingPort(client), plan, solution, from_here=from_here)
+        plan_tracking(ClientWorldPort(client), plan, solution, from_here=from_here)
     except AwayFromStart as error:
         raise GuiError(f"{error}; --from-here to move it there first") from None
 
@@ -485,7 +486,8 @@ def _run_controls(args, plan, handle) -> int:
     one line per row: its time, where the link the planner tracks is and, for a problem with
     a query, its distance to the goal in the planner's metric (``_goal_meter``): the figure
     ``plan`` printed for the same path."""
-    from gui.core.control_path import control_size, read_control_path, run_on_client
+    from gui.core.control_path import control_size, read_control_path
+    from gui.ros.world_port import run_on_client
     with reading("control path", args.controls):
         rows = read_control_path(args.controls, control_size(handle))
     meter = _goal_meter(plan, handle)

@@ -7,18 +7,18 @@ seconds, separated by spaces, tabs or commas; blank lines and lines starting wit
 skipped. A car's rows have two controls (steering, wheel speed), whatever its control file.
 
 ``MAPPING`` (below) says what a row does; docs/INTERFACE.md shows it (tools/interface_doc.py).
-``run_control_path(port, handle, rows)`` applies rows through a ``ControlPort``: the world calls
-a row needs (servo targets, forces for its duration) and the state they depend on.
-``ClientPort`` is one over a ``gui.ros.client.WorldClient``: each row is one Propagate of the
-world (paused) for its duration, kept, as Kautham's propagation steps its ODE world.
+``run_control_path(port, handle, rows)`` applies rows through a ``gui.core.world_port.WorldPort``:
+the world calls a row needs (servo targets, forces for its duration) and the state they depend
+on; over a world node (``gui.ros.world_port``) each row is one Propagate of the world (paused)
+for its duration, kept, as Kautham's propagation steps its ODE world. ``hold(port, handle)``
+holds a robot where it is (what Ctrl-C leaves of a path).
 """
 from __future__ import annotations
 
 import os
 import pathlib
-import time
-from dataclasses import dataclass, field
-from typing import Callable, Dict, List, Optional, Protocol, Sequence, Tuple
+from dataclasses import dataclass
+from typing import Callable, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -26,8 +26,9 @@ from gui.core.kautham import environment
 from gui.core.model import CAR, FREE_BODY, MOBILE
 from gui.core.paths import read_rows
 from gui.core.plan import ServoCommand
+from gui.core.world_port import BodyState, WorldPort
 from gui.errors import PathFileError
-from odin_common.interface import SERVO_MAX_SPEED, ForceKind
+from odin_common.defaults import SERVO_MAX_SPEED
 from odin_common.rotations import quaternion_to_matrix
 
 MAPPING = """\
@@ -102,23 +103,6 @@ class Actuation:
     servo: Optional[ServoCommand] = None
     forces: Tuple[Tuple[str, Tuple[float, float, float]], ...] = ()
     base_velocity: Optional[Tuple[str, Tuple[float, float, float]]] = None
-
-
-BodyState = Tuple[np.ndarray, np.ndarray, np.ndarray]
-"""(position (3,) m of the object's frame, quaternion (w, x, y, z), linear velocity (3,) m/s
-of the centre of mass), world frame."""
-
-
-class ControlPort(Protocol):
-    """What running a control path needs of the world."""
-
-    def body_state(self, body_id: str) -> BodyState: ...
-
-    def set_servo(self, command: ServoCommand) -> None: ...
-
-    def set_body_velocity(self, body_id: str, linear, angular) -> None: ...
-
-    def advance(self, duration: float, forces: Sequence[Tuple[str, Sequence[float]]]) -> None: ...
 
 
 def control_size(handle) -> int:
@@ -224,7 +208,7 @@ def _base_origin(handle, state: Optional[BodyState]) -> np.ndarray:
     """(3,) m, world: the base link's origin in the base body's ``state``."""
     if state is None:
         raise ValueError(f"{handle.name}: a free base needs its state to be driven")
-    position, quaternion, _ = state
+    position, quaternion = state[0], state[1]
     pose = np.eye(4)
     pose[:3, :3] = quaternion_to_matrix(quaternion)
     pose[:3, 3] = position
@@ -245,7 +229,7 @@ def _base_velocity(handle, target_pose: np.ndarray, state: Optional[BodyState],
 def _base_force(handle, target_pose: np.ndarray, state: Optional[BodyState], duration: float,
                 axes: Sequence[int], defaults: ControlDefaults) -> Tuple[str, tuple]:
     base = _base_origin(handle, state)
-    velocity = state[2]
+    velocity = state[2]             # the centre of mass's linear velocity (m/s)
     body = handle.bodies[0]
     mass = handle.base_mass
     force = np.zeros(3)
@@ -267,7 +251,7 @@ class RowResult:
     watched: Optional[BodyState] = None
 
 
-def run_control_path(port: ControlPort, handle, rows: Sequence[ControlRow],
+def run_control_path(port: WorldPort, handle, rows: Sequence[ControlRow],
                      defaults: ControlDefaults = ControlDefaults(),
                      progress: Optional[Callable[[RowResult], None]] = None,
                      stop: Optional[Callable[[], bool]] = None,
@@ -303,61 +287,6 @@ def run_control_path(port: ControlPort, handle, rows: Sequence[ControlRow],
     return results
 
 
-@dataclass
-class ClientPort:
-    """A ControlPort over a ``gui.ros.client.WorldClient``: each row is one Propagate, kept
-    (the world must be paused: ``run_on_client`` pauses it). ``real_time``: each row takes at
-    least its duration of wall-clock time, so that a Viewer shows the motion at its pace."""
-    client: object
-    real_time: bool = True
-    sleep: Callable[[float], None] = time.sleep
-    _states: Dict[str, BodyState] = field(default_factory=dict)
-
-    def body_state(self, body_id: str) -> BodyState:
-        if body_id not in self._states:
-            self._states[body_id] = self.client.body_kinematics(body_id)[:3]
-        return self._states[body_id]
-
-    def set_servo(self, command: ServoCommand) -> None:
-        self.client.set_servo(command)
-
-    def set_body_velocity(self, body_id: str, linear, angular) -> None:
-        self.client.set_body_velocity(body_id, linear=list(linear), angular=list(angular))
-        self._states.pop(body_id, None)
-
-    def advance(self, duration: float, forces) -> None:
-        started = time.monotonic()
-        result = self.client.propagate(duration, forces=[
-            dict(object_id=body, kind=ForceKind.FORCE, vector=list(vector))
-            for body, vector in forces], keep=True)
-        self._states = {i: (np.array(p), np.array(q), np.array(v))
-                        for i, (p, q, v, _) in result.states.items()}
-        if self.real_time:
-            self.sleep(max(0.0, duration - (time.monotonic() - started)))
-
-
-def run_on_client(client, handle, rows: Sequence[ControlRow], real_time: bool = True,
-                  progress: Optional[Callable[[RowResult], None]] = None,
-                  sleep: Callable[[float], None] = time.sleep,
-                  stop: Optional[Callable[[], bool]] = None,
-                  watch: Optional[str] = None) -> List[RowResult]:
-    """``run_control_path`` through a ``ClientPort`` (``watch``: its body to report), the
-    world paused meanwhile (and running again afterwards if it was). Stopped by ``stop()``,
-    the robot is held where it is (``hold_on_client``) before the world runs again."""
-    running = client.world().simulating
-    if running:
-        client.pause()
-    try:
-        results = run_control_path(ClientPort(client, real_time, sleep), handle, rows,
-                                   progress=progress, stop=stop, watch=watch)
-        if stop is not None and stop():
-            hold_on_client(client, handle)
-        return results
-    finally:
-        if running:
-            client.start()
-
-
 def hold_servo(handle, present: Sequence[float]) -> ServoCommand:
     """Set Servo that holds ``handle``'s robot still: each joint's motor toward its
     ``present`` value (rad or m, Kautham's joint values: ``built_at`` plus what the world
@@ -378,21 +307,17 @@ def hold_servo(handle, present: Sequence[float]) -> ServoCommand:
                         rates=(0.0,) * len(relative), max_speeds=speeds)
 
 
-def hold_on_client(client, handle) -> None:
-    """Holds ``handle``'s robot where it is through a ``gui.ros.client.WorldClient``: its
-    servos toward the joints' present values (``hold_servo``), a free base's velocity
-    zero (what Ctrl-C leaves of a path)."""
+def hold(port: WorldPort, handle) -> None:
+    """Holds ``handle``'s robot where it is: its servos toward the joints' present values
+    (``hold_servo``), a free base's velocity zero (what Ctrl-C leaves of a path)."""
     if handle.motor_ids and (handle.kind == CAR or
                              len(handle.motor_ids) == len(handle.joint_ids)):
-        response = client.call("get_state", joints=list(handle.joint_ids))
-        moved = np.array([j.positions[0] for j in response.joints], dtype=float)
-        client.set_servo(hold_servo(handle, np.asarray(handle.built_at, dtype=float) + moved))
+        moved = port.joint_positions(handle.joint_ids)
+        port.set_servo(hold_servo(handle, np.asarray(handle.built_at, dtype=float) + moved))
     if handle.kind in (FREE_BODY, MOBILE, CAR):
-        client.set_body_velocity(handle.bodies[0].body_id, linear=[0.0, 0.0, 0.0],
-                                 angular=[0.0, 0.0, 0.0])
+        port.set_body_velocity(handle.bodies[0].body_id, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
 
 
 __all__ = ["MAPPING", "ControlDefaults", "ControlRow", "ServoCommand", "Actuation",
-           "ControlPort", "control_size", "read_control_path", "write_control_path", "actuation",
-           "run_control_path", "RowResult", "ClientPort", "run_on_client", "hold_servo",
-           "hold_on_client"]
+           "control_size", "read_control_path", "write_control_path", "actuation",
+           "run_control_path", "RowResult", "hold_servo", "hold"]

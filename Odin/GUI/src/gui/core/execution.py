@@ -35,18 +35,18 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
-from typing import Callable, Dict, List, Optional, Protocol, Sequence, Tuple
+from typing import Callable, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from gui.core.control_path import ServoCommand, hold_on_client
+from gui.core.control_path import ServoCommand
 from gui.core.kautham.solutions import ATTACH, Solution
 from gui.core.model import PRISMATIC
 from gui.core.trajectory import BaseLimits, Trajectory, rotation_error
+from gui.core.world_port import WorldPort
 from gui.errors import GuiError, PathFileError
-from odin_common.interface import SERVO_GAIN, SERVO_MAX_SPEED, JointType
+from odin_common.defaults import SERVO_GAIN, SERVO_MAX_SPEED
 from odin_common.rotations import quaternion_to_matrix
-from odin_common.specs import JointSpec
 
 
 @dataclass(frozen=True)
@@ -73,37 +73,6 @@ class TrackingDefaults:
     def base_limits(self) -> BaseLimits:
         return BaseLimits(self.base_speed, self.base_acceleration, self.base_angular_speed,
                           self.base_angular_acceleration)
-
-
-Collision = Tuple[str, str, float, float]
-"""(first geometry, second geometry, depth m, time first seen s)."""
-BodyState = Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
-"""(position (3,) m, quaternion (w, x, y, z), linear (3,) m/s, angular (3,) rad/s), world."""
-
-
-class TrackingPort(Protocol):
-    """What tracked execution needs of the world."""
-
-    def step(self) -> float: ...
-
-    def gravity(self) -> np.ndarray: ...
-
-    def masses(self, body_ids: Sequence[str]) -> float: ...
-
-    def joint_positions(self, joint_ids: Sequence[str]) -> np.ndarray: ...
-
-    def body_state(self, body_id: str) -> BodyState: ...
-
-    def set_servo(self, command: ServoCommand) -> None: ...
-
-    def set_body_velocity(self, body_id: str, linear, angular) -> None: ...
-
-    def advance(self, duration: float,
-                forces: Sequence[Tuple[str, Sequence[float]]]) -> Sequence[Collision]: ...
-
-    def attach(self, body1: str, body2: str) -> str: ...
-
-    def detach(self, joint_id: str) -> None: ...
 
 
 class AwayFromStart(GuiError):
@@ -228,7 +197,7 @@ def _instance_of(body) -> str:
     return body.parts[0].name.split("#")[0]
 
 
-def _present(port: TrackingPort, robot: _Robot) -> Tuple[np.ndarray, Optional[np.ndarray]]:
+def _present(port: WorldPort, robot: _Robot) -> Tuple[np.ndarray, Optional[np.ndarray]]:
     """A robot's joint values (rad / m) and base pose (4, 4 world) now."""
     h = robot.handle
     joints = np.asarray(h.built_at, dtype=float).copy()
@@ -244,7 +213,7 @@ def _present(port: TrackingPort, robot: _Robot) -> Tuple[np.ndarray, Optional[np
     return joints, base
 
 
-def plan_tracking(port: TrackingPort, plan, solution: Solution,
+def plan_tracking(port: WorldPort, plan, solution: Solution,
                   defaults: TrackingDefaults = TrackingDefaults(), from_here: bool = False):
     """(robots, trajectory, events) for ``solution`` from the robots' present state;
     ``AwayFromStart`` when a robot is farther from the path's first sample than
@@ -315,7 +284,7 @@ def _segments(robots: Sequence[_Robot], trajectory: Trajectory, done_s: float) -
     return out
 
 
-def execute_tracked(port: TrackingPort, plan, solution: Solution,
+def execute_tracked(port: WorldPort, plan, solution: Solution,
                     defaults: TrackingDefaults = TrackingDefaults(),
                     progress: Optional[Callable[[float, float], None]] = None,
                     real_time: bool = False, sleep: Callable[[float], None] = time.sleep,
@@ -327,7 +296,7 @@ def execute_tracked(port: TrackingPort, plan, solution: Solution,
     the run there: the report covers the periods run (``duration_s``). ``from_here``: a
     robot away from the path's start is moved there first (else ``AwayFromStart``)."""
     robots, trajectory, events = plan_tracking(port, plan, solution, defaults, from_here)
-    step = port.step()
+    step = port.step_values().step
     period = step * max(1, round(defaults.period / step))
     ticks = int(math.ceil((trajectory.duration + defaults.settle) / period - 1e-9))
     names, units = _channels(robots)
@@ -402,12 +371,12 @@ def _servo(handle, targets: np.ndarray, rates: np.ndarray,
                         gains=(defaults.gain,) * len(relative), max_speeds=tuple(speeds))
 
 
-def _base_weights(port: TrackingPort, robots: Sequence[_Robot]) -> Dict[str, float]:
+def _base_weights(port: WorldPort, robots: Sequence[_Robot]) -> Dict[str, float]:
     return {r.handle.name: port.masses([b.body_id for b in r.handle.bodies])
             for r in robots if r.base is not None}
 
 
-def _drive_base(port: TrackingPort, robot: _Robot, middle, end, mass: float,
+def _drive_base(port: WorldPort, robot: _Robot, middle, end, mass: float,
                 gravity: np.ndarray, defaults: TrackingDefaults) -> Tuple[str, tuple]:
     """Sets the base body's velocity toward its target; returns the gravity-cancelling force
     (the robot's whole mass, on the base body)."""
@@ -422,7 +391,7 @@ def _drive_base(port: TrackingPort, robot: _Robot, middle, end, mass: float,
     return body.body_id, tuple(float(v) for v in -mass * gravity)
 
 
-def _compare(port: TrackingPort, robots: Sequence[_Robot], sample) -> Tuple[np.ndarray,
+def _compare(port: WorldPort, robots: Sequence[_Robot], sample) -> Tuple[np.ndarray,
                                                                             np.ndarray]:
     """(target, actual) per channel: joints, then per driven base x y z and the rotation
     (target's entry 0, actual's entry the angle between them)."""
@@ -439,7 +408,7 @@ def _compare(port: TrackingPort, robots: Sequence[_Robot], sample) -> Tuple[np.n
     return np.concatenate(target), np.concatenate(actual)
 
 
-def _apply(port: TrackingPort, event: _Event, made: Dict[Tuple[str, str], str],
+def _apply(port: WorldPort, event: _Event, made: Dict[Tuple[str, str], str],
            holds: Dict[str, str]) -> None:
     """Makes or removes the event's attachment. An obstacle held where the problem put it
     (``holds``: ``BuildPlan.holds``, "" while attached) is let go when attached and held again
@@ -458,85 +427,5 @@ def _apply(port: TrackingPort, event: _Event, made: Dict[Tuple[str, str], str],
             holds[event.obstacle_body] = port.attach(event.obstacle_body, "")
 
 
-# -- the world through gui.ros.client.WorldClient ---------------------------------------------
-@dataclass
-class ClientTrackingPort:
-    """A TrackingPort over a ``gui.ros.client.WorldClient``: each period one kept Propagate
-    (the world paused: ``run_tracked_on_client`` pauses it)."""
-    client: object
-    _step: Optional[float] = None
-    _states: Dict[str, BodyState] = field(default_factory=dict)
-
-    def step(self) -> float:
-        if self._step is None:
-            self._step = float(self.client.step_values().step)
-        return self._step
-
-    def gravity(self) -> np.ndarray:
-        return np.asarray(self.client.world_parameters().gravity, dtype=float)
-
-    def masses(self, body_ids: Sequence[str]) -> float:
-        return float(sum(self.client.call("get_state", objects=list(body_ids)).masses))
-
-    def joint_positions(self, joint_ids: Sequence[str]) -> np.ndarray:
-        response = self.client.call("get_state", joints=list(joint_ids))
-        return np.array([j.positions[0] for j in response.joints], dtype=float)
-
-    def body_state(self, body_id: str) -> BodyState:
-        if body_id not in self._states:
-            self._states[body_id] = self.client.body_kinematics(body_id)
-        return self._states[body_id]
-
-    def set_servo(self, command: ServoCommand) -> None:
-        self.client.set_servo(command)
-
-    def set_body_velocity(self, body_id: str, linear, angular) -> None:
-        self.client.set_body_velocity(body_id, linear=list(linear), angular=list(angular))
-        self._states.pop(body_id, None)
-
-    def advance(self, duration: float, forces) -> List[Collision]:
-        from odin_common.interface import ForceKind
-        result = self.client.propagate(duration, forces=[
-            dict(object_id=body, kind=ForceKind.FORCE, vector=list(vector))
-            for body, vector in forces], keep=True)
-        self._states = {i: tuple(np.array(v) for v in s) for i, s in result.states.items()}
-        return [(a, b, float(depth), float(when) - result.start_time)
-                for a, b, depth, when in result.collisions]
-
-    def attach(self, body1: str, body2: str) -> str:
-        return self.client.add_joint(JointSpec(type=JointType.FIXED, body1=body1,
-                                               body2=body2))
-
-    def detach(self, joint_id: str) -> None:
-        self.client.remove_joint(joint_id)
-
-
-def run_tracked_on_client(client, plan, solution: Solution,
-                          defaults: TrackingDefaults = TrackingDefaults(),
-                          progress: Optional[Callable[[float, float], None]] = None,
-                          real_time: bool = False,
-                          stop: Optional[Callable[[], bool]] = None,
-                          from_here: bool = False) -> TrackingReport:
-    """``execute_tracked`` through a ``ClientTrackingPort`` (``from_here`` as there), the
-    world paused meanwhile (and running again afterwards if it was). Stopped by ``stop()``,
-    each robot of the solution is held where it is (``hold_on_client``) before the world
-    runs again."""
-    running = client.world().simulating
-    if running:
-        client.pause()
-    try:
-        report = execute_tracked(ClientTrackingPort(client), plan, solution, defaults,
-                                 progress=progress, real_time=real_time, stop=stop,
-                                 from_here=from_here)
-        if stop is not None and stop():
-            for name in solution.paths:
-                hold_on_client(client, plan.robot(name))
-        return report
-    finally:
-        if running:
-            client.start()
-
-
-__all__ = ["TrackingDefaults", "TrackingPort", "TrackingReport", "AwayFromStart",
-           "plan_tracking", "start_offset", "execute_tracked", "ClientTrackingPort",
-           "run_tracked_on_client"]
+__all__ = ["TrackingDefaults", "TrackingReport", "AwayFromStart", "plan_tracking",
+           "start_offset", "execute_tracked"]

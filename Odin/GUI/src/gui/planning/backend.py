@@ -10,8 +10,9 @@ planner's propagation of a control for n steps is n such calls in a row, exactly
 ``run_path`` runs the n rows of the control path it becomes (one kept Propagate per row), so
 that the written plan replays bit for bit in a fresh world.
 
-``CoreBackend``: the VirtualWorld's Core in this process, built from the problem's plan
-(fastest: no messages). ``gui.planning.pool.PoolBackend``: world nodes over ROS.
+``CoreBackend``: the VirtualWorld's Core in this process (``gui.planning.core_world``), built
+from the problem's plan (fastest: no messages). ``gui.planning.pool.PoolBackend``: world
+nodes over ROS.
 """
 from __future__ import annotations
 
@@ -19,13 +20,13 @@ from typing import Dict, List, NamedTuple, Optional, Protocol, Sequence, Tuple
 
 import numpy as np
 
-from gui.core.control_path import Actuation, BodyState, ControlRow, ServoCommand, actuation
-from gui.core.overlaps import settle_overlaps
-from gui.core.plan import BuildPlan, BuiltIds
+from gui.core.control_path import Actuation, ControlRow, ServoCommand, actuation
+from gui.core.plan import BuildPlan
+from gui.core.world_port import BodyState
+from gui.planning.core_world import CoreWorld
 from gui.planning.problem import PlanningProblem
-from odin_common.interface import BODY_STATE_SIZE, BODY_STATE_SLICES, ForceKind
+from odin_common.interface import BODY_STATE_SIZE, BODY_STATE_SLICES
 from odin_common.rotations import quaternion_to_matrix
-from odin_common.step_values import StepValues
 
 
 class Outcome(NamedTuple):
@@ -57,121 +58,11 @@ class Backend(Protocol):
     def close(self) -> None: ...
 
 
-class CoreWorld:
-    """A VirtualWorld Core behind the WorldClient methods a build plan calls (``execute``
-    sends the whole plan), and ``step_values``, the Set Step values in force."""
-
-    def __init__(self, parameters=None, resources=None,
-                 step_values: Optional[StepValues] = None):
-        """``parameters`` (WorldParameters), ``resources`` (ResourceLimits) and
-        ``step_values``: the world's to start from (None: the defaults)."""
-        from virtual_world.core import Core
-        from odin_common.limits import ResourceLimits
-        self.core = Core(parameters, ResourceLimits() if resources is None else resources)
-        self.step_values = StepValues() if step_values is None else step_values
-
-    def close(self) -> None:
-        self.core.close()
-
-    def pause(self) -> bool:
-        """A Core steps only when asked: it is always paused."""
-        return False
-
-    def set_world(self, **changes):
-        return self.core.set_world_parameters(**changes)
-
-    def set_step(self, step=None, steps_per_cycle=None, cycle_time=None, rate=None):
-        self.step_values = StepValues(step, steps_per_cycle, rate)
-        return self.step_values
-
-    def build_entity(self, spec):
-        return self.core.build_entity(spec)
-
-    def build_object(self, spec) -> str:
-        return self.core.build_object(spec).id
-
-    def build_composite(self, spec) -> str:
-        return self.core.build_composite(spec).id
-
-    def add_joint(self, spec) -> str:
-        return self.core.add_joint(spec)
-
-    def add_motor(self, spec) -> str:
-        return self.core.add_motor(spec)
-
-    def set_joint_parameters(self, joint_id, parameters) -> None:
-        self.core.set_joint_parameters(joint_id, parameters)
-
-    def set_servo(self, command: ServoCommand) -> None:
-        """Set Servo's lists split per motor, as the world node splits them."""
-        servos = {m: {} for m in command.motors}
-        for name in ("targets", "rates", "gains", "max_speeds", "max_forces"):
-            values = getattr(command, name)
-            if name == "targets" or len(values):
-                for motor, split in self.core.split_per_axis(list(command.motors),
-                                                             list(values), name).items():
-                    servos[motor][name] = split
-        self.core.set_servos(servos)
-
-    def exempt_overlaps(self, min_depth: float) -> list:
-        return [(c.first, c.second, c.depth) for c in self.core.exempt_overlaps(min_depth)]
-
-    def check_collision(self, poses) -> list:
-        return [(c.first, c.second, c.depth) for c in self.core.check_collision(poses)]
-
-    def execute(self, plan: BuildPlan) -> dict:
-        return send_plan(self, plan)
-
-
-def send_plan(world, plan: BuildPlan) -> dict:
-    """Sends every step of ``plan`` to ``world`` (a CoreWorld or a gui.ros WorldClient),
-    records the world's IDs in it and settles the parts it built inside each other as the
-    world node's loads do (gui.core.overlaps.settle_overlaps, answered as "overlaps" and
-    "overlaps_exempt", warned about by no one); no robot is declared (the planner's worlds
-    publish nothing anyone reads)."""
-    ids = BuiltIds()
-    for step in plan.steps:
-        step.send(world, ids)
-    plan.record_world_ids(ids)
-    overlaps, exempt = settle_overlaps(world, plan)
-    return {**ids.as_dict(), "overlaps": overlaps, "overlaps_exempt": exempt}
-
-
 def step_actuation(problem: PlanningProblem, control: Sequence[float], base) -> Actuation:
     """What applying ``control`` for one propagation step asks of the world (servo settings,
     forces), the robot's base being in ``base`` (position m, quaternion (w, x, y, z), linear
     velocity m/s; world frame) when the step starts."""
     return actuation(problem.handle, ControlRow(tuple(control), problem.step), base)
-
-
-class CorePort:
-    """gui.core.control_path.ControlPort over a CoreWorld: each row one kept propagation, as
-    ``run_path``'s ClientPort runs it on a world node."""
-
-    def __init__(self, world: CoreWorld):
-        self.world = world
-
-    def body_state(self, body_id: str):
-        position, quaternion, linear, _ = self.world.core.body_state(body_id)
-        return np.asarray(position), np.asarray(quaternion), np.asarray(linear)
-
-    def set_servo(self, command: ServoCommand) -> None:
-        self.world.set_servo(command)
-
-    def set_body_velocity(self, body_id: str, linear, angular) -> None:
-        self.world.core.set_velocity(body_id, linear=tuple(linear), angular=tuple(angular))
-
-    def advance(self, duration: float, forces):
-        # a control path reads the world through body_state: the answer's states go unread
-        return self.world.core.propagate(duration, self.world.step_values.step,
-                                         body_forces=force_requests(forces), keep=True,
-                                         read_states=False)
-
-
-def force_requests(forces) -> list:
-    """An actuation's forces as Propagate's body forces (keyword arguments of add_body_force)."""
-    return [dict(object_id=body, kind=ForceKind.FORCE, vector=tuple(vector))
-            for body, vector in forces]
 
 
 class VectorBodies:
@@ -186,25 +77,26 @@ class VectorBodies:
             start = 1 + index * BODY_STATE_SIZE
             com = np.asarray(com, dtype=np.float64)
             self._slots[name] = (*(slice(start + f.start, start + f.stop)
-                                   for f in (_POSITION, _QUATERNION, _LINEAR)),
+                                   for f in (_POSITION, _QUATERNION, _LINEAR, _ANGULAR)),
                                  com, not com.any())
 
     def body(self, state: np.ndarray, name: str) -> BodyState:
-        """The body ``name``'s (frame origin (3,) m, quaternion (w, x, y, z), linear velocity
-        (3,) m/s of its centre of mass), world frame, in ``state``: read-only (views of it)."""
-        position, quaternion, linear, com, centred = self._slots[name]
+        """The body ``name``'s state (gui.core.world_port.BodyState: frame origin, quaternion,
+        velocities) in ``state``: read-only (views of it)."""
+        position, quaternion, linear, angular, com, centred = self._slots[name]
         position, quaternion = state[position], state[quaternion]
         if centred:
             x, y, z = position.tolist()
             if x and y and z:
                 # origin = position - R @ 0 = position: subtracting a zero changes no value
                 # but a zero's sign, hence the non-zero position (body_state's very bits)
-                return position, quaternion, state[linear]
-        return position - quaternion_to_matrix(quaternion) @ com, quaternion, state[linear]
+                return BodyState(position, quaternion, state[linear], state[angular])
+        return BodyState(position - quaternion_to_matrix(quaternion) @ com, quaternion,
+                         state[linear], state[angular])
 
 
-_POSITION, _QUATERNION, _LINEAR = (BODY_STATE_SLICES[name]
-                                   for name in ("position", "quaternion", "linear"))
+_POSITION, _QUATERNION, _LINEAR, _ANGULAR = (
+    BODY_STATE_SLICES[name] for name in ("position", "quaternion", "linear", "angular"))
 
 
 class CoreBackend:
@@ -224,7 +116,6 @@ class CoreBackend:
             raise
         self.bodies = VectorBodies({b.id: (index, b.center_of_mass)
                                     for index, b in enumerate(bodies)})
-        self.port = CorePort(self.world)
         self.propagations = 0
         self._servo_sent: Optional[ServoCommand] = None
 
@@ -236,8 +127,8 @@ class CoreBackend:
         return self._tracked(state)
 
     def _tracked(self, state: np.ndarray):
-        position, quaternion, linear = self.bodies.body(state, self.problem.tracked_body)
-        return self.problem.tracked_origin(position, quaternion), linear.copy()
+        body = self.bodies.body(state, self.problem.tracked_body)
+        return self.problem.tracked_origin(body.position, body.quaternion), body.linear.copy()
 
     def propagate(self, requests):
         return [self._one(state, control) for state, control in requests]
@@ -252,10 +143,10 @@ class CoreBackend:
             core.checked_state_vector(state)     # a bad state changes no servo either
             # the same settings again change nothing: a control held over several steps
             # is sent once (this world's servos are set by this back end alone)
-            self.port.set_servo(act.servo)
+            self.world.set_servo(act.servo)
             self._servo_sent = act.servo
         # propagate_state checks the state's values before it changes anything
-        result = core.propagate_state(state, problem.step, self.world.step_values.step,
+        result = core.propagate_state(state, problem.step, self.world.step_values().step,
                                       act.forces)
         self.propagations += 1
         position, linear = self._tracked(result.state)
@@ -265,5 +156,4 @@ class CoreBackend:
         self.world.close()
 
 
-__all__ = ["Outcome", "Backend", "CoreWorld", "CorePort", "CoreBackend", "VectorBodies",
-           "force_requests", "send_plan", "step_actuation"]
+__all__ = ["Outcome", "Backend", "CoreBackend", "VectorBodies", "step_actuation"]

@@ -19,8 +19,9 @@ import numpy as np
 
 from gui.core.plan import BuildPlan
 from gui.errors import PlanningError
-from gui.planning.backend import (Outcome, VectorBodies, force_requests, send_plan,
-                                  step_actuation)
+from gui.core.world_port import build
+from gui.planning.backend import Outcome, VectorBodies, step_actuation
+from gui.planning.core_world import force_requests
 from gui.planning.problem import PlanningProblem
 from odin_common.messages import body_force_message
 
@@ -33,6 +34,7 @@ class PoolBackend:
                  timeout: float = 30.0):
         from gui.ros.client import WorldClient
         from gui.ros.pool import PoolError, WorldPool
+        from gui.ros.world_port import ClientWorldPort
         self.problem = problem
         self.propagations = 0
         self._pool_error = PoolError
@@ -46,7 +48,8 @@ class PoolBackend:
                 try:
                     client.new_scene()
                     client.pause()
-                    send_plan(client, plan)
+                    # no robot declared: the planner's worlds publish nothing anyone reads
+                    build(ClientWorldPort(client), plan)
                     self.step = client.step_values().step
                 finally:
                     client.close()

@@ -24,21 +24,20 @@ file (gui.window.simulation_tab) call ``load_scene``. It needs no ROS: ``client`
 from __future__ import annotations
 
 import dataclasses
-from typing import Callable, Optional
+from typing import Optional
 
 import numpy as np
 
 from gui.core.plan import BuildPlan, BuiltIds
+from gui.core.world_port import Progress
 from gui.errors import GuiError
 from gui.planning import rehearsal_cache
-from gui.planning.backend import CoreWorld
+from gui.planning.core_world import CoreWorld
 from odin_common.errors import OdinError
 from odin_common.limits import ResourceLimits
 from odin_common.step_values import StepValues
 from odin_common.world_parameters import WorldParameters
 
-Progress = Callable[[int, object, str], None]
-"""``progress(k, step, answer)`` after step k (1-based) of a plan was answered."""
 
 
 class _RehearsalWorld(CoreWorld):
@@ -47,10 +46,10 @@ class _RehearsalWorld(CoreWorld):
 
     def set_step(self, step=None, steps_per_cycle=None, cycle_time=None, rate=None):
         from virtual_world.core.step_values import resolve
-        self.step_values, _ = resolve(self.step_values, step=step or 0.0,
-                                      steps_per_cycle=steps_per_cycle or 0,
-                                      cycle_time=cycle_time or 0.0, rate=rate or 0.0)
-        return self.step_values
+        self._step_values, _ = resolve(self._step_values, step=step or 0.0,
+                                       steps_per_cycle=steps_per_cycle or 0,
+                                       cycle_time=cycle_time or 0.0, rate=rate or 0.0)
+        return self._step_values
 
 
 def rehearse(plan: BuildPlan, parameters: WorldParameters, step_values: StepValues,

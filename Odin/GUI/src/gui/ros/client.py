@@ -27,11 +27,13 @@ from typing import Callable, Dict, NamedTuple, Optional, Sequence, Tuple
 
 import numpy as np
 
-from gui.core.overlaps import overlap_warning, settle_overlaps
+from gui.core.overlaps import overlap_warning
 from gui.core.plan import BuildPlan, BuiltIds, RobotHandle
+from gui.core.world_port import Built, Progress, build
 from gui.core.robot_description import RobotDescription, describe_robot
 from gui.errors import WorldError
 from gui.ros.services import ServiceCaller, join_ros_graph
+from gui.ros.world_port import ClientWorldPort
 from Services.srv import BuildEntityRequest
 from odin_common.errors import InvalidArgument
 from odin_common.limits import ResourceLimits
@@ -43,12 +45,6 @@ from odin_common.specs import CompositeSpec, EntitySpec, JointSpec, MotorSpec, O
 from odin_common.step_values import StepValues
 from odin_common.world_parameters import (PARAMETER_INFO, PARAMETERS, ParameterInfo,
                                           WorldParameters, set_world_flags)
-
-
-class BuiltEntity(NamedTuple):
-    """Build Entity's answer: the entity's name and its members' IDs (objects first)."""
-    name: str
-    ids: Tuple[str, ...]
 
 
 def _floats(values) -> list:
@@ -254,10 +250,10 @@ class WorldClient:
         """Build Composite; returns its ID (">part1>part2...")."""
         return self.call("build_composite", composite=composite_message(spec)).id
 
-    def build_entity(self, spec: EntitySpec) -> BuiltEntity:
+    def build_entity(self, spec: EntitySpec) -> Built:
         """Build Entity (all or nothing); returns its name and its members' IDs."""
         response = self._caller.send("build_entity", _packed_build_entity(spec))
-        return BuiltEntity(response.id, tuple(response.ids))
+        return Built(response.id, tuple(response.ids))
 
     def remove_object(self, object_id: str) -> None:
         """Remove Object, with its joints, motors and forces."""
@@ -359,6 +355,19 @@ class WorldClient:
         return (np.array(b.position), np.array(b.orientation), np.array(b.linear),
                 np.array(b.angular))
 
+    def masses(self, object_ids: Sequence[str]) -> Tuple[float, ...]:
+        """Get State: each object's mass (kg), in order (none asked: none)."""
+        if not len(object_ids):             # Get State's empty list asks for every body
+            return ()
+        return tuple(float(m) for m in self.call("get_state", objects=list(object_ids)).masses)
+
+    def joint_positions(self, joint_ids: Sequence[str]) -> np.ndarray:
+        """Get State: each joint's first axis position (rad or m), in order."""
+        if not len(joint_ids):
+            return np.empty(0)
+        response = self.call("get_state", joints=list(joint_ids))
+        return np.array([j.positions[0] for j in response.joints], dtype=float)
+
     def set_servo(self, command) -> None:
         """Set Servo from a gui.core.control_path.ServoCommand (motors, targets rad or m,
         rates, gains 1/s, speed limits, force limits)."""
@@ -425,8 +434,7 @@ class WorldClient:
         from Messages.msg import Robot
         self.call("set_robot", robot=Robot(name=name), remove=True)
 
-    def execute(self, plan: BuildPlan,
-                progress: Optional[Callable[[int, object, str], None]] = None,
+    def execute(self, plan: BuildPlan, progress: Optional[Progress] = None,
                 mesh_dir: Optional[str] = None, ids: Optional[BuiltIds] = None) -> dict:
         """Sends every step of ``plan`` in order, then declares each robot it built (Set
         Robot); returns the world's IDs: {"bodies": {planned body ID: world ID}, "joints":
@@ -441,16 +449,10 @@ class WorldClient:
         (``gui.core.overlaps``) are warned about once and answered as "overlaps": [Overlap];
         in a problem Kautham never simulates they are exempt until they have moved apart
         ("overlaps_exempt": True)."""
-        ids = BuiltIds() if ids is None else ids
-        for k, step in enumerate(plan.steps, start=1):
-            answer = step.send(self, ids)
-            if progress is not None:
-                progress(k, step, answer)
-        plan.record_world_ids(ids)
+        ids, overlaps, exempt = build(ClientWorldPort(self), plan, progress, ids)
         folder = robot_mesh_dir() if mesh_dir is None else mesh_dir
         namespaces = {handle.name: self.set_robot(describe_robot(handle, folder))
                       for handle in plan.robots}
-        overlaps, exempt = settle_overlaps(self, plan)
         if overlaps:
             logging.getLogger("gui.core.overlaps").warning(
                 overlap_warning(plan.problem.source, overlaps, exempt))
