@@ -9,7 +9,8 @@ from geometry_msgs.msg import Point, Pose
 from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray
 
-from odin_common.interface import PLANE_DRAWN_SIZE, PLANE_DRAWN_THICKNESS, Shape
+from odin_common.defaults import PLANE_DRAWN_SIZE, PLANE_DRAWN_THICKNESS
+from odin_common.interface import Shape
 from viewer.errors import ViewerError
 from viewer.portal.markers import (MarkerIntake, RawMarkerArray, marker_view, read_markers,
                                    view_fields)

@@ -10,8 +10,8 @@ from tf2_msgs.msg import TFMessage
 from visualization_msgs.msg import Marker, MarkerArray
 
 from Messages.msg import Robot as RobotMessage
-from odin_common.interface import (COLLIDING_COLOR, DEFAULT_COLOR, WORLD_FRAME, JointType,
-                                   frame_id, robot_namespace)
+from odin_common.defaults import COLLIDING_COLOR, DEFAULT_COLOR
+from odin_common.interface import WORLD_FRAME, JointType, frame_id, robot_namespace
 from odin_common.rotations import compose_poses, quaternion_to_matrix
 from odin_common.specs import CompositeSpec, JointSpec, ObjectSpec, PartSpec
 from virtual_world.core import Core

@@ -2,7 +2,10 @@
 
 The constants of the .msg and .srv files as ``IntEnum``s (a test pins each one to the
 generated message classes), what each joint type takes, the thesis's shape-by-parameter-count
-rule, the composite-ID rule, and the services each node offers with their types.
+rule, the composite-ID rule, tf frame and namespace rules, the body state vector's layout,
+and the services each node offers with their types. Values that are choices rather than
+facts of the interface (solver thresholds, servo defaults, colours) are in
+``odin_common.defaults``.
 """
 from __future__ import annotations
 
@@ -90,11 +93,11 @@ class Solver(IntEnum):
     """Services/SetWorld ``solver``."""
     QUICKSTEP = 0        # dWorldQuickStep: iterative, handles piles
     WORLDSTEP = 1        # dWorldStep: the thesis's exact "big matrix" solver
-    AUTO = 2             # per step: dWorldStep while the whole step is small (at most
-    #                      AUTO_SOLVER_MAX_ROWS rows) or an island is articulated (joints,
-    #                      motors) and the largest island has at most AUTO_SOLVER_MAX_ISLAND_ROWS
-    #                      rows (a robot held by its motors, a grasp: exact), QuickStep
-    #                      otherwise (piles, many bodies at rest); the default
+    AUTO = 2             # per step: dWorldStep while the whole step is small or an island
+    #                      is articulated (joints, motors) and the largest island small enough
+    #                      (a robot held by its motors, a grasp: exact; the bounds are
+    #                      odin_common.defaults.AUTO_SOLVER_*), QuickStep otherwise (piles,
+    #                      many bodies at rest); the default
 
 
 class DivergencePolicy(IntEnum):
@@ -102,34 +105,6 @@ class DivergencePolicy(IntEnum):
     ``divergence_policy``; the .srv names the values in its comments only)."""
     PARK = 0             # the body is parked (kinematic, still, no collisions); the world goes on
     PARK_AND_PAUSE = 1   # parked, and the simulation paused (the world keeps answering)
-
-
-AUTO_SOLVER_MAX_ROWS = 120
-"""Solver.AUTO's small-system bound: the most constraint rows a whole step may have (each joint
-counted at its most: 6 for a hinge, slider or fixed joint, 3 for a contact, ball or motor) to be
-solved by dWorldStep whatever its islands; the pinned planning experiments were recorded under
-this clause, so it stays beside the island rule (docs/PERFORMANCE.md). The island rule takes an
-articulation (AUTO_SOLVER_ARTICULATION_ROWS) that this clause does not admit among other
-bodies' rows."""
-
-AUTO_SOLVER_ARTICULATION_ROWS = 45
-"""Solver.AUTO's island rule: an island whose joints and motors alone, counted as
-AUTO_SOLVER_MAX_ROWS counts them (9 for a hinge held by its servo), have at least this many
-rows is an articulation dWorldStep solves (while the largest island stays within
-AUTO_SOLVER_MAX_ISLAND_ROWS): five servo-held joints or more, any manipulator arm, with or
-without its gripper or hand. QuickStep's iterations let such a chain shake off its pose among
-other bodies' contacts: a YuMi arm and gripper on its kinematic base (9 joints) moved 6.4 mm in
-2 s, a UR arm of MADAR (6) 3.4 mm; under dWorldStep 0.04 mm. Smaller articulations among
-contacts keep QuickStep, as Kautham's car (36 rows) had when its plans were pinned (they and
-the chain's and the sphere's stay bit-identical); docs/PERFORMANCE.md."""
-
-AUTO_SOLVER_MAX_ISLAND_ROWS = 400
-"""Solver.AUTO's bound: the most constraint rows the largest island of a step may have to be
-solved by dWorldStep (each joint counted as ODE 0.16 does: 5 for a hinge or slider, 6 for a
-fixed joint, 3 for a ball or a contact, plus 1 per powered or limited axis; a motor 1 per
-powered axis). ODE steps islands one by one and dWorldStep's cost is cubic in an island's
-rows: the bound keeps the TX90 + hand grasping a can (about 300 rows) exact and sends a pile
-of 100 spheres (about 700) to QuickStep; measured in docs/PERFORMANCE.md."""
 
 
 # ---------------------------------------------------------------------------------- joints
@@ -236,15 +211,6 @@ def motor_joint(motor_id: str) -> str:
     """What a default motor ID names after its prefix (its joint's ID for a motor on a joint);
     "" for an ID of one's own."""
     return motor_id[len(MOTOR_PREFIX):] if motor_id.startswith(MOTOR_PREFIX) else ""
-
-
-# ---------------------------------------------------------------------------------- servos
-
-SERVO_GAIN = 20.0
-"""1/s: a servo's default position gain (its motor's speed per unit of position error; the
-error then decays with a time constant of 1/gain)."""
-SERVO_MAX_SPEED = 2.0
-"""rad/s or m/s: a servo's default speed limit (a robot's own limits take its place)."""
 
 
 # ---------------------------------------------------------------------------------- shapes
@@ -381,18 +347,6 @@ def robot_link_frame(namespace: str, link: str) -> str:
     return f"{namespace}/{link}"
 
 
-# ---------------------------------------------------------------------------------- display
-
-DEFAULT_COLOR = (0.62, 0.70, 0.82, 1.0)
-"""(r, g, b, a): how an object sent with an all-zero colour is drawn (Viewer and markers)."""
-COLLIDING_COLOR = (0.35, 0.35, 0.35, 1.0)
-"""(r, g, b, a): an object while the world reports it colliding (thesis 6.4.1: dark grey)."""
-PLANE_DRAWN_SIZE = 60.0
-"""m: a plane (infinite in the world) is drawn as a square floor this wide..."""
-PLANE_DRAWN_THICKNESS = 0.002
-"""m: ...and this thin, its top face on the plane."""
-
-
 # ------------------------------------------------------------------ body state vectors
 
 BODY_STATE_FIELDS: Tuple[Tuple[str, int], ...] = (
@@ -458,16 +412,13 @@ class NodeParameter(NamedTuple):
     what: str
 
 
-__all__ = ["NodeParameter", "SERVO_GAIN", "SERVO_MAX_SPEED", "JointType", "JointParameter",
-           "SetJointAction", "MotorKind", "AxisFrame", "ServoDrive", "ForceKind", "Solver",
-           "DivergencePolicy", "AUTO_SOLVER_MAX_ROWS", "AUTO_SOLVER_ARTICULATION_ROWS",
-           "AUTO_SOLVER_MAX_ISLAND_ROWS", "JOINT_AXES_USED", "JOINT_USES_ANCHOR",
-           "JOINT_NEEDS_TWO_BODIES", "JOINT_AXIS2_ON_BODY2", "JOINT_FORCE_MAGNITUDES",
-           "JOINT_STATE_AXES", "JOINT_PARAMETERS", "JOINT_PARAMETER_AXES", "MOTOR_PARAMETERS",
-           "UNIT_PARAMETERS", "NON_NEGATIVE_PARAMETERS", "joint_type", "default_joint_id",
-           "MOTOR_PREFIX", "default_motor_id", "motor_joint", "Shape", "SHAPE_BY_PARAMETER_COUNT",
-           "SHAPE_PARAMETERS", "shape_of", "shape_kind", "COMPOSITE_MARK", "composite_id",
-           "is_composite_id", "WORLD_NAMESPACE", "VIEWER_NAMESPACE", "WORLD_SERVICES",
-           "VIEWER_SERVICES", "WORLD_FRAME", "frame_id", "unique_frame", "name_segment",
-           "robot_namespace", "robot_link_frame", "DEFAULT_COLOR", "COLLIDING_COLOR",
-           "PLANE_DRAWN_SIZE", "PLANE_DRAWN_THICKNESS"]
+__all__ = ["NodeParameter", "JointType", "JointParameter", "SetJointAction", "MotorKind",
+           "AxisFrame", "ServoDrive", "ForceKind", "Solver", "DivergencePolicy", "JOINT_AXES_USED",
+           "JOINT_USES_ANCHOR", "JOINT_NEEDS_TWO_BODIES", "JOINT_AXIS2_ON_BODY2",
+           "JOINT_FORCE_MAGNITUDES", "JOINT_STATE_AXES", "JOINT_PARAMETERS", "JOINT_PARAMETER_AXES",
+           "MOTOR_PARAMETERS", "UNIT_PARAMETERS", "NON_NEGATIVE_PARAMETERS", "joint_type",
+           "default_joint_id", "MOTOR_PREFIX", "default_motor_id", "motor_joint", "Shape",
+           "SHAPE_BY_PARAMETER_COUNT", "SHAPE_PARAMETERS", "shape_of", "shape_kind",
+           "COMPOSITE_MARK", "composite_id", "is_composite_id", "WORLD_NAMESPACE",
+           "VIEWER_NAMESPACE", "WORLD_SERVICES", "VIEWER_SERVICES", "WORLD_FRAME", "frame_id",
+           "unique_frame", "name_segment", "robot_namespace", "robot_link_frame"]

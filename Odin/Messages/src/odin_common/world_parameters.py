@@ -114,9 +114,9 @@ PARAMETERS: Tuple[ParameterInfo, ...] = (
     ParameterInfo("solver", "int", "-",
                   "0 QuickStep (iterative, handles piles), 1 dWorldStep (the thesis's exact "
                   "solver, cubic in each island's constraints), 2 auto (each step: dWorldStep "
-                  "while the whole step has at most odin_common.interface.AUTO_SOLVER_MAX_ROWS "
+                  "while the whole step has at most odin_common.defaults.AUTO_SOLVER_MAX_ROWS "
                   "constraint rows, or an island is articulated (joints, motors) and the largest "
-                  "island has at most odin_common.interface.AUTO_SOLVER_MAX_ISLAND_ROWS, "
+                  "island has at most odin_common.defaults.AUTO_SOLVER_MAX_ISLAND_ROWS, "
                   "QuickStep otherwise: piles, many bodies at rest, a larger island)",
                   "set_solver", 0, 2,
                   label="Solver", group=_SOLVER, choices=("QuickStep", "WorldStep", "auto")),

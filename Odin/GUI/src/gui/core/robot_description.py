@@ -46,7 +46,8 @@ from gui.core.kinematics import pose_to_position_quaternion
 from gui.core.model import FIXED, PRISMATIC, REVOLUTE, LinkModel, RobotModel
 from gui.core.sizes import read_input_file
 from gui.errors import ProblemError
-from odin_common.interface import DEFAULT_COLOR, SERVO_MAX_SPEED, name_segment, unique_frame
+from odin_common.defaults import DEFAULT_COLOR, SERVO_MAX_SPEED
+from odin_common.interface import name_segment, unique_frame
 
 
 @dataclass(frozen=True)

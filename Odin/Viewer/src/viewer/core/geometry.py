@@ -21,8 +21,8 @@ from typing import Sequence
 import numpy as np
 
 from odin_common.errors import InvalidArgument
-from odin_common.interface import (PLANE_DRAWN_SIZE, PLANE_DRAWN_THICKNESS, SHAPE_PARAMETERS,
-                                   Shape, shape_of)
+from odin_common.defaults import PLANE_DRAWN_SIZE, PLANE_DRAWN_THICKNESS
+from odin_common.interface import SHAPE_PARAMETERS, Shape, shape_of
 from odin_common.limits import MIN_SIZE, shown
 from odin_common.meshes import (DISPLAY_TOLERANCE, capsule_mesh, cluster_vertices,  # noqa: F401
                                 display_mesh, unique_rows)

@@ -30,7 +30,7 @@ import numpy as np
 # DEFAULT_COLOR: an object sent with an all-zero colour; COLLIDING_COLOR: while reported as
 # colliding (thesis 6.4.1: "dark gray"); shared with the world's RViz markers
 from odin_common.errors import InvalidArgument
-from odin_common.interface import COLLIDING_COLOR, DEFAULT_COLOR
+from odin_common.defaults import COLLIDING_COLOR, DEFAULT_COLOR
 from odin_common.limits import check_name, shown
 from viewer.core.camera import Camera
 from viewer.errors import ViewerError

@@ -24,7 +24,8 @@ from typing import List, NamedTuple, Optional, Tuple
 import numpy as np
 from visualization_msgs.msg import Marker, MarkerArray
 
-from odin_common.interface import PLANE_DRAWN_SIZE, PLANE_DRAWN_THICKNESS, Shape
+from odin_common.defaults import PLANE_DRAWN_SIZE, PLANE_DRAWN_THICKNESS
+from odin_common.interface import Shape
 from viewer.errors import ViewerError
 
 IDENTITY = ((0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0))

@@ -12,8 +12,8 @@ from typing import List, Mapping, Sequence, Set
 import numpy as np
 
 from odin_common import limits
-from odin_common.interface import (JOINT_AXIS2_ON_BODY2, SERVO_GAIN, SERVO_MAX_SPEED, AxisFrame,
-                                   JointParameter, MotorKind)
+from odin_common.defaults import SERVO_GAIN, SERVO_MAX_SPEED
+from odin_common.interface import JOINT_AXIS2_ON_BODY2, AxisFrame, JointParameter, MotorKind
 from odin_common.limits import shown
 from odin_common.specs import MotorSpec
 from virtual_world.core import kinematic, validation as check
@@ -199,7 +199,7 @@ def _servo_arguments(scene: Scene, motor: MotorRecord) -> tuple:
 def set_servos(scene: Scene, servos: Mapping[str, Mapping]) -> None:
     """Servo mode for each motor: {motor id: {"targets": per axis (rad or m, the joint's
     reported units), optional "rates" (feed-forward, rad/s or m/s; 0), "gains" (1/s;
-    interface.SERVO_GAIN), "max_speeds" (rad/s or m/s; interface.SERVO_MAX_SPEED),
+    defaults.SERVO_GAIN), "max_speeds" (rad/s or m/s; defaults.SERVO_MAX_SPEED),
     "max_forces" (N m or N; the motor's as it is)}}, as core.actuation.split_servo_lists
     gives them. Before every step the motor's speed on each axis becomes clamp(rate + gain
     (target - q), +-max_speed) with q the joint's value. A servo drives a motor made on a joint

@@ -13,8 +13,9 @@ from typing import List, Sequence, Tuple
 
 import numpy as np
 
-from odin_common.interface import (AUTO_SOLVER_ARTICULATION_ROWS, AUTO_SOLVER_MAX_ISLAND_ROWS,
-                                   AUTO_SOLVER_MAX_ROWS, DivergencePolicy)
+from odin_common.defaults import (AUTO_SOLVER_ARTICULATION_ROWS, AUTO_SOLVER_MAX_ISLAND_ROWS,
+                                  AUTO_SOLVER_MAX_ROWS)
+from odin_common.interface import DivergencePolicy
 from odin_common.world_parameters import WorldParameters
 from virtual_world.ode import handles
 from virtual_world.ode.bindings import ffi, lib

@@ -26,8 +26,9 @@ from typing import Dict, Iterable, Optional, Sequence, Tuple
 import numpy as np
 from visualization_msgs.msg import Marker, MarkerArray
 
-from odin_common.interface import (COLLIDING_COLOR, DEFAULT_COLOR, PLANE_DRAWN_SIZE,
-                                   PLANE_DRAWN_THICKNESS, Shape, shape_of)
+from odin_common.defaults import (COLLIDING_COLOR, DEFAULT_COLOR, PLANE_DRAWN_SIZE,
+                                  PLANE_DRAWN_THICKNESS)
+from odin_common.interface import Shape, shape_of
 from odin_common.meshes import capsule_mesh, display_mesh, facing_outwards
 from odin_common.rotations import compose_poses, wxyz_to_xyzw
 from virtual_world.core.arrays import flat_float64, uint32_array

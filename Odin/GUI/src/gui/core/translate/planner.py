@@ -24,8 +24,8 @@ from gui.core.translate.joints import (fixed_joint, joint_motors, link_drive, li
                                        motor_kind)
 from gui.core.world_settings import default_world, kautham_world
 from gui.errors import ProblemError
-from odin_common.interface import (SERVO_MAX_SPEED, MotorKind, Shape as ShapeKind,
-                                   default_motor_id)
+from odin_common.defaults import SERVO_MAX_SPEED
+from odin_common.interface import MotorKind, Shape as ShapeKind, default_motor_id
 from odin_common.specs import (CompositeSpec, EntitySpec, JointSpec, ObjectSpec, Surface,
                                WORLD_SURFACE)
 
