@@ -131,7 +131,7 @@ def _native(exe: pathlib.Path, mode: int, forces: int, motors: int) -> Run:
 
 def build_scene(core, mode: int, forces: int, motors: int) -> None:
     """The scene of native/core_scene.c through the Core API."""
-    from virtual_world.core import FORCE, ObjectSpec
+    from virtual_world.core import FORCE, MotorSpec, ObjectSpec
 
     # native/core_scene.c steps with QuickStep; the Core's default solver (auto) would take
     # dWorldStep for the pile's first steps (few contact rows) and do other work
@@ -155,9 +155,10 @@ def build_scene(core, mode: int, forces: int, motors: int) -> None:
         core.build_object(ObjectSpec(f"s{i}", [0.1], mass=1.0, position=pos))
     for i in range(forces):
         core.add_body_force(f"s{i % 100}", FORCE, (0.0, 0.0, 0.5))
-    ids = [core.create_motor(body1=f"s{i}", axes=[0, 0, 1], axis_frames=[1])
+    ids = [core.add_motor(MotorSpec(body1=f"s{i}", axes=[0, 0, 1], axis_frames=[1]))
            for i in range(motors)]
-    core.set_motor_velocities({motor: [0.5] for motor in ids})
+    if ids:
+        core.set_velocity(motors=ids, velocities=[0.5] * len(ids))
 
 
 def print_poses(core) -> None:

@@ -11,10 +11,10 @@ import math
 import pytest
 
 import virtual_world.ode.world
-from odin_common.interface import (AUTO_SOLVER_ARTICULATION_ROWS, AUTO_SOLVER_MAX_ISLAND_ROWS,
-                                   AUTO_SOLVER_MAX_ROWS, JointType,
-                                   Shape, Solver)
-from virtual_world.core import Core, ObjectSpec, WorldParameters
+from odin_common.defaults import (AUTO_SOLVER_ARTICULATION_ROWS, AUTO_SOLVER_MAX_ISLAND_ROWS,
+                                  AUTO_SOLVER_MAX_ROWS)
+from odin_common.interface import JointType, Shape, Solver
+from virtual_world.core import Core, JointSpec, MotorSpec, ObjectSpec, WorldParameters
 
 from test_core_snapshots import pile, state_bytes
 
@@ -36,9 +36,9 @@ def arm(core, links=7):
                                      position=((k + 0.5) * LINK, 0.0, ARM_Z),
                                      shape=Shape.CAPSULE, orientation=Z_ONTO_X))
         axis = (0.0, 1.0, 0.0) if k % 2 == 0 else (0.0, 0.0, 1.0)
-        joint = core.create_joint(JointType.HINGE, f"link{k}", parent,
-                                  anchor=(k * LINK, 0.0, ARM_Z), axis1=axis)
-        servos.append(core.create_motor(joint=joint, max_forces=[300.0]))
+        joint = core.add_joint(JointSpec(JointType.HINGE, f"link{k}", parent,
+                                         anchor=(k * LINK, 0.0, ARM_Z), axis1=axis))
+        servos.append(core.add_motor(MotorSpec(joint=joint, max_forces=[300.0])))
         parent = f"link{k}"
     core.set_servo(servos, [0.0] * len(servos))
     return parent
@@ -219,8 +219,8 @@ def sphere_chain(core, n, radius=0.05, gap=0.12):
     for i in range(n):
         core.build_object(ObjectSpec(f"c{i}", [radius], position=(i * gap, 0.0,
                                                                     radius - 0.0001)))
-        core.create_joint(JointType.BALL, f"c{i}", parent,
-                          anchor=((i - 0.5) * gap, 0.0, radius - 0.0001))
+        core.add_joint(JointSpec(JointType.BALL, f"c{i}", parent,
+                                 anchor=((i - 0.5) * gap, 0.0, radius - 0.0001)))
         parent = f"c{i}"
 
 
@@ -252,7 +252,7 @@ def test_a_choice_that_changes_mid_run_is_bit_identical_run_after_run_and_from_a
 
     def held_pile(core):
         pile(core)
-        core.create_joint(JointType.BALL, "s0", "", anchor=(-0.21, -0.21, 0.12))
+        core.add_joint(JointSpec(JointType.BALL, "s0", "", anchor=(-0.21, -0.21, 0.12)))
 
     first = _run(Solver.AUTO, held_pile, 1200)[0]
     assert _run(Solver.AUTO, held_pile, 1200)[0] == first

@@ -6,7 +6,8 @@ import pytest
 
 from odin_common import OdinError
 from virtual_world import core as vc
-from virtual_world.core import Core, CompositeSpec, EntitySpec, ObjectSpec, PartSpec
+from virtual_world.core import (CompositeSpec, Core, EntitySpec, JointSpec, MotorSpec, ObjectSpec,
+                                PartSpec)
 from virtual_world.errors import (Closed, CoreError, DuplicateName, InvalidArgument,
                                   Unsupported, UnknownName)
 
@@ -19,8 +20,8 @@ def core():
     c.build_object(ObjectSpec("a", [0.1], position=(0, 0, 1)))
     c.build_object(ObjectSpec("b", [0.1, 0.2, 0.3], position=(1, 0, 1)))
     c.build_object(ObjectSpec("wall", [1, 1, 1], position=(5, 0, 0), geometry_only=True))
-    c.create_joint(vc.HINGE, "a", "b", anchor=(0.5, 0, 1))
-    c.create_motor(joint="1:a&b")
+    c.add_joint(JointSpec(vc.HINGE, "a", "b", anchor=(0.5, 0, 1)))
+    c.add_motor(MotorSpec(joint="1:a&b"))
     c.add_body_force("a", vc.FORCE, (1, 0, 0))
     c.add_joint_force("1:a&b", [0.1])
     yield c
@@ -139,7 +140,7 @@ def test_bad_entities_build_nothing(core):
 def test_bad_joints(core, args, error):
     before = snapshot(core)
     with pytest.raises(error):
-        core.create_joint(*args)
+        core.add_joint(JointSpec(*args))
     assert snapshot(core) == before
 
 
@@ -147,16 +148,16 @@ def test_bad_joints(core, args, error):
     (dict(axis1=(0, 0, 0)), InvalidArgument),
     (dict(axis1=(0, NAN, 1)), InvalidArgument),
     (dict(anchor=(0, 0)), InvalidArgument),
-    (dict(joint_type=vc.UNIVERSAL, axis1=(1, 0, 0), axis2=(2, 0, 0)), InvalidArgument),
-    (dict(joint_id="1:a&b"), DuplicateName),
+    (dict(type=vc.UNIVERSAL, axis1=(1, 0, 0), axis2=(2, 0, 0)), InvalidArgument),
+    (dict(id="1:a&b"), DuplicateName),
 ])
 def test_bad_joint_arguments(core, kwargs, error):
     core.build_object(ObjectSpec("c", [0.1], position=(2, 0, 1)))
     before = snapshot(core)
     kwargs = dict(kwargs)
-    joint_type = kwargs.pop("joint_type", vc.HINGE)
+    joint_type = kwargs.pop("type", vc.HINGE)
     with pytest.raises(error):
-        core.create_joint(joint_type, "c", "", **kwargs)
+        core.add_joint(JointSpec(joint_type, "c", "", **kwargs))
     assert snapshot(core) == before
 
 
@@ -179,7 +180,7 @@ def test_bad_joint_parameters(core, joint, params, error):
 
 def test_joint_parameters_fit_type(core):
     core.build_object(ObjectSpec("c", [0.1], position=(2, 0, 1)))
-    ball = core.create_joint(vc.BALL, "c", "")
+    ball = core.add_joint(JointSpec(vc.BALL, "c", ""))
     with pytest.raises(Unsupported):
         core.set_joint_parameters(ball, [(vc.LO_STOP, 1, 0.0)])
     core.set_joint_parameters(ball, [(vc.CFM, 1, 1e-6), (vc.ERP, 1, 0.5)])
@@ -192,34 +193,34 @@ def test_joint_parameters_fit_type(core):
 def test_bad_motors(core):
     before = snapshot(core)
     with pytest.raises(DuplicateName):
-        core.create_motor(joint="1:a&b")
+        core.add_motor(MotorSpec(joint="1:a&b"))
     with pytest.raises(UnknownName):
-        core.create_motor(joint="nope")
+        core.add_motor(MotorSpec(joint="nope"))
     with pytest.raises(InvalidArgument):
-        core.create_motor(body1="a", axes=[0, 0, 1, 1])
+        core.add_motor(MotorSpec(body1="a", axes=[0, 0, 1, 1]))
     with pytest.raises(InvalidArgument):
-        core.create_motor(body1="a", axes=[0, 0, 0])
+        core.add_motor(MotorSpec(body1="a", axes=[0, 0, 0]))
     with pytest.raises(InvalidArgument):
-        core.create_motor(body1="a", axes=[0, 0, 1], axis_frames=[2])  # body2 is the world
+        core.add_motor(MotorSpec(body1="a", axes=[0, 0, 1], axis_frames=[2]))  # body2 is the world
     with pytest.raises(InvalidArgument):
-        core.create_motor(body1="a", axes=[0, 0, 1] * 4)
+        core.add_motor(MotorSpec(body1="a", axes=[0, 0, 1] * 4))
     with pytest.raises(InvalidArgument):
-        core.create_motor(body1="a", kind=7, axes=[0, 0, 1])
+        core.add_motor(MotorSpec(body1="a", kind=7, axes=[0, 0, 1]))
     with pytest.raises(InvalidArgument):
-        core.create_motor()
+        core.add_motor(MotorSpec())
     with pytest.raises(UnknownName):
-        core.set_motor_velocities({"motor:1:a&b": [1.0], "nope": [1.0]})
+        core.set_velocity(motors=["motor:1:a&b", "nope"], velocities=[1.0, 1.0])
     with pytest.raises(InvalidArgument):
-        core.set_motor_velocities({"motor:1:a&b": [1.0, 2.0]})
+        core.set_velocity(motors=["motor:1:a&b"], velocities=[1.0, 2.0])
     with pytest.raises(InvalidArgument):
-        core.set_motor_velocities({"motor:1:a&b": [NAN]})
+        core.set_velocity(motors=["motor:1:a&b"], velocities=[NAN])
     assert snapshot(core) == before
     assert core.motor_goals()["motor:1:a&b"] == [0.0]
     core.build_object(ObjectSpec("c", [0.1], position=(2, 0, 1)))
-    ball = core.create_joint(vc.BALL, "c", "")
+    ball = core.add_joint(JointSpec(vc.BALL, "c", ""))
     with pytest.raises(Unsupported):
-        core.create_motor(joint=ball)  # a ball has no axes of its own
-    assert core.create_motor(joint=ball, axes=[1, 0, 0, 0, 1, 0]) == f"motor:{ball}"
+        core.add_motor(MotorSpec(joint=ball))  # a ball has no axes of its own
+    assert core.add_motor(MotorSpec(joint=ball, axes=[1, 0, 0, 0, 1, 0])) == f"motor:{ball}"
 
 
 def test_bad_forces(core):
@@ -244,7 +245,7 @@ def test_bad_forces(core):
         core.remove_joint_force("jointforce:x:0")
     assert snapshot(core) == before
     core.build_object(ObjectSpec("c", [0.1], position=(2, 0, 1)))
-    fixed = core.create_joint(vc.FIXED, "c", "")
+    fixed = core.add_joint(JointSpec(vc.FIXED, "c", ""))
     with pytest.raises(Unsupported):
         core.add_joint_force(fixed, [1.0])
 

@@ -9,8 +9,8 @@ import pytest
 
 from odin_common import limits
 from odin_common.interface import DivergencePolicy
-from virtual_world.core import (FORCE, TORQUE, CompositeSpec, Core, ObjectSpec, PartSpec,
-                               WorldParameters)
+from virtual_world.core import (FORCE, TORQUE, CompositeSpec, Core, MotorSpec, ObjectSpec, PartSpec,
+                                WorldParameters)
 from virtual_world.errors import InvalidArgument
 
 H = 0.001
@@ -119,7 +119,7 @@ def test_a_snapshot_from_before_brings_the_body_back_to_life():
     lambda c: c.build_object(ObjectSpec("heavy", [0.1], mass=1e12)),
     lambda c: c.build_object(ObjectSpec("tiny", [1e-9])),
     lambda c: c.build_object(ObjectSpec("huge", [3e4, 1, 1])),
-    lambda c: c.create_motor(body1="s0", axes=[0, 0, 1], max_forces=[1e9]),
+    lambda c: c.add_motor(MotorSpec(body1="s0", axes=[0, 0, 1], max_forces=[1e9])),
     lambda c: c.step(1e-9),
     lambda c: c.step(2.0),
     lambda c: c.set_world_parameters(gravity=(0, 0, -1e6)),
@@ -140,11 +140,11 @@ def test_a_request_beyond_the_sane_ranges_is_refused_and_changes_nothing(request
 def test_a_fast_motor_goal_is_refused():
     core = Core()
     pile(core, n=1)
-    motor = core.create_motor(body1="s0", axes=[0, 0, 1])
+    motor = core.add_motor(MotorSpec(body1="s0", axes=[0, 0, 1]))
     with pytest.raises(InvalidArgument, match="not finite"):
-        core.set_motor_velocities({motor: [math.inf]})
+        core.set_velocity(motors=[motor], velocities=[math.inf])
     with pytest.raises(InvalidArgument, match="beyond the limit"):
-        core.set_motor_velocities({motor: [1e6]})
+        core.set_velocity(motors=[motor], velocities=[1e6])
     core.close()
 
 

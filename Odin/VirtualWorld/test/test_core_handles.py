@@ -7,7 +7,7 @@ import pytest
 
 from virtual_world import core as vc
 from virtual_world.ode import handles
-from virtual_world.core import CompositeSpec, Core, ObjectSpec, PartSpec
+from virtual_world.core import CompositeSpec, Core, JointSpec, MotorSpec, ObjectSpec, PartSpec
 from virtual_world.ode.bindings import ffi, lib
 from virtual_world.ode.runtime import drain_messages
 
@@ -48,9 +48,9 @@ def build_scene(core):
     core.build_composite(CompositeSpec([PartSpec("p1", [0.1]),
                                         PartSpec("p2", [0.1, 0.1, 0.1], position=(0.3, 0, 0))],
                                        position=(2, 0, 1)))
-    core.create_joint(vc.HINGE, "s", "mesh", anchor=(0.5, 0, 1))
-    core.create_motor(joint="1:s&mesh")
-    core.create_joint(vc.BALL, ">p1>p2", "", anchor=(2, 0, 1))
+    core.add_joint(JointSpec(vc.HINGE, "s", "mesh", anchor=(0.5, 0, 1)))
+    core.add_motor(MotorSpec(joint="1:s&mesh"))
+    core.add_joint(JointSpec(vc.BALL, ">p1>p2", "", anchor=(2, 0, 1)))
     core.add_body_force("s", vc.FORCE, (0, 0, 1))
     core.add_joint_force("1:s&mesh", [0.1])
     core.step(0.001, 10)

@@ -21,7 +21,7 @@ CHILD = textwrap.dedent(r'''
     from hypothesis import HealthCheck, given, settings, strategies as st
     from odin_common.errors import OdinError
     from odin_common.interface import JointParameter, JointType
-    from virtual_world.core import Core, ObjectSpec, WorldParameters
+    from virtual_world.core import Core, JointSpec, MotorSpec, ObjectSpec, WorldParameters
 
     def magnitudes():
         """Log-uniform 1e-320 .. 1e308 of either sign, with 0."""
@@ -95,18 +95,18 @@ CHILD = textwrap.dedent(r'''
         attempt("force", core.add_body_force, a, draw(st.sampled_from([0, 1])),
                 v("force", st.floats(-100, 100), 3), False, draw(st.booleans()),
                 v("point", SMALL, 3))
-        joint = attempt("joint", core.create_joint,
-                        draw(st.sampled_from(list(JointType))), a,
-                        names[1] if len(names) > 1 else "", v("anchor", SMALL, 3),
-                        v("axis", SMALL, 3),
-                        parameters=[(draw(st.sampled_from(list(JointParameter))), 1,
-                                     v("joint value", st.floats(-2, 2)))
-                                    for _ in range(draw(st.integers(0, 3)))])
+        joint = attempt("joint", core.add_joint, JointSpec(
+            draw(st.sampled_from(list(JointType))), a, names[1] if len(names) > 1 else "",
+            v("anchor", SMALL, 3), v("axis", SMALL, 3),
+            parameters=[(draw(st.sampled_from(list(JointParameter))), 1,
+                         v("joint value", st.floats(-2, 2)))
+                        for _ in range(draw(st.integers(0, 3)))]))
         if joint is not None:
-            motor = attempt("motor", core.create_motor, joint=joint,
-                            max_forces=[v("max force", st.floats(0, 100))])
+            motor = attempt("motor", core.add_motor, MotorSpec(
+                joint=joint, max_forces=[v("max force", st.floats(0, 100))]))
             if motor is not None:
-                attempt("goal", core.set_motor_velocities, {motor: [v("goal", SMALL)]})
+                attempt("goal", core.set_velocity, motors=[motor],
+                        velocities=[v("goal", SMALL)])
             attempt("joint force", core.add_joint_force, joint, [v("joint force", SMALL)])
         step = v("step", st.sampled_from([1e-3, 1e-2, 1e-4]))
         for _ in range(3):
@@ -163,16 +163,16 @@ def test_a_heavy_inertia_that_a_body_can_have_is_accepted():
 STOP_AND_UNLIMITED_FORCE = textwrap.dedent(r'''
     import odin_common  # noqa: F401
     from odin_common.interface import JointParameter as P, JointType as J
-    from virtual_world.core import Core, ObjectSpec
+    from virtual_world.core import Core, JointSpec, MotorSpec, ObjectSpec
     core = Core()
     core.build_object(ObjectSpec("arm", [0.2, 0.3], mass=0.5, position=(0.3, 0.0, 0.0)))
     core.build_object(ObjectSpec("hub", [0.3], mass=4.0, position=(-0.3, 0.0, 0.0)))
     core.set_velocity("arm", (0.0, 2.0, 0.0), (0.0, 0.0, 5.0))
     if "joint" in __import__("sys").argv:    # the joint's own motor, unlimited, past a stop
-        core.create_joint(J.HINGE, "arm", "hub", axis1=(0.0, 0.0, 1.0),
-                          parameters=[(P.LO_STOP, 1, 0.3), (P.MAX_FORCE, 1, -2.0)])
+        core.add_joint(JointSpec(J.HINGE, "arm", "hub", axis1=(0.0, 0.0, 1.0),
+                                 parameters=[(P.LO_STOP, 1, 0.3), (P.MAX_FORCE, 1, -2.0)]))
     else:                                     # a motor of unlimited force given a stop
-        motor = core.create_motor(body1="arm", body2="hub", axes=[0.0, 0.0, 1.0])
+        motor = core.add_motor(MotorSpec(body1="arm", body2="hub", axes=[0.0, 0.0, 1.0]))
         core.set_joint_parameters(motor, [(P.HI_STOP, 1, -0.2)])
     core.step(0.002, 50)
     print("stepped", core.state()[2])
@@ -201,12 +201,12 @@ def test_an_unlimited_force_is_odes_infinity_until_its_axis_has_a_stop():
     reads infinity throughout."""
     import math
     from odin_common.interface import JointParameter as P
-    from virtual_world.core import Core, ObjectSpec
+    from virtual_world.core import Core, MotorSpec, ObjectSpec
     from virtual_world.ode import joints as ode_joints
     with Core() as core:
         core.build_object(ObjectSpec("arm", [0.2, 0.3], mass=0.5, position=(0.3, 0.0, 0.0)))
         core.build_object(ObjectSpec("hub", [0.3], mass=4.0, position=(-0.3, 0.0, 0.0)))
-        motor = core.create_motor(body1="arm", body2="hub", axes=[0.0, 0.0, 1.0])
+        motor = core.add_motor(MotorSpec(body1="arm", body2="hub", axes=[0.0, 0.0, 1.0]))
         record = core._scene.motors[motor]
 
         def held() -> float:

@@ -52,8 +52,8 @@ import pytest
 
 from odin_common.rotations import quaternion_multiply
 from virtual_world.core import (ANGULAR, BALL, Core, FIXED, FORCE, HI_STOP, HINGE, HINGE2,
-                                LINEAR, LO_STOP, ObjectSpec, PISTON, PLANE2D, PR, PU, SLIDER,
-                                TORQUE, UNIVERSAL)
+                                JointSpec, LINEAR, LO_STOP, MotorSpec, ObjectSpec, PISTON, PLANE2D,
+                                PR, PU, SLIDER, TORQUE, UNIVERSAL)
 from virtual_world.errors import InvalidArgument, Unsupported
 
 H = 0.001          # s, step
@@ -201,7 +201,7 @@ def test_joint_force_to_the_world_moves_the_body_along_plus_axis(core, bodies, j
                                                                  magnitudes, force, torque,
                                                                  measures):
     block(core)
-    core.create_joint(joint_type, *bodies, anchor=(0, 0, 0), joint_id="j", **axes)
+    core.add_joint(JointSpec(joint_type, *bodies, anchor=(0, 0, 0), id="j", **axes))
     core.add_joint_force("j", magnitudes)
     core.step(H, N)
     accel = np.asarray(force, dtype=float) / BLOCK_MASS          # a = F / m
@@ -221,7 +221,7 @@ def test_ball_torque_turns_a_body_about_the_world_torque(core, bodies):
     # a sphere, so that any direction is principal: alpha = tau / I along tau
     sphere(core, "s1", M1)
     core.set_poses([("s1", (0, 0, 0), quaternion((1, 2, 3), 0.7))])   # turned: tau stays world
-    core.create_joint(BALL, *bodies, anchor=(0, 0, 0), joint_id="ball")
+    core.add_joint(JointSpec(BALL, *bodies, anchor=(0, 0, 0), id="ball"))
     tau = np.array([0.003, -0.004, 0.012])
     core.add_joint_force("ball", tau.tolist())
     core.step(H, N)
@@ -265,7 +265,7 @@ def test_joint_torque_between_two_bodies_turns_body1_forward_and_body2_back(
         core, joint_type, axes, magnitudes, torque, measures):
     sphere(core, "s1", M1)
     sphere(core, "s3", M3)
-    core.create_joint(joint_type, "s1", "s3", anchor=(0, 0, 0), joint_id="j", **axes)
+    core.add_joint(JointSpec(joint_type, "s1", "s3", anchor=(0, 0, 0), id="j", **axes))
     core.add_joint_force("j", magnitudes)
     core.step(H, N)
     torque = np.asarray(torque, dtype=float)
@@ -300,7 +300,7 @@ def test_joint_force_between_two_bodies_pushes_body1_forward_and_body2_back(
     axis = unit(axis)
     sphere(core, "s1", M1)
     sphere(core, "s3", M3, position=0.3 * axis)
-    core.create_joint(joint_type, "s1", "s3", anchor=0.15 * axis, joint_id="j", **axes)
+    core.add_joint(JointSpec(joint_type, "s1", "s3", anchor=0.15 * axis, id="j", **axes))
     core.add_joint_force("j", magnitudes)
     core.step(H, N)
     force = magnitudes[0] * axis
@@ -359,13 +359,13 @@ def test_motor_on_a_joint_holds_the_signed_goal_speed_of_every_axis(core, joint_
     block(core)
     if "s3" in bodies:
         sphere(core, "s3", M3)
-    core.create_joint(joint_type, *bodies, anchor=(0, 0, 0), joint_id="j", **axes)
+    core.add_joint(JointSpec(joint_type, *bodies, anchor=(0, 0, 0), id="j", **axes))
     # The joint's axes, unlimited force. Each motor axis must stay fixed in the body (or the
     # world) its joint axis is fixed in: axis2 of a universal, hinge-2 or PU joint is fixed in
     # body2, so a motor that kept it in body1 would drive axis2 cos(angle1) . (w1 - w2) and
     # its joint rate would run away as goal / cos(angle1) while body1 turns.
-    core.create_motor("m", joint="j", kind=kind)
-    core.set_motor_velocities({"m": goals})
+    core.add_motor(MotorSpec(id="m", joint="j", kind=kind))
+    core.set_velocity(motors=["m"], velocities=goals)
     # An unlimited motor closes the gap to its goal in a few steps: the world's CFM (1e-5)
     # softens its row, so that each step leaves c = (CFM / h) / (CFM / h + 1 / inertia) of it,
     # at most 0.02 here (the 2 kg block's slide); after 5 steps c^5 < 1e-8.
@@ -399,10 +399,10 @@ def test_motor_on_a_joint_holds_the_signed_goal_speed_of_every_axis(core, joint_
 def test_motor_short_of_force_accelerates_at_max_force_over_inertia_toward_the_goal(
         core, joint_type, axes, kind, goal, max_force, inertia, goal_sign):
     block(core)
-    core.create_joint(joint_type, "block", "", anchor=(0, 0, 0), joint_id="j", **axes)
-    core.create_motor("m", joint="j", kind=kind, max_forces=[max_force])
+    core.add_joint(JointSpec(joint_type, "block", "", anchor=(0, 0, 0), id="j", **axes))
+    core.add_motor(MotorSpec(id="m", joint="j", kind=kind, max_forces=[max_force]))
     goal = goal_sign * goal
-    core.set_motor_velocities({"m": [goal]})
+    core.set_velocity(motors=["m"], velocities=[goal])
     a = math.copysign(max_force / inertia, goal)   # the whole max force, toward the goal
     core.step(H, N)
     state = joint_state(core, "j")
@@ -465,7 +465,7 @@ def test_stops_hold_the_joint_at_its_signed_limits(core, joint_type, axes, body2
     block(core)
     if body2:
         sphere(core, body2, M3)
-    core.create_joint(joint_type, "block", body2, anchor=(0, 0, 0), joint_id="j", **axes)
+    core.add_joint(JointSpec(joint_type, "block", body2, anchor=(0, 0, 0), id="j", **axes))
     core.set_joint_parameters("j", [(LO_STOP, parameter_axis, lo), (HI_STOP, parameter_axis, hi)])
     pushing = core.add_body_force("block", kind, push)
     # between the stops the joint moves freely: the closed form, short of hi
@@ -498,7 +498,7 @@ def test_fixed_joint_keeps_two_bodies_0_3_m_apart_under_forces(core):
     sphere(core, "s3", M3, position=(0.3, 0, 0))
     turned = quaternion((0, 0, 1), 0.4)
     core.set_poses([("s3", (0.3, 0, 0), turned)])
-    core.create_joint(FIXED, "s1", "s3", joint_id="fixed")
+    core.add_joint(JointSpec(FIXED, "s1", "s3", id="fixed"))
     # pulling them apart along the line of centres and twisting them about x and z, with no
     # net force or torque on the pair: joined, they stay put; unjoined, each would move.
     # (Pulling, not pressing: world-fixed forces pressing a pair together would tip it over at
@@ -522,7 +522,7 @@ def test_fixed_joint_keeps_two_bodies_0_3_m_apart_under_forces(core):
 def test_fixed_joint_moves_the_pair_as_one_body(core):
     sphere(core, "s1", M1)
     sphere(core, "s3", M3, position=(0.3, 0, 0))
-    core.create_joint(FIXED, "s1", "s3", joint_id="fixed")
+    core.add_joint(JointSpec(FIXED, "s1", "s3", id="fixed"))
     # along the line of centres: no torque about the pair's centre of mass, a = F / (m1 + m3)
     core.add_body_force("s1", FORCE, (-2.0, 0, 0))
     core.step(H, N)
@@ -539,7 +539,7 @@ def test_fixed_joint_moves_the_pair_as_one_body(core):
 
 def test_fixed_joint_to_the_world_holds_the_body(core):
     block(core, position=(0.5, -0.2, 0.3))
-    core.create_joint(FIXED, "", "block", joint_id="fixed")
+    core.add_joint(JointSpec(FIXED, "", "block", id="fixed"))
     core.add_body_force("block", FORCE, (1.0, -2.0, 3.0))
     core.add_body_force("block", TORQUE, (0.02, 0.03, -0.01))
     core.step(H, 1000)
@@ -553,7 +553,7 @@ def test_fixed_joint_to_the_world_holds_the_body(core):
 
 def test_plane_2d_keeps_the_body_in_z_0_while_pushed_out_of_it(core):
     block(core)
-    core.create_joint(PLANE2D, "block", "", joint_id="plane")
+    core.add_joint(JointSpec(PLANE2D, "block", "", id="plane"))
     force, torque = np.array([1.0, -2.0, 5.0]), np.array([0.03, -0.02, 0.01])
     core.add_body_force("block", FORCE, force)
     core.add_body_force("block", TORQUE, torque)
@@ -613,7 +613,7 @@ GEOMETRY = [
 def test_joint_states_report_the_imposed_geometry_with_signs(core, joint_type, axes, pose,
                                                              expected):
     block(core)
-    core.create_joint(joint_type, "block", "", anchor=(0, 0, 0), joint_id="j", **axes)
+    core.add_joint(JointSpec(joint_type, "block", "", anchor=(0, 0, 0), id="j", **axes))
     assert joint_state(core, "j").positions == pytest.approx((0.0,) * len(expected), abs=1e-12)
     core.set_poses([("block", *pose)])
     assert joint_state(core, "j").positions == pytest.approx(expected, abs=1e-12)
@@ -622,7 +622,7 @@ def test_joint_states_report_the_imposed_geometry_with_signs(core, joint_type, a
 def test_hinge2_states_report_steering_of_body1_and_spin_of_body2(core):
     block(core)
     sphere(core, "s3", M3)
-    core.create_joint(HINGE2, "block", "s3", anchor=(0, 0, 0), axis1=Z, axis2=Y, joint_id="j")
+    core.add_joint(JointSpec(HINGE2, "block", "s3", anchor=(0, 0, 0), axis1=Z, axis2=Y, id="j"))
     # body1 steered by 0.25 about axis1: angle1 = +0.25 (body1 relative to body2)
     core.set_poses([("block", (0, 0, 0), turn((Z, 0.25)))])
     assert joint_state(core, "j").positions == pytest.approx((0.25, 0.0), abs=1e-12)
@@ -640,5 +640,5 @@ def test_hinge2_states_report_steering_of_body1_and_spin_of_body2(core):
 def test_a_hinge2_joint_to_the_world_is_refused_not_a_crash(core, bodies):
     sphere(core, "s1", M1)
     with pytest.raises((Unsupported, InvalidArgument)):
-        core.create_joint(HINGE2, *bodies, axis1=Z, axis2=Y, joint_id="j")
+        core.add_joint(JointSpec(HINGE2, *bodies, axis1=Z, axis2=Y, id="j"))
     assert core.joint_ids() == []

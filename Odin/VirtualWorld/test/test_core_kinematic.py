@@ -8,9 +8,11 @@ import math
 import numpy as np
 import pytest
 
-from odin_common.interface import SERVO_GAIN, SERVO_MAX_SPEED, MotorKind, ServoDrive
+from odin_common.defaults import SERVO_GAIN, SERVO_MAX_SPEED
+from odin_common.interface import MotorKind, ServoDrive
 from odin_common.rotations import quaternion_to_matrix
-from virtual_world.core import HINGE, SLIDER, UNIVERSAL, Core, ObjectSpec, WorldParameters
+from virtual_world.core import (HINGE, SLIDER, UNIVERSAL, Core, JointSpec, MotorSpec, ObjectSpec,
+                                WorldParameters)
 from virtual_world.errors import InvalidArgument, Unsupported, UnknownName
 
 H = 0.001
@@ -24,9 +26,9 @@ def two_link_arm(max_force=0.5):
     core = Core(WorldParameters(gravity=GRAVITY, solver=1))
     core.build_object(ObjectSpec("upper", [0.5, 0.05, 0.05], mass=1.0, position=(0.25, 0, 0)))
     core.build_object(ObjectSpec("fore", [0.5, 0.05, 0.05], mass=1.0, position=(0.75, 0, 0)))
-    shoulder = core.create_joint(HINGE, "upper", "", anchor=(0, 0, 0), axis1=(0, 1, 0))
-    elbow = core.create_joint(HINGE, "upper", "fore", anchor=(0.5, 0, 0), axis1=(0, 0, 1))
-    motors = [core.create_motor(joint=j, max_forces=[max_force]) for j in (shoulder, elbow)]
+    shoulder = core.add_joint(JointSpec(HINGE, "upper", "", anchor=(0, 0, 0), axis1=(0, 1, 0)))
+    elbow = core.add_joint(JointSpec(HINGE, "upper", "fore", anchor=(0.5, 0, 0), axis1=(0, 0, 1)))
+    motors = [core.add_motor(MotorSpec(joint=j, max_forces=[max_force])) for j in (shoulder, elbow)]
     return core, (shoulder, elbow), motors
 
 
@@ -44,7 +46,7 @@ def turned(axis, angle):
 def test_the_links_follow_the_commanded_speeds_exactly_against_gravity():
     core, joints, motors = two_link_arm()
     core.set_drive(motors, ServoDrive.KINEMATIC)
-    core.set_motor_velocities({motors[0]: [0.5], motors[1]: [-1.0]})
+    core.set_velocity(motors=[motors[0], motors[1]], velocities=[0.5, -1.0])
     core.step(H, 1000)
     assert values(core, joints) == pytest.approx([0.5, -1.0], abs=1e-12)
     # the upper rod turned 0.5 rad about +y at the origin: its centre from (0.25, 0, 0)
@@ -99,11 +101,11 @@ def test_a_box_in_the_way_is_pushed_and_the_link_does_not_give_way():
     core = Core(WorldParameters(gravity=(0.0, 0.0, 0.0), solver=1))
     core.build_object(ObjectSpec("pusher", [0.1, 0.4, 0.4], mass=1.0, position=(0, 0, 0)))
     core.build_object(ObjectSpec("box", [0.2, 0.2, 0.2], mass=50.0, position=(0.3, 0, 0)))
-    rail = core.create_joint(SLIDER, "pusher", "", axis1=(1, 0, 0))
+    rail = core.add_joint(JointSpec(SLIDER, "pusher", "", axis1=(1, 0, 0)))
     # 1 N: far too weak to push 50 kg
-    motor = core.create_motor(joint=rail, kind=MotorKind.LINEAR, max_forces=[1.0])
+    motor = core.add_motor(MotorSpec(joint=rail, kind=MotorKind.LINEAR, max_forces=[1.0]))
     core.set_drive([motor], ServoDrive.KINEMATIC)
-    core.set_motor_velocities({motor: [0.5]})
+    core.set_velocity(motors=[motor], velocities=[0.5])
     core.step(H, 1000)
     assert values(core, [rail]) == pytest.approx([0.5], abs=1e-12)
     pusher_x = core.body_state("pusher")[0][0]
@@ -118,10 +120,10 @@ def test_a_box_in_the_way_is_pushed_and_the_link_does_not_give_way():
 def test_a_link_driven_out_of_the_world_stops_at_its_extent():
     core = Core(WorldParameters(gravity=(0.0, 0.0, 0.0), world_extent=10.0))
     core.build_object(ObjectSpec("carriage", [0.1, 0.1, 0.1], mass=1.0))
-    rail = core.create_joint(SLIDER, "carriage", "", axis1=(1, 0, 0))
-    motor = core.create_motor(joint=rail, kind=MotorKind.LINEAR)
+    rail = core.add_joint(JointSpec(SLIDER, "carriage", "", axis1=(1, 0, 0)))
+    motor = core.add_motor(MotorSpec(joint=rail, kind=MotorKind.LINEAR))
     core.set_drive([motor], ServoDrive.KINEMATIC)
-    core.set_motor_velocities({motor: [100.0]})
+    core.set_velocity(motors=[motor], velocities=[100.0])
     core.step(0.01, 200)                                   # 200 m asked for
     x = core.body_state("carriage")[0][0]
     assert 9.0 < x <= 10.0 and core.take_divergences() == []
@@ -163,7 +165,7 @@ def test_the_drive_goes_from_the_world_outwards():
 ])
 def test_bad_requests_are_refused_and_change_nothing(motor_ids, drive, error):
     core, joints, motors = two_link_arm()
-    core.set_motor_velocities({motors[0]: [0.5]})
+    core.set_velocity(motors=[motors[0]], velocities=[0.5])
     before = core.body_state_vector()
     with pytest.raises(error):
         core.set_servo(motors + motor_ids, [0.1] * len(motors + motor_ids), drive=drive)
@@ -175,7 +177,7 @@ def test_bad_requests_are_refused_and_change_nothing(motor_ids, drive, error):
 
 def test_two_motors_on_one_joint_cannot_both_drive_it():
     core, joints, motors = two_link_arm()
-    second = core.create_motor("second", joint=joints[0])
+    second = core.add_motor(MotorSpec(id="second", joint=joints[0]))
     with pytest.raises(InvalidArgument, match="both drive"):
         core.set_drive([motors[0], second], ServoDrive.KINEMATIC)
     core.set_drive([motors[0]], ServoDrive.KINEMATIC)
@@ -188,8 +190,8 @@ def test_two_motors_on_one_joint_cannot_both_drive_it():
 def test_a_joint_the_drive_cannot_move_is_refused():
     core = Core(WorldParameters(gravity=GRAVITY))
     core.build_object(ObjectSpec("a", [0.1, 0.1, 0.1], mass=1.0))
-    joint = core.create_joint(UNIVERSAL, "a", "", axis1=(1, 0, 0), axis2=(0, 1, 0))
-    motor = core.create_motor(joint=joint)
+    joint = core.add_joint(JointSpec(UNIVERSAL, "a", "", axis1=(1, 0, 0), axis2=(0, 1, 0)))
+    motor = core.add_motor(MotorSpec(joint=joint))
     with pytest.raises(Unsupported, match="hinge or a slider"):
         core.set_drive([motor], ServoDrive.KINEMATIC)
     assert core.kinematic_links() == {}
@@ -210,7 +212,7 @@ def test_removing_a_joint_returns_the_links_beyond_it_to_dynamic():
 def test_a_snapshot_puts_the_drive_back_and_replays_bit_for_bit():
     core, joints, motors = two_link_arm()
     core.set_drive(motors, ServoDrive.KINEMATIC)
-    core.set_motor_velocities({motors[0]: [0.5], motors[1]: [-1.0]})
+    core.set_velocity(motors=[motors[0], motors[1]], velocities=[0.5, -1.0])
     core.save_state("moving")
     core.step(H, 300)
     first = core.body_state_vector()

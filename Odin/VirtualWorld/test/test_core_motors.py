@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from virtual_world.core import (ANGULAR, CFM, ERP, HI_STOP, HINGE, LO_STOP, MAX_FORCE, Core,
-                                ObjectSpec, WorldParameters)
+                                JointSpec, MotorSpec, ObjectSpec, WorldParameters)
 from virtual_world.errors import InvalidArgument
 
 H = 0.001
@@ -39,10 +39,10 @@ def test_a_motor_axis_turns_with_the_frame_it_is_fixed_in(core, slot, frame):
     core.build_object(ObjectSpec("ball", [0.1], mass=1.0))
     bodies = ("ball", "") if slot == 1 else ("", "ball")
     axis_frame = 0 if frame == "world" else slot
-    motor = core.create_motor(body1=bodies[0], body2=bodies[1], kind=ANGULAR,
-                              axes=[1.0, 0.0, 0.0], axis_frames=[axis_frame])
+    motor = core.add_motor(MotorSpec(body1=bodies[0], body2=bodies[1], kind=ANGULAR,
+                                     axes=[1.0, 0.0, 0.0], axis_frames=[axis_frame]))
     core.set_poses([("ball", (0.0, 0.0, 0.0), TURN_Z)])
-    core.set_motor_velocities({motor: [2.0]})
+    core.set_velocity(motors=[motor], velocities=[2.0])
     core.step(H)
     expected = (2.0, 0.0, 0.0) if frame == "world" else (0.0, 2.0, 0.0)
     np.testing.assert_allclose(core.body_state("ball")[3], np.multiply(expected, SOFT),
@@ -53,16 +53,16 @@ def test_a_motor_without_force_cannot_move_the_body_and_an_unlimited_one_reaches
     """Max force 0 N m: the goal 1 rad/s stays a wish; max force < 0 (unlimited): the goal
     is the speed after one step."""
     core.build_object(ObjectSpec("wheel", [0.1], mass=1.0))   # I = I_BALL about any axis
-    joint = core.create_joint(HINGE, "", "wheel", axis1=(0.0, 0.0, 1.0))
-    motor = core.create_motor(joint=joint, max_forces=[0.0])
-    core.set_motor_velocities({motor: [1.0]})
+    joint = core.add_joint(JointSpec(HINGE, "", "wheel", axis1=(0.0, 0.0, 1.0)))
+    motor = core.add_motor(MotorSpec(joint=joint, max_forces=[0.0]))
+    core.set_velocity(motors=[motor], velocities=[1.0])
     core.step(H, 10)
     assert core.joint_states()[0].rates[0] == 0.0
     core.set_joint_parameters(motor, [(MAX_FORCE, 1, -1.0)])
     core.step(H)
     assert core.joint_states()[0].rates[0] == pytest.approx(SOFT, rel=1e-9)
     core.set_joint_parameters(motor, [(MAX_FORCE, 1, 0.0)])
-    core.set_motor_velocities({motor: [-1.0]})
+    core.set_velocity(motors=[motor], velocities=[-1.0])
     core.step(H, 10)
     assert core.joint_states()[0].rates[0] == pytest.approx(SOFT, rel=1e-9)   # coasts on
 
@@ -72,7 +72,7 @@ def test_parameter_ranges_include_their_bounds_and_axes_start_at_1(core):
     0 (axes count from 1) and values just outside are refused, and refused calls change
     nothing."""
     core.build_object(ObjectSpec("a", [0.1], mass=1.0))
-    joint = core.create_joint(HINGE, "", "a", axis1=(0.0, 0.0, 1.0))
+    joint = core.add_joint(JointSpec(HINGE, "", "a", axis1=(0.0, 0.0, 1.0)))
     core.set_joint_parameters(joint, [(ERP, 1, 0.0), (ERP, 1, 1.0), (CFM, 1, 0.0)])
     for bad in ([(ERP, 0, 0.5)], [(ERP, 1, -1e-9)], [(ERP, 1, 1 + 1e-9)], [(CFM, 1, -1e-9)]):
         with pytest.raises(InvalidArgument):
@@ -83,27 +83,28 @@ def test_a_motor_on_a_joint_takes_the_joints_bodies_and_no_others(core):
     """Naming one body of a joint that is not the joint's is refused, as naming both is."""
     for name in ("a", "b", "c"):
         core.build_object(ObjectSpec(name, [0.1], mass=1.0, position=(hash(name) % 7, 0, 0)))
-    joint = core.create_joint(HINGE, "a", "b", anchor=(0.0, 0.0, 0.0), axis1=(0.0, 0.0, 1.0))
+    joint = core.add_joint(JointSpec(HINGE, "a", "b", anchor=(0.0, 0.0, 0.0),
+                                     axis1=(0.0, 0.0, 1.0)))
     for bodies in (("c", ""), ("", "c"), ("a", "c")):
         with pytest.raises(InvalidArgument):
-            core.create_motor(joint=joint, body1=bodies[0], body2=bodies[1])
+            core.add_motor(MotorSpec(joint=joint, body1=bodies[0], body2=bodies[1]))
     assert core.motor_ids() == []
-    assert core.create_motor(joint=joint, body1="a", body2="b") == f"motor:{joint}"
+    assert core.add_motor(MotorSpec(joint=joint, body1="a", body2="b")) == f"motor:{joint}"
 
 
-def test_set_velocities_splits_one_flat_list_among_motors_by_their_axes(core):
+def test_set_velocity_splits_one_flat_list_among_motors_by_their_axes(core):
     """Set Velocity's list (1.5) + (0.5, -0.25): the one-axis motor takes the first value,
     the two-axis motor the next two; each ball turns at its goals (softened as above). A list
     of the wrong length is refused and changes nothing."""
     core.build_object(ObjectSpec("one", [0.1], mass=1.0))
     core.build_object(ObjectSpec("two", [0.1], mass=1.0, position=(1.0, 0.0, 0.0)))
-    m1 = core.create_motor(motor_id="m1", body1="one", axes=[0.0, 0.0, 1.0], axis_frames=[0])
-    m2 = core.create_motor(motor_id="m2", body1="two", axes=[1.0, 0.0, 0.0, 0.0, 1.0, 0.0],
-                           axis_frames=[0, 0])
+    m1 = core.add_motor(MotorSpec(id="m1", body1="one", axes=[0.0, 0.0, 1.0], axis_frames=[0]))
+    m2 = core.add_motor(MotorSpec(id="m2", body1="two", axes=[1.0, 0.0, 0.0, 0.0, 1.0, 0.0],
+                                  axis_frames=[0, 0]))
     with pytest.raises(InvalidArgument):
-        core.set_velocities(motor_ids=[m1, m2], velocities=[1.5, 0.5])
+        core.set_velocity(motors=[m1, m2], velocities=[1.5, 0.5])
     assert core.motor_goals() == {m1: [0.0], m2: [0.0, 0.0]}
-    core.set_velocities(motor_ids=[m1, m2], velocities=[1.5, 0.5, -0.25])
+    core.set_velocity(motors=[m1, m2], velocities=[1.5, 0.5, -0.25])
     assert core.motor_goals() == {m1: [1.5], m2: [0.5, -0.25]}
     core.step(H)
     np.testing.assert_allclose(core.body_state("one")[3], np.multiply((0.0, 0.0, 1.5), SOFT),
@@ -114,8 +115,8 @@ def test_set_velocities_splits_one_flat_list_among_motors_by_their_axes(core):
 
 def test_a_motors_max_force_may_be_given_as_infinite(core):
     core.build_object(ObjectSpec("ball", [0.1], mass=1.0))
-    motor = core.create_motor(body1="ball", axes=[0.0, 0.0, 1.0], max_forces=[math.inf])
-    core.set_motor_velocities({motor: [3.0]})
+    motor = core.add_motor(MotorSpec(body1="ball", axes=[0.0, 0.0, 1.0], max_forces=[math.inf]))
+    core.set_velocity(motors=[motor], velocities=[3.0])
     core.step(H)
     assert core.body_state("ball")[3][2] == pytest.approx(3.0 * SOFT, rel=1e-9)
 
@@ -124,8 +125,8 @@ def test_joint_parameters_given_at_creation_act(core):
     """Stops at +-0.2 rad given with the hinge: a 1 N m torque on a ball (I = I_BALL) would
     turn it 0.5 * 250 * 1^2 = 125 rad in 1 s; the stop holds it near 0.2 rad."""
     core.build_object(ObjectSpec("arm", [0.1], mass=1.0))
-    joint = core.create_joint(HINGE, "", "arm", axis1=(0.0, 0.0, 1.0),
-                              parameters=[(LO_STOP, 1, -0.2), (HI_STOP, 1, 0.2)])
+    joint = core.add_joint(JointSpec(HINGE, "", "arm", axis1=(0.0, 0.0, 1.0),
+                                     parameters=[(LO_STOP, 1, -0.2), (HI_STOP, 1, 0.2)]))
     core.add_joint_force(joint, [1.0])
     core.step(H, 1000)
     assert core.joint_states()[0].positions[0] == pytest.approx(0.2, abs=0.02)

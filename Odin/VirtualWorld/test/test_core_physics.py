@@ -6,7 +6,7 @@ import pytest
 
 from odin_common.interface import JOINT_FORCE_MAGNITUDES
 from virtual_world import core as vc
-from virtual_world.core import Core, ObjectSpec, WorldParameters
+from virtual_world.core import Core, JointSpec, MotorSpec, ObjectSpec, WorldParameters
 from virtual_world.errors import UnknownName
 
 
@@ -46,7 +46,7 @@ def test_hinge_pendulum_small_angle_period(core):
     theta0 = 0.05
     core.build_object(ObjectSpec("bob", [r], mass=m,
                                  position=(L * math.sin(theta0), 0, -L * math.cos(theta0))))
-    core.create_joint(vc.HINGE, "", "bob", anchor=(0, 0, 0), axis1=(0, 1, 0))
+    core.add_joint(JointSpec(vc.HINGE, "", "bob", anchor=(0, 0, 0), axis1=(0, 1, 0)))
     h = 0.0005
     angles, times = [], []
     for i in range(8000):
@@ -78,10 +78,10 @@ def test_box_at_rest_on_plane_stays_within_surface_layer(core):
 def test_angular_motor_reaches_goal_speed(core):
     core.set_world_parameters(gravity=(0, 0, 0))
     core.build_object(ObjectSpec("wheel", [0.2, 0.05], mass=1.0))
-    joint = core.create_joint(vc.HINGE, "", "wheel", axis1=(0, 0, 1))
-    motor = core.create_motor(joint=joint, max_forces=[5.0])
+    joint = core.add_joint(JointSpec(vc.HINGE, "", "wheel", axis1=(0, 0, 1)))
+    motor = core.add_motor(MotorSpec(joint=joint, max_forces=[5.0]))
     assert motor == "motor:" + joint
-    core.set_motor_velocities({motor: [3.0]})
+    core.set_velocity(motors=[motor], velocities=[3.0])
     core.step(0.001, 10)
     assert 0 < core.joint_states()[0].rates[0] < 3.0  # limited force: not there yet
     core.step(0.001, 2000)
@@ -91,9 +91,9 @@ def test_angular_motor_reaches_goal_speed(core):
 def test_linear_motor_reaches_goal_speed(core):
     core.set_world_parameters(gravity=(0, 0, 0))
     core.build_object(ObjectSpec("cart", [0.2, 0.2, 0.2], mass=2.0))
-    joint = core.create_joint(vc.SLIDER, "", "cart", axis1=(1, 0, 0))
-    motor = core.create_motor(joint=joint, kind=vc.LINEAR)
-    core.set_motor_velocities({motor: [0.7]})
+    joint = core.add_joint(JointSpec(vc.SLIDER, "", "cart", axis1=(1, 0, 0)))
+    motor = core.add_motor(MotorSpec(joint=joint, kind=vc.LINEAR))
+    core.set_velocity(motors=[motor], velocities=[0.7])
     core.step(0.001, 5)
     state = core.joint_states()[0]
     assert state.rates[0] == pytest.approx(0.7, rel=1e-3)
@@ -187,7 +187,7 @@ def test_joined_bodies_get_no_contacts(core):
     assert core.last_step_contacts > 0
     core.set_poses([("a", (0, 0, 0), (1, 0, 0, 0)), ("b", (0.15, 0, 0), (1, 0, 0, 0))],
                    reset_velocity=True)
-    core.create_joint(vc.BALL, "a", "b", anchor=(0.075, 0, 0))
+    core.add_joint(JointSpec(vc.BALL, "a", "b", anchor=(0.075, 0, 0)))
     core.step(0.001, 10)
     assert core.last_step_contacts == 0
     assert core.read_collisions() == []
@@ -232,11 +232,11 @@ def test_forces_in_world_and_body_frame_and_at_a_point(core):
 def test_joint_forces(core):
     core.set_world_parameters(gravity=(0, 0, 0))
     core.build_object(ObjectSpec("wheel", [1, 1, 1], mass=12.0))  # Izz = 12*2/12 = 2
-    hinge = core.create_joint(vc.HINGE, "", "wheel", axis1=(0, 0, 1))
+    hinge = core.add_joint(JointSpec(vc.HINGE, "", "wheel", axis1=(0, 0, 1)))
     core.build_object(ObjectSpec("cart", [0.1, 0.1, 0.1], mass=4.0, position=(5, 0, 0)))
-    slider = core.create_joint(vc.SLIDER, "", "cart", axis1=(0, 1, 0))
+    slider = core.add_joint(JointSpec(vc.SLIDER, "", "cart", axis1=(0, 1, 0)))
     core.build_object(ObjectSpec("knob", [1, 1, 1], mass=12.0, position=(10, 0, 0)))
-    ball = core.create_joint(vc.BALL, "", "knob", anchor=(10, 0, 0))
+    ball = core.add_joint(JointSpec(vc.BALL, "", "knob", anchor=(10, 0, 0)))
     assert core.add_joint_force(hinge, [1.0]) == f"jointforce:{hinge}:0"
     core.add_joint_force(slider, [2.0])
     core.add_joint_force(ball, [0.0, 2.0, 0.0])
@@ -361,8 +361,8 @@ def test_every_joint_type_steps_and_reports(core, joint_type, n):
     core.build_object(ObjectSpec("a", [0.1], position=(0, 0, 1)))
     core.build_object(ObjectSpec("b", [0.1], position=(0.3, 0, 1)))
     body2 = "" if joint_type == vc.PLANE2D else "b"
-    jid = core.create_joint(joint_type, "a", body2, anchor=(0.15, 0, 1), axis1=(0, 0, 1),
-                            axis2=(0, 1, 0), axis3=(1, 0, 0))
+    jid = core.add_joint(JointSpec(joint_type, "a", body2, anchor=(0.15, 0, 1), axis1=(0, 0, 1),
+                                   axis2=(0, 1, 0), axis3=(1, 0, 0)))
     assert jid == f"{joint_type}:a&{body2}"
     if joint_type in JOINT_FORCE_MAGNITUDES:
         core.add_joint_force(jid, [0.1] * len(JOINT_FORCE_MAGNITUDES[joint_type]))
@@ -375,7 +375,7 @@ def test_every_joint_type_steps_and_reports(core, joint_type, n):
 def test_joint_stops_hold(core):
     core.set_world_parameters(gravity=(0, 0, -9.81))
     core.build_object(ObjectSpec("arm", [0.05], position=(0.5, 0, 0)))
-    jid = core.create_joint(vc.HINGE, "", "arm", anchor=(0, 0, 0), axis1=(0, 1, 0))
+    jid = core.add_joint(JointSpec(vc.HINGE, "", "arm", anchor=(0, 0, 0), axis1=(0, 1, 0)))
     core.set_joint_parameters(jid, [(vc.LO_STOP, 1, -0.2), (vc.HI_STOP, 1, 0.2)])
     core.step(0.001, 2000)
     angle = core.joint_states()[0].positions[0]
@@ -453,8 +453,8 @@ def test_contact_reports_carry_normals_and_the_forces_that_hold_a_box(core):
 def test_a_joint_reports_the_force_it_applies(core):
     core.set_world_parameters(solver=vc.WORLDSTEP)
     core.build_object(ObjectSpec("bob", [0.1], mass=2.0, position=(0.5, 0, 0)))
-    joint = core.create_joint(vc.HINGE, "bob", "", anchor=(0, 0, 0), axis1=(0, 1, 0))
-    core.create_motor(joint=joint)                 # holds it level
+    joint = core.add_joint(JointSpec(vc.HINGE, "bob", "", anchor=(0, 0, 0), axis1=(0, 1, 0)))
+    core.add_motor(MotorSpec(joint=joint))          # holds it level
     core.step(0.001, 20)
     _, (reaction,), (motor,) = core.state()
     assert reaction.force1[2] == pytest.approx(2.0 * 9.81, rel=1e-3)   # up, m g

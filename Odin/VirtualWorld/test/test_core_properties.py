@@ -114,7 +114,7 @@ class CoreRequests(RuleBasedStateMachine):
     def drive_motor(self, data, values):
         motor = data.draw(st.sampled_from(self.core.motor_ids()))
         if data.draw(st.booleans()):
-            self.attempt(self.core.set_motor_velocities, {motor: values})
+            self.attempt(self.core.set_velocity, motors=[motor], velocities=values)
         else:
             self.attempt(self.core.set_servo, [motor], values)
 

@@ -4,7 +4,7 @@ first law), while what was kept goes on acting."""
 import numpy as np
 import pytest
 
-from virtual_world.core import FORCE, HINGE, Core, ObjectSpec, WorldParameters
+from virtual_world.core import FORCE, HINGE, Core, JointSpec, MotorSpec, ObjectSpec, WorldParameters
 
 H = 0.001
 N = 100
@@ -21,7 +21,7 @@ def test_a_removed_joint_torque_stops_and_the_joint_keeps_its_rate(core):
     """A 1 N m hinge torque on a box with I_zz = 2 kg m^2 turns it at 0.5 rad/s^2: 0.05 rad/s
     after 0.1 s; removed, the rate stays 0.05 rad/s."""
     core.build_object(ObjectSpec("wheel", [1.0, 1.0, 1.0], mass=12.0))   # I = 12 * 2 / 12
-    joint = core.create_joint(HINGE, "", "wheel", axis1=(0.0, 0.0, 1.0))
+    joint = core.add_joint(JointSpec(HINGE, "", "wheel", axis1=(0.0, 0.0, 1.0)))
     torque = core.add_joint_force(joint, [1.0])
     core.step(H, N)
     assert core.joint_states()[0].rates[0] == pytest.approx(0.05, rel=1e-9)
@@ -51,10 +51,10 @@ def test_a_removed_joint_is_forgotten_by_its_bodies_and_takes_its_motors(core):
     reports no joint, no motor; removing a motor first leaves nothing for its joint to take."""
     for name, x in (("a", 0.0), ("b", 1.0), ("c", 2.0)):
         core.build_object(ObjectSpec(name, [0.1], mass=1.0, position=(x, 0.0, 0.0)))
-    ab = core.create_joint(HINGE, "a", "b", anchor=(0.5, 0.0, 0.0), axis1=(0.0, 0.0, 1.0))
-    bc = core.create_joint(HINGE, "b", "c", anchor=(1.5, 0.0, 0.0), axis1=(0.0, 0.0, 1.0))
-    m_ab = core.create_motor(joint=ab)
-    m_bc = core.create_motor(joint=bc)
+    ab = core.add_joint(JointSpec(HINGE, "a", "b", anchor=(0.5, 0.0, 0.0), axis1=(0.0, 0.0, 1.0)))
+    bc = core.add_joint(JointSpec(HINGE, "b", "c", anchor=(1.5, 0.0, 0.0), axis1=(0.0, 0.0, 1.0)))
+    m_ab = core.add_motor(MotorSpec(joint=ab))
+    m_bc = core.add_motor(MotorSpec(joint=bc))
     removed = core.remove_joint(ab)
     assert removed.joints == (ab,) and removed.motors == (m_ab,)
     assert core.motor_ids() == [m_bc] and core.joint_ids() == [bc]
@@ -97,9 +97,9 @@ def test_removing_an_object_reports_every_joint_motor_and_force_that_went_with_i
     force: all four go with it, and the outer balls, now free, keep their velocities."""
     for name, x in (("a", 0.0), ("b", 1.0), ("c", 2.0)):
         core.build_object(ObjectSpec(name, [0.1], mass=1.0, position=(x, 0.0, 0.0)))
-    ab = core.create_joint(HINGE, "a", "b", anchor=(0.5, 0.0, 0.0), axis1=(0.0, 0.0, 1.0))
-    bc = core.create_joint(HINGE, "b", "c", anchor=(1.5, 0.0, 0.0), axis1=(0.0, 0.0, 1.0))
-    motor = core.create_motor(motor_id="spin", body1="b", body2="a", axes=[1.0, 0.0, 0.0])
+    ab = core.add_joint(JointSpec(HINGE, "a", "b", anchor=(0.5, 0.0, 0.0), axis1=(0.0, 0.0, 1.0)))
+    bc = core.add_joint(JointSpec(HINGE, "b", "c", anchor=(1.5, 0.0, 0.0), axis1=(0.0, 0.0, 1.0)))
+    motor = core.add_motor(MotorSpec(id="spin", body1="b", body2="a", axes=[1.0, 0.0, 0.0]))
     force = core.add_body_force("b", FORCE, (0.0, 1.0, 0.0))
     removed = core.remove_object("b")
     assert set(removed.joints) == {ab, bc} and removed.motors == (motor,)

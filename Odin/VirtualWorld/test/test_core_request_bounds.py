@@ -205,7 +205,7 @@ def test_a_body_or_joint_holds_at_most_max_forces_per_owner(core):
     with pytest.raises(InvalidArgument, match="MAX_FORCES_PER_OWNER"):
         core.propagate(0.01, 0.001, body_forces=[push] * (MAX_FORCES_PER_OWNER + 1))
     assert len(core.body_force_ids()) == MAX_FORCES_PER_OWNER
-    joint = core.create_joint(1, "free", "", axis1=(0.0, 0.0, 1.0))
+    joint = core.add_joint(JointSpec(1, "free", "", axis1=(0.0, 0.0, 1.0)))
     for _ in range(MAX_FORCES_PER_OWNER):
         core.add_joint_force(joint, [0.1])
     with pytest.raises(InvalidArgument, match="MAX_FORCES_PER_OWNER"):

@@ -1,7 +1,7 @@
 """Requests as the Portal passes them: ROS messages leave unused fields at zero."""
 import pytest
 
-from virtual_world.core import HINGE, UNIVERSAL, Core, ObjectSpec
+from virtual_world.core import HINGE, UNIVERSAL, Core, JointSpec, MotorSpec, ObjectSpec
 from virtual_world.errors import InvalidArgument, UnknownName
 
 
@@ -23,18 +23,18 @@ def test_only_the_axes_a_joint_type_uses_are_checked(core):
     core.build_object(ObjectSpec("b", [0.1], position=(0.5, 0, 0)))
     core.build_object(ObjectSpec("c", [0.1], position=(1.0, 0, 0)))
     zero = (0.0, 0.0, 0.0)
-    core.create_joint(HINGE, "a", "b", axis1=(0, 0, 1), axis2=zero, axis3=zero)
+    core.add_joint(JointSpec(HINGE, "a", "b", axis1=(0, 0, 1), axis2=zero, axis3=zero))
     with pytest.raises(InvalidArgument):
-        core.create_joint(HINGE, "b", "c", axis1=zero)
+        core.add_joint(JointSpec(HINGE, "b", "c", axis1=zero))
     with pytest.raises(InvalidArgument):
-        core.create_joint(UNIVERSAL, "b", "c", axis1=(0, 0, 1), axis2=zero)
+        core.add_joint(JointSpec(UNIVERSAL, "b", "c", axis1=(0, 0, 1), axis2=zero))
     assert core.joint_ids() == ["1:a&b"]
 
 
 def test_motor_axis_counts(core):
     core.build_object(ObjectSpec("a", [0.1]))
-    joint = core.create_joint(HINGE, "a", "", axis1=(0, 0, 1))
-    motor = core.create_motor(joint=joint)
+    joint = core.add_joint(JointSpec(HINGE, "a", "", axis1=(0, 0, 1)))
+    motor = core.add_motor(MotorSpec(joint=joint))
     assert core.motor_axis_counts([motor]) == [1]
     with pytest.raises(UnknownName):
         core.motor_axis_counts(["motor:none"])

@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from odin_common.interface import SERVO_MAX_SPEED
-from virtual_world.core import (HINGE, HINGE2, SLIDER, UNIVERSAL, Core, ObjectSpec,
-                                WorldParameters)
+from odin_common.defaults import SERVO_MAX_SPEED
+from virtual_world.core import (HINGE, HINGE2, SLIDER, UNIVERSAL, Core, JointSpec, MotorSpec,
+                                ObjectSpec, WorldParameters)
 from virtual_world.errors import InvalidArgument, UnknownName, Unsupported
 
 H = 0.001
@@ -19,8 +19,8 @@ def rotor(gravity=(0.0, 0.0, 0.0), max_force=100.0):
     """A rod on a hinge about y at the origin (mass 1 kg, its centre 0.25 m out along x)."""
     core = Core(WorldParameters(gravity=gravity, solver=1))
     core.build_object(ObjectSpec("rod", [0.5, 0.05, 0.05], mass=1.0, position=(0.25, 0, 0)))
-    joint = core.create_joint(HINGE, "rod", "", anchor=(0, 0, 0), axis1=(0, 1, 0))
-    motor = core.create_motor(joint=joint, max_forces=[max_force])
+    joint = core.add_joint(JointSpec(HINGE, "rod", "", anchor=(0, 0, 0), axis1=(0, 1, 0)))
+    motor = core.add_motor(MotorSpec(joint=joint, max_forces=[max_force]))
     return core, joint, motor
 
 
@@ -81,12 +81,12 @@ def test_a_servo_too_weak_for_its_load_gives_way_at_its_force_limit():
 def test_a_slider_servo_and_a_universal_servo_reach_their_targets():
     core = Core(WorldParameters(gravity=(0, 0, 0), solver=1))
     core.build_object(ObjectSpec("cart", [0.2, 0.2, 0.2], position=(0, 0, 0)))
-    slider = core.create_joint(SLIDER, "cart", "", axis1=(1, 0, 0))
-    linear = core.create_motor(joint=slider, kind=1, max_forces=[100.0])
+    slider = core.add_joint(JointSpec(SLIDER, "cart", "", axis1=(1, 0, 0)))
+    linear = core.add_motor(MotorSpec(joint=slider, kind=1, max_forces=[100.0]))
     core.build_object(ObjectSpec("head", [0.1], position=(3, 0, 0)))
-    universal = core.create_joint(UNIVERSAL, "head", "", anchor=(3, 0, 0), axis1=(1, 0, 0),
-                                  axis2=(0, 1, 0))
-    both = core.create_motor(joint=universal, max_forces=[100.0, 100.0])
+    universal = core.add_joint(JointSpec(UNIVERSAL, "head", "", anchor=(3, 0, 0), axis1=(1, 0, 0),
+                                         axis2=(0, 1, 0)))
+    both = core.add_motor(MotorSpec(joint=universal, max_forces=[100.0, 100.0]))
     # the universal's servo keeps the default speed limit
     core.set_servo([linear, both], [0.4, 0.2, -0.3],
                    max_speeds=[1.0, SERVO_MAX_SPEED, SERVO_MAX_SPEED])
@@ -100,11 +100,11 @@ def test_a_slider_servo_and_a_universal_servo_reach_their_targets():
 def test_a_servo_on_a_hinge2s_second_axis_pulls_the_right_way():
     core = Core(WorldParameters(gravity=(0, 0, 0), solver=1))
     core.build_object(ObjectSpec("chassis", [1, 1, 0.2], position=(0, 0, 0)))
-    core.create_joint(8, "chassis", "")              # fixed to the world
+    core.add_joint(JointSpec(8, "chassis", ""))      # fixed to the world
     core.build_object(ObjectSpec("wheel", [0.2, 0.1], position=(1, 0, 0)))
-    hinge2 = core.create_joint(HINGE2, "chassis", "wheel", anchor=(1, 0, 0), axis1=(0, 0, 1),
-                               axis2=(0, 1, 0))
-    motor = core.create_motor(joint=hinge2, max_forces=[50.0, 50.0])
+    hinge2 = core.add_joint(JointSpec(HINGE2, "chassis", "wheel", anchor=(1, 0, 0), axis1=(0, 0, 1),
+                                      axis2=(0, 1, 0)))
+    motor = core.add_motor(MotorSpec(joint=hinge2, max_forces=[50.0, 50.0]))
     core.set_servo([motor], [0.1, 0.5])
     core.step(H, 2000)
     state = {s.id: s for s in core.joint_states()}[hinge2]
@@ -132,7 +132,7 @@ def test_a_servo_holds_its_joint_where_set_position_put_it():
 def test_a_goal_speed_takes_a_motor_out_of_servo_mode():
     core, joint, motor = rotor()
     core.set_servo([motor], [0.0])
-    core.set_motor_velocities({motor: [1.0]})
+    core.set_velocity(motors=[motor], velocities=[1.0])
     assert core.servo_states() == []
     core.step(H, 200)
     assert angle(core, joint) == pytest.approx(0.2, rel=1e-3)
@@ -167,7 +167,7 @@ def test_a_released_servo_holds_still_and_a_snapshot_brings_the_servo_back():
 ])
 def test_bad_servo_requests_are_refused_and_change_nothing(motors, lists, error):
     core, joint, motor = rotor()
-    core.create_motor(body1="rod", axes=[0, 0, 1])   # a motor without a joint
+    core.add_motor(MotorSpec(body1="rod", axes=[0, 0, 1]))   # a motor without a joint
     with pytest.raises(error):
         core.set_servo(motors, **lists)
     assert core.servo_states() == []

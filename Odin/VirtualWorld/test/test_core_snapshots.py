@@ -9,8 +9,8 @@ import sys
 import numpy as np
 import pytest
 
-from virtual_world.core import (FORCE, HINGE, LO_STOP, MAX_FORCE, Core, ObjectSpec,
-                                WorldParameters)
+from virtual_world.core import (FORCE, HINGE, LO_STOP, MAX_FORCE, Core, JointSpec, MotorSpec,
+                                ObjectSpec, WorldParameters)
 from odin_common import OdinError
 from virtual_world.errors import InvalidArgument, UnknownName
 
@@ -93,7 +93,7 @@ def hub(core):
     core.build_object(ObjectSpec("b", [0.1], position=(0.05, 0.19, 1)))
     core.build_object(ObjectSpec("c", [0.1], position=(0.05, -0.19, 1)))
     core.build_object(ObjectSpec("d", [0.1, 0.1, 0.1], position=(-0.3, 0, 1)))
-    core.create_joint(HINGE, "a", "d", anchor=(-0.15, 0, 1), axis1=(0, 0, 1))
+    core.add_joint(JointSpec(HINGE, "a", "d", anchor=(-0.15, 0, 1), axis1=(0, 0, 1)))
     core.set_velocity("d", angular=(0, 0, 3.0))
 
 
@@ -156,14 +156,14 @@ def arm(core):
     for k in range(3):
         core.build_object(ObjectSpec(f"l{k}", [0.3, 0.05, 0.05], mass=1.0,
                                      position=(0.15 + 0.3 * k, 0, 0.5)))
-        joint = core.create_joint(HINGE, previous, f"l{k}", anchor=(0.3 * k, 0, 0.5),
-                                  axis1=(0, 1, 0))
-        core.create_motor(joint=joint, max_forces=[8.0])
+        joint = core.add_joint(JointSpec(HINGE, previous, f"l{k}", anchor=(0.3 * k, 0, 0.5),
+                                         axis1=(0, 1, 0)))
+        core.add_motor(MotorSpec(joint=joint, max_forces=[8.0]))
         previous = f"l{k}"
     core.set_joint_parameters("1:&l0", [(LO_STOP, 1, -0.5)])
     core.add_joint_force("1:l0&l1", [0.3])
     core.add_body_force("l2", FORCE, (0, 0, -2.0))
-    core.set_motor_velocities({"motor:1:&l0": [0.4], "motor:1:l0&l1": [-0.2]})
+    core.set_velocity(motors=["motor:1:&l0", "motor:1:l0&l1"], velocities=[0.4, -0.2])
 
 
 @pytest.mark.parametrize("build", [pile, arm], ids=["pile", "arm"])
@@ -188,7 +188,7 @@ def test_a_snapshot_brings_back_goals_parameters_and_forces(core):
     expected = state_bytes(core)
     core.restore_state("before changes")
     # change every kind of state a snapshot holds ...
-    core.set_motor_velocities({"motor:1:&l0": [-1.0], "motor:1:l1&l2": [2.0]})
+    core.set_velocity(motors=["motor:1:&l0", "motor:1:l1&l2"], velocities=[-1.0, 2.0])
     core.set_joint_parameters("1:&l0", [(LO_STOP, 1, -0.1)])
     core.set_joint_parameters("motor:1:l0&l1", [(MAX_FORCE, 1, 1.0)])
     core.add_body_force("l0", FORCE, (5, 0, 0))
@@ -294,7 +294,7 @@ def test_propagation_from_a_snapshot_under_controls_then_kept(core):
     after = state_bytes(core)
     # the same by hand
     core.restore_state("start")
-    core.set_motor_velocities(goals)
+    core.set_velocity(motors=["motor:1:&l0"], velocities=[-0.8])
     pushed = core.add_body_force("l2", FORCE, (0.0, 0.0, 20.0))
     core.step(H, 200)
     core.remove_body_force(pushed)

@@ -18,7 +18,8 @@ import itertools
 import numpy as np
 import pytest
 
-from virtual_world.core import HINGE, QUICKSTEP, WORLDSTEP, Core, ObjectSpec, WorldParameters
+from virtual_world.core import (HINGE, QUICKSTEP, WORLDSTEP, Core, JointSpec, ObjectSpec,
+                                WorldParameters)
 
 H = 0.001          # s
 R = 0.125          # m, sphere radius
@@ -223,8 +224,8 @@ def _swing(solver, iterations):
     try:
         core.build_object(ObjectSpec("l1", [0.5, 0.05, 0.05], mass=1.0, position=(0.25, 0, 0)))
         core.build_object(ObjectSpec("l2", [0.5, 0.05, 0.05], mass=5.0, position=(0.75, 0, 0)))
-        core.create_joint(HINGE, "", "l1", anchor=(0.0, 0.0, 0.0), axis1=(0.0, 1.0, 0.0))
-        core.create_joint(HINGE, "l1", "l2", anchor=(0.5, 0.0, 0.0), axis1=(0.0, 1.0, 0.0))
+        core.add_joint(JointSpec(HINGE, "", "l1", anchor=(0.0, 0.0, 0.0), axis1=(0.0, 1.0, 0.0)))
+        core.add_joint(JointSpec(HINGE, "l1", "l2", anchor=(0.5, 0.0, 0.0), axis1=(0.0, 1.0, 0.0)))
         core.step(H, 200)
         position, orientation, _, _ = core.body_state("l2")
         return np.concatenate([position, orientation])

@@ -10,7 +10,7 @@ import math
 import scenes
 from measure import rotate
 from odin_common.interface import JointType, MotorKind, Shape, Solver
-from virtual_world.core import Core, ObjectSpec, WorldParameters
+from virtual_world.core import Core, JointSpec, MotorSpec, ObjectSpec, WorldParameters
 
 #: the capsule's z turned onto x: (w, x, y, z), a quarter turn about y
 Z_ONTO_X = (math.cos(math.pi / 4), 0.0, math.sin(math.pi / 4), 0.0)
@@ -52,9 +52,9 @@ class Sim:
             core.build_object(ObjectSpec(f"link{k}", [scenes.LINK_RADIUS, length], mass=mass,
                                          position=centre, shape=Shape.CAPSULE,
                                          orientation=(1, 0, 0, 0) if vertical else Z_ONTO_X))
-            joint = core.create_joint(JointType.HINGE, f"link{k}", parent, anchor=anchor,
-                                      axis1=axis)
-            motor = core.create_motor(joint=joint, max_forces=[scenes.MOTOR_MAX_TORQUE])
+            joint = core.add_joint(JointSpec(JointType.HINGE, f"link{k}", parent, anchor=anchor,
+                                             axis1=axis))
+            motor = core.add_motor(MotorSpec(joint=joint, max_forces=[scenes.MOTOR_MAX_TORQUE]))
             servos.append(motor)
             parent = f"link{k}"
         core.set_servo(servos, [0.0] * len(servos))
@@ -66,18 +66,19 @@ class Sim:
         core = self.core
         centre, sides, mass = scenes.PALM
         core.build_object(ObjectSpec("palm", list(sides), mass=mass, position=centre))
-        core.create_joint(JointType.FIXED, "palm", "link6")
+        core.add_joint(JointSpec(JointType.FIXED, "palm", "link6"))
         core.build_object(ObjectSpec("can", [scenes.CAN_RADIUS, scenes.CAN_LENGTH],
                                      mass=scenes.CAN_MASS, position=scenes.CAN))
-        velocities = {}
+        fingers = []
         for k, (position, direction) in enumerate(scenes.fingers()):
             core.build_object(ObjectSpec(f"finger{k}", list(scenes.FINGER_SIDES),
                                          mass=scenes.FINGER_MASS, position=position))
-            joint = core.create_joint(JointType.SLIDER, f"finger{k}", "palm", axis1=direction)
-            motor = core.create_motor(joint=joint, kind=MotorKind.LINEAR,
-                                      max_forces=[scenes.FINGER_FORCE])
-            velocities[motor] = [scenes.FINGER_SPEED]
-        core.set_motor_velocities(velocities)
+            joint = core.add_joint(JointSpec(JointType.SLIDER, f"finger{k}", "palm",
+                                             axis1=direction))
+            motor = core.add_motor(MotorSpec(joint=joint, kind=MotorKind.LINEAR,
+                                             max_forces=[scenes.FINGER_FORCE]))
+            fingers.append(motor)
+        core.set_velocity(motors=fingers, velocities=[scenes.FINGER_SPEED] * len(fingers))
         self.bodies = 11
 
     def step(self, n: int) -> None:

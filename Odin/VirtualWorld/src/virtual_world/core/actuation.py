@@ -1,20 +1,41 @@
-"""Set Servo's rules over a scene: servos on motors and the drive of their joints.
+"""Set Velocity's and Set Servo's rules over a scene: objects' velocities, motors' goal speeds
+and servos, and the drive of their joints.
 
-Set Servo's request gives its lists flat, one value per motor axis in the motors' order; the
-split per motor is a rule of the world, so it is here, once, for the Portal and for a Core
-driven in process alike. Everything is checked before anything changes (core.motors checks the
-servos, core.kinematic the drive).
+Both requests give their per-axis lists flat, one value per motor axis in the motors' order;
+the split per motor is a rule of the world, so it is here, once, for the Portal and for a Core
+driven in process alike. Everything is checked before anything changes (core.objects checks
+the velocities, core.motors the goals and servos, core.kinematic the drive).
 """
 from __future__ import annotations
 
 from typing import Dict, Mapping, Sequence, Tuple
 
 from odin_common.interface import ServoDrive
-from virtual_world.core import kinematic, motors
+from odin_common.limits import shown
+from virtual_world.core import kinematic, motors, objects
 from virtual_world.core.scene import Scene
+from virtual_world.errors import InvalidArgument
 
 #: Set Servo's per-axis lists, in the request's order; ``targets`` is always given
 SERVO_LISTS = ("targets", "rates", "gains", "max_speeds", "max_forces")
+
+
+def set_velocity(scene: Scene, object_id: str, linear, angular, motor_ids: Sequence[str],
+                 velocities: Sequence[float]) -> None:
+    """Set Velocity (Core.set_velocity): the object's velocities (None: kept) and the motors'
+    goal speeds from one flat list, all checked before any is set."""
+    if len(motor_ids) == 0 and not object_id:
+        raise InvalidArgument("nothing to set: give an object or motors")
+    if object_id and linear is None and angular is None:
+        raise InvalidArgument(f"object {shown(object_id)} given without set_linear or "
+                              "set_angular")
+    if object_id:
+        scene.body_object(object_id, "set_velocity")
+        linear, angular = objects.check_velocities(scene, linear, angular)
+    goals = motors.split_per_axis(scene, motor_ids, velocities) if len(motor_ids) else {}
+    motors.set_velocities(scene, goals)
+    if object_id:
+        objects.set_velocity(scene, object_id, linear, angular)
 
 
 def split_servo_lists(scene: Scene, motor_ids: Sequence[str],

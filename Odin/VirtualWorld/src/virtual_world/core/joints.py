@@ -85,7 +85,7 @@ def set_joint_parameters(scene: Scene, joint_id: str,
     Ranges: ERP-like, BOUNCE and FUDGE_FACTOR in [0, 1]; CFM-like >= 0; stops may be +-inf;
     MAX_FORCE negative means infinite. Ball and fixed joints take CFM and ERP only;
     suspension parameters need a hinge2; plane-2D joints take none. On a motor, VELOCITY
-    sets its goal speed (as set_motor_velocities does)."""
+    sets its goal speed (as Core.set_velocity does)."""
     motor = scene.motors.get(joint_id)
     if motor is not None:
         checked = _check_parameters(parameters, MOTOR_PARAMETERS, motor.naxes, "motor",

@@ -186,46 +186,23 @@ class Core:
         motors.retarget_servos(self._scene, {object_id for object_id, *_ in poses})
 
     @disturbs
-    def set_velocity(self, object_id: str, linear=None, angular=None) -> None:
-        """Sets the linear velocity of the centre of mass (m/s, world) and/or the angular
-        velocity (rad/s, world) of a body; None keeps the current one."""
-        objects.set_velocity(self._scene, object_id, linear, angular)
-
-    @disturbs
-    def set_velocities(self, object_id: str = "", linear=None, angular=None,
-                       motor_ids: Sequence[str] = (), velocities: Sequence[float] = ()) -> None:
-        """Set Velocity: an object's velocities and/or motor goal speeds (one flat list, each
-        motor taking as many values as it has axes), all checked before any is set."""
-        if len(motor_ids) == 0 and not object_id:
-            raise InvalidArgument("nothing to set: give an object or motors")
-        if object_id and linear is None and angular is None:
-            raise InvalidArgument(f"object {shown(object_id)} given without set_linear or "
-                                  "set_angular")
-        scene = self._scene
-        if object_id:
-            scene.body_object(object_id, "set_velocity")
-            linear, angular = objects.check_velocities(scene, linear, angular)
-        goals = motors.split_per_axis(scene, motor_ids, velocities) if len(motor_ids) else {}
-        motors.set_velocities(scene, goals)
-        if object_id:
-            objects.set_velocity(scene, object_id, linear, angular)
+    def set_velocity(self, object_id: str = "", linear=None, angular=None,
+                     motors: Sequence[str] = (), velocities: Sequence[float] = ()) -> None:
+        """Set Velocity: an object's linear velocity of the centre of mass (m/s, world) and/or
+        angular velocity (rad/s, world), None keeping the current one, and/or goal speeds of
+        ``motors`` (rad/s or m/s; ``velocities`` one flat list, each motor taking as many
+        values as it has axes, in order; a servo given a speed leaves servo mode). At least
+        an object with one of its velocities, or motors; all checked before any is set."""
+        actuation.set_velocity(self._scene, object_id, linear, angular, motors, velocities)
 
     # ------------------------------------------------------------------ joints and motors
 
     @changes_contents
     def add_joint(self, spec: JointSpec) -> str:
         """Creates a joint and sets its parameters, all or nothing (see JointSpec); returns
-        its id."""
+        its id. PLANE2D keeps body1 in the plane z = 0 (body2 must be ""); FIXED keeps the
+        bodies' present relative pose; one joint per pair of bodies."""
         return joints.create_joint(self._scene, spec)
-
-    def create_joint(self, joint_type: int, body1: str, body2: str, anchor=(0.0, 0.0, 0.0),
-                     axis1=(0.0, 0.0, 1.0), axis2=(1.0, 0.0, 0.0), axis3=(0.0, 1.0, 0.0),
-                     joint_id: str = "", parameters: Sequence = ()) -> str:
-        """add_joint with the fields of JointSpec as arguments. Joint types: JointType;
-        PLANE2D keeps body1 in the plane z = 0 (body2 must be ""); FIXED keeps the bodies'
-        present relative pose; one joint per pair of bodies."""
-        return self.add_joint(JointSpec(joint_type, body1, body2, anchor, axis1, axis2, axis3,
-                                        parameters, joint_id))
 
     @locked
     def joint_ids(self) -> List[str]:
@@ -255,13 +232,6 @@ class Core:
         """Creates a motor (see MotorSpec) at zero goal speed; returns its id."""
         return motors.create_motor(self._scene, spec)
 
-    def create_motor(self, motor_id: str = "", joint: str = "", body1: str = "",
-                     body2: str = "", kind: int = MotorKind.ANGULAR, axes: Sequence[float] = (),
-                     axis_frames: Sequence[int] = (), max_forces: Sequence[float] = ()) -> str:
-        """add_motor with the fields of MotorSpec as arguments."""
-        return self.add_motor(MotorSpec(joint, kind, body1, body2, axes, axis_frames,
-                                        max_forces, motor_id))
-
     @locked
     def motor_ids(self) -> List[str]:
         return list(self._scene.motors)
@@ -286,8 +256,8 @@ class Core:
         """Set Servo: servo mode for ``motors``, each tracking a position target on its
         joint's axes. The lists are flat, one value per motor axis in the motors' order:
         ``targets`` (rad or m); optional, empty meaning not given: ``rates`` (feed-forward,
-        rad/s or m/s; 0), ``gains`` (1/s; interface.SERVO_GAIN), ``max_speeds`` (rad/s or
-        m/s; interface.SERVO_MAX_SPEED), ``max_forces`` (N m or N; the motor's as it is).
+        rad/s or m/s; 0), ``gains`` (1/s; defaults.SERVO_GAIN), ``max_speeds`` (rad/s or
+        m/s; defaults.SERVO_MAX_SPEED), ``max_forces`` (N m or N; the motor's as it is).
         ``drive`` (ServoDrive) for their joints (core.kinematic: KINEMATIC, the links follow
         the servos' law exactly). All checked before anything changes."""
         actuation.set_servo(self._scene, motors, {
@@ -324,11 +294,6 @@ class Core:
     @changes_contents
     def remove_motor(self, motor_id: str) -> None:
         motors.remove_motor(self._scene, motor_id)
-
-    @disturbs
-    def set_motor_velocities(self, velocities: Mapping[str, Sequence[float]]) -> None:
-        """Goal speeds (rad/s or m/s) per motor axis; all checked before any is set."""
-        motors.set_velocities(self._scene, velocities)
 
     # ------------------------------------------------------------------ forces
 

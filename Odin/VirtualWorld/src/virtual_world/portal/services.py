@@ -164,7 +164,7 @@ class WorldServices:
         return {"message": f"moved {len(request.situations)} object(s)"}
 
     def set_velocity(self, request) -> dict:
-        self.core.set_velocities(
+        self.core.set_velocity(
             request.object, tuple(request.linear) if request.set_linear else None,
             tuple(request.angular) if request.set_angular else None, list(request.motors),
             list(request.velocities))
