@@ -44,7 +44,7 @@ def built_overlaps(plan, pairs: Sequence[Tuple[str, str, float]],
 
 
 def settle_overlaps(world, plan) -> Tuple[List[Overlap], bool]:
-    """After ``plan`` was built in ``world`` (a gui.ros WorldClient or a planning CoreWorld):
+    """After ``plan`` was built in ``world`` (a gui.core.world_port.WorldPort):
     the pairs it built inside each other and whether they are exempt. In a problem Kautham
     never simulates the world is asked to exempt them (Exempt Overlaps) until they have moved
     apart; under Kautham's physics they are only found (Check Collision)."""

@@ -13,10 +13,10 @@ Every step answers the same calls:
 - ``describe()``: {"bodies": [...], "joints": [...]}, problem_info's JSON;
 - ``entries(answer)``: the ``StepEntry`` lines it adds to a listing of what was built, given
   the world's answer to it;
-- ``send(client, ids)``: calls the typed method of ``client`` (a
-  ``gui.ros.client.WorldClient``; only its methods are used, so this module needs no ROS),
-  records the world's IDs in ``ids`` (``BuiltIds``) and returns the world's answer (an ID).
-``WorldClient.execute(plan)`` sends a whole plan, the Qt window does the same step by step.
+- ``send(world, ids)``: makes its request through ``world`` (a
+  ``gui.core.world_port.WorldPort``: a world node's or a Core's), records the world's IDs in
+  ``ids`` (``BuiltIds``) and returns the world's answer (an ID).
+``gui.core.world_port.build(world, plan)`` sends a whole plan.
 
 Units are SI (m, rad, kg, s); positions and quaternions (w, x, y, z) are world frame unless
 said otherwise; a pose is a (4, 4) homogeneous array (``gui.core.kinematics``).
@@ -35,8 +35,10 @@ from odin_common.interface import JointType
 from odin_common.specs import CompositeSpec, EntitySpec, JointSpec, MotorSpec, ObjectSpec
 
 if TYPE_CHECKING:
-    # only a type: the plan carries the settings its maker chose, and the module that makes
-    # them reads Kautham's environment, which the plan's vocabulary must not depend on
+    # types only: gui.core.world_port builds plans (it imports this module); and the plan
+    # carries the settings its maker chose, and the module that makes them reads Kautham's
+    # environment, which the plan's vocabulary must not depend on
+    from gui.core.world_port import WorldPort
     from gui.core.world_settings import WorldSettings
 
 BodySpec = Union[ObjectSpec, CompositeSpec]
@@ -140,14 +142,14 @@ class WorldStep:
         return [StepEntry("World", name, _short_value(value))
                 for name, value in self.parameters.items() if name in self.own]
 
-    def send(self, client, ids: BuiltIds) -> str:
+    def send(self, world: "WorldPort", ids: BuiltIds) -> str:
         """Pauses the world, then sets the parameters; answers "set". A problem is built,
         and left, at its start: a running world would let links fall while the requests that
         join them are still on their way, and a plan replays from the state it started from
         (the Sphere's, landed after the seconds between the load and the replay, ended 0.69 m
         from a goal its plan reached within 0.25 m)."""
-        client.pause()
-        client.set_world(**self.parameters)
+        world.pause()
+        world.set_world(**self.parameters)
         return "set"
 
 
@@ -175,9 +177,9 @@ class StepSizeStep:
         """One "World" line: the step, when it is the problem's."""
         return [StepEntry("World", "step", f"{self.step:g} s")] if self.own else []
 
-    def send(self, client, ids: BuiltIds) -> str:
+    def send(self, world: "WorldPort", ids: BuiltIds) -> str:
         """Sets the step; answers the step the world took ("h s")."""
-        values = client.set_step(step=self.step, steps_per_cycle=self.steps_per_cycle,
+        values = world.set_step(step=self.step, steps_per_cycle=self.steps_per_cycle,
                                  rate=self.rate)
         return f"{values.step:g} s"
 
@@ -214,9 +216,9 @@ class EntityStep:
         """One "Links" line per member (its planned ID)."""
         return [StepEntry("Links", _short(m.id), m.id) for m in self.spec.members]
 
-    def send(self, client, ids: BuiltIds) -> str:
+    def send(self, world: "WorldPort", ids: BuiltIds) -> str:
         """Builds the entity, records its members' world IDs; answers the entity's name."""
-        built = client.build_entity(self.spec)
+        built = world.build_entity(self.spec)
         for member, world_id in zip(self.spec.members, built.ids):
             ids.bodies[member.id] = world_id
         return built.name
@@ -245,9 +247,9 @@ class ObjectStep:
         """One ``SCENE_OBJECTS`` line."""
         return [StepEntry(SCENE_OBJECTS, self.spec.id, str(answer))]
 
-    def send(self, client, ids: BuiltIds) -> str:
+    def send(self, world: "WorldPort", ids: BuiltIds) -> str:
         """Builds the object; records and answers its world ID."""
-        world_id = ids.bodies[self.spec.id] = client.build_object(self.spec)
+        world_id = ids.bodies[self.spec.id] = world.build_object(self.spec)
         return world_id
 
 
@@ -276,9 +278,9 @@ class CompositeStep:
         return [StepEntry(SCENE_OBJECTS, f"{_short(parts[0].name, '#')} ({len(parts)} parts)",
                           str(answer))]
 
-    def send(self, client, ids: BuiltIds) -> str:
+    def send(self, world: "WorldPort", ids: BuiltIds) -> str:
         """Builds the composite; records and answers its world ID."""
-        world_id = ids.bodies[self.spec.id] = client.build_composite(self.spec)
+        world_id = ids.bodies[self.spec.id] = world.build_composite(self.spec)
         return world_id
 
 
@@ -321,12 +323,12 @@ class JointStep:
         """One "Joints" line."""
         return [StepEntry("Joints", _short(self.key), str(answer))]
 
-    def send(self, client, ids: BuiltIds) -> str:
+    def send(self, world: "WorldPort", ids: BuiltIds) -> str:
         """Creates the joint between the bodies' world IDs; records and answers its ID."""
         spec = self.spec
         spec = dataclasses.replace(spec, body1=ids.bodies.get(spec.body1, spec.body1),
                                    body2=ids.bodies.get(spec.body2, spec.body2))
-        world_id = ids.joints[self.key] = client.add_joint(spec)
+        world_id = ids.joints[self.key] = world.add_joint(spec)
         return world_id
 
 
@@ -363,15 +365,15 @@ class MotorStep:
         name = _short(self.joint_key) + (f" ({self.purpose})" if self.purpose else "")
         return [StepEntry("Motors", name, str(answer))]
 
-    def send(self, client, ids: BuiltIds) -> str:
+    def send(self, world: "WorldPort", ids: BuiltIds) -> str:
         """Adds the motor on the joint's world ID and sets its parameters; records and answers
         its ID."""
         joint = ids.joints[self.joint_key]
         spec = dataclasses.replace(self.spec, joint=joint, id=self.spec.id and (
             f"{self.purpose}:{joint}" if self.purpose else self.spec.id))
-        world_id = ids.motors[self.key] = client.add_motor(spec)
+        world_id = ids.motors[self.key] = world.add_motor(spec)
         if self.parameters:
-            client.set_joint_parameters(world_id, self.parameters)
+            world.set_joint_parameters(world_id, self.parameters)
         return world_id
 
 
@@ -400,10 +402,10 @@ class HoldStep:
         """Nothing new to list (the motors are listed)."""
         return []
 
-    def send(self, client, ids: BuiltIds) -> str:
+    def send(self, world: "WorldPort", ids: BuiltIds) -> str:
         """Sets the servos on the world's motor IDs; answers "held"."""
         zeros = (0.0,) * len(self.joint_keys)
-        client.set_servo(ServoCommand(tuple(ids.motors[k] for k in self.joint_keys), zeros,
+        world.set_servo(ServoCommand(tuple(ids.motors[k] for k in self.joint_keys), zeros,
                                       rates=zeros, max_speeds=self.max_speeds))
         return "held"
 
