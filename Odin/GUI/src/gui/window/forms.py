@@ -1,7 +1,8 @@
 """Forms: grids of labelled fields, and the field a world parameter's row of the table asks for.
 
 ``form_grid`` lays out rows of cells (a text becomes a label, a cell may span columns, a row
-may take the spare height), so a tab lists its rows instead of placing each widget by hand.
+may take the spare height), so a tab lists its rows instead of placing each widget by hand;
+``list_box`` is a tab's list of what the world holds with its buttons beside it.
 ``ParameterField`` is the input of one ``odin_common.world_parameters.ParameterInfo``, chosen by
 its kind and range: the Settings tab's rows come from the table alone.
 """
@@ -10,7 +11,8 @@ from __future__ import annotations
 import html
 from typing import Any, Callable, NamedTuple, Optional, Sequence, Union
 
-from PyQt5.QtWidgets import QCheckBox, QComboBox, QGridLayout, QLabel, QLayout, QWidget
+from PyQt5.QtWidgets import (QCheckBox, QComboBox, QGridLayout, QGroupBox, QHBoxLayout,
+                             QLabel, QLayout, QListWidget, QVBoxLayout, QWidget)
 
 from gui.window.fields import BIG, ChoiceButtons, VectorRow, int_spin, spin
 from odin_common.world_parameters import ParameterInfo
@@ -57,6 +59,20 @@ def form_grid(rows: Sequence[Sequence[Cell]], parent: Optional[QWidget] = None) 
         if isinstance(cells, Growing):
             grid.setRowStretch(row, 1)
     return grid
+
+
+def list_box(title: str, items: QListWidget, side: Sequence[QWidget]) -> QGroupBox:
+    """A group box ``title``: the list ``items`` over its spare width, the widgets of ``side``
+    (buttons, notes, check boxes) in a column at its right, from the top."""
+    box = QGroupBox(title)
+    row = QHBoxLayout(box)
+    row.addWidget(items, 1)
+    column = QVBoxLayout()
+    for widget in side:
+        column.addWidget(widget)
+    column.addStretch(1)
+    row.addLayout(column)
+    return box
 
 
 # -- world parameters ---------------------------------------------------------------------------

@@ -13,7 +13,7 @@ from PyQt5.QtWidgets import (QComboBox, QGroupBox, QHBoxLayout, QListWidget, QLi
                              QPushButton, QVBoxLayout, QWidget)
 
 from gui.window.fields import InputError, VectorRow, checked_spin, int_spin
-from gui.window.forms import form_grid
+from gui.window.forms import form_grid, list_box
 from gui.window.scene import JOINT_TYPE_NAMES
 from odin_common.interface import (JOINT_AXES_USED, JOINT_USES_ANCHOR, JointParameter,
                                    JointType, MotorKind)
@@ -80,15 +80,8 @@ class JointsTab(QWidget):
         self.remove_button = QPushButton("Remove")
         self.set_button = QPushButton("Set parameters")
         self.motor_button = QPushButton("Add motor")
-        listing = QGroupBox("Joint list")
-        lay = QHBoxLayout(listing)
-        lay.addWidget(self.list, 1)
-        side = QVBoxLayout()
-        side.addWidget(self.remove_button)
-        side.addWidget(self.set_button)
-        side.addWidget(self.motor_button)
-        side.addStretch(1)
-        lay.addLayout(side)
+        listing = list_box("Joint list", self.list,
+                           [self.remove_button, self.set_button, self.motor_button])
 
         top = QHBoxLayout()
         top.addWidget(create, 1)

@@ -54,6 +54,20 @@ class MainWindow(QMainWindow):
         self._reading_world = False       # a Get World is queued or running
         self._read_again = False          # ... and something changed since it was asked
 
+        self._build_panels(viewer if ros else None)
+        self._lay_out()
+        self._build_status_bar(world)
+        self.resize(1100, 760)
+        self._connect_and_start_timers()
+        self.link = None
+        if ros:
+            self._link_ros(world, viewer)
+        self.worker.start()
+        self.path_worker.start()
+
+    def _build_panels(self, viewer: Optional[str]) -> None:
+        """The five tabs, the Viewer's image (``viewer``: its namespace, None without ROS), the
+        joint plot and the message log."""
         self.tabs = QTabWidget()
         self.simulation = SimulationTab(self)
         self.settings = SettingsTab(self)
@@ -64,8 +78,7 @@ class MainWindow(QMainWindow):
                            (self.objects, "Objects"), (self.motion, "Motion"),
                            (self.joints, "Joints")]:
             self.tabs.addTab(tab, title)
-        self.viewer_panel = ViewerPanel(viewer=viewer if ros else None,
-                                        frame_points=self.scene.robot_points)
+        self.viewer_panel = ViewerPanel(viewer=viewer, frame_points=self.scene.robot_points)
         self.viewer_panel.message.connect(self.show_error)
         self.plot = JointPlotPanel(label=lambda channel: channel_label(channel, self.scene))
         self.scene.changed.connect(
@@ -75,6 +88,8 @@ class MainWindow(QMainWindow):
         self.log.setMaximumBlockCount(500)
         self.log.setPlaceholderText("Messages from the world appear here.")
 
+    def _lay_out(self) -> None:
+        """The tabs left of the image over the plot, the log below them all."""
         right = QSplitter(Qt.Vertical)
         right.addWidget(self.viewer_panel)
         right.addWidget(self.plot)
@@ -93,6 +108,8 @@ class MainWindow(QMainWindow):
         layout.addWidget(outer)
         self.setCentralWidget(central)
 
+    def _build_status_bar(self, world: str) -> None:
+        """The busy and connection labels, waiting for the world at namespace ``world``."""
         self.busy_text = ""
         self.connection_text = ""
         self.connection_label = QLabel()
@@ -100,8 +117,10 @@ class MainWindow(QMainWindow):
         self.statusBar().addPermanentWidget(self.busy_label)
         self.statusBar().addPermanentWidget(self.connection_label)
         self._show_connection(False, f"VirtualWorld absent: waiting for {world}")
-        self.resize(1100, 760)
 
+    def _connect_and_start_timers(self) -> None:
+        """The worker's connection state, the health check (every 0.25 s) and the idle Get
+        World (every REFRESH_PERIOD s)."""
         self.worker.connection.connect(self._on_connection)
         self._health = QTimer(self)
         self._health.timeout.connect(self._check_health)
@@ -111,16 +130,15 @@ class MainWindow(QMainWindow):
         self._refresh.timeout.connect(self._poll_world)
         self._refresh.start(int(REFRESH_PERIOD * 1000))
 
-        self.link = None
-        if ros:
-            from gui.window.ros_link import RosLink
-            self.link = RosLink(world, viewer, self)
-            self.link.world_update.connect(self.on_world_update)
-            self.link.joint_data.connect(self.scene.on_joint_data)
-            self.link.joint_states.connect(self.plot.on_joint_states)
-            self.link.image.connect(self.viewer_panel.on_image)
-        self.worker.start()
-        self.path_worker.start()
+    def _link_ros(self, world: str, viewer: str) -> None:
+        """The topics of the world at ``world`` and the Viewer at ``viewer``, into the scene,
+        the plot and the image."""
+        from gui.window.ros_link import RosLink
+        self.link = RosLink(world, viewer, self)
+        self.link.world_update.connect(self.on_world_update)
+        self.link.joint_data.connect(self.scene.on_joint_data)
+        self.link.joint_states.connect(self.plot.on_joint_states)
+        self.link.image.connect(self.viewer_panel.on_image)
 
     # -- calls --------------------------------------------------------------------------------
     def call(self, label: str, fn: Callable, on_done: Optional[Callable] = None,

@@ -39,8 +39,19 @@ class MotionTab(QWidget):
         super().__init__(parent)
         self.window = window
         self.toolbox = QToolBox()
+        for page, title in [(self._object_page(), "Move object"),
+                            (self._joint_page(), "Move joint"),
+                            (self._motor_page(), "Move motor"),
+                            (self._robot_page(), "Move robot")]:
+            self.toolbox.addItem(page, title)
+        layout = QVBoxLayout(self)
+        layout.addWidget(self.toolbox)
+        self._connect(window)
+        self._action_changed()
+        self._joint_changed()
 
-        # -- move object
+    def _object_page(self) -> QWidget:
+        """Move object: a force, torque or velocity (at a point), and the forces in force."""
         page = QWidget()
         self.object = QComboBox()
         actions = ChoiceButtons(ACTIONS)          # index = action
@@ -59,9 +70,10 @@ class MotionTab(QWidget):
                    [self.at_point, self.point, self.point_relative],
                    [None, None, self.move_button],
                    [span(self.forces, 2), self.delete_force_button]], page)
-        self.toolbox.addItem(page, "Move object")
+        return page
 
-        # -- move joint
+    def _joint_page(self) -> QWidget:
+        """Move joint: a force or torque per axis, and the joint forces in force."""
         page = QWidget()
         self.joint = QComboBox()
         self.magnitudes = VectorRow(["1", "2", "3"], (1.0, 0.0, 0.0), -1e6, 1e6, 3, 0.5)
@@ -73,9 +85,10 @@ class MotionTab(QWidget):
                     self.joint_force_button],
                    ["Forces and torques"],
                    [span(self.joint_forces, 2), self.delete_joint_force_button]], page)
-        self.toolbox.addItem(page, "Move joint")
+        return page
 
-        # -- move motor
+    def _motor_page(self) -> QWidget:
+        """Move motor: goal speeds per axis."""
         page = QWidget()
         self.motor = QComboBox()
         self.motor_speeds = VectorRow(["1", "2", "3"], (0.5, 0.0, 0.0), -1e3, 1e3, 3, 0.1)
@@ -83,9 +96,10 @@ class MotionTab(QWidget):
         form_grid([["Motor", span(self.motor, 2)],
                    ["Goal speed per axis\n(rad/s or m/s)", self.motor_speeds, self.motor_button],
                    growing()], page)
-        self.toolbox.addItem(page, "Move motor")
+        return page
 
-        # -- move robot
+    def _robot_page(self) -> QWidget:
+        """Move robot: the path files, Stop, and the tracked path's plot."""
         page = QWidget()
         self.robot = QComboBox()
         self.units = QComboBox()
@@ -112,11 +126,10 @@ class MotionTab(QWidget):
                    [self.tracked_button, self.stop_button],
                    [span(self.path_status, 3)],
                    growing(span(self.tracking_plot, 3))], page)
-        self.toolbox.addItem(page, "Move robot")
+        return page
 
-        layout = QVBoxLayout(self)
-        layout.addWidget(self.toolbox)
-
+    def _connect(self, window) -> None:
+        """The widgets to this tab's actions, the scene's changes (of ``window``) to its lists."""
         self.action_group.buttonClicked.connect(lambda _b: self._action_changed())
         self.at_point.toggled.connect(lambda _b: self._action_changed())
         self.move_button.clicked.connect(self.move_object)
@@ -133,8 +146,6 @@ class MotionTab(QWidget):
         self.tracked_button.clicked.connect(lambda: self.choose_path("tracked"))
         self.stop_button.clicked.connect(self.stop_path)
         window.scene.changed.connect(self._scene_changed)
-        self._action_changed()
-        self._joint_changed()
 
     # -- lists ----------------------------------------------------------------------------
     @staticmethod
@@ -339,7 +350,7 @@ class MotionTab(QWidget):
             return
 
         def work(client, job):
-            from gui.ros.world_port import run_on_client
+            from gui.core.control_path import run_on_client
             run_on_client(client, handle, rows, progress=lambda r: job.progress(r.index),
                           sleep=job.sleep)
             return len(rows)
@@ -365,7 +376,7 @@ class MotionTab(QWidget):
         name = pathlib.Path(path).name
 
         def work(client, job):
-            from gui.ros.world_port import run_tracked_on_client
+            from gui.core.execution import run_tracked_on_client
             from gui.window.worker import Cancelled
 
             def progress(t: float, total: float) -> None:

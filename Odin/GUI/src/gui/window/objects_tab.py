@@ -19,7 +19,7 @@ from PyQt5.QtWidgets import (QCheckBox, QComboBox, QFileDialog, QFormLayout, QGr
 
 from gui.window.fields import InputError, VectorRow, name_edit, quaternion_row, spin, \
     unit_quaternion
-from gui.window.forms import form_grid, span
+from gui.window.forms import form_grid, list_box, span
 from odin_common.rotations import quaternion_to_matrix
 from odin_common.specs import CompositeSpec, ObjectSpec
 
@@ -39,12 +39,44 @@ class ObjectsTab(QWidget):
     def __init__(self, window, parent=None):
         super().__init__(parent)
         self.window = window
+        create = self._build_create()
+        listing = self._build_listing()
+        layout = QVBoxLayout(self)
+        layout.addWidget(create)
+        layout.addWidget(listing, 1)
+        self._connect(window)
+        self._shape_changed(0)
 
+    def _build_create(self) -> QGroupBox:
+        """The Create object group: name, shape and its parameters, mass and flags, pose."""
         self.name = name_edit()
         self.shape = QComboBox()
         self.shape.addItems(SHAPES)
         self.preset = QComboBox()
-        self.stack = QStackedWidget()
+        self.stack = self._build_shape_pages()
+        self.mass = spin(1.0, 1e-6, 1e6, 4, 0.1, "kg")
+        self.fixed = QCheckBox("fixed")
+        self.fixed.setToolTip("a body held at its pose")
+        self.static = QCheckBox("static")
+        self.static.setToolTip("geometry only: collides, never moves, no mass")
+        self.position = VectorRow("xyz", (0.0, 0.0, 1.0), -1e4, 1e4, 3, 0.1, "m")
+        self.orientation = quaternion_row()
+        self.create_button = QPushButton("Create it!")
+
+        create = QGroupBox("Create object")
+        mass_row = QHBoxLayout()
+        mass_row.addWidget(self.mass, 1)
+        mass_row.addWidget(self.fixed)
+        mass_row.addWidget(self.static)
+        form_grid([["Name", self.name], ["Shape", self.shape], ["Preset", self.preset],
+                   [span(self.stack, 2)], ["Mass", mass_row], ["Position", self.position],
+                   ["Orientation", self.orientation], [None, self.create_button]], create)
+        return create
+
+    def _build_shape_pages(self) -> QStackedWidget:
+        """One page of parameters a shape, in the order of SHAPES (the chooser's index): the
+        primitives' sizes (m), then the mesh file and its scale."""
+        stack = QStackedWidget()
         self.radius = spin(0.1, 1e-4, 100.0, 4, 0.01, "m")
         self.cyl_radius = spin(0.033, 1e-4, 100.0, 4, 0.01, "m")
         self.cyl_length = spin(0.12, 1e-4, 100.0, 4, 0.01, "m")
@@ -65,7 +97,7 @@ class ObjectsTab(QWidget):
             form = QFormLayout(page)
             for label, widget in rows:
                 form.addRow(label, widget)
-            self.stack.addWidget(page)
+            stack.addWidget(page)
         page = QWidget()
         form = QFormLayout(page)
         row = QHBoxLayout()
@@ -73,26 +105,11 @@ class ObjectsTab(QWidget):
         row.addWidget(self.mesh_browse)
         form.addRow("File", row)
         form.addRow("Scale", self.mesh_scale)
-        self.stack.addWidget(page)
+        stack.addWidget(page)
+        return stack
 
-        self.mass = spin(1.0, 1e-6, 1e6, 4, 0.1, "kg")
-        self.fixed = QCheckBox("fixed")
-        self.fixed.setToolTip("a body held at its pose")
-        self.static = QCheckBox("static")
-        self.static.setToolTip("geometry only: collides, never moves, no mass")
-        self.position = VectorRow("xyz", (0.0, 0.0, 1.0), -1e4, 1e4, 3, 0.1, "m")
-        self.orientation = quaternion_row()
-        self.create_button = QPushButton("Create it!")
-
-        create = QGroupBox("Create object")
-        mass_row = QHBoxLayout()
-        mass_row.addWidget(self.mass, 1)
-        mass_row.addWidget(self.fixed)
-        mass_row.addWidget(self.static)
-        form_grid([["Name", self.name], ["Shape", self.shape], ["Preset", self.preset],
-                   [span(self.stack, 2)], ["Mass", mass_row], ["Position", self.position],
-                   ["Orientation", self.orientation], [None, self.create_button]], create)
-
+    def _build_listing(self) -> QGroupBox:
+        """The Object list: every object in the world, Remove, and Set transformation."""
         self.list = QListWidget()
         self.remove_button = QPushButton("Remove")
         self.set_position_check = QCheckBox("Position")
@@ -100,22 +117,12 @@ class ObjectsTab(QWidget):
         self.set_orientation_check = QCheckBox("Orientation")
         self.set_orientation_check.setChecked(True)
         self.set_button = QPushButton("Set transformation")
-        listing = QGroupBox("Object list")
-        lay = QHBoxLayout(listing)
-        lay.addWidget(self.list, 1)
-        side = QVBoxLayout()
-        side.addWidget(self.remove_button)
-        side.addWidget(QLabel("Set transformation\n(from the fields above):"))
-        side.addWidget(self.set_position_check)
-        side.addWidget(self.set_orientation_check)
-        side.addWidget(self.set_button)
-        side.addStretch(1)
-        lay.addLayout(side)
+        return list_box("Object list", self.list, [
+            self.remove_button, QLabel("Set transformation\n(from the fields above):"),
+            self.set_position_check, self.set_orientation_check, self.set_button])
 
-        layout = QVBoxLayout(self)
-        layout.addWidget(create)
-        layout.addWidget(listing, 1)
-
+    def _connect(self, window) -> None:
+        """The widgets to this tab's actions, the scene's changes (of ``window``) to its lists."""
         self.shape.currentIndexChanged.connect(self._shape_changed)
         self.preset.activated.connect(self._apply_preset)
         self.mesh_browse.clicked.connect(self.choose_mesh)
@@ -125,7 +132,6 @@ class ObjectsTab(QWidget):
         self.static.toggled.connect(lambda on: (self.mass.setEnabled(not on),
                                                 self.fixed.setEnabled(not on)))
         window.scene.changed.connect(self._scene_changed)
-        self._shape_changed(0)
 
     # -- shape chooser ------------------------------------------------------------------------
     def _shape_changed(self, index: int) -> None:
