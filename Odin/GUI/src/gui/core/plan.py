@@ -35,10 +35,8 @@ from odin_common.interface import JointType
 from odin_common.specs import CompositeSpec, EntitySpec, JointSpec, MotorSpec, ObjectSpec
 
 if TYPE_CHECKING:
-    # types only: gui.core.world_port builds plans (it imports this module); and the plan
-    # carries the settings its maker chose, and the module that makes them reads Kautham's
-    # environment, which the plan's vocabulary must not depend on
-    from gui.core.world_port import WorldPort
+    # only a type: the plan carries the settings its maker chose, and the module that makes
+    # them reads Kautham's environment, which the plan's vocabulary must not depend on
     from gui.core.world_settings import WorldSettings
 
 BodySpec = Union[ObjectSpec, CompositeSpec]
@@ -142,7 +140,7 @@ class WorldStep:
         return [StepEntry("World", name, _short_value(value))
                 for name, value in self.parameters.items() if name in self.own]
 
-    def send(self, world: "WorldPort", ids: BuiltIds) -> str:
+    def send(self, world, ids: BuiltIds) -> str:
         """Pauses the world, then sets the parameters; answers "set". A problem is built,
         and left, at its start: a running world would let links fall while the requests that
         join them are still on their way, and a plan replays from the state it started from
@@ -177,7 +175,7 @@ class StepSizeStep:
         """One "World" line: the step, when it is the problem's."""
         return [StepEntry("World", "step", f"{self.step:g} s")] if self.own else []
 
-    def send(self, world: "WorldPort", ids: BuiltIds) -> str:
+    def send(self, world, ids: BuiltIds) -> str:
         """Sets the step; answers the step the world took ("h s")."""
         values = world.set_step(step=self.step, steps_per_cycle=self.steps_per_cycle,
                                  rate=self.rate)
@@ -216,7 +214,7 @@ class EntityStep:
         """One "Links" line per member (its planned ID)."""
         return [StepEntry("Links", _short(m.id), m.id) for m in self.spec.members]
 
-    def send(self, world: "WorldPort", ids: BuiltIds) -> str:
+    def send(self, world, ids: BuiltIds) -> str:
         """Builds the entity, records its members' world IDs; answers the entity's name."""
         built = world.build_entity(self.spec)
         for member, world_id in zip(self.spec.members, built.ids):
@@ -247,7 +245,7 @@ class ObjectStep:
         """One ``SCENE_OBJECTS`` line."""
         return [StepEntry(SCENE_OBJECTS, self.spec.id, str(answer))]
 
-    def send(self, world: "WorldPort", ids: BuiltIds) -> str:
+    def send(self, world, ids: BuiltIds) -> str:
         """Builds the object; records and answers its world ID."""
         world_id = ids.bodies[self.spec.id] = world.build_object(self.spec)
         return world_id
@@ -278,7 +276,7 @@ class CompositeStep:
         return [StepEntry(SCENE_OBJECTS, f"{_short(parts[0].name, '#')} ({len(parts)} parts)",
                           str(answer))]
 
-    def send(self, world: "WorldPort", ids: BuiltIds) -> str:
+    def send(self, world, ids: BuiltIds) -> str:
         """Builds the composite; records and answers its world ID."""
         world_id = ids.bodies[self.spec.id] = world.build_composite(self.spec)
         return world_id
@@ -323,7 +321,7 @@ class JointStep:
         """One "Joints" line."""
         return [StepEntry("Joints", _short(self.key), str(answer))]
 
-    def send(self, world: "WorldPort", ids: BuiltIds) -> str:
+    def send(self, world, ids: BuiltIds) -> str:
         """Creates the joint between the bodies' world IDs; records and answers its ID."""
         spec = self.spec
         spec = dataclasses.replace(spec, body1=ids.bodies.get(spec.body1, spec.body1),
@@ -365,7 +363,7 @@ class MotorStep:
         name = _short(self.joint_key) + (f" ({self.purpose})" if self.purpose else "")
         return [StepEntry("Motors", name, str(answer))]
 
-    def send(self, world: "WorldPort", ids: BuiltIds) -> str:
+    def send(self, world, ids: BuiltIds) -> str:
         """Adds the motor on the joint's world ID and sets its parameters; records and answers
         its ID."""
         joint = ids.joints[self.joint_key]
@@ -402,7 +400,7 @@ class HoldStep:
         """Nothing new to list (the motors are listed)."""
         return []
 
-    def send(self, world: "WorldPort", ids: BuiltIds) -> str:
+    def send(self, world, ids: BuiltIds) -> str:
         """Sets the servos on the world's motor IDs; answers "held"."""
         zeros = (0.0,) * len(self.joint_keys)
         world.set_servo(ServoCommand(tuple(ids.motors[k] for k in self.joint_keys), zeros,

@@ -106,15 +106,15 @@ def _code() -> str:
     if _code_digest is None:
         import odin_common
         import virtual_world
-        from gui.core import plan
-        from gui.planning import backend, rehearsal
         digest = hashlib.sha256()
         world = pathlib.Path(virtual_world.__file__).parent
         files = sorted([*world.glob("core/*.py"), *world.glob("ode/*.[pch]*")])
         common = pathlib.Path(odin_common.__file__).parent
         files += sorted(common.glob("*.py"))
-        files += [pathlib.Path(m.__file__) for m in (plan, backend, rehearsal)]
-        files.append(pathlib.Path(__file__))
+        # read by path, not imported: the rehearsal imports this module
+        here = pathlib.Path(__file__).parent
+        files += [here.parent / "core" / "plan.py", here / "core_world.py", here / "rehearsal.py",
+                  pathlib.Path(__file__)]
         for path in files:
             digest.update(path.name.encode() + b"\0" + path.read_bytes())
         _code_digest = digest.hexdigest()

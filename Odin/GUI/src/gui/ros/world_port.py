@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Callable, Dict, List, Optional, Sequence
+from typing import Callable, Dict, List, Optional, Sequence
 
 import numpy as np
 
@@ -24,16 +24,14 @@ from odin_common.interface import ForceKind, JointType
 from odin_common.specs import JointSpec
 from odin_common.step_values import StepValues
 
-if TYPE_CHECKING:
-    from gui.ros.client import WorldClient
-
 
 @dataclass
 class ClientWorldPort:
-    """A WorldPort over ``client``; the world must be paused while it advances (the runs
-    below pause it). ``real_time``: an advance takes at least its duration of wall-clock
-    time (``sleep`` waits), so that a Viewer shows the motion at its pace."""
-    client: "WorldClient"
+    """A WorldPort over ``client`` (a gui.ros.client.WorldClient); the world must be paused
+    while it advances (the runs below pause it). ``real_time``: an advance takes at least its
+    duration of wall-clock time (``sleep`` waits), so that a Viewer shows the motion at its
+    pace."""
+    client: object
     real_time: bool = False
     sleep: Callable[[float], None] = time.sleep
     _step_values: Optional[StepValues] = None
@@ -122,7 +120,7 @@ class ClientWorldPort:
         self.client.remove_joint(joint_id)
 
 
-def _paused(client: "WorldClient", run: Callable[[], object]):
+def _paused(client, run: Callable[[], object]):
     """``run()`` with the world paused, started again afterwards if it was running."""
     running = client.world().simulating
     if running:
@@ -134,7 +132,7 @@ def _paused(client: "WorldClient", run: Callable[[], object]):
             client.start()
 
 
-def run_on_client(client: "WorldClient", handle, rows: Sequence[ControlRow],
+def run_on_client(client, handle, rows: Sequence[ControlRow],
                   real_time: bool = True,
                   progress: Optional[Callable[[RowResult], None]] = None,
                   sleep: Callable[[float], None] = time.sleep,
@@ -153,7 +151,7 @@ def run_on_client(client: "WorldClient", handle, rows: Sequence[ControlRow],
     return _paused(client, run)
 
 
-def run_tracked_on_client(client: "WorldClient", plan, solution: Solution,
+def run_tracked_on_client(client, plan, solution: Solution,
                           defaults: TrackingDefaults = TrackingDefaults(),
                           progress: Optional[Callable[[float, float], None]] = None,
                           real_time: bool = False,
@@ -173,7 +171,7 @@ def run_tracked_on_client(client: "WorldClient", plan, solution: Solution,
     return _paused(client, run)
 
 
-def hold_on_client(client: "WorldClient", handle) -> None:
+def hold_on_client(client, handle) -> None:
     """Holds ``handle``'s robot where it is in ``client``'s world (``control_path.hold``)."""
     hold(ClientWorldPort(client), handle)
 
