@@ -7,8 +7,9 @@ Layers, each a module of its own:
   mass        mass properties of shapes (ODE's formulas, trimesh for meshes) and their checks;
   records     what the Core keeps of what it built, and the results it answers;
   scene       one ODE world and the records that name what is in it;
-  objects, joints, motors, forces, readout
-              the requests, by topic, over a scene;
+  objects, joints, motors, actuation, forces, snapshots, propagation, readout
+              the requests, by topic, over a scene (actuation: Set Velocity and Set Servo;
+              propagation: body state vectors and propagations);
   world       ``Core``: one scene behind a lock, the world parameters and the step;
   loop, step_values
               the node's running loop and step values, without ROS.

@@ -26,7 +26,7 @@ from odin_common.limits import shown, shown_list
 from virtual_world.core import exemptions, forces, guard, kinematic, motors, readout
 from virtual_world.core.records import BodyForceRecord, Collision, JointForceRecord
 from virtual_world.core.scene import Scene
-from virtual_world.errors import InvalidArgument
+from virtual_world.errors import InvalidArgument, UnknownName
 from virtual_world.ode import bodies
 from virtual_world.ode import joints as ode_joints
 
@@ -84,6 +84,15 @@ def check_room(held: Dict[str, Snapshot], name: str, snapshot: Snapshot) -> None
                               f"{others / 2 ** 20:.4g} MB of saved states held exceeds "
                               f"{limits.MAX_SNAPSHOT_MB:,} MB (MAX_SNAPSHOT_MB); remove some "
                               "first")
+
+
+def named(scene: Scene, name: str) -> Snapshot:
+    """The snapshot saved under ``name``; UnknownName (listing the saved ones) otherwise."""
+    snapshot = scene.snapshots.get(name) if isinstance(name, str) else None
+    if snapshot is None:
+        raise UnknownName(f"no snapshot {shown(name)} (saved: "
+                          f"{shown_list(sorted(scene.snapshots))})")
+    return snapshot
 
 
 def contents(scene: Scene) -> Contents:

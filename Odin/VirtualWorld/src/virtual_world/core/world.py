@@ -1,10 +1,11 @@
 """The Core: the virtual world of the thesis's chapter 5, ROS-free.
 
 ``Core`` holds one Scene behind one re-entrant lock (rospy serves calls on threads of its
-own) and forwards each request to the module of its topic: objects, joints, motors, forces,
-readout. It owns the world parameters and the step. Every argument is checked before any ODE
-call, so an error raised here means nothing changed; the rules that span topics (Set
-Velocity's all-or-nothing, a joint with its parameters) live here, never in a Portal.
+own) and forwards each request to the module of its topic: objects, joints, motors,
+actuation (Set Velocity and Set Servo), forces, snapshots, propagation (state vectors and
+propagations), readout. It owns the world parameters and the step. Every argument is checked
+before any ODE call, so an error raised here means nothing changed; the rules of the world
+live in the Core, never in a Portal.
 
 Conventions: SI units; world frame unless said; quaternions (w, x, y, z). An object's frame is
 the one its spec's pose gives; "body frame" in this API means the object's frame (ODE's body
@@ -13,27 +14,25 @@ moved by forces or contacts, infinite mass for them.
 """
 from __future__ import annotations
 
-import functools
 import threading
-import time
 from typing import Dict, List, Mapping, Optional, Sequence, Tuple
 
 import numpy as np
 
-from odin_common import limits
-from odin_common.interface import ForceKind, JointType, MotorKind, ServoDrive, Solver
-from odin_common.limits import ResourceLimits, shown, shown_list
+from odin_common.interface import ServoDrive, Solver
+from odin_common.limits import ResourceLimits, shown
 from odin_common.specs import CompositeSpec, EntitySpec, JointSpec, MotorSpec, ObjectSpec
 from odin_common.world_parameters import WorldParameters
 from virtual_world.core import (actuation, exemptions, forces, guard, joints, long_calls,
-                                motors, objects, readout, snapshots, validation as check)
+                                motors, objects, propagation, readout, snapshots,
+                                validation as check)
 from virtual_world.core.requests import changes_contents, changes_state, disturbs, locked
-from virtual_world.core.records import (BodyState, Built, BuiltEntity, Collision, Divergence,
+from virtual_world.core.records import (Built, BuiltEntity, Collision, Divergence,
                                         JointReaction, JointState, MotorState, ObjectState,
                                         Propagation, Removed, ServoState,
                                         StatePropagation)
 from virtual_world.core.scene import Scene
-from virtual_world.errors import Closed, CoreError, InvalidArgument, UnknownName
+from virtual_world.errors import Closed, InvalidArgument
 from virtual_world.ode import bodies
 from virtual_world.ode.handles import TriMeshDataCache
 from virtual_world.ode.runtime import init_ode
@@ -356,7 +355,7 @@ class Core:
         """Puts back the state saved under ``name``: stepping on from it gives bit-identical
         results to stepping on from when it was saved. Refused when the scene's objects,
         joints or motors are no longer those it was saved with."""
-        snapshot = self._snapshot(name)
+        snapshot = snapshots.named(self._scene, name)
         snapshots.check_fits(self._scene, snapshot, f"snapshot {shown(name)}")
         snapshots.put_back(self._scene, snapshot)
 
@@ -366,15 +365,8 @@ class Core:
 
     @locked
     def remove_state(self, name: str) -> None:
-        self._snapshot(name)
+        snapshots.named(self._scene, name)
         del self._scene.snapshots[name]
-
-    def _snapshot(self, name: str):
-        snapshot = self._scene.snapshots.get(name) if isinstance(name, str) else None
-        if snapshot is None:
-            raise UnknownName(f"no snapshot {shown(name)} (saved: "
-                              f"{shown_list(sorted(self._scene.snapshots))})")
-        return snapshot
 
     @locked
     def body_state_vector(self) -> np.ndarray:
@@ -386,16 +378,7 @@ class Core:
         per exempt pair (``exempt_overlaps``: 1.0 exempt, 0.0 parted; none without them).
         ``set_body_state_vector`` puts it back bit for bit. Motors, servos and persistent
         forces are not in it: they stay as they are."""
-        return self._state_vector()
-
-    def _state_vector(self) -> np.ndarray:
-        scene = self._scene
-        return np.concatenate(([float(scene.c.rand_seed)],
-                               bodies.read_states(self._body_ptrs()).ravel(),
-                               exemptions.live(scene)))
-
-    def _body_ptrs(self) -> list:
-        return [o.body.ptr for o in self._scene.objects.values() if o.body is not None]
+        return propagation.state_vector(self._scene)
 
     @changes_state
     def set_body_state_vector(self, vector: Sequence[float]) -> None:
@@ -403,46 +386,14 @@ class Core:
         stepping on from it gives the results stepping on from when it was read gave. Under
         auto_disable the bodies' rest counts start again here (ODE's count is in no vector),
         so a body about to fall asleep may sleep some steps later than it did."""
-        self._put_state_vector(self._checked_state_vector(vector))
+        scene = self._scene
+        propagation.put_state_vector(scene, propagation.checked_state_vector(scene, vector))
 
     @locked
     def checked_state_vector(self, vector: Sequence[float]) -> np.ndarray:
         """``vector`` as contiguous float64 when it is a body state vector of this world (its
         size, finite values, a 32-bit generator state); InvalidArgument otherwise."""
-        return self._checked_state_vector(vector)
-
-    def _checked_state_vector(self, vector: Sequence[float]) -> np.ndarray:
-        vector = self._sized_state_vector(vector)
-        fault = bodies.state_vector_fault(vector, len(self._scene.exempt_pairs))
-        if fault >= 0:
-            raise _state_vector_fault(vector, fault, len(self._scene.exempt_pairs))
-        return vector
-
-    def _sized_state_vector(self, vector: Sequence[float]) -> np.ndarray:
-        """``vector`` as contiguous float64 when it has the size of this world's body state
-        vectors; its values are checked by state_vector_fault."""
-        try:
-            vector = np.ascontiguousarray(vector, dtype=np.float64)
-        except (TypeError, ValueError):
-            raise InvalidArgument(f"a body state vector holds numbers; got "
-                                  f"{str(vector)[:60]}") from None
-        exempt = len(self._scene.exempt_pairs)
-        size = 1 + self._scene.body_array().count * bodies.BODY_STATE_SIZE + exempt
-        if vector.shape != (size,):
-            pairs = f" + {exempt} exempt pairs" if exempt else ""
-            raise InvalidArgument(f"a body state vector of this world has {size} finite "
-                                  f"values (1 + {bodies.BODY_STATE_SIZE} per body{pairs}); "
-                                  f"got shape {vector.shape}")
-        return vector
-
-    def _put_state_vector(self, vector: np.ndarray) -> None:
-        scene, ptrs = self._scene, self._body_ptrs()
-        end = 1 + len(ptrs) * bodies.BODY_STATE_SIZE
-        bodies.write_states(ptrs, vector[1:end].reshape(len(ptrs), bodies.BODY_STATE_SIZE))
-        exemptions.put_live(scene, vector[end:])
-        scene.c.clear_records()
-        scene.carried = {}
-        scene.c.rand_seed = int(vector[0])
+        return propagation.checked_state_vector(self._scene, vector)
 
     @locked
     def reset(self) -> None:
@@ -473,39 +424,8 @@ class Core:
         (core.long_calls): asked between pieces of the run; when it says the caller has gone
         the world goes back to the state before the call, as after a refusal, kept or not,
         and long_calls.Cancelled is raised."""
-        scene = self._scene
-        step_size, steps = _steps_of(duration, step_size)
-        check.shared(limits.check_work, f"propagate {duration:.6g} s at {step_size:g} s",
-                     steps, scene.body_array().count)
-        keep = check.flag("keep", keep)
-        start_snapshot = self._snapshot(start) if start else None
-        if start_snapshot is not None:
-            snapshots.check_fits(scene, start_snapshot, f"snapshot {shown(start)}")
-        if start_state is not None and len(start_state):
-            if start_snapshot is not None:
-                raise InvalidArgument("give a start snapshot or a start state, not both")
-            start_state = self._checked_state_vector(start_state)
-        else:
-            start_state = None
-        before = snapshots.take(scene)
-        started = time.perf_counter()
-        try:
-            if start_snapshot is not None:
-                snapshots.put_back(scene, start_snapshot)
-            if start_state is not None:
-                self._put_state_vector(start_state)
-            if motor_goals:
-                motors.set_velocities(scene, motor_goals)
-            added = [forces.add_body_force(scene, **dict(f)) for f in body_forces]
-            result = self._run(steps, step_size, read_states, cancelled)
-            for force_id in added:
-                forces.remove_body_force(scene, force_id)
-        except Exception:
-            snapshots.put_back(scene, before)   # a refused control changes nothing
-            raise
-        if not keep:
-            snapshots.put_back(scene, before)
-        return result._replace(wall_time=time.perf_counter() - started, kept=keep)
+        return propagation.propagate(self._scene, duration, step_size, motor_goals, body_forces,
+                                     start, keep, start_state, read_states, cancelled)
 
     @changes_state
     def propagate_state(self, start_state: Sequence[float], duration: float, step_size: float,
@@ -517,45 +437,8 @@ class Core:
         state reached. The states and pairs are bit for bit those of ``propagate`` from
         ``start_state`` with these forces as body forces and ``keep`` (tests/ compare them);
         its answer holds only what a planner reads. Everything is checked first."""
-        scene = self._scene
-        step_size, steps = _steps_of(duration, step_size)
-        start_state = self._sized_state_vector(start_state)
-        try:
-            pushes = _checked_pushes(scene, forces)
-        except CoreError:
-            self._checked_state_vector(start_state)     # a bad state is said first
-            raise
-        state, steps, pairs = scene.c.propagate(scene.body_array(), start_state, pushes,
-                                                step_size, steps)
-        if steps < 0:        # C checks the state's values before it changes anything
-            raise _state_vector_fault(start_state, -1 - steps, len(scene.exempt_pairs))
-        scene.carried = {}
-        scene.sim_time += step_size * steps
-        guard.collect(scene, step_size)
-        return StatePropagation(state, scene.pair_names(pairs), steps)
-
-    def _run(self, steps: int, step_size: float, read_states: bool = True,
-             cancelled: Optional[long_calls.Cancel] = None) -> Propagation:
-        """Steps with every step's collisions recorded; what a propagation answers."""
-        scene = self._scene
-        readout.carry_collisions(scene, set())
-        carried, scene.carried = scene.carried, {}
-        start_time, start_step = scene.sim_time, scene.c.step_count
-        scene.c.record_every_step = True
-        try:
-            steps = long_calls.run_steps(scene, step_size, steps, cancelled)
-        finally:
-            scene.c.record_every_step = False
-        collisions = tuple(sorted(
-            c._replace(first_time=start_time + (step - start_step) * step_size)
-            for c, step in readout.named_records(scene)))
-        scene.c.clear_records()
-        scene.carried = carried
-        states = tuple(BodyState(i, *(tuple(v.tolist()) for v in readout.body_state(scene, i)))
-                       for i, o in scene.objects.items() if o.body is not None) \
-            if read_states else ()
-        return Propagation(start_time, step_size, steps, states, collisions, 0.0, False,
-                           self._state_vector())
+        return propagation.propagate_state(self._scene, start_state, duration, step_size,
+                                           forces)
 
     @changes_contents
     def exempt_overlaps(self, min_depth: float) -> List[Collision]:
@@ -714,53 +597,4 @@ class Core:
         return readout.read_collisions(self._scene)
 
 
-def _state_vector_fault(vector: np.ndarray, index: int, exempt: int) -> InvalidArgument:
-    """The refusal of a body state vector whose value ``index`` cannot be put back (its last
-    ``exempt`` values are exempt pairs' states)."""
-    if index == 0:
-        return InvalidArgument(f"random generator state {shown(float(vector[0]))} is not a "
-                               "32-bit integer")
-    if index >= vector.size - exempt:
-        return InvalidArgument(f"an exempt pair's state is 0.0 or 1.0; value {index} is "
-                               f"{shown(float(vector[index]))}")
-    return InvalidArgument(f"a body state vector's values are finite; value {index} is "
-                           f"{shown(float(vector[index]))}")
-
-
-def _checked_pushes(scene: Scene, pushes: Sequence[Tuple[str, Sequence[float]]]) -> list:
-    """(object id, force N world) pairs as (body ptr, force) for CWorld.propagate, each
-    checked as add_body_force checks a force at the centre of mass."""
-    checked = []
-    for push in pushes:
-        try:
-            object_id, vector = push
-        except (TypeError, ValueError):
-            raise InvalidArgument(f"force {shown(push)} is not (object id, force vector)") from None
-        checked.append((scene.body_object(object_id, "force").body.ptr,
-                        forces.checked_vector(object_id, ForceKind.FORCE, vector)))
-    return checked
-
-
-def _steps_of(duration: float, step_size: float) -> Tuple[float, int]:
-    """(step_size, the number of steps) of a propagation of ``duration`` s, both checked;
-    remembered for plain floats (a planner asks the same every step)."""
-    if type(duration) is float and type(step_size) is float:   # noqa: E721 - not bool
-        return _remembered_steps(duration, step_size)
-    return _checked_steps(duration, step_size)
-
-
-@functools.lru_cache(maxsize=64)
-def _remembered_steps(duration: float, step_size: float) -> Tuple[float, int]:
-    return _checked_steps(duration, step_size)
-
-
-def _checked_steps(duration: float, step_size: float) -> Tuple[float, int]:
-    duration = check.number("duration", duration)
-    step_size = check.step_size(step_size)
-    if duration <= 0:
-        raise InvalidArgument(f"duration={shown(duration)} must be positive")
-    return step_size, check.step_count(max(1, round(min(duration / step_size, 1e18))),
-                                       f"duration={shown(duration)} s at step {shown(step_size)} s")
-
-
-__all__ = ["Core", "ForceKind", "JointType", "MotorKind"]
+__all__ = ["Core"]
