@@ -1,5 +1,5 @@
 """Whatever a tool is given, a failure is ONE line on stderr and exit status 2, never a
-traceback (issue 39; gui.cli_boundary): hostile option values (a timeout of 1e300 s overflowed
+traceback (issue 39; gui.tools.common): hostile option values (a timeout of 1e300 s overflowed
 the socket's timer; a control held 1e20 steps reached OMPL as a TypeError; a bad integer
 printed argparse's usage before its error), hostile files (a folder, non-UTF-8 bytes, 1e999,
 nesting 100,000 deep), for problem_info, load_problem, run_path, plan and benchmark. No ROS
@@ -93,7 +93,7 @@ def test_benchmark_refuses_a_seed_out_of_ompl_range_in_one_line(kautham_dir, tmp
 
 def test_run_path_refuses_doubling_a_path_past_its_row_limit(ros_master, kautham_dir,
                                                              tmp_path):
-    """--double 19 of 3 rows would be 1.5 million rows (gui.cli.MAX_PATH_ROWS): refused
+    """--double 19 of 3 rows would be 1.5 million rows (gui.tools.run_path.MAX_PATH_ROWS): refused
     before the path is refined or the world is looked for."""
     path = tmp_path / "three.path"
     path.write_text("0 0 0\n10 10 0\n20 20 0\n")

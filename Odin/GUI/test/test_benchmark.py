@@ -40,8 +40,8 @@ BENCHMARK_FILE = """<?xml version="1.0"?>
 
 
 def _tool(*args, **kwargs):
-    return subprocess.run([sys.executable, "-c", "from gui.planning.benchmark_cli import "
-                           "benchmark_main; import sys; sys.exit(benchmark_main())", *args],
+    return subprocess.run([sys.executable, "-c", "from gui.tools.benchmark import main; "
+                           "import sys; sys.exit(main())", *args],
                           capture_output=True, text=True, timeout=300, **kwargs)
 
 
@@ -231,8 +231,8 @@ def test_ctrl_c_stops_the_workers_runs_and_keeps_the_finished_ones(kautham_dir, 
     options = ["--problem", str(kautham_dir.joinpath(*SPHERE)), "--planners", "KPIECE1",
                "--runs", "6", "--time", "120", "--out", str(out), "--no-plots"]
     mark = f"ODIN_TEST_BENCHMARK={os.getpid()}-{time.monotonic_ns()}"
-    tool = subprocess.Popen([sys.executable, "-c", "from gui.planning.benchmark_cli import "
-                             "benchmark_main; import sys; sys.exit(benchmark_main())",
+    tool = subprocess.Popen([sys.executable, "-c", "from gui.tools.benchmark import main; "
+                             "import sys; sys.exit(main())",
                              *options, "--workers", "2"], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True,
                             env=dict(os.environ, ODIN_TEST_BENCHMARK=mark.split("=", 1)[1]),

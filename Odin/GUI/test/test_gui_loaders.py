@@ -366,9 +366,9 @@ def test_problem_info_prints_json():
 
 
 def test_problem_info_does_not_import_rospy():
-    code = ("import sys; from gui.cli import problem_info_main; import io, contextlib\n"
+    code = ("import sys; from gui.tools.problem_info import main; import io, contextlib\n"
             "with contextlib.redirect_stdout(io.StringIO()):\n"
-            f"    problem_info_main([{str(LEGACY / 'TRO/2DRR_obstacle.xml')!r}])\n"
+            f"    main([{str(LEGACY / 'TRO/2DRR_obstacle.xml')!r}])\n"
             "assert 'rospy' not in sys.modules, 'rospy imported'")
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert result.returncode == 0, result.stderr

@@ -16,7 +16,7 @@ import sys
 
 import pytest
 
-from gui.cli import problem_info_main
+from gui.tools.problem_info import main as problem_info_main
 from gui.core import shapes
 from gui.core.kautham.corpus import (WHOLE_CORPUS_TESTS, whole_corpus_dir,
                                      whole_missing_message)
@@ -422,7 +422,7 @@ def _rss_of_problem_info(problem, tmp_path) -> tuple:
     import subprocess
     script = ("import resource, sys\n"
               "resource.setrlimit(resource.RLIMIT_AS, (2 * 2 ** 30, 2 * 2 ** 30))\n"
-              "from gui.cli import problem_info_main\n"
+              "from gui.tools.problem_info import main as problem_info_main\n"
               "status = problem_info_main([sys.argv[1]])\n"
               "print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss // 1024, "
               "file=sys.stderr)\n"

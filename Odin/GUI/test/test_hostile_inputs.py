@@ -12,7 +12,7 @@ import pathlib
 
 import pytest
 
-from gui.cli import problem_info_main
+from gui.tools.problem_info import main as problem_info_main
 from gui.core import shape_cache, shapes, sizes
 from gui.core.control_path import read_control_path
 from gui.core.kautham.problem import load_problem

@@ -14,7 +14,7 @@ import re
 import numpy as np
 import pytest
 
-from gui.cli import problem_info_main
+from gui.tools.problem_info import main as problem_info_main
 from gui.core.kautham.problem import load_problem
 from gui.core.kautham.robot_rob import read_dh_robot
 from gui.core.kautham.urdf import read_urdf

@@ -142,8 +142,8 @@ def test_write_control_path_refuses_bad_rows_and_writes_nothing(tmp_path):
 
 
 def _plan_tool(*args):
-    return subprocess.run([sys.executable, "-c", "import sys; from gui.cli import plan_main; "
-                           "sys.exit(plan_main())", *args], capture_output=True, text=True,
+    return subprocess.run([sys.executable, "-c", "import sys; from gui.tools.plan import main; "
+                           "sys.exit(main())", *args], capture_output=True, text=True,
                           timeout=300)
 
 

@@ -1,4 +1,4 @@
-"""The tools' boundary (gui.cli_boundary): whatever escapes a tool's main is one line on
+"""The tools' boundary (gui.tools.common): whatever escapes a tool's main is one line on
 stderr and status 2; a bug says it is one; Ctrl-C and a closed pipe pass to
 odin_common.tool.run untouched."""
 from __future__ import annotations
@@ -7,8 +7,8 @@ import argparse
 
 import pytest
 
-from gui.cli_boundary import (MAX_SECONDS, ToolParser, count, hertz, one_line_errors, reading,
-                              seconds)
+from gui.tools.common import (MAX_SECONDS, ToolParser, count, hertz, one_line_errors,
+                              reading, seconds)
 from gui.errors import GuiError, ProblemError
 
 

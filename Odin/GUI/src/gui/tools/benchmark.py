@@ -11,15 +11,15 @@ import logging
 import os
 import sys
 import time
-from typing import Optional, Sequence
+from dataclasses import dataclass
+from typing import Optional, Sequence, Tuple
 
-from gui.cli_boundary import ToolParser, count, one_line_errors, reading, seconds
 from gui.errors import GuiError
 from gui.planning.benchmark import SCHEDULER_TIMEOUT_S
+from gui.tools.common import ToolParser, count, one_line_errors, reading, seconds
 from odin_common.tool import stop_on_ctrl_c
 
 TOOL = "benchmark"
-
 
 MAX_RUNS = 1_000_000
 """Runs per planner one benchmark may ask (each is a search of up to its time limit)."""
@@ -76,93 +76,146 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _overrides(args) -> dict:
-    """The search settings the command line changes (SearchSettings field: value)."""
-    given = {name: getattr(args, name) for name in
-             ("min_control_steps", "max_control_steps", "goal_bias", "goal_tolerance")
-             if getattr(args, name) is not None}
-    for name in ("min_control_steps", "max_control_steps"):
-        if name in given and given[name] < 1:
-            raise GuiError(f"--{name.replace('_', '-')} {given[name]}: at least 1")
-    if given.get("min_control_steps", 1) > given.get("max_control_steps", 10 ** 9):
-        raise GuiError("--min-control-steps is above --max-control-steps")
-    if "goal_bias" in given and not 0.0 <= given["goal_bias"] <= 1.0:
-        raise GuiError(f"--goal-bias {given['goal_bias']:g}: between 0 and 1")
-    if "goal_tolerance" in given and not given["goal_tolerance"] > 0:
-        raise GuiError(f"--goal-tolerance {given['goal_tolerance']:g}: must be positive")
-    return given
+@dataclass(frozen=True)
+class SearchOverrides:
+    """The search settings the command line changes in every problem's own (None: the
+    problem's; ``gui.planning.problem.SearchSettings``): control steps, KPIECE1's and RRT's
+    goal bias (a fraction), the goal region's radius (m, in the plane)."""
+    min_control_steps: Optional[int] = None
+    max_control_steps: Optional[int] = None
+    goal_bias: Optional[float] = None
+    goal_tolerance: Optional[float] = None
+
+    def given(self) -> dict:
+        """The settings given (SearchSettings field: value), checked; GuiError otherwise."""
+        given = {name: getattr(self, name) for name in
+                 ("min_control_steps", "max_control_steps", "goal_bias", "goal_tolerance")
+                 if getattr(self, name) is not None}
+        for name in ("min_control_steps", "max_control_steps"):
+            if name in given and given[name] < 1:
+                raise GuiError(f"--{name.replace('_', '-')} {given[name]}: at least 1")
+        if given.get("min_control_steps", 1) > given.get("max_control_steps", 10 ** 9):
+            raise GuiError("--min-control-steps is above --max-control-steps")
+        if "goal_bias" in given and not 0.0 <= given["goal_bias"] <= 1.0:
+            raise GuiError(f"--goal-bias {given['goal_bias']:g}: between 0 and 1")
+        if "goal_tolerance" in given and not given["goal_tolerance"] > 0:
+            raise GuiError(f"--goal-tolerance {given['goal_tolerance']:g}: must be positive")
+        return given
+
+
+@dataclass(frozen=True)
+class BenchmarkRequest:
+    """What benchmark is asked: a Kautham benchmark ``file`` or ``problems`` (one of the
+    two); ``planners`` ("A,B"), ``runs``, ``time`` (s), ``max_mem`` (MB) replacing the
+    file's (None: its own); run k of every planner seeded ``seed`` + k; the results in the
+    folder ``out`` (``resume``: the runs it holds kept); Dask's ``scheduler`` (its answer
+    awaited ``scheduler_timeout`` s) or ``workers`` local processes (0: none, None: one per
+    core); ``plots``: PNG figures written."""
+    file: Optional[str] = None
+    problems: Tuple[str, ...] = ()
+    planners: Optional[str] = None
+    runs: Optional[int] = None
+    time: Optional[float] = None
+    max_mem: Optional[float] = None
+    seed: int = 1
+    out: str = "benchmark"
+    resume: bool = False
+    scheduler: Optional[str] = None
+    workers: Optional[int] = None
+    scheduler_timeout: Optional[float] = None
+    plots: bool = True
+    overrides: SearchOverrides = SearchOverrides()
+
+
+def _request(args) -> BenchmarkRequest:
+    return BenchmarkRequest(
+        args.file, tuple(args.problem), planners=args.planners, runs=args.runs, time=args.time,
+        max_mem=args.max_mem, seed=args.seed, out=args.out, resume=args.resume,
+        scheduler=args.scheduler, workers=args.workers,
+        scheduler_timeout=args.scheduler_timeout, plots=not args.no_plots,
+        overrides=SearchOverrides(args.min_control_steps, args.max_control_steps,
+                                  args.goal_bias, args.goal_tolerance))
 
 
 @one_line_errors(TOOL)
-def benchmark_main(argv: Optional[Sequence[str]] = None) -> int:
-    args = _parser().parse_args(argv)
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    request = _request(_parser().parse_args(argv))
     logging.getLogger("gui.core").setLevel(logging.ERROR)   # problem_info lists what is unused
-    prepared, out = _prepare(args)
-    return _run(args, prepared, out)
+    return run_benchmark(request)
 
 
-def _experiments(args):
+def run_benchmark(request: BenchmarkRequest) -> int:
+    """Runs the runs the request asks (those ``out`` does not hold yet, with ``resume``),
+    writes the logs, runs.jsonl, summary.json and plots; 0, or 130 when Ctrl-C stopped it
+    (the finished runs kept)."""
+    prepared, out = _prepare(request)
+    return _run(request, prepared, out)
+
+
+def _experiments(request: BenchmarkRequest):
     from dataclasses import replace
     from gui.planning import benchmark_spec as spec
-    if bool(args.file) == bool(args.problem):
+    if bool(request.file) == bool(request.problems):
         raise GuiError("give a benchmark file or --problem (one or more), not both or neither")
-    if args.runs is not None and args.runs < 1:
-        raise GuiError(f"--runs {args.runs}: at least 1")
-    if args.time is not None and not args.time > 0:
-        raise GuiError(f"--time {args.time:g}: must be positive")
-    if args.max_mem is not None and not args.max_mem > 0:
-        raise GuiError(f"--max-mem {args.max_mem:g}: must be positive")
-    planners = [p.strip() for p in args.planners.split(",") if p.strip()] \
-        if args.planners else None
-    if args.planners is not None and not planners:
-        raise GuiError(f"--planners {args.planners!r}: no planner named")
-    if args.problem:
-        with reading("problem", ", ".join(args.problem)):
-            return spec.command_line_experiments(args.problem, planners, args.runs or 10,
-                                                 args.time, args.max_mem)
-    with reading("benchmark file", args.file):
-        experiments = spec.read_benchmark_file(args.file)
+    if request.runs is not None and request.runs < 1:
+        raise GuiError(f"--runs {request.runs}: at least 1")
+    if request.time is not None and not request.time > 0:
+        raise GuiError(f"--time {request.time:g}: must be positive")
+    if request.max_mem is not None and not request.max_mem > 0:
+        raise GuiError(f"--max-mem {request.max_mem:g}: must be positive")
+    planners = [p.strip() for p in request.planners.split(",") if p.strip()] \
+        if request.planners else None
+    if request.planners is not None and not planners:
+        raise GuiError(f"--planners {request.planners!r}: no planner named")
+    if request.problems:
+        with reading("problem", ", ".join(request.problems)):
+            return spec.command_line_experiments(request.problems, planners,
+                                                 request.runs or 10, request.time,
+                                                 request.max_mem)
+    with reading("benchmark file", request.file):
+        experiments = spec.read_benchmark_file(request.file)
     if planners:
         experiments = spec.with_planners(experiments, planners)
     return tuple(replace(e, request=replace(
-        e.request, run_count=args.runs or e.request.run_count,
-        max_time=args.time or e.request.max_time,
-        max_mem=args.max_mem or e.request.max_mem)) for e in experiments)
+        e.request, run_count=request.runs or e.request.run_count,
+        max_time=request.time or e.request.max_time,
+        max_mem=request.max_mem or e.request.max_mem)) for e in experiments)
 
 
-def _prepare(args):
+def _prepare(request: BenchmarkRequest):
     from gui.planning.benchmark import prepare
     from gui.planning.benchmark_plots import check_plotting
-    experiments = _experiments(args)
-    out = os.path.abspath(args.out)
+    experiments = _experiments(request)
+    out = os.path.abspath(request.out)
     if os.path.exists(out) and not os.path.isdir(out):
-        raise GuiError(f"--out {args.out}: a file, not a folder")
+        raise GuiError(f"--out {request.out}: a file, not a folder")
     parent = os.path.dirname(out)
     if not os.path.isdir(parent) or not os.access(parent, os.W_OK | os.X_OK):
-        raise GuiError(f"--out {args.out}: cannot make it in {parent}")
-    if args.scheduler_timeout is not None and not args.scheduler_timeout > 0:
-        raise GuiError(f"--scheduler-timeout {args.scheduler_timeout:g}: must be positive")
-    if args.scheduler_timeout is not None and not args.scheduler:
+        raise GuiError(f"--out {request.out}: cannot make it in {parent}")
+    timeout = request.scheduler_timeout
+    if timeout is not None and not timeout > 0:
+        raise GuiError(f"--scheduler-timeout {timeout:g}: must be positive")
+    if timeout is not None and not request.scheduler:
         raise GuiError("--scheduler-timeout: only with --scheduler")
-    args.scheduler_timeout = args.scheduler_timeout or SCHEDULER_TIMEOUT_S
-    if args.workers is not None and args.workers < 0:
-        raise GuiError(f"--workers {args.workers}: 0 or more")
-    if not args.no_plots:
+    if request.workers is not None and request.workers < 0:
+        raise GuiError(f"--workers {request.workers}: 0 or more")
+    if request.plots:
         check_plotting()
-    return prepare(experiments, args.seed, _overrides(args)), out
+    return prepare(experiments, request.seed, request.overrides.given()), out
 
 
-def _run(args, prepared, out: str) -> int:
+def _run(request: BenchmarkRequest, prepared, out: str) -> int:
     from gui.planning.benchmark import DaskRunner, Progress, ResultStore, run_serially
     # a scheduler that does not answer is bad input: refused before anything is written
-    runner = DaskRunner(args.scheduler, timeout_s=args.scheduler_timeout) \
-        if args.scheduler else None
+    runner = DaskRunner(request.scheduler,
+                        timeout_s=request.scheduler_timeout or SCHEDULER_TIMEOUT_S) \
+        if request.scheduler else None
     try:
         os.makedirs(out, exist_ok=True)
-        store = ResultStore(out, prepared, args.resume)
+        store = ResultStore(out, prepared, request.resume)
         todo = store.missing(prepared.tasks)
-        if runner is None and todo and args.workers != 0:
-            runner = DaskRunner(None, args.workers or os.cpu_count() or 1)
+        if runner is None and todo and request.workers != 0:
+            runner = DaskRunner(None, request.workers or os.cpu_count() or 1)
     except BaseException:
         if runner is not None:
             runner.close()
@@ -171,7 +224,7 @@ def _run(args, prepared, out: str) -> int:
         where = "in this process"
     else:
         workers = len(runner.client.scheduler_info().get("workers", {}))
-        where = f"on Dask: {args.scheduler or 'a local cluster'}, {workers} workers"
+        where = f"on Dask: {request.scheduler or 'a local cluster'}, {workers} workers"
     print(f"{TOOL}: {len(todo)} runs to do of {len(prepared.tasks)} ({where}); results in "
           f"{out}", flush=True)
     show = any(e.request.display_progress for e, _ in prepared.experiments)
@@ -201,7 +254,7 @@ def _run(args, prepared, out: str) -> int:
         progress.finish()
         if runner is not None:
             runner.close()
-    _write_outputs(args, prepared, store, out, started, time.monotonic() - clock, hosts)
+    _write_outputs(request, prepared, store, out, started, time.monotonic() - clock, hosts)
     if interrupted:
         print(f"{TOOL}: stopped: {len(store.results)} of {len(prepared.tasks)} runs kept in "
               f"{store.path} (--resume goes on)", file=sys.stderr)
@@ -209,7 +262,7 @@ def _run(args, prepared, out: str) -> int:
     return 0
 
 
-def _write_outputs(args, prepared, store, out, started, total_s, hosts) -> None:
+def _write_outputs(request, prepared, store, out, started, total_s, hosts) -> None:
     from gui.planning.benchmark import summary
     from gui.planning.benchmark_log import write_log
     data = summary(prepared, store.results)
@@ -234,7 +287,7 @@ def _write_outputs(args, prepared, store, out, started, total_s, hosts) -> None:
                   max_mem=experiment.request.max_mem,
                   run_count=experiment.request.run_count, total_s=total_s, setup=setup,
                   started=started)
-    if not args.no_plots and store.results:
+    if request.plots and store.results:
         from gui.planning.benchmark_plots import write_plots
         data["plots"] = [os.path.basename(p) for p in write_plots(out, data, store.results)]
     with open(os.path.join(out, "summary.json"), "w") as f:
@@ -242,4 +295,4 @@ def _write_outputs(args, prepared, store, out, started, total_s, hosts) -> None:
     print(json.dumps(data, indent=1), flush=True)
 
 
-__all__ = ["benchmark_main"]
+__all__ = ["BenchmarkRequest", "SearchOverrides", "main", "run_benchmark"]

@@ -1,0 +1,236 @@
+"""``rosrun GUI plan PROBLEM --planner NAME --time S --out PATH``: a motion plan for the
+problem's query, made by one of OMPL's control planners through Odin's physics
+(``gui.planning``), written as a Kautham control path (``run_path --controls`` runs it); the
+search's statistics printed as JSON. Exits 1 with one line when no solution was found in
+time, 2 on bad input, 130 on Ctrl-C (nothing written)."""
+from __future__ import annotations
+
+import enum
+import json
+import os
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Callable, Optional, Sequence, Tuple
+
+from gui.errors import GuiError
+from gui.tools.common import (ProblemFile, ToolParser, add_build_options, check_master,
+                              check_output, count, fail, one_line_errors, seconds,
+                              warnings_to_stderr)
+from odin_common.errors import OdinError
+from odin_common.tool import stop_on_ctrl_c
+
+if TYPE_CHECKING:
+    from gui.planning.bridge import PlanResult
+
+TOOL = "plan"
+
+DEFAULT_TIME_LIMIT_S = 10.0
+"""s: a search's time limit when neither --time nor the problem ("_Max Planning Time") gives
+one."""
+
+
+class Backend(enum.Enum):
+    """Where the searches' worlds are: in this process, or the world nodes of --worlds."""
+    CORE = "core"
+    POOL = "pool"
+
+
+@dataclass(frozen=True)
+class PlanRequest:
+    """What plan is asked: the problem's query searched by ``planner`` for ``time`` s
+    (None: the problem's "_Max Planning Time", else DEFAULT_TIME_LIMIT_S) with OMPL's
+    ``seed`` (None: drawn); ``parallel`` searches at once (seeds ``seed`` + k). ``worlds``:
+    the pool's namespaces, comma-separated, each waited for ``world_timeout`` s.
+    ``goal_tolerance`` (m), ``min_control_steps``, ``max_control_steps``: the search's
+    settings (None: the problem's, ``gui.planning.problem.SearchSettings``). ``out``: the
+    control path file to write."""
+    problem: ProblemFile
+    out: str
+    planner: str = "KPIECE1"
+    time: Optional[float] = None
+    seed: Optional[int] = None
+    backend: Backend = Backend.CORE
+    worlds: str = "/virtual_world"
+    world_timeout: float = 30.0
+    robot: Optional[str] = None
+    goal_tolerance: Optional[float] = None
+    min_control_steps: Optional[int] = None
+    max_control_steps: Optional[int] = None
+    parallel: int = 1
+
+    def searches(self) -> str:
+        """How the tool's lines name the searches after the first."""
+        return f" and the next {self.parallel - 1}" if self.parallel > 1 else ""
+
+
+@dataclass(frozen=True)
+class PlanOutcome:
+    """A search's result (the first exact solution of the parallel searches, else the
+    closest), its time limit (s) and its (first) seed."""
+    result: PlanResult
+    time_limit: float
+    seed: int
+
+
+def search(request: PlanRequest, stop: Callable[[], bool]) -> PlanOutcome:
+    """Says what it searches, with the seed, searches, then prints the statistics.
+    ``stop()`` true (Ctrl-C) ends the search and raises KeyboardInterrupt."""
+    from gui.planning import bridge
+    make_backend, time_limit = _backends(request)
+    seed = request.seed if request.seed is not None else _fresh_seed(request.parallel)
+    searching = (f"plan: {request.planner} searching for up to {time_limit:g} s, seed {seed}"
+                 f"{request.searches()} (--seed {seed} repeats it)")
+    if request.parallel == 1:
+        backend = make_backend(0)
+        print(searching, flush=True)        # once the world is built: the search starts now
+        try:
+            result = bridge.plan(backend, request.planner, time_limit, seed, stop)
+        finally:
+            backend.close()
+        print(json.dumps(result.statistics(), indent=1), flush=True)
+        return PlanOutcome(result, time_limit, seed)
+    from gui.planning.parallel import plan_in_parallel
+    print(searching, flush=True)
+    result, outcomes = plan_in_parallel(make_backend, request.parallel, request.planner,
+                                        time_limit, seed, stop)
+    print(json.dumps({**result.statistics(), "searches": [o.summary() for o in outcomes]},
+                     indent=1), flush=True)
+    return PlanOutcome(result, time_limit, seed)
+
+
+def _fresh_seed(searches: int) -> int:
+    """A seed for OMPL from the system's entropy, in the lower half of [1, MAX_SEED], room
+    left for ``searches`` consecutive ones."""
+    from gui.planning.bridge import MAX_SEED
+    return 1 + int.from_bytes(os.urandom(4), "little") % ((MAX_SEED + 1) // 2 - 1 - searches)
+
+
+def _backends(request: PlanRequest) -> Tuple[Callable[[int], object], float]:
+    """(make_backend(k): the back end of search k of ``request.parallel``, the searches'
+    time limit s). Every search's back end holds the problem's world: the Core builds one in
+    the process calling it; with the pool, search k gets every ``request.parallel``-th world
+    of ``request.worlds`` from the k-th."""
+    from gui.planning.problem import SearchSettings, planning_problem
+    if request.parallel < 1:
+        raise GuiError(f"--parallel {request.parallel}: need 1 or more searches")
+    if request.backend is Backend.POOL:
+        namespaces = _pool_namespaces(request)
+        check_master(TOOL, request.world_timeout)
+    build_plan = request.problem.read()
+    settings = SearchSettings.of_problem(build_plan, goal_tolerance=request.goal_tolerance,
+                                         min_control_steps=request.min_control_steps,
+                                         max_control_steps=request.max_control_steps)
+    problem = planning_problem(build_plan, request.robot, settings)
+    planner = build_plan.problem.planner
+    time_limit = request.time if request.time is not None else \
+        (planner.search.time_limit if planner and planner.search.time_limit
+         else DEFAULT_TIME_LIMIT_S)
+    if request.backend is Backend.POOL:
+
+        def pool_backend(k: int):
+            from gui.planning.pool import PoolBackend
+            return PoolBackend(build_plan, problem, namespaces[k::request.parallel],
+                               timeout=request.world_timeout)
+        return pool_backend, time_limit
+
+    def core_backend(k: int):
+        from gui.planning.backend import CoreBackend
+        return CoreBackend(build_plan, problem)
+    return core_backend, time_limit
+
+
+def _pool_namespaces(request: PlanRequest) -> list:
+    """The world nodes' namespaces of --worlds, at least one per search."""
+    namespaces = [n.strip() for n in request.worlds.split(",") if n.strip()]
+    if not namespaces:
+        raise GuiError(f"--worlds {request.worlds!r}: no namespace given")
+    if len(namespaces) < request.parallel:
+        raise GuiError(f"--parallel {request.parallel} searches need as many worlds; "
+                       f"--worlds names {len(namespaces)}")
+    return namespaces
+
+
+def _write(request: PlanRequest, outcome: PlanOutcome) -> None:
+    """The motion plan written to ``request.out`` as a control path, its comments saying
+    how it was made."""
+    from gui.core.control_path import write_control_path
+    result = outcome.result
+    write_control_path(request.out, result.rows, comments=(
+        f"control path planned by rosrun GUI plan {request.problem.path}",
+        f"planner {request.planner}, seed {result.seed}, {result.time_s:.2f} s, "
+        f"ends {result.goal_distance:.4f} m from the goal",
+        "each row: the robot's controls in [0, 1], then the duration (s)"))
+    print(f"plan: {len(result.rows)} rows ({result.duration:.3f} s) written to {request.out}")
+
+
+def _parser() -> ToolParser:
+    from gui.planning.bridge import MAX_SEED, PLANNERS
+    from gui.planning.parallel import MAX_SEARCHES
+    from gui.planning.problem import MAX_CONTROL_STEPS
+    parser = ToolParser(
+        prog=TOOL, description="Plan a Kautham physics problem's query with an OMPL control "
+        "planner through Odin's world; write the solution as a control path.")
+    parser.add_argument("problem", help="the problem XML file")
+    parser.add_argument("--planner", default="KPIECE1",
+                        help=f"OMPL control planner: {', '.join(PLANNERS)} [KPIECE1]")
+    parser.add_argument("--time", type=seconds, default=None, metavar="S",
+                        help="wall-clock seconds the planner may search [the problem's "
+                        "\"_Max Planning Time\", else 10]")
+    parser.add_argument("--out", required=True, metavar="PATH",
+                        help="control path file to write (rows: controls, duration s)")
+    parser.add_argument("--seed", type=count(1, MAX_SEED), default=None,
+                        help="OMPL's random seed [drawn at random, printed and written with "
+                        "the path: --seed repeats a run]")
+    parser.add_argument("--backend", choices=[b.value for b in Backend], default="core",
+                        help="core: the world in this process [default]; pool: the world "
+                        "nodes of --worlds over ROS (cleared and built from the problem)")
+    parser.add_argument("--worlds", default="/virtual_world", metavar="NS[,NS...]",
+                        help="--backend pool: the world nodes' namespaces [/virtual_world]")
+    parser.add_argument("--world-timeout", type=seconds, default=30.0, metavar="S",
+                        help="--backend pool: how long to wait for each world [30]")
+    parser.add_argument("--robot", help="robot name (default: the first robot)")
+    parser.add_argument("--goal-tolerance", type=float, default=None, metavar="M",
+                        help="goal region radius in the plane, m [0.25]")
+    parser.add_argument("--min-control-steps", type=count(1, MAX_CONTROL_STEPS),
+                        default=None, metavar="N",
+                        help="a control is held at least N propagation steps [the problem's "
+                        "\"Min Control Steps\", else 2]")
+    parser.add_argument("--max-control-steps", type=count(1, MAX_CONTROL_STEPS),
+                        default=None, metavar="N",
+                        help="and at most N [the problem's \"Max Control Steps\", else 30]")
+    parser.add_argument("--parallel", type=count(1, MAX_SEARCHES), default=1, metavar="N",
+                        help="N independent searches at once, seeds SEED..SEED+N-1, each in a "
+                        "process with a back end of its own (pool: its share of --worlds); "
+                        "the first solution wins [1]")
+    add_build_options(parser)
+    return parser
+
+
+def _request(args) -> PlanRequest:
+    return PlanRequest(
+        ProblemFile.of_args(args), args.out, planner=args.planner, time=args.time,
+        seed=args.seed, backend=Backend(args.backend), worlds=args.worlds,
+        world_timeout=args.world_timeout, robot=args.robot,
+        goal_tolerance=args.goal_tolerance, min_control_steps=args.min_control_steps,
+        max_control_steps=args.max_control_steps, parallel=args.parallel)
+
+
+@one_line_errors(TOOL)
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    request = _request(_parser().parse_args(argv))
+    warnings_to_stderr(TOOL)
+    try:
+        check_output("--out", request.out)
+        with stop_on_ctrl_c() as stop:
+            outcome = search(request, stop)
+        if not outcome.result.solved:
+            return fail(TOOL, GuiError(
+                f"{request.problem.path}: no solution within {outcome.time_limit:g} s "
+                f"({request.planner}, seed {outcome.seed}{request.searches()}): the closest "
+                f"plan ends {outcome.result.goal_distance:.3f} m from the goal")) - 1
+        _write(request, outcome)
+    except (OdinError, OSError) as error:   # an OSError as it is, not by its class
+        return fail(TOOL, error)
+    return 0
+
+
+__all__ = ["DEFAULT_TIME_LIMIT_S", "Backend", "PlanOutcome", "PlanRequest", "main", "search"]
