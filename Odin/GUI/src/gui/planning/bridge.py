@@ -254,15 +254,23 @@ def _planner(oc, si, name: str, goal_bias: float):
 
 
 MAX_SEED = 2 ** 32 - 1
-"""The largest seed OMPL takes (its generators' seed is a 32-bit unsigned integer)."""
+"""The largest seed OMPL takes (its generators' seed is a 32-bit unsigned integer): the one
+home of the seeds' range, which every check and option of a seed reads."""
+
+
+def check_seed(seed: int, room: int = 0) -> None:
+    """PlanningError unless ``seed`` is an integer in [1, MAX_SEED - ``room``] (``room``:
+    the seeds kept free above it, for the searches that follow it)."""
+    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 < seed <= MAX_SEED - room:
+        below = f"2^{MAX_SEED.bit_length()}" + (f" - {room}" if room else "")
+        raise PlanningError(f"seed {seed!r} must be an integer in [1, {below})")
 
 
 def seed_ompl(seed: int) -> None:
     """Seeds OMPL's random generators; effective for a process's first search only (OMPL
     seeds each generator from one master it makes once)."""
     _, _, ou = _ompl()
-    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 < seed <= MAX_SEED:
-        raise PlanningError(f"seed {seed!r} must be an integer in [1, 2^32)")
+    check_seed(seed)
     ou.RNG.setSeed(seed)
 
 
@@ -372,4 +380,5 @@ def _propagations(backend) -> int:
     return int(getattr(backend, "propagations", 0))
 
 
-__all__ = ["PLANNERS", "UNCONSTRUCTIBLE", "PlanResult", "plan", "replay", "seed_ompl"]
+__all__ = ["MAX_SEED", "PLANNERS", "UNCONSTRUCTIBLE", "PlanResult", "check_seed", "plan", "replay",
+           "seed_ompl"]

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 from typing import Callable, List, Optional, Tuple
 
 from gui.errors import PlanningError
-from gui.planning.bridge import MAX_SEED, PlanResult, plan
+from gui.planning.bridge import PlanResult, check_seed, plan
 
 START_GRACE_S = 60.0
 """s: how long a child may take to build its back end before its search starts."""
@@ -75,8 +75,7 @@ def plan_in_parallel(make_backend: Callable[[int], object], count: int, planner:
     if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= MAX_SEARCHES:
         raise PlanningError(f"parallel searches {count!r}: need a whole number in [1, "
                             f"{MAX_SEARCHES}] (MAX_SEARCHES)")
-    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 < seed <= MAX_SEED - count:
-        raise PlanningError(f"seed {seed!r} must be an integer in [1, 2^32 - {count})")
+    check_seed(seed, room=count)
     context = multiprocessing.get_context("fork")
     answers = context.Queue()
     children = [context.Process(target=_search, daemon=True, name=f"search{k}",
