@@ -12,6 +12,10 @@ import tempfile
 
 import pytest
 
+from odin_common.blas import use_reference_blas
+
+use_reference_blas()  # before world_client (rospy) or a test imports numpy (odin_common.blas)
+
 ROOT = pathlib.Path(__file__).resolve().parent
 # the raw test client of the world node (tests/nodes/world_client.py) serves the GUI's window
 # tests too, whichever test file runs first or alone

@@ -21,7 +21,6 @@ figure is missing, a figure was refused or a module failed.
 README is left alone and only the figures measured are checked). ``ODIN_BENCH_ROUNDS=3`` runs
 fewer rounds in the modules that repeat rounds (for development on a shared machine).
 """
-import odin_common  # noqa: F401  (first, before numpy: the reference BLAS, odin_common.blas)
 import datetime
 import importlib.util
 import json
@@ -30,6 +29,10 @@ import statistics
 import sys
 import time
 import traceback
+
+from odin_common.blas import use_reference_blas
+
+use_reference_blas()  # before the benchmarks import numpy (odin_common.blas)
 
 HERE = pathlib.Path(__file__).resolve().parent
 ROOT = HERE.parent.parent

@@ -25,7 +25,6 @@ policy). Every message is stamped with simulated time; lost messages are counted
 """
 from __future__ import annotations
 
-import odin_common  # noqa: F401  (first, before numpy: the reference BLAS, odin_common.blas)
 import json
 import math
 import os
@@ -36,7 +35,11 @@ import time
 from dataclasses import dataclass, field
 from typing import Iterable, Optional, Sequence
 
-import numpy as np
+from odin_common.blas import use_reference_blas
+
+use_reference_blas()  # before numpy (odin_common.blas)
+
+import numpy as np  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent.parent
 
@@ -48,7 +51,7 @@ KAUTHAM_DIR = pathlib.Path(os.environ.get(ENVIRONMENT, ROOT.parent / "shared" / 
 EXAMPLES = KAUTHAM_DIR / "legacy_2012" / "examples"
 PATHS_DIR = ROOT / "Odin" / "GUI" / "paths"
 
-#: The Viewer's colour for a colliding object (viewer.core.scene.COLLIDING_COLOR), 0..255.
+#: The Viewer's colour for a colliding object (odin_common.defaults.COLLIDING_COLOR), 0..255.
 COLLIDING_RGB = (89, 89, 89)
 
 #: The ICRA09 scene of the TX90 problems (pile, grasp): the table is a 0.5 m cube on the floor,

@@ -17,7 +17,7 @@ import pytest
 
 CHILD = textwrap.dedent(r'''
     import math, sys
-    import odin_common  # noqa: F401 - numpy on the reference BLAS first
+    from odin_common.blas import use_reference_blas; use_reference_blas()  # before numpy
     from hypothesis import HealthCheck, given, settings, strategies as st
     from odin_common.errors import OdinError
     from odin_common.interface import JointParameter, JointType
@@ -161,7 +161,7 @@ def test_a_heavy_inertia_that_a_body_can_have_is_accepted():
 
 
 STOP_AND_UNLIMITED_FORCE = textwrap.dedent(r'''
-    import odin_common  # noqa: F401
+    from odin_common.blas import use_reference_blas; use_reference_blas()
     from odin_common.interface import JointParameter as P, JointType as J
     from virtual_world.core import Core, JointSpec, MotorSpec, ObjectSpec
     core = Core()

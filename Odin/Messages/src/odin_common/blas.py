@@ -14,10 +14,17 @@ a 4x4 inverse on a busy 2-core host instead of 5 us).
 
 How: the reference libraries are loaded by path, globally, before numpy. numpy's extensions ask
 for ``libblas.so.3`` and ``liblapack.so.3`` by soname, and the dynamic loader hands them the
-libraries of that soname already loaded. Every Odin node and tool imports ``odin_common``
-(which calls :func:`use_reference_blas`) before numpy; a process that imported numpy first
-keeps the machine's choice (:func:`in_use` says which). ``OPENBLAS_NUM_THREADS`` is set to 1 as
-well, for a process where OpenBLAS is loaded all the same.
+libraries of that soname already loaded. A process that imported numpy first keeps the
+machine's choice (:func:`in_use` says which). ``OPENBLAS_NUM_THREADS`` is set to 1 as well, for
+a process where OpenBLAS is loaded all the same.
+
+Who calls :func:`use_reference_blas`, first thing: the ``__init__`` of each node package
+(``virtual_world``, ``viewer``, ``gui``), which every process that computes with Odin imports
+before numpy (a node, a tool, a test, a Dask worker unpickling a search: workers start no
+entry point of Odin's); the repository's ``conftest.py``; and the tools that import numpy
+before any of those packages (``tools/bench/run.py``, ``tools/corpus/corpus_checks.py``,
+``tools/experiments/common.py``). Importing ``odin_common`` itself loads nothing: a process
+that only reads the interface's facts keeps its libraries.
 """
 from __future__ import annotations
 

@@ -4,4 +4,6 @@
 thread, PNG snapshots); ``viewer.portal`` is the ROS node over it (``main()``).
 """
 
-import odin_common  # noqa: F401,E402  (first: numpy on the reference BLAS, odin_common.blas)
+from odin_common.blas import use_reference_blas
+
+use_reference_blas()  # before anything imports numpy (odin_common.blas: why, and who calls it)

@@ -1,3 +1,5 @@
 """Odin's physics node: a ROS-free Core over libode (``virtual_world.core``, ``virtual_world.ode``)
 and its ROS Portal (``virtual_world.portal``)."""
-import odin_common  # noqa: F401  (first: numpy on the reference BLAS, odin_common.blas)
+from odin_common.blas import use_reference_blas
+
+use_reference_blas()  # before anything imports numpy (odin_common.blas: why, and who calls it)
