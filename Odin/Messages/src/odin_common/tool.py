@@ -5,6 +5,11 @@ print a BrokenPipeError traceback (twice: once more when it flushes stdout at ex
 user expects what a C tool does: stop, print nothing, exit 128 + SIGPIPE (141). Ctrl-C likewise
 ends with 128 + SIGINT (130) and no traceback. Every script in Odin/*/scripts and nodes/ runs
 its main through ``run``.
+
+Why it lives in the shared floor, beside the interface's facts: it is the one behaviour every
+executable of every package shares (the world's and the Viewer's nodes, the replay tool, the
+GUI's window and tools), and Messages is the one package all of them depend on. Like the
+rest of ``odin_common`` it imports no ROS and no node package.
 """
 from __future__ import annotations
 
