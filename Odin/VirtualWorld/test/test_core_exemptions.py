@@ -4,7 +4,7 @@ vectors carry bit for bit (virtual_world.core.exemptions)."""
 import numpy as np
 import pytest
 
-from virtual_world.core import Core, ObjectSpec, WorldParameters
+from virtual_world.core import ObjectSpec
 from virtual_world.errors import InvalidArgument
 
 H = 0.001
@@ -18,13 +18,6 @@ def box_in_wall(core, x=0.35, name="box", y=0.0):
         core.build_object(ObjectSpec("wall", [0.2, 1, 1], position=(0.5, 0, 0),
                                      geometry_only=True))
     core.build_object(ObjectSpec(name, [2 * BOX_HALF] * 3, position=(x, y, 0)))
-
-
-@pytest.fixture
-def core():
-    c = Core(WorldParameters(gravity=(0.0, 0.0, 0.0)))
-    yield c
-    c.close()
 
 
 def x_of(core, name="box"):

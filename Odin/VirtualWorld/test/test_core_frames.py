@@ -13,8 +13,7 @@ import numpy as np
 import pytest
 
 from odin_common import interface
-from virtual_world.core import (Core, CompositeSpec, FORCE, ObjectSpec, PartSpec, TORQUE,
-                                WorldParameters)
+from virtual_world.core import CompositeSpec, FORCE, ObjectSpec, PartSpec, TORQUE
 
 
 # ------------------------------------------------------------------ independent mathematics
@@ -107,13 +106,6 @@ def composite(prefix, position, rotation=COMPOSITE_ROTATION, **flags):
 
 def composite_id(prefix):
     return interface.composite_id([prefix + p[0] for p in PARTS])
-
-
-@pytest.fixture
-def core():
-    c = Core(WorldParameters(gravity=(0.0, 0.0, 0.0)))
-    yield c
-    c.close()
 
 
 def assert_parts_posed(core, prefix, position, rotation):

@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pytest
 
-from virtual_world.core import (ANGULAR, CFM, ERP, HI_STOP, HINGE, LO_STOP, MAX_FORCE, Core,
+from virtual_world.core import (ANGULAR, CFM, ERP, HI_STOP, HINGE, LO_STOP, MAX_FORCE,
                                 JointSpec, MotorSpec, ObjectSpec, WorldParameters)
 from virtual_world.errors import InvalidArgument
 
@@ -21,13 +21,6 @@ H = 0.001
 TURN_Z = (math.cos(math.pi / 4), 0.0, 0.0, math.sin(math.pi / 4))   # 90 deg about z: x -> y
 I_BALL = 0.4 * 1.0 * 0.1 ** 2                                         # kg m^2, 1 kg, r = 0.1 m
 SOFT = 1.0 / (1.0 + WorldParameters().cfm * I_BALL / H)              # 0.99996
-
-
-@pytest.fixture
-def core():
-    c = Core(WorldParameters(gravity=(0.0, 0.0, 0.0)))
-    yield c
-    c.close()
 
 
 @pytest.mark.parametrize("slot", [1, 2])

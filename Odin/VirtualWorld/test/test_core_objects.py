@@ -5,17 +5,10 @@ import math
 import numpy as np
 import pytest
 
-from virtual_world.core import TORQUE, Core, ObjectSpec, WorldParameters
+from virtual_world.core import TORQUE, ObjectSpec
 from virtual_world.errors import InvalidArgument
 
 H = 0.001
-
-
-@pytest.fixture
-def core():
-    c = Core(WorldParameters(gravity=(0.0, 0.0, 0.0)))
-    yield c
-    c.close()
 
 
 def test_a_given_inertia_is_the_bodys_and_sets_its_angular_acceleration(core):

@@ -10,13 +10,6 @@ H = 0.001
 N = 100
 
 
-@pytest.fixture
-def core():
-    c = Core(WorldParameters(gravity=(0.0, 0.0, 0.0)))
-    yield c
-    c.close()
-
-
 def test_a_removed_joint_torque_stops_and_the_joint_keeps_its_rate(core):
     """A 1 N m hinge torque on a box with I_zz = 2 kg m^2 turns it at 0.5 rad/s^2: 0.05 rad/s
     after 0.1 s; removed, the rate stays 0.05 rad/s."""

@@ -387,16 +387,15 @@ def place_static(geom, position: np.ndarray, orientation: np.ndarray,
 
 
 def build_object(scene: Scene, spec: ObjectSpec) -> Built:
-    prepared = prepare_object(spec, scene.resources.max_mesh_triangles)
-    check_ranges(scene, [prepared])
-    check_new_names(scene, [prepared])
-    built = build(scene, prepared)
-    remember_shapes([prepared])
-    return built
+    return _build_one(scene, prepare_object(spec, scene.resources.max_mesh_triangles))
 
 
 def build_composite(scene: Scene, spec: CompositeSpec) -> Built:
-    prepared = prepare_composite(spec, scene.resources.max_mesh_triangles)
+    return _build_one(scene, prepare_composite(spec, scene.resources.max_mesh_triangles))
+
+
+def _build_one(scene: Scene, prepared: _Prepared) -> Built:
+    """A prepared object or composite checked against the scene, then built."""
     check_ranges(scene, [prepared])
     check_new_names(scene, [prepared])
     built = build(scene, prepared)

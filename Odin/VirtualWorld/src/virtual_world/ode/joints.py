@@ -71,6 +71,20 @@ _STATE = {  # per joint type: (position getters, rate getters), one per reported
             lib.dJointGetPUAngle2Rate)),
 }
 
+_PLACE = {  # per joint type: ODE's setters of its anchor and axes, each with what it takes
+    T.BALL: ((lib.dJointSetBallAnchor, "anchor"),),
+    T.HINGE: ((lib.dJointSetHingeAnchor, "anchor"), (lib.dJointSetHingeAxis, "axis1")),
+    T.SLIDER: ((lib.dJointSetSliderAxis, "axis1"),),
+    T.PISTON: ((lib.dJointSetPistonAnchor, "anchor"), (lib.dJointSetPistonAxis, "axis1")),
+    T.UNIVERSAL: ((lib.dJointSetUniversalAnchor, "anchor"),
+                  (lib.dJointSetUniversalAxis1, "axis1"), (lib.dJointSetUniversalAxis2, "axis2")),
+    T.HINGE2: ((lib.dJointSetHinge2Anchor, "anchor"),),
+    T.PR: ((lib.dJointSetPRAnchor, "anchor"), (lib.dJointSetPRAxis1, "axis1"),
+           (lib.dJointSetPRAxis2, "axis2")),
+    T.PU: ((lib.dJointSetPUAnchor, "anchor"), (lib.dJointSetPUAxis1, "axis1"),
+           (lib.dJointSetPUAxis2, "axis2"), (lib.dJointSetPUAxis3, "axis3")),
+}
+
 _AXES = {  # the axes a motor on a joint of this type drives, by motor kind
     MotorKind.ANGULAR: {
         T.HINGE: (lib.dJointGetHingeAxis,), T.PISTON: (lib.dJointGetPistonAxis,),
@@ -103,33 +117,11 @@ def configure_joint(joint, kind: JointType, anchor: Sequence[float], axis1: Sequ
                     axis2: Sequence[float], axis3: Sequence[float]) -> None:
     """Sets the anchor (m, world) and the axes (unit, world) ``kind`` uses; a fixed joint
     keeps the bodies' present relative pose."""
-    a = list(anchor)
-    if kind == T.BALL:
-        lib.dJointSetBallAnchor(joint, *a)
-    elif kind == T.HINGE:
-        lib.dJointSetHingeAnchor(joint, *a)
-        lib.dJointSetHingeAxis(joint, *axis1)
-    elif kind == T.SLIDER:
-        lib.dJointSetSliderAxis(joint, *axis1)
-    elif kind == T.PISTON:
-        lib.dJointSetPistonAnchor(joint, *a)
-        lib.dJointSetPistonAxis(joint, *axis1)
-    elif kind == T.UNIVERSAL:
-        lib.dJointSetUniversalAnchor(joint, *a)
-        lib.dJointSetUniversalAxis1(joint, *axis1)
-        lib.dJointSetUniversalAxis2(joint, *axis2)
-    elif kind == T.HINGE2:
-        lib.dJointSetHinge2Anchor(joint, *a)
+    given = {"anchor": list(anchor), "axis1": axis1, "axis2": axis2, "axis3": axis3}
+    for setter, name in _PLACE.get(kind, ()):
+        setter(joint, *given[name])
+    if kind == T.HINGE2:     # ODE sets a hinge-2's axes in one call, as 4-vectors
         lib.dJointSetHinge2Axes(joint, list(axis1) + [0.0], list(axis2) + [0.0])
-    elif kind == T.PR:
-        lib.dJointSetPRAnchor(joint, *a)
-        lib.dJointSetPRAxis1(joint, *axis1)
-        lib.dJointSetPRAxis2(joint, *axis2)
-    elif kind == T.PU:
-        lib.dJointSetPUAnchor(joint, *a)
-        lib.dJointSetPUAxis1(joint, *axis1)
-        lib.dJointSetPUAxis2(joint, *axis2)
-        lib.dJointSetPUAxis3(joint, *axis3)
     elif kind == T.FIXED:
         lib.dJointSetFixed(joint)
 
