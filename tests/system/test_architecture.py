@@ -102,7 +102,7 @@ def test_module_imports_only_what_its_layer_may(name, path):
 
 # the roscore test harness (a private master per test, process groups, rosrun's search) is for
 # tests and tools: no node loads it when it starts, not even through odin_common's modules
-PORTALS = ("virtual_world.portal", "viewer.portal", "gui.ros")
+PORTALS = ("virtual_world.portal", "viewer.portal", "gui.ros", "gui.window")
 HARNESS = "odin_common.ros_master"
 _NAMED = {name: path for name, path in MODULES}
 
