@@ -350,7 +350,7 @@ class MotionTab(QWidget):
             return
 
         def work(client, job):
-            from gui.core.control_path import run_on_client
+            from gui.ros.world_port import run_on_client
             run_on_client(client, handle, rows, progress=lambda r: job.progress(r.index),
                           sleep=job.sleep)
             return len(rows)
@@ -376,7 +376,7 @@ class MotionTab(QWidget):
         name = pathlib.Path(path).name
 
         def work(client, job):
-            from gui.core.execution import run_tracked_on_client
+            from gui.ros.world_port import run_tracked_on_client
             from gui.window.worker import Cancelled
 
             def progress(t: float, total: float) -> None:
