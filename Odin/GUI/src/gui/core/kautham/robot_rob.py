@@ -34,8 +34,9 @@ import pathlib
 import numpy as np
 
 from gui.core.kautham.controls import parse_control_set
-from gui.core.kautham.units import LEGACY, SI, Units, scale_problem
-from gui.core.kautham.xmlfile import Node, read_xml
+from gui.core.kautham.robot_file import read_robot_root
+from gui.core.kautham.units import LEGACY, SI, Units
+from gui.core.kautham.xmlfile import Node
 from gui.core.kinematics import pose_from_axis_angle, rot_x, rot_z, translation
 from gui.core.model import FIXED, PRISMATIC, REVOLUTE, Ignored, LinkModel, RobotModel
 from gui.core.shapes import read_shape
@@ -50,13 +51,7 @@ def units_of(path: pathlib.Path) -> Units:
 def read_dh_robot(path: pathlib.Path, scale: float = 1.0) -> RobotModel:
     """Reads a .rob/.dh file with its link geometry; everything in SI."""
     units = units_of(path)
-    root = read_xml(path, "robot file")
-    problem = scale_problem(scale)
-    if problem is not None:
-        raise root.error(f"scale {scale!r} {problem}")
-    if root.tag != "Robot":
-        raise root.error(f"expected a <Robot> element, found <{root.tag}>")
-    name = root.get("name") or path.stem
+    root, name = read_robot_root(path, "robot file", "Robot", scale)
     dh_raw = root.get("DHType", "Standard").strip()
     matches = [t for t in DH_TYPES if t.lower() == dh_raw.lower()]
     if not matches:

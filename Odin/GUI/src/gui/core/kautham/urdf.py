@@ -28,8 +28,9 @@ from typing import List, Optional
 
 import numpy as np
 
-from gui.core.kautham.units import inertia_problem, mass_problem, scale_problem
-from gui.core.kautham.xmlfile import LenientNumber, Node, parse_number, read_xml
+from gui.core.kautham.robot_file import read_robot_root
+from gui.core.kautham.units import inertia_problem, mass_problem
+from gui.core.kautham.xmlfile import LenientNumber, Node, parse_number
 from gui.core.kinematics import rpy_matrix
 from gui.core.model import FIXED, PRISMATIC, REVOLUTE, Ignored, Inertial, LinkModel, RobotModel
 from gui.core.shapes import Primitive, Shape, read_shape
@@ -277,19 +278,48 @@ def read_urdf(path: pathlib.Path, scale: float = 1.0) -> RobotModel:
 
 
 def _read_urdf(path: pathlib.Path, scale: float, lenient: list) -> RobotModel:
-    root = read_xml(path, "URDF file", lenient)
-    problem = scale_problem(scale)
-    if problem is not None:
-        raise root.error(f"scale {scale!r} {problem}")
-    if root.tag != "robot":
-        raise root.error(f"expected a <robot> element, found <{root.tag}>")
-    name = root.get("name") or path.stem
+    root, name = read_robot_root(path, "URDF file", "robot", scale, lenient)
     ignored: List[Ignored] = []
+    materials = _materials(root)
+    link_nodes = _link_nodes(root)
+    for child in root.children:
+        if child.tag.lower() not in _ROBOT_CHILDREN_USED:
+            ignored.append(Ignored(str(path), child.line, f"<{child.tag}>",
+                                   "not simulated by Odin (transmissions and the like)"))
+    gazebo = _gazebo_blocks(root, link_nodes, path, ignored)
+    joint_of_child = _parent_joints(root, link_nodes)
+    order = _parents_first(root, link_nodes, joint_of_child)
+    index = {n: i for i, n in enumerate(order)}
+    links = []
+    for lname in order:
+        node = link_nodes[lname]
+        inertial = _inertial(node, scale)
+        common = dict(mass=inertial.mass if inertial else None, inertial=inertial,
+                      shape=_link_shape(node, scale, path, materials),
+                      surface=_contact_surface(node, gazebo.get(lname)), source=str(path))
+        joint = joint_of_child.get(lname)
+        if joint is None:
+            links.append(LinkModel(name=lname, parent=None, pre=np.eye(4), post=np.eye(4),
+                                   line=node.line, **common))
+            continue
+        parent = index[joint.find("parent").get("link")]
+        links.append(_jointed_link(joint, lname, parent, scale, common))
+        _joint_ignored(joint, path, ignored)
+    return RobotModel(name=name, links=links, source=str(path), kind="urdf", ignored=ignored)
+
+
+def _materials(root: Node) -> dict:
+    """{name: (r, g, b, a)} of the robot's named ``<material>`` colours."""
     materials = {}
     for mat in root.findall("material"):
         col = mat.find("color")
         if col is not None:
             materials[mat.get("name", "")] = tuple(col.numbers("rgba", 4))
+    return materials
+
+
+def _link_nodes(root: Node) -> dict:
+    """{link name: its <link>}, in file order; at least one, no name twice."""
     link_nodes = {}
     for link in root.findall("link"):
         lname = link.require("name")
@@ -298,11 +328,12 @@ def _read_urdf(path: pathlib.Path, scale: float, lenient: list) -> RobotModel:
         link_nodes[lname] = link
     if not link_nodes:
         raise root.error("has no <link>")
-    for child in root.children:
-        if child.tag.lower() not in _ROBOT_CHILDREN_USED:
-            ignored.append(Ignored(str(path), child.line, f"<{child.tag}>",
-                                   "not simulated by Odin (transmissions and the like)"))
-    gazebo = _gazebo_blocks(root, link_nodes, path, ignored)
+    return link_nodes
+
+
+def _parent_joints(root: Node, link_nodes: dict) -> dict:
+    """{child link name: the <joint> that moves it}: every joint of a supported type between
+    two links of ``link_nodes``, no link with two parent joints."""
     joint_of_child = {}
     for joint in root.findall("joint"):
         jtype = joint.require("type")
@@ -318,50 +349,59 @@ def _read_urdf(path: pathlib.Path, scale: float, lenient: list) -> RobotModel:
         if child.get("link") in joint_of_child:
             raise joint.error(f"link \"{child.get('link')}\" has two parent joints")
         joint_of_child[child.get("link")] = joint
+    return joint_of_child
+
+
+def _parents_first(root: Node, link_nodes: dict, joint_of_child: dict) -> list:
+    """The link names, parents first: breadth-first from the one root link, children in file
+    order."""
     roots = [n for n in link_nodes if n not in joint_of_child]
     if len(roots) != 1:
         raise root.error(f"needs exactly one root link, found {len(roots)}: {roots}")
-    # Parents first (breadth-first from the root, children in file order).
     children: dict = {n: [] for n in link_nodes}
     for child_name, joint in joint_of_child.items():
         children[joint.find("parent").get("link")].append(child_name)
     order = [roots[0]]
     for n in order:
         order.extend(sorted(children[n], key=lambda c: joint_of_child[c].line))
-    index = {n: i for i, n in enumerate(order)}
-    links = []
-    for lname in order:
-        node = link_nodes[lname]
-        inertial = _inertial(node, scale)
-        common = dict(mass=inertial.mass if inertial else None, inertial=inertial,
-                      shape=_link_shape(node, scale, path, materials),
-                      surface=_contact_surface(node, gazebo.get(lname)), source=str(path))
-        joint = joint_of_child.get(lname)
-        if joint is None:
-            links.append(LinkModel(name=lname, parent=None, pre=np.eye(4), post=np.eye(4),
-                                   line=node.line, **common))
-            continue
-        kind = _JOINT_KINDS[joint.get("type")]
-        axis = np.array([1.0, 0.0, 0.0])
-        ax = joint.find("axis")
-        if ax is not None:
-            axis = np.asarray(ax.numbers("xyz", 3), dtype=float)
-        norm = float(np.linalg.norm(axis))
-        if kind != FIXED and norm == 0.0:
-            raise (ax or joint).error("joint axis is zero")
-        axis = axis / norm if norm else np.array([1.0, 0.0, 0.0])
-        limits, effort, velocity = _joint_limits(joint, kind, scale)
-        damping = friction = 0.0
-        dynamics = joint.find("dynamics")
-        if dynamics is not None and kind != FIXED:
-            damping, friction = dynamics.number("damping", 0.0), dynamics.number("friction", 0.0)
-            if damping < 0 or friction < 0:
-                raise dynamics.error("damping and friction cannot be negative")
-        _joint_ignored(joint, path, ignored)
-        links.append(LinkModel(
-            name=lname, parent=index[joint.find("parent").get("link")],
-            pre=_origin(joint, scale), post=np.eye(4), joint=kind, axis=axis, limits=limits,
-            line=joint.line, joint_name=joint.get("name", lname),
-            continuous=joint.get("type") == "continuous", effort=effort, velocity=velocity,
-            damping=damping, friction=friction, **common))
-    return RobotModel(name=name, links=links, source=str(path), kind="urdf", ignored=ignored)
+    return order
+
+
+def _jointed_link(joint: Node, name: str, parent: int, scale: float, common: dict
+                  ) -> LinkModel:
+    """The link ``name`` that ``joint`` moves, its parent link the model's link ``parent``;
+    ``common``: the link's own fields (mass, inertial, shape, surface, source)."""
+    kind = _JOINT_KINDS[joint.get("type")]
+    axis = _joint_axis(joint, kind)
+    limits, effort, velocity = _joint_limits(joint, kind, scale)
+    damping, friction = _joint_dynamics(joint, kind)
+    return LinkModel(
+        name=name, parent=parent,
+        pre=_origin(joint, scale), post=np.eye(4), joint=kind, axis=axis, limits=limits,
+        line=joint.line, joint_name=joint.get("name", name),
+        continuous=joint.get("type") == "continuous", effort=effort, velocity=velocity,
+        damping=damping, friction=friction, **common)
+
+
+def _joint_axis(joint: Node, kind: str) -> np.ndarray:
+    """The unit ``<axis xyz>`` of a joint in its frame (+x without one; a fixed joint's zero
+    axis is +x, any other joint's is an error)."""
+    axis = np.array([1.0, 0.0, 0.0])
+    ax = joint.find("axis")
+    if ax is not None:
+        axis = np.asarray(ax.numbers("xyz", 3), dtype=float)
+    norm = float(np.linalg.norm(axis))
+    if kind != FIXED and norm == 0.0:
+        raise (ax or joint).error("joint axis is zero")
+    return axis / norm if norm else np.array([1.0, 0.0, 0.0])
+
+
+def _joint_dynamics(joint: Node, kind: str) -> tuple:
+    """(damping, friction) of a joint's ``<dynamics>``: (0, 0) without one or when fixed."""
+    damping = friction = 0.0
+    dynamics = joint.find("dynamics")
+    if dynamics is not None and kind != FIXED:
+        damping, friction = dynamics.number("damping", 0.0), dynamics.number("friction", 0.0)
+        if damping < 0 or friction < 0:
+            raise dynamics.error("damping and friction cannot be negative")
+    return damping, friction
