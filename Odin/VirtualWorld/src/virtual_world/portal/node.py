@@ -1,17 +1,15 @@
 """VirtualWorld's Portal: the ROS layer over the Core (thesis chapter 4).
 
 Node ``virtual_world`` (``rosrun VirtualWorld virtualWorld``). Every name below is in the node's
-private namespace, so ``~build_object`` is ``/virtual_world/build_object``. The Portal converts
+private namespace, so ``~world_update`` is ``/virtual_world/world_update``. The Portal converts
 messages and forwards them to the Core, whose rules decide; it answers every refusal with
 ``success: false`` and the Core's message, and changes nothing then.
 
-Services (odin_common.interface.WORLD_SERVICES; Services/*, each answering ``success`` and
-``message``): ``~new_scene``, ``~set_world``, ``~set_step``, ``~step_once``, ``~start``,
-``~build_object``, ``~build_composite``, ``~build_entity``, ``~remove_object``,
-``~set_joint``, ``~set_motor``, ``~set_position``, ``~set_velocity``, ``~set_external_force``,
-``~set_joint_force``; and Odin's own: ``~get_world`` (what the world holds, the values in
-force), ``~save_state``, ``~restore_state``, ``~reset`` (snapshots), ``~propagate`` (run under
-controls without publishing, then back) and ``~check_collision`` (a synchronous query).
+Services: one server per entry of odin_common.interface.WORLD_SERVICES (its name under ``~``
+-> its type in the Services package: the thesis's, then Odin's own), each answering
+``success`` and ``message`` and served by the method of the same name of
+portal.services.WorldServices; docs/INTERFACE.md describes each, with an example. (The table
+is the one list: tests/system/test_layout_doc.py keeps this docstring from naming them.)
 
 Topics published (every cycle, or at ``~rate`` per wall-clock second under ``~free_run``),
 all stamped with the world clock (portal.clock: simulated time that never goes back, also
