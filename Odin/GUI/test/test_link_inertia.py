@@ -5,7 +5,7 @@ import numpy as np
 
 from gui.core import inertia
 from gui.core.model import Inertial, LinkModel
-from gui.core.shapes import Mesh, Primitive, Shape
+from gui.core.geometry import Mesh, Primitive, Shape
 
 
 def room_link(moment: float) -> LinkModel:

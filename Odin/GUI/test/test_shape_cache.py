@@ -6,6 +6,7 @@ import multiprocessing
 import os
 import subprocess
 import sys
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -56,7 +57,7 @@ def test_a_cached_shape_is_the_shape_read_bit_for_bit_and_is_not_read_again(cach
     _same(_read(model), first)
     copy = tmp_path / "elsewhere.iv"           # the same content elsewhere: the same entry
     copy.write_text(SCENE)
-    _same(_read(copy), shapes.replace(first, source=str(copy)))
+    _same(_read(copy), replace(first, source=str(copy)))
     assert len(list(cache.glob("*.shape"))) == 1
 
 

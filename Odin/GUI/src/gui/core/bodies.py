@@ -18,7 +18,7 @@ import numpy as np
 from gui.core import inertia as inertia_rule
 from gui.core.kinematics import pose_to_position_quaternion
 from gui.core.plan import BodySpec
-from gui.core.shapes import Shape
+from gui.core.geometry import Shape
 from odin_common.specs import CompositeSpec, ObjectSpec, PartSpec, Surface
 
 

@@ -20,7 +20,7 @@ from typing import Optional, Sequence, Tuple
 import numpy as np
 
 from gui.core.model import Ignored, LinkModel
-from gui.core.shapes import Shape
+from gui.core.geometry import Shape
 from odin_common.limits import inertia_problem, primitive_corners
 
 AUTO, FILE, SHAPE = "auto", "file", "shape"

@@ -29,8 +29,8 @@ from typing import Optional, Sequence
 
 import numpy as np
 
+from gui.core.geometry import Shape
 from gui.core.kinematics import joint_motion
-from gui.core.shapes import Shape
 from odin_common.specs import WORLD_SURFACE, Surface
 
 FIXED, REVOLUTE, PRISMATIC = "fixed", "revolute", "prismatic"

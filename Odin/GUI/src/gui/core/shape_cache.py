@@ -36,16 +36,13 @@ import pathlib
 import re
 import struct
 import tempfile
-from typing import TYPE_CHECKING, Callable, Optional
+from typing import Callable, Optional
 
 import numpy as np
 
+from gui.core.geometry import Mesh, Primitive, Shape
+from gui.core.kautham.units import lengths_problem
 from odin_common.limits import shown
-
-if TYPE_CHECKING:
-    # only a type: shapes imports this module at its top, so at run time the functions below
-    # import what they build from shapes when they run, never at import
-    from gui.core.shapes import Shape
 
 log = logging.getLogger(__name__)
 
@@ -88,7 +85,7 @@ def cache_dir() -> pathlib.Path:
     return pathlib.Path(root) / "shapes"
 
 
-def cached(content: bytes, source: str, reading: str, read: Callable[[], "Shape"]) -> "Shape":
+def cached(content: bytes, source: str, reading: str, read: Callable[[], Shape]) -> Shape:
     """The shape of a geometry file's ``content`` (its bytes, as read once by
     ``gui.core.sizes.read_input_file``; ``source`` names the file) read as ``reading`` says (a
     text naming scale and defaults): from the cache when an entry for that content exists,
@@ -113,17 +110,19 @@ def _names_other_files(content: bytes) -> bool:
             and _REFERENCES.search(content) is not None)
 
 
+_READERS = ("shapes.py", "geometry.py", "shape_cache.py")
+"""The modules (beside this one) that turn a file's bytes into a shape: read by their files,
+not imported (``shapes`` imports this module)."""
 _readers_digest: Optional[str] = None
 
 
 def _readers_version() -> str:
-    """SHA-256 of the source of the modules that turn a file into a shape."""
+    """SHA-256 of the source of the modules that turn a file into a shape (_READERS)."""
     global _readers_digest
     if _readers_digest is None:
-        from gui.core import shapes
         digest = hashlib.sha256()
-        for source in (shapes.__file__, __file__):
-            digest.update(pathlib.Path(source).read_bytes())
+        for name in _READERS:
+            digest.update(pathlib.Path(__file__).with_name(name).read_bytes())
         _readers_digest = digest.hexdigest()
     return _readers_digest
 
@@ -160,7 +159,6 @@ def _refuse_constant(name: str):
 def _decode(data: bytes, source: str):
     """The Shape an entry's bytes hold, every field verified (module docstring); raises
     ValueError (or a KeyError, TypeError...) for bytes that are not a whole, sound entry."""
-    from gui.core.shapes import Shape
     if not data.startswith(_MAGIC) or len(data) < len(_MAGIC) + _HEADER_SIZE.size:
         raise ValueError("not an entry of this format")
     at = len(_MAGIC) + _HEADER_SIZE.size
@@ -190,8 +188,6 @@ def _whole(value) -> int:
 
 
 def _decode_mesh(header, data: bytes, at: int):
-    from gui.core.kautham.units import lengths_problem
-    from gui.core.shapes import Mesh
     sizes = header["sizes"]
     if not isinstance(sizes, list) or len(sizes) != 2:
         raise ValueError(f"mesh sizes {shown(sizes)}")
@@ -216,8 +212,6 @@ _PARAMETER_COUNTS = {"sphere": 1, "cylinder": 2, "box": 3}
 
 
 def _decode_primitive(p):
-    from gui.core.kautham.units import lengths_problem
-    from gui.core.shapes import Primitive
     kind = p["kind"]
     if kind not in _PARAMETER_COUNTS:
         raise ValueError(f"a primitive of kind {shown(kind)}")

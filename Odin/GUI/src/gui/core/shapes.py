@@ -35,14 +35,14 @@ import pathlib
 import re
 import tempfile
 import warnings
-from dataclasses import dataclass, field, replace
-from typing import Optional
+from dataclasses import dataclass
 
 import numpy as np
 
 from gui.core import shape_cache
+from gui.core.geometry import DEFAULT_COLOR, Mesh, Primitive, Shape, check_lengths
 from gui.errors import ShapeError
-from gui.core.kautham.units import lengths_problem, scale_problem
+from gui.core.kautham.units import scale_problem
 from gui.core.kinematics import rot_x
 from gui.core.sizes import check_input_path, read_input_file
 from odin_common.limits import MAX_MESH_TRIANGLES
@@ -55,7 +55,7 @@ TRIMESH_SUFFIXES = (".stl", ".obj", ".ply", ".off", ".glb", ".gltf", ".dae")
 class ShapeDefaults:
     """Tunables of shape reading."""
     merge_tolerance: float = 1e-6   # m: vertices closer than about this are merged
-    default_color: tuple = (0.0, 0.0, 0.0, 0.0)  # all zero: the Viewer's default colour
+    default_color: tuple = DEFAULT_COLOR
     # a file holding more is refused: the world refuses such a mesh anyway, and a VRML file's
     # DEF/USE instancing can make a few lines expand into billions of triangles
     max_triangles: int = MAX_MESH_TRIANGLES
@@ -65,108 +65,6 @@ class ShapeDefaults:
 
 
 DEFAULTS = ShapeDefaults()
-
-
-@dataclass(frozen=True, eq=False)
-class Mesh:
-    """A triangle mesh: ``vertices`` (N, 3) float64, m; ``triangles`` (M, 3) uint32,
-    counter-clockwise seen from outside as the file gives them."""
-    vertices: np.ndarray
-    triangles: np.ndarray
-    color: tuple = DEFAULTS.default_color
-
-
-@dataclass(frozen=True, eq=False)
-class Primitive:
-    """A sphere, cylinder (along its frame's z) or box; ``parameters`` as in Object.msg (m);
-    ``pose`` (4, 4): the primitive's frame in the shape's frame."""
-    kind: str
-    parameters: tuple
-    pose: np.ndarray
-    color: tuple = DEFAULTS.default_color
-
-
-@dataclass(frozen=True, eq=False)
-class Shape:
-    """What one geometry file holds, in metres, in the file's (link's) frame."""
-    source: str
-    mesh: Optional[Mesh] = None
-    primitives: tuple = field(default_factory=tuple)
-
-    @property
-    def triangle_count(self) -> int:
-        return 0 if self.mesh is None else int(len(self.mesh.triangles))
-
-    @property
-    def is_empty(self) -> bool:
-        return self.mesh is None and not self.primitives
-
-    def transformed(self, T: np.ndarray) -> "Shape":
-        """The same shape with every coordinate mapped through the rigid pose ``T``."""
-        mesh = self.mesh
-        if mesh is not None:
-            v = mesh.vertices @ T[:3, :3].T + T[:3, 3]
-            mesh = replace(mesh, vertices=v)
-        prims = tuple(replace(p, pose=T @ p.pose) for p in self.primitives)
-        return replace(self, mesh=mesh, primitives=prims)
-
-    def scaled(self, factors) -> "Shape":
-        """The shape with x, y, z multiplied by ``factors`` (3,), which may differ and be
-        negative (a URDF ``<mesh scale="1 -1 -1">``): a mirrored mesh keeps its triangles
-        counter-clockwise seen from outside. A sphere, cylinder or box cannot stretch unevenly:
-        factors of different sizes are a ``ShapeError`` when the shape has one."""
-        f = np.asarray(factors, dtype=float)
-        for factor in f:
-            problem = scale_problem(abs(float(factor)))
-            if problem is not None:
-                raise ShapeError(f"scale {tuple(float(v) for v in f)}: each factor's size "
-                                 f"{problem}", self.source)
-        mesh = self.mesh
-        if mesh is not None:
-            check_lengths(mesh.vertices, f"a vertex scaled by {tuple(float(v) for v in f)}",
-                          self.source, float(np.max(np.abs(f))))
-            triangles = mesh.triangles if np.prod(f) > 0 else mesh.triangles[:, ::-1].copy()
-            mesh = replace(mesh, vertices=mesh.vertices * f, triangles=triangles)
-        size = float(abs(f[0]))
-        if self.primitives and not np.allclose(np.abs(f), size, rtol=1e-9, atol=0.0):
-            raise ShapeError(f"a sphere, cylinder or box cannot be scaled by {tuple(f)} "
-                             "(factors of different sizes)", self.source)
-        for p in self.primitives:
-            check_lengths(np.append(p.parameters, p.pose[:3, 3]), "a sphere, cylinder or "
-                          f"box scaled by {size:g}", self.source, size)
-        return replace(self, mesh=mesh,
-                       primitives=tuple(_mirrored(p, np.sign(f), size) for p in self.primitives))
-
-    def with_color(self, color: tuple) -> "Shape":
-        mesh = None if self.mesh is None else replace(self.mesh, color=tuple(color))
-        prims = tuple(replace(p, color=tuple(color)) for p in self.primitives)
-        return replace(self, mesh=mesh, primitives=prims)
-
-    def merged(self, other: "Shape") -> "Shape":
-        """Both shapes in one (meshes concatenated, primitives appended)."""
-        mesh = self.mesh
-        if other.mesh is not None:
-            if mesh is None:
-                mesh = other.mesh
-            else:
-                tri = np.vstack([mesh.triangles, other.mesh.triangles + len(mesh.vertices)])
-                mesh = Mesh(np.vstack([mesh.vertices, other.mesh.vertices]),
-                            tri.astype(np.uint32), mesh.color)
-        return Shape(self.source, mesh, self.primitives + other.primitives)
-
-
-def _mirrored(primitive: Primitive, signs: np.ndarray, size: float) -> Primitive:
-    """``primitive`` scaled by ``size`` and mirrored by the axis signs (+-1, 3). A mirror is
-    improper, a pose cannot be: the primitive is symmetric about its own x = 0 plane (a
-    sphere, a box, a cylinder along z), so mirroring it there too keeps its shape and makes
-    the rotation proper."""
-    pose = primitive.pose.copy()
-    pose[:3, :3] = np.diag(signs) @ pose[:3, :3]
-    if np.prod(signs) < 0:
-        pose[:3, :3] = pose[:3, :3] @ np.diag([-1.0, 1.0, 1.0])
-    pose[:3, 3] = signs * pose[:3, 3] * size
-    return replace(primitive, pose=pose,
-                   parameters=tuple(float(v) * size for v in primitive.parameters))
 
 
 def merge_vertices(corners: np.ndarray, tolerance: float = DEFAULTS.merge_tolerance
@@ -245,14 +143,6 @@ def check_scale(scale: float, source) -> None:
     problem = scale_problem(float(scale))
     if problem is not None:
         raise ShapeError(f"scale {float(scale)!r} {problem}", source)
-
-
-def check_lengths(values, what: str, source, scale: float = 1.0) -> None:
-    """A ShapeError naming ``source`` and ``what`` unless ``values`` times ``scale`` are
-    lengths a model may hold (gui.core.kautham.units.lengths_problem)."""
-    problem = lengths_problem(values, scale)
-    if problem is not None:
-        raise ShapeError(f"{what} {problem}", source)
 
 
 def _finish(raw: _Raw, scale: float, defaults: ShapeDefaults, source: str) -> Shape:
@@ -553,18 +443,6 @@ def _collect(coin, root, max_triangles: int, max_shape_nodes: int) -> _Raw:
     tri_colors: list = []
     prims: list = []
     current = {"color": DEFAULTS.default_color, "start": 0, "pose": np.eye(4), "shape_nodes": 0}
-    lazy = coin.SoLazyElement
-
-    def color_of(action):
-        state = action.getState()
-        d = lazy.getDiffuse(state, 0).getValue()
-        t = lazy.getTransparency(state, 0)
-        return (float(d[0]), float(d[1]), float(d[2]), float(1.0 - t))
-
-    def model_pose(action):
-        m = action.getModelMatrix()
-        rows = np.array(m.getValue(), dtype=np.float64)
-        return rows.T  # Coin's matrices act on row vectors
 
     def over_limit():
         return (len(tris) > max_triangles or len(prims) > max_triangles
@@ -577,24 +455,7 @@ def _collect(coin, root, max_triangles: int, max_shape_nodes: int) -> _Raw:
     def on_primitive(_data, action, node):
         if shape_node():
             return coin.SoCallbackAction.ABORT
-        T = model_pose(action)
-        R = T[:3, :3]
-        s = np.linalg.norm(R, axis=0)
-        s[s == 0] = 1.0
-        T[:3, :3] = R / s
-        name = node.getTypeId().getName().getString()
-        color = color_of(action)
-        if name == "Sphere":
-            dims = (node.radius.getValue() * float(np.mean(s)),)
-            prims.append(("sphere", dims, T, color))
-        elif name == "Cylinder":
-            dims = (node.radius.getValue() * float((s[0] + s[2]) / 2),
-                    node.height.getValue() * float(s[1]))
-            prims.append(("cylinder", dims, T @ rot_x(-np.pi / 2), color))
-        else:
-            dims = (node.width.getValue() * float(s[0]), node.height.getValue() * float(s[1]),
-                    node.depth.getValue() * float(s[2]))
-            prims.append(("box", dims, T, color))
+        prims.append(_coin_primitive(node, _model_pose(action), _coin_color(coin, action)))
         return coin.SoCallbackAction.PRUNE
 
     runs: list = []   # (first triangle, end, model pose (4, 4), colour) per shape node
@@ -603,8 +464,8 @@ def _collect(coin, root, max_triangles: int, max_shape_nodes: int) -> _Raw:
         if shape_node():
             return coin.SoCallbackAction.ABORT
         _close_run()
-        current["color"] = color_of(action)
-        current["pose"] = model_pose(action)
+        current["color"] = _coin_color(coin, action)
+        current["pose"] = _model_pose(action)
         current["start"] = len(tris)
         return coin.SoCallbackAction.CONTINUE
 
@@ -629,9 +490,50 @@ def _collect(coin, root, max_triangles: int, max_shape_nodes: int) -> _Raw:
     action.addTriangleCallback(coin.SoShape.getClassTypeId(), on_triangle, None)
     action.apply(root)
     _close_run()
+    return _Raw(_placed(tris, runs), tri_colors, prims, current["shape_nodes"])
+
+
+def _coin_color(coin, action) -> tuple:
+    """(r, g, b, a) of the shape ``action`` is at: its diffuse colour, 1 - transparency."""
+    state = action.getState()
+    d = coin.SoLazyElement.getDiffuse(state, 0).getValue()
+    t = coin.SoLazyElement.getTransparency(state, 0)
+    return (float(d[0]), float(d[1]), float(d[2]), float(1.0 - t))
+
+
+def _model_pose(action) -> np.ndarray:
+    """(4, 4) the model matrix where ``action`` is, acting on column vectors (file units)."""
+    m = action.getModelMatrix()
+    rows = np.array(m.getValue(), dtype=np.float64)
+    return rows.T  # Coin's matrices act on row vectors
+
+
+def _coin_primitive(node, T: np.ndarray, color: tuple) -> tuple:
+    """(kind, sizes, pose (4, 4), colour) of a Coin sphere, cylinder or cube at the model pose
+    ``T`` (file units): the scale of ``T``'s columns goes into the sizes, the pose keeps the
+    rotation; Coin's cylinder, along its y, becomes Odin's along z."""
+    R = T[:3, :3]
+    s = np.linalg.norm(R, axis=0)
+    s[s == 0] = 1.0
+    T[:3, :3] = R / s
+    name = node.getTypeId().getName().getString()
+    if name == "Sphere":
+        return ("sphere", (node.radius.getValue() * float(np.mean(s)),), T, color)
+    if name == "Cylinder":
+        dims = (node.radius.getValue() * float((s[0] + s[2]) / 2),
+                node.height.getValue() * float(s[1]))
+        return ("cylinder", dims, T @ rot_x(-np.pi / 2), color)
+    dims = (node.width.getValue() * float(s[0]), node.height.getValue() * float(s[1]),
+            node.depth.getValue() * float(s[2]))
+    return ("box", dims, T, color)
+
+
+def _placed(tris: list, runs: list) -> np.ndarray:
+    """(M, 3, 3) the triangles' corners in the file's frame: each run of a shape node's
+    triangles (first, end, model pose, colour) mapped from its object space by its pose."""
     corners = np.array(tris, dtype=np.float64).reshape(-1, 3, 3)
     for start, end, pose, _color in runs:
         if not np.allclose(pose, np.eye(4)):
             block = corners[start:end]
             corners[start:end] = block @ pose[:3, :3].T + pose[:3, 3]
-    return _Raw(corners, tri_colors, prims, current["shape_nodes"])
+    return corners

@@ -28,12 +28,13 @@ from typing import List, Optional
 
 import numpy as np
 
+from gui.core.geometry import Primitive, Shape
 from gui.core.kautham.robot_file import read_robot_root
 from gui.core.kautham.units import inertia_problem, mass_problem
 from gui.core.kautham.xmlfile import LenientNumber, Node, parse_number
 from gui.core.kinematics import rpy_matrix
 from gui.core.model import FIXED, PRISMATIC, REVOLUTE, Ignored, Inertial, LinkModel, RobotModel
-from gui.core.shapes import Primitive, Shape, read_shape
+from gui.core.shapes import read_shape
 from gui.errors import ShapeError
 from odin_common.limits import shown
 from odin_common.specs import WORLD_SURFACE, Surface
