@@ -250,8 +250,10 @@ class Core:
         return motors.split_per_axis(self._scene, motor_ids, values)
 
     @disturbs
-    def set_servo(self, motors: Sequence[str], targets: Sequence[float], rates=(), gains=(),
-                  max_speeds=(), max_forces=(), drive: int = ServoDrive.UNCHANGED) -> None:
+    def set_servo(self, motors: Sequence[str], targets: Sequence[float],
+                  rates: Sequence[float] = (), gains: Sequence[float] = (),
+                  max_speeds: Sequence[float] = (), max_forces: Sequence[float] = (),
+                  drive: int = ServoDrive.UNCHANGED) -> None:
         """Set Servo: servo mode for ``motors``, each tracking a position target on its
         joint's axes. The lists are flat, one value per motor axis in the motors' order:
         ``targets`` (rad or m); optional, empty meaning not given: ``rates`` (feed-forward,
