@@ -19,16 +19,8 @@ from gui.core.control_path import ControlRow, run_control_path
 from gui.core.kautham.problem import load_problem
 from gui.core.model import FIXED_BASE
 from gui.errors import ProblemError
-from gui_core_world import CoreWorld
 from kautham_files import KINEMATIC, SHELF, default_parameters, plan_steps, write_problem
 from odin_common.interface import JointParameter, JointType, Shape
-
-
-@pytest.fixture
-def world():
-    w = CoreWorld()
-    yield w
-    w.close()
 
 
 ARM = """<?xml version="1.0"?><robot name="arm">

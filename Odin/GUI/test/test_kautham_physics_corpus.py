@@ -22,7 +22,6 @@ from gui.core.kautham.corpus import corpus_dir
 from gui.core.kautham.problem import load_problem
 from gui.core.model import FREE_BODY
 from gui.core.world_settings import with_values
-from gui_core_world import CoreWorld
 from kautham_files import default_parameters, plan_steps
 from odin_common.interface import Shape
 
@@ -30,13 +29,6 @@ KAUTHAM = corpus_dir() or pathlib.Path("/no-kautham-corpus")
 SPHERE_DIR = KAUTHAM / "current_2025" / "demos" / "OMPL_ode_demos" / "Sphere"
 SCRIPTS = pathlib.Path(__file__).resolve().parents[1] / "scripts"
 WALL = 4.8 - 0.25          # the inner faces of the arena's walls (centre 4.8, 0.5 thick)
-
-
-@pytest.fixture
-def world():
-    w = CoreWorld()
-    yield w
-    w.close()
 
 
 # -- the corpus's ODE demos --------------------------------------------------------------------

@@ -20,16 +20,8 @@ from gui.core.control_path import ControlRow, read_control_path, run_control_pat
 from gui.core.kautham.problem import load_problem
 from gui.core.model import CAR, MOBILE
 from gui.errors import PathFileError
-from gui_core_world import CoreWorld
 from kautham_files import KINEMATIC, SHELF, plan_steps, write_problem
 from odin_common.interface import JointParameter, JointType
-
-
-@pytest.fixture
-def world():
-    w = CoreWorld()
-    yield w
-    w.close()
 
 
 # -- a car ----------------------------------------------------------------------------------------
