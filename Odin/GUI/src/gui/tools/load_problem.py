@@ -29,7 +29,7 @@ class LoadRequest:
 class _WorldConnection:
     """A WorldClient made on a thread of its own, started before the problem is read: joining
     the ROS graph and finding the world (~0.25 s, mostly waiting on the master) then overlaps
-    reading and building the problem's plan (~0.5 s) instead of following it."""
+    reading the problem and making its build plan (~0.5 s) instead of following it."""
 
     def __init__(self, timeout: float):
         # imported here, not on the thread (the service classes too, which WorldClient
@@ -71,15 +71,16 @@ def load(request: LoadRequest, say: Callable[[str], None]) -> str:
         "requests")
     from gui.planning.rehearsal import load_scene, warm_up
     from gui.planning.rehearsal_cache import plan_digest, seen
-    plan_key = plan_digest(build_plan)
-    if not seen(plan_key):  # a rehearsal to come: its imports while the world is found
+    digest = plan_digest(build_plan)
+    if not seen(digest):    # a rehearsal to come: its imports while the world is found
         warm_up()           # (the connecting thread imports nothing)
     client = connection.client()
 
     def progress(k: int, step, answer_id: str) -> None:
         say(f"[{k}/{total}] {step.label()} -> {answer_id}")
 
-    load_scene(client, build_plan, keep=request.keep, progress=progress, plan_key=plan_key)
+    load_scene(client, build_plan, keep=request.keep, progress=progress,
+               plan_key=digest)
     return client.namespace
 
 

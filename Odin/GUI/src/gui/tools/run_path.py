@@ -240,7 +240,7 @@ def _run_tracked(request: PathRequest, build_plan: BuildPlan, handle: RobotHandl
     is not used: the solution names its robots."""
     from gui.core.kautham.solutions import read_solution
     from gui.ros.world_port import run_tracked_on_client
-    with reading("plan", request.path):
+    with reading("plan", request.path):         # the word its users know: a Kautham plan
         solution = read_solution(request.path, build_plan.problem, request.robot,
                                  request.units)
     client, solver = _tracked_world(request, build_plan, solution)
