@@ -266,7 +266,7 @@ def test_plan_chain_pushes_box2_aside_and_reaches_kautham_s_goal_threshold():
 # over 60 s (issue 32). The car's pieces stay here: its planning problem and propagations
 # (Odin/GUI/test/test_planning_robots.py), its control paths run in a world node and their
 # distance to the goal (tests/nodes/test_run_path_reports.py), its build
-# (Odin/GUI/test/test_kautham_physics.py).
+# (Odin/GUI/test/test_kautham_physics_mobile.py).
 
 
 def test_one_command_runs_several_experiments(kautham_dir):

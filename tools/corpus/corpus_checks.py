@@ -14,8 +14,11 @@ import tempfile
 import time
 import traceback
 
-import odin_common  # noqa: F401  (before numpy: the reference BLAS, odin_common.blas)
-import numpy as np
+from odin_common.blas import use_reference_blas
+
+use_reference_blas()  # before numpy (odin_common.blas)
+
+import numpy as np  # noqa: E402
 
 PROBLEM_INFO_TIMEOUT = 300.0
 """s: problem_info taking longer has hung (the largest TIAGo problems take ~10 s here)."""
@@ -36,7 +39,7 @@ _MISSING = re.compile(r'file "([^"]+)" not found|: (geometry file|robot file|URD
 def preload() -> None:
     """Imports what problem_info uses once, before the children are forked: a child then
     starts in milliseconds (a `rosrun GUI problem_info` process spends seconds importing)."""
-    import gui.cli  # noqa: F401
+    import gui.tools.problem_info  # noqa: F401
     import gui.core.kautham.problem  # noqa: F401
     import gui.core.translate  # noqa: F401
     import trimesh  # noqa: F401
@@ -46,7 +49,7 @@ def preload() -> None:
 
 
 def problem_info(corpus: pathlib.Path, relative: str) -> dict:
-    """problem_info on one file, as its script runs it (``gui.cli.problem_info_main`` in a
+    """problem_info on one file, as its script runs it (``gui.tools.problem_info.main`` in a
     process of its own, stdout and stderr its own files; an exception that escapes is
     printed as Python prints it): {"status": ok | refused | failed, ...}."""
     started = time.monotonic()
@@ -73,8 +76,8 @@ def problem_info(corpus: pathlib.Path, relative: str) -> dict:
 
 
 def _problem_info_main(argv: list) -> int:
-    from gui.cli import problem_info_main
-    return problem_info_main(argv)
+    from gui.tools.problem_info import main
+    return main(argv)
 
 
 def _run_forked(main, timeout: float):

@@ -38,7 +38,7 @@ def test_the_tx90_with_its_hand_holds_its_pose_for_10_s_under_the_default_solver
     worst, world = hold(kautham_dir)
     try:
         assert world.core.world_parameters.solver == WorldParameters().solver == Solver.AUTO
-        assert world.step_values.step == pytest.approx(0.001)
+        assert world.step_values().step == pytest.approx(0.001)
         assert world.core.last_step_solver == Solver.WORLDSTEP
         # one island, no contact: 24 hinges (5 rows, 6 at a limit: the fixed Tcp-Palm joint,
         # fingers at their stops) and their 24 powered motors (1 row)

@@ -84,12 +84,12 @@ class PoolBackend:
         return self._start.copy()
 
     def tracked_state(self, state):
-        position, quaternion, linear = self._body(state, self.problem.tracked_body)
-        return self.problem.tracked_origin(position, quaternion), linear.copy()
+        body = self._body(state, self.problem.tracked_body)
+        return self.problem.tracked_origin(body.position, body.quaternion), body.linear.copy()
 
     def _body(self, state, name: str):
-        """A body's (frame origin m, quaternion (w, x, y, z), linear velocity m/s), world
-        frame, in a state vector of the problem's world."""
+        """A body's state (gui.core.world_port.BodyState) in a state vector of the problem's
+        world."""
         state = np.asarray(state, dtype=np.float64)
         if state.shape != self._start.shape:
             raise PlanningError(f"a state vector of the problem's world has "

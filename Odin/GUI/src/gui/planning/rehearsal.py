@@ -17,7 +17,7 @@ alone, with the room the world has left under ``max_objects``: a clash with what
 holds (a name already taken) is found by the node only, and then undone as above, leaving
 the scene as it was.
 
-This module is the one home of the rule: ``load_problem`` (gui.cli) and the window's Open
+This module is the one home of the rule: ``load_problem`` (gui.tools) and the window's Open
 file (gui.window.simulation_tab) call ``load_scene``. It needs no ROS: ``client`` is a
 ``gui.ros.client.WorldClient`` (only its methods are called).
 """
