@@ -286,11 +286,13 @@ class Planner:
     """The problem's ``<Planner>``: its ``name``; ``physics``: one of Kautham's ODE planners,
     which simulate the problem (a ground plane, dynamic obstacles: ``Problem.physics``);
     ``settings``: the physics its parameters ask for; ``search``: what they ask of a
-    planner's search."""
+    planner's search; ``geometric``: a geometric planner's parameters Odin uses, (field,
+    value) pairs (gui.core.kautham.problem.PLANNER_GEOMETRIC; gui.planning.geometric)."""
     name: str
     physics: bool
     settings: PlannerPhysics = PlannerPhysics()
     search: PlannerSearch = PlannerSearch()
+    geometric: tuple = ()
     source: str = ""
     line: Optional[int] = None
 

@@ -1,8 +1,11 @@
 """``rosrun GUI plan PROBLEM --planner NAME --time S --out PATH``: a motion plan for the
-problem's query, made by one of OMPL's control planners through Odin's physics
-(``gui.planning``), written as a Kautham control path (``run_path --controls`` runs it); the
-search's statistics printed as JSON. Exits 1 with one line when no solution was found in
-time, 2 on bad input, 130 on Ctrl-C (nothing written)."""
+problem's query. A problem for one of Kautham's ODE planners is searched by one of OMPL's
+control planners through Odin's physics (``gui.planning.bridge``) and written as a Kautham
+control path (``run_path --controls`` runs it); any other by one of OMPL's geometric planners
+over Odin's geometry (``gui.planning.geometric``: the problem's own planner and parameters)
+and written as a Kautham task file (``run_path --tracked`` runs it). The search's statistics
+are printed as JSON. Exits 1 with one line when no solution was found in time, 2 on bad input,
+130 on Ctrl-C (nothing written)."""
 from __future__ import annotations
 
 import enum
@@ -20,6 +23,7 @@ from odin_common.tool import stop_on_ctrl_c
 
 if TYPE_CHECKING:
     from gui.planning.bridge import PlanResult
+    from gui.planning.geometric import GeometricResult
 
 TOOL = "plan"
 
@@ -40,12 +44,13 @@ class PlanRequest:
     (None: the problem's "_Max Planning Time", else DEFAULT_TIME_LIMIT_S) with OMPL's
     ``seed`` (None: drawn); ``parallel`` searches at once (seeds ``seed`` + k). ``worlds``:
     the pool's namespaces, comma-separated, each waited for ``world_timeout`` s.
-    ``goal_tolerance`` (m), ``min_control_steps``, ``max_control_steps``: the search's
-    settings (None: the problem's, ``gui.planning.problem.SearchSettings``). ``out``: the
-    control path file to write."""
+    ``goal_tolerance`` (m), ``min_control_steps``, ``max_control_steps``: a control search's
+    settings (None: the problem's, ``gui.planning.problem.SearchSettings``); ``resolution``
+    (m): a geometric search's (None: ``gui.planning.geometric.RESOLUTION``). ``planner``:
+    None, the problem's (a control search's: KPIECE1). ``out``: the file to write."""
     problem: ProblemFile
     out: str
-    planner: str = "KPIECE1"
+    planner: Optional[str] = None
     time: Optional[float] = None
     seed: Optional[int] = None
     backend: Backend = Backend.CORE
@@ -56,6 +61,7 @@ class PlanRequest:
     min_control_steps: Optional[int] = None
     max_control_steps: Optional[int] = None
     parallel: int = 1
+    resolution: Optional[float] = None
 
     def searches(self) -> str:
         """How the tool's lines name the searches after the first."""
@@ -64,33 +70,115 @@ class PlanRequest:
 
 @dataclass(frozen=True)
 class PlanOutcome:
-    """A search's result (the first exact solution of the parallel searches, else the
-    closest), its time limit (s) and its (first) seed."""
+    """A control search's result (the first exact solution of the parallel searches, else
+    the closest), its time limit (s) and its (first) seed."""
     result: PlanResult
     time_limit: float
     seed: int
 
+    def failure(self, request: PlanRequest) -> str:
+        return (f"{request.problem.path}: no solution within {self.time_limit:g} s "
+                f"({self.result.planner}, seed {self.seed}{request.searches()}): the closest "
+                f"plan ends {self.result.goal_distance:.3f} m from the goal")
 
-def search(request: PlanRequest, stop: Callable[[], bool]) -> PlanOutcome:
-    """Says what it searches, with the seed, searches, then prints the statistics.
-    ``stop()`` true (Ctrl-C) ends the search and raises KeyboardInterrupt."""
+    def write(self, request: PlanRequest) -> None:
+        """The motion plan written to ``request.out`` as a control path, its comments
+        saying how it was made."""
+        from gui.core.control_path import write_control_path
+        result = self.result
+        write_control_path(request.out, result.rows, comments=(
+            f"control path planned by rosrun GUI plan {request.problem.path}",
+            f"planner {result.planner}, seed {result.seed}, {result.time_s:.2f} s, "
+            f"ends {result.goal_distance:.4f} m from the goal",
+            "each row: the robot's controls in [0, 1], then the duration (s)"))
+        print(f"plan: {len(result.rows)} rows ({result.duration:.3f} s) written to "
+              f"{request.out}")
+
+
+@dataclass(frozen=True)
+class GeometricOutcome:
+    """A geometric search's result, its time limit (s), its seed and the build plan it
+    searched (the path's configurations are the plan's robots')."""
+    result: GeometricResult
+    time_limit: float
+    seed: int
+    build_plan: object
+
+    def failure(self, request: PlanRequest) -> str:
+        return (f"{request.problem.path}: no solution within {self.time_limit:g} s "
+                f"({self.result.planner}, seed {self.seed})")
+
+    def write(self, request: PlanRequest) -> None:
+        """The path written to ``request.out`` as a Kautham task file."""
+        from gui.planning.geometric import task_rows, write_task
+        rows = task_rows(self.build_plan, self.result.path)
+        write_task(request.out, f"{self.result.planner} seed {self.seed}", rows)
+        print(f"plan: {len(rows)} configurations written to {request.out} (a Kautham task "
+              "file: run_path --tracked runs it)")
+
+
+GEOMETRIC_ONLY_FOR_CONTROL = (("backend", Backend.CORE, "--backend"),
+                              ("goal_tolerance", None, "--goal-tolerance"),
+                              ("min_control_steps", None, "--min-control-steps"),
+                              ("max_control_steps", None, "--max-control-steps"),
+                              ("parallel", 1, "--parallel"), ("robot", None, "--robot"))
+"""(request field, its value when not given, option): what only a control search takes (a
+geometric search plans every robot of the query together, in this process)."""
+
+
+def _geometric_search(request: PlanRequest, build_plan, stop) -> GeometricOutcome:
+    """The problem's query searched over Odin's geometry (gui.planning.geometric)."""
+    from dataclasses import replace
+
+    from gui.planning.geometric import RESOLUTION, GeometricSettings, solve
+    for name, unset, option in GEOMETRIC_ONLY_FOR_CONTROL:
+        if getattr(request, name) != unset:
+            raise GuiError(f"{option}: only a search of a problem for one of Kautham's ODE "
+                           "planners takes it; this problem is planned geometrically")
+    settings = GeometricSettings.of_problem(build_plan)
+    settings = replace(settings, planner=request.planner or settings.planner,
+                       time_limit=request.time if request.time is not None
+                       else settings.time_limit,
+                       resolution=request.resolution or RESOLUTION)
+    seed = request.seed if request.seed is not None else _fresh_seed(1)
+    print(f"plan: {settings.planner} searching for up to {settings.time_limit:g} s, seed "
+          f"{seed} (--seed {seed} repeats it)", flush=True)
+    result = solve(build_plan, settings, seed, stop)
+    print(json.dumps(result.statistics(), indent=1), flush=True)
+    return GeometricOutcome(result, settings.time_limit, seed, build_plan)
+
+
+def search(request: PlanRequest, stop: Callable[[], bool]):
+    """Says what it searches, with the seed, searches, then prints the statistics; a
+    PlanOutcome, or a GeometricOutcome for a problem without physics. ``stop()`` true
+    (Ctrl-C) ends the search and raises KeyboardInterrupt."""
     from gui.planning import bridge
-    make_backend, time_limit = _backends(request)
+    if request.backend is Backend.POOL:
+        _pool_namespaces(request)           # a bad --worlds is said before anything waits
+        check_master(TOOL, request.world_timeout)
+    build_plan = request.problem.read()
+    if not build_plan.physics:
+        return _geometric_search(request, build_plan, stop)
+    if request.resolution is not None:
+        raise GuiError("--resolution: only a geometric search takes it; this problem is "
+                       "for one of Kautham's ODE planners")
+    planner = request.planner or "KPIECE1"
+    make_backend, time_limit = _backends(request, build_plan)
     seed = request.seed if request.seed is not None else _fresh_seed(request.parallel)
-    searching = (f"plan: {request.planner} searching for up to {time_limit:g} s, seed {seed}"
+    searching = (f"plan: {planner} searching for up to {time_limit:g} s, seed {seed}"
                  f"{request.searches()} (--seed {seed} repeats it)")
     if request.parallel == 1:
         backend = make_backend(0)
         print(searching, flush=True)        # once the world is built: the search starts now
         try:
-            result = bridge.plan(backend, request.planner, time_limit, seed, stop)
+            result = bridge.plan(backend, planner, time_limit, seed, stop)
         finally:
             backend.close()
         print(json.dumps(result.statistics(), indent=1), flush=True)
         return PlanOutcome(result, time_limit, seed)
     from gui.planning.parallel import plan_in_parallel
     print(searching, flush=True)
-    result, outcomes = plan_in_parallel(make_backend, request.parallel, request.planner,
+    result, outcomes = plan_in_parallel(make_backend, request.parallel, planner,
                                         time_limit, seed, stop)
     print(json.dumps({**result.statistics(), "searches": [o.summary() for o in outcomes]},
                      indent=1), flush=True)
@@ -104,7 +192,7 @@ def _fresh_seed(searches: int) -> int:
     return 1 + int.from_bytes(os.urandom(4), "little") % ((MAX_SEED + 1) // 2 - 1 - searches)
 
 
-def _backends(request: PlanRequest) -> Tuple[Callable[[int], object], float]:
+def _backends(request: PlanRequest, build_plan) -> Tuple[Callable[[int], object], float]:
     """(make_backend(k): the back end of search k of ``request.parallel``, the searches'
     time limit s). Every search's back end holds the problem's world: the Core builds one in
     the process calling it; with the pool, search k gets every ``request.parallel``-th world
@@ -114,8 +202,6 @@ def _backends(request: PlanRequest) -> Tuple[Callable[[int], object], float]:
         raise GuiError(f"--parallel {request.parallel}: need 1 or more searches")
     if request.backend is Backend.POOL:
         namespaces = _pool_namespaces(request)
-        check_master(TOOL, request.world_timeout)
-    build_plan = request.problem.read()
     settings = SearchSettings.of_problem(build_plan, goal_tolerance=request.goal_tolerance,
                                          min_control_steps=request.min_control_steps,
                                          max_control_steps=request.max_control_steps)
@@ -149,29 +235,21 @@ def _pool_namespaces(request: PlanRequest) -> list:
     return namespaces
 
 
-def _write(request: PlanRequest, outcome: PlanOutcome) -> None:
-    """The motion plan written to ``request.out`` as a control path, its comments saying
-    how it was made."""
-    from gui.core.control_path import write_control_path
-    result = outcome.result
-    write_control_path(request.out, result.rows, comments=(
-        f"control path planned by rosrun GUI plan {request.problem.path}",
-        f"planner {request.planner}, seed {result.seed}, {result.time_s:.2f} s, "
-        f"ends {result.goal_distance:.4f} m from the goal",
-        "each row: the robot's controls in [0, 1], then the duration (s)"))
-    print(f"plan: {len(result.rows)} rows ({result.duration:.3f} s) written to {request.out}")
-
-
 def _parser() -> ToolParser:
     from gui.planning.bridge import MAX_SEED, PLANNERS
+    from gui.planning.geometric import OMPL_PLANNERS, RESOLUTION
     from gui.planning.parallel import MAX_SEARCHES
     from gui.planning.problem import MAX_CONTROL_STEPS
     parser = ToolParser(
-        prog=TOOL, description="Plan a Kautham physics problem's query with an OMPL control "
-        "planner through Odin's world; write the solution as a control path.")
+        prog=TOOL, description="Plan a Kautham problem's query: a physics problem with an "
+        "OMPL control planner through Odin's world (written as a control path), any other "
+        "with an OMPL geometric planner over Odin's geometry (written as a Kautham task "
+        "file).")
     parser.add_argument("problem", help="the problem XML file")
-    parser.add_argument("--planner", default="KPIECE1",
-                        help=f"OMPL control planner: {', '.join(PLANNERS)} [KPIECE1]")
+    parser.add_argument("--planner", default=None,
+                        help=f"OMPL planner: for a physics problem a control planner, "
+                        f"{', '.join(PLANNERS)} [KPIECE1]; for any other a geometric one, "
+                        f"{', '.join(OMPL_PLANNERS)} [the problem's]")
     parser.add_argument("--time", type=seconds, default=None, metavar="S",
                         help="wall-clock seconds the planner may search [the problem's "
                         "\"_Max Planning Time\", else 10]")
@@ -201,6 +279,10 @@ def _parser() -> ToolParser:
                         help="N independent searches at once, seeds SEED..SEED+N-1, each in a "
                         "process with a back end of its own (pool: its share of --worlds); "
                         "the first solution wins [1]")
+    parser.add_argument("--resolution", type=float, default=None, metavar="M",
+                        help="a geometric search: no link moves more than M between two "
+                        "checked configurations of a motion, so none goes deeper than M/2 "
+                        f"into anything [{RESOLUTION}]")
     add_build_options(parser)
     return parser
 
@@ -211,7 +293,8 @@ def _request(args) -> PlanRequest:
         seed=args.seed, backend=Backend(args.backend), worlds=args.worlds,
         world_timeout=args.world_timeout, robot=args.robot,
         goal_tolerance=args.goal_tolerance, min_control_steps=args.min_control_steps,
-        max_control_steps=args.max_control_steps, parallel=args.parallel)
+        max_control_steps=args.max_control_steps, parallel=args.parallel,
+        resolution=args.resolution)
 
 
 @one_line_errors(TOOL)
@@ -223,14 +306,12 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         with stop_on_ctrl_c() as stop:
             outcome = search(request, stop)
         if not outcome.result.solved:
-            return fail(TOOL, GuiError(
-                f"{request.problem.path}: no solution within {outcome.time_limit:g} s "
-                f"({request.planner}, seed {outcome.seed}{request.searches()}): the closest "
-                f"plan ends {outcome.result.goal_distance:.3f} m from the goal")) - 1
-        _write(request, outcome)
+            return fail(TOOL, GuiError(outcome.failure(request))) - 1
+        outcome.write(request)
     except (OdinError, OSError) as error:   # an OSError as it is, not by its class
         return fail(TOOL, error)
     return 0
 
 
-__all__ = ["DEFAULT_TIME_LIMIT_S", "Backend", "PlanOutcome", "PlanRequest", "main", "search"]
+__all__ = ["DEFAULT_TIME_LIMIT_S", "Backend", "GeometricOutcome", "PlanOutcome", "PlanRequest",
+           "main", "search"]

@@ -84,6 +84,11 @@ PLANNER_SEARCH = {"Min Control Steps": "min_control_steps",
                   "Max Control Steps": "max_control_steps", "Goal Bias": "goal_bias",
                   "Max Speed": "max_speed", "_Max Planning Time": "time_limit"}
 """The ODE planners' parameters Odin's planning bridge uses (PlannerSearch field names)."""
+PLANNER_GEOMETRIC = {"Range": "range", "Goal Bias": "goal_bias",
+                     "_Max Planning Time": "time_limit", "Max Planning Time": "time_limit",
+                     "Simplify Solution": "simplify"}
+"""The geometric planners' parameters Odin's geometric planning uses (gui.planning.geometric:
+GeometricSettings field names)."""
 _WHOLE_PARAMETERS = ("max_contacts", "min_control_steps", "max_control_steps")
 
 _ROBOT_CHILDREN = {
@@ -339,21 +344,25 @@ class _Loader:
         name_node = parameters.find("Name")
         name = name_node.text.strip() if name_node is not None else ""
         physics = name in PHYSICS_PLANNERS
-        values, search, unused = {}, {}, []
+        values, search, geometric, unused = {}, {}, {}, []
         for parameter in parameters.findall("Parameter"):
             pname = (parameter.get("name") or "").strip()
-            field = PLANNER_PHYSICS.get(pname, PLANNER_SEARCH.get(pname)) if physics else None
+            field = PLANNER_PHYSICS.get(pname, PLANNER_SEARCH.get(pname)) if physics else \
+                PLANNER_GEOMETRIC.get(pname)
             if field is None:
                 unused.append(pname)
                 continue
             try:
                 value = parse_text_number(parameter)
             except ProblemError:
-                if self.current:
+                if self.current and physics:    # a physics setting Odin cannot read
                     raise
                 unused.append(pname)
                 continue
             value = _planner_parameter(parameter, pname, field, value)
+            if not physics:
+                geometric[field] = value
+                continue
             (values if pname in PLANNER_PHYSICS else search)[field] = value
         if unused:
             self.ignore(parameters, f"planner {name or '(unnamed)'} parameters "
@@ -367,7 +376,7 @@ class _Loader:
                         "the problem is built without Kautham's physics (no ground, "
                         "obstacles with a mass only are bodies)")
         return Planner(name, physics, PlannerPhysics(**values), PlannerSearch(**search),
-                       node.path, parameters.line)
+                       tuple(geometric.items()), node.path, parameters.line)
 
     def _query(self, planner: Node, robots: List[Instance]) -> None:
         queries = planner.find("Queries")
@@ -468,7 +477,7 @@ def _planner_parameter(node: Node, name: str, field: str, value: float):
         return int(value)
     if field == "goal_bias" and not 0.0 <= value <= 1.0:
         raise node.error(f"Goal Bias {node.text.strip()!r} is not in [0, 1]")
-    if field in ("max_speed", "time_limit") and not value > 0.0:
+    if field in ("max_speed", "time_limit", "range") and not value > 0.0:
         raise node.error(f"{name} {node.text.strip()!r} is not positive")
     return value
 

@@ -1,0 +1,615 @@
+"""Kautham's geometric queries solved with OMPL's geometric planners over Odin's own geometry
+(ROS-free; OMPL 2 from PyPI).
+
+The space is Kautham's: the problem's control space [0, 1]^k (the query's ``<Init>`` and
+``<Goal>``), each vector mapped through every robot's controls to its joints and base
+(``gui.core.kautham.controls``; a 2012 problem's robots each take their own slice of it, a
+current problem's robots the whole vector). Distances are Euclidean there, as in Kautham.
+
+A state is valid when no link the controls move touches anything (``GeometricWorld``): the
+problem's scene is built in a VirtualWorld Core of this process and asked Check Collision with
+the robots' links placed by forward kinematics (ODE's collision detection, no contacts made,
+nothing stepped). Pairs of parts that no control moves relative to each other (a fixed base on
+its table) are not asked about: they are as the problem built them whatever the path does;
+bodies joined by a joint (adjacent links) never collide in the world, and parts built inside
+each other are exempt there (gui.core.overlaps).
+
+A motion is valid when every configuration along it is (``GeometricWorld.motion_checks``):
+along a straight segment of the control space each joint value changes monotonically (linear,
+then clamped to its limits), so no point of a link moves farther than
+``sum_j |delta q_j| r_j`` (revolute joints: r_j bounds the distance from the joint to any point
+beyond it; prismatic joints and a base's translation: their own change), plus, for a base that
+turns, the turn's angle times the robot's reach. The segment is checked at enough points that
+no link moves more than ``resolution`` between two of them: a link at any configuration of a
+valid motion is then within ``resolution / 2`` of a collision-free placement, so no link goes
+deeper than that into anything (1 mm with the default 2 mm).
+
+``solve(plan, settings)`` answers a ``GeometricResult``; ``solve_file(problem_file, ...)``
+loads and plans a Kautham file first.
+"""
+from __future__ import annotations
+
+import logging
+import math
+import time
+from dataclasses import dataclass, replace
+from typing import Callable, Dict, List, Optional, Sequence, Tuple
+
+import numpy as np
+
+from gui.core.kinematics import pose_to_position_quaternion
+from gui.core.model import PRISMATIC
+from gui.core.plan import BuildPlan
+from gui.errors import PlanningError
+
+GEOMETRIC_PLANNERS = {
+    "omplRRTConnect": "RRTConnect", "omplRRT": "RRT", "omplPRM": "PRM",
+    "omplRRTStar": "RRTstar", "omplKPIECE": "KPIECE1", "omplKPIECE1": "KPIECE1",
+    "omplBKPIECE": "BKPIECE1", "omplLBKPIECE": "LBKPIECE1", "omplPRMstar": "PRMstar",
+    "omplFMT": "FMT", "omplBITstar": "BITstar", "PRM": "PRM",
+}
+"""Kautham's geometric planners and the OMPL planner that runs each (the same algorithm)."""
+NEAREST_PLANNERS = {
+    "omplRRTStarPMD": "RRTstar", "omplLazyRRT": "RRT", "omplpRRT": "RRT", "omplEST": "KPIECE1",
+    "omplSBL": "LBKPIECE1", "omplpSBL": "LBKPIECE1", "omplLazyPRM": "PRM",
+    "omplTRRT": "RRT", "omplRRTConnectPMD": "RRTConnect",
+}
+"""Kautham's geometric planners that OMPL's Python wheel lacks, and the nearest it has (said in
+one warning)."""
+OMPL_PLANNERS = ("RRTConnect", "RRT", "RRTstar", "PRM", "PRMstar", "KPIECE1", "BKPIECE1",
+                 "LBKPIECE1", "FMT", "BITstar")
+"""The geometric planners ``--planner`` may name (OMPL's class names)."""
+DEFAULT_TIME_LIMIT = 10.0
+"""s: a search's time when the problem gives none (Kautham's default _Max Planning Time)."""
+SIMPLIFY_MIN_S = 1.0
+"""s: the least a found path's simplification is given when the search used its time."""
+CHECKS_BETWEEN_CLOCKS = 16
+"""A motion's checks between two readings of the search's clock (a check takes about 1 ms)."""
+RESOLUTION = 0.002
+"""m: the largest motion of any link point between two checked configurations of a motion:
+no link goes deeper than half of it into anything along a valid motion (module docstring)."""
+RESOLUTION_RANGE = (1e-4, 0.1)
+"""m: the resolutions a search takes (finer: a motion of a metre would be 10,000 checks)."""
+
+log = logging.getLogger("gui.planning.geometric")
+
+
+@dataclass(frozen=True)
+class GeometricSettings:
+    """How one search runs: ``planner`` (an OMPL class name of ``OMPL_PLANNERS``),
+    ``time_limit`` s of wall clock, ``range`` (Kautham's Range: the longest motion a tree
+    extends by, in control-space units; None: OMPL's default), ``goal_bias`` (None: OMPL's),
+    ``simplify`` (shortcut and smooth the path found, as Kautham's Simplify Solution),
+    ``resolution`` m (module docstring)."""
+    planner: str = "RRTConnect"
+    time_limit: float = DEFAULT_TIME_LIMIT
+    range: Optional[float] = None
+    goal_bias: Optional[float] = None
+    simplify: bool = True
+    resolution: float = RESOLUTION
+
+    @classmethod
+    def of_problem(cls, plan: BuildPlan) -> "GeometricSettings":
+        """The problem's planner and parameters as Kautham would run them."""
+        planner = plan.problem.planner
+        if planner is None or not planner.name:
+            return cls()
+        name = GEOMETRIC_PLANNERS.get(planner.name)
+        if name is None and planner.name in NEAREST_PLANNERS:
+            name = NEAREST_PLANNERS[planner.name]
+            log.warning("planner %s: OMPL's Python wheel has no such planner; %s, the nearest, "
+                        "plans instead", planner.name, name)
+        if name is None:
+            raise PlanningError(f"planner {planner.name!r} is not one of Kautham's geometric "
+                                f"planners Odin runs ({', '.join(sorted(GEOMETRIC_PLANNERS))})")
+        given = dict(planner.geometric)
+        return cls(planner=name, time_limit=given.get("time_limit", DEFAULT_TIME_LIMIT),
+                   range=given.get("range"), goal_bias=given.get("goal_bias"),
+                   simplify=bool(given.get("simplify", 1.0)))
+
+    def check(self) -> None:
+        if self.planner not in OMPL_PLANNERS:
+            raise PlanningError(f"unknown geometric planner {self.planner!r}: one of "
+                                f"{', '.join(OMPL_PLANNERS)}")
+        if not (math.isfinite(self.time_limit) and self.time_limit > 0):
+            raise PlanningError(f"time {self.time_limit!r} s must be positive")
+        if self.range is not None and not (math.isfinite(self.range) and self.range > 0):
+            raise PlanningError(f"Range {self.range!r} must be positive")
+        low, high = RESOLUTION_RANGE
+        if not (math.isfinite(self.resolution) and low <= self.resolution <= high):
+            raise PlanningError(f"resolution {self.resolution!r} m must be in [{low:g}, "
+                                f"{high:g}] m")
+
+
+@dataclass(frozen=True)
+class GeometricResult:
+    """What a search found. ``solved``: a path from the query's start to its goal exactly;
+    ``path``: its states (n, k) in the control space ([0, 1]^k, empty when none);
+    ``configurations``: per state, each robot's (base pose (4, 4), joints (rad or m));
+    ``time_s``: wall-clock seconds of the search; ``states``: the states of the path;
+    ``checks``: configurations checked for collision during the search; ``length``: the
+    path's length in the control space; ``status``: OMPL's planner status."""
+    planner: str
+    seed: Optional[int]
+    solved: bool
+    path: np.ndarray
+    time_s: float
+    checks: int
+    length: float
+    status: str
+
+    @property
+    def states(self) -> int:
+        return len(self.path)
+
+    def statistics(self) -> dict:
+        """The result as JSON values (``rosrun GUI plan``'s statistics)."""
+        return {"planner": self.planner, "seed": self.seed, "solved": self.solved,
+                "exact": self.solved, "time_s": round(self.time_s, 6),
+                "states": self.states, "collision_checks": self.checks,
+                "collision_checks_per_s": round(self.checks / self.time_s, 1)
+                if self.time_s > 0 else None,
+                "path_length": round(self.length, 9), "status": self.status}
+
+
+# -- the robots as the control space moves them ---------------------------------------------
+class _Robot:
+    """One robot of the plan: its slice of the control vector and the bodies it moves, with
+    the bounds of how far a change of its joints or base moves any point of them."""
+
+    def __init__(self, handle, part: slice, specs: Dict[str, object]):
+        self.handle = handle
+        self.part = part
+        model = handle.instance.model
+        self.links = model.links
+        self.movable = model.movable_links()
+        self.moves_base = bool(handle.instance.controls.se3)
+        self.radii = _body_radii(handle, specs)
+        self.reach = _reach(model, self.radii)          # m, from the base frame's origin
+        self.arms = [_joint_arm(model, i, self.radii) for i in self.movable]
+        moved = set(self.movable)
+        for i, link in enumerate(self.links):         # a child of a moved link moves too
+            if link.parent in moved:
+                moved.add(i)
+        if self.moves_base:
+            moved = set(range(len(self.links)))
+        self.moved_bodies = {handle.bodies[i].body_id for i in moved}
+
+    def configuration(self, controls: np.ndarray):
+        """(base pose (4, 4), joint values) the control vector puts this robot in."""
+        c = self.handle.instance.controls.configuration(self.handle.instance,
+                                                        controls[self.part])
+        return c.base_pose, c.joints
+
+    def poses(self, configuration) -> list:
+        base, joints = configuration
+        return self.handle.situations(joints, base)
+
+    def motion_bound(self, a, b) -> float:
+        """m: no point of this robot's links moves farther than this along the straight
+        segment of the control space from configuration ``a`` to ``b`` (module docstring)."""
+        (base_a, q_a), (base_b, q_b) = a, b
+        bound = 0.0
+        for arm, i, da in zip(self.arms, self.movable, np.abs(q_b - q_a)):
+            bound += da if self.links[i].joint == PRISMATIC else da * arm
+        if self.moves_base:
+            bound += float(np.linalg.norm(base_b[:3, 3] - base_a[:3, 3]))
+            bound += _angle(base_a[:3, :3], base_b[:3, :3]) * self.reach
+        return bound
+
+
+def _body_radii(handle, specs: Dict[str, object]) -> List[float]:
+    """Per link, m: the largest distance from the link frame's origin to any point of its
+    body's geometry (``specs``: the plan's body specs by ID)."""
+    return [float(np.linalg.norm(body.offset[:3, 3])) + _spec_radius(specs[body.body_id])
+            for body in handle.bodies]
+
+
+def _spec_radius(spec) -> float:
+    parts = getattr(spec, "parts", None)
+    if parts is None:
+        return _shape_radius(spec)
+    return max((float(np.linalg.norm(p.position)) + _shape_radius(p) for p in parts),
+               default=0.0)
+
+
+def _shape_radius(shape) -> float:
+    """m: the largest distance from a shape's frame origin to a point of it."""
+    from odin_common.interface import Shape, shape_of
+    values = np.asarray(shape.parameters, dtype=float)
+    kind = shape_of(len(values), shape.shape)
+    if kind == Shape.SPHERE:
+        return float(values[0])
+    if kind == Shape.CYLINDER:
+        return float(math.hypot(values[0], values[1] / 2))
+    if kind == Shape.CAPSULE:
+        return float(values[0] + values[1] / 2)
+    if kind == Shape.BOX:
+        return float(np.linalg.norm(values[:3]) / 2)
+    if kind == Shape.MESH and values.size:
+        return float(np.max(np.linalg.norm(values.reshape(-1, 3), axis=1)))
+    return 0.0
+
+
+def _chain_length(model, ancestor: int, link: int) -> float:
+    """m: an upper bound of the distance from link ``ancestor``'s joint frame to link
+    ``link``'s frame, whatever the joints between them (the lengths of their offsets, a
+    prismatic joint's full travel)."""
+    total = 0.0
+    i = link
+    while i is not None and i != ancestor:
+        current = model.links[i]
+        total += _offset_length(current)
+        i = current.parent
+    return total + float(np.linalg.norm(model.links[ancestor].post[:3, 3]))
+
+
+def _offset_length(link) -> float:
+    length = float(np.linalg.norm(link.pre[:3, 3]) + np.linalg.norm(link.post[:3, 3]))
+    if link.movable and link.joint == PRISMATIC and link.limits is not None:
+        length += max(abs(link.limits[0]), abs(link.limits[1]))
+    return length
+
+
+def _descendants(model, index: int) -> List[int]:
+    out, frontier = [index], [index]
+    while frontier:
+        parent = frontier.pop()
+        children = [i for i, link in enumerate(model.links) if link.parent == parent]
+        out += children
+        frontier += children
+    return out
+
+
+def _joint_arm(model, index: int, radii: Sequence[float]) -> float:
+    """m: bounds the distance from movable joint ``index``'s axis to any point of the links it
+    moves (its link and all beyond it)."""
+    return max(_chain_length(model, index, i) + radii[i] for i in _descendants(model, index))
+
+
+def _reach(model, radii: Sequence[float]) -> float:
+    """m: bounds the distance from the base frame's origin to any point of the robot."""
+    return max(_chain_length(model, 0, i) + _offset_length(model.links[0]) + radii[i]
+               for i in range(len(model.links)))
+
+
+def _angle(a: np.ndarray, b: np.ndarray) -> float:
+    """rad: the angle of the rotation from ``a`` to ``b`` (3, 3)."""
+    cosine = (np.trace(a.T @ b) - 1.0) / 2.0
+    return float(math.acos(max(-1.0, min(1.0, cosine))))
+
+
+def _robot_parts(plan: BuildPlan) -> List[Tuple[object, slice]]:
+    """Each robot with controls and its slice of the query's control vector: a current
+    problem's robots all map the whole vector, a 2012 problem's robots each the next
+    ``size`` values in robot order (gui.core.kautham.problem's query)."""
+    robots = [h for h in plan.robots if h.instance.controls is not None]
+    if not robots:
+        raise PlanningError("no robot of the problem has controls to plan with")
+    if plan.problem.format != "2012":
+        return [(h, slice(None)) for h in robots]
+    parts, end = [], 0
+    for handle in robots:
+        size = handle.instance.controls.size
+        parts.append((handle, slice(end, end + size)))
+        end += size
+    return parts
+
+
+def _robots(plan: BuildPlan) -> List[_Robot]:
+    specs = {spec.id: spec for spec in plan.bodies()}
+    return [_Robot(h, part, specs) for h, part in _robot_parts(plan)]
+
+
+def query(plan: BuildPlan) -> Tuple[np.ndarray, np.ndarray]:
+    """The query's start and goal in the control space (k,): PlanningError without one."""
+    parts = _robot_parts(plan)
+    if any(h.start is None or h.goal is None or h.start.controls is None
+           or h.goal.controls is None for h, _ in parts):
+        raise PlanningError("the problem has no query (<Init> and <Goal>) to plan")
+    if parts[0][1] == slice(None):
+        handle = parts[0][0]
+        return np.array(handle.start.controls, float), np.array(handle.goal.controls, float)
+    return (np.concatenate([np.array(h.start.controls, float) for h, _ in parts]),
+            np.concatenate([np.array(h.goal.controls, float) for h, _ in parts]))
+
+
+# -- the scene and its collision queries ------------------------------------------------------
+class GeometricWorld:
+    """The problem's scene in a Core of this process, asked whether configurations of the
+    control space collide (module docstring). ``checks``: configurations asked so far."""
+
+    def __init__(self, plan: BuildPlan, resolution: float = RESOLUTION):
+        from gui.planning.core_world import CoreWorld
+        self.resolution = resolution
+        self.robots = _robots(plan)
+        self.world = CoreWorld()
+        try:
+            self.world.execute(plan)
+            core = self.world.core
+            self.moved = {name for r in self.robots for body in r.moved_bodies
+                          for name in core.geometry_names(body)}
+        except Exception:
+            self.world.close()
+            raise
+        self.size = len(query(plan)[0])
+        self.checks = 0
+
+    def close(self) -> None:
+        self.world.close()
+
+    def configurations(self, controls: Sequence[float]) -> list:
+        """Each robot's (base pose, joints) for the control vector."""
+        c = np.asarray(controls, dtype=float)
+        return [r.configuration(c) for r in self.robots]
+
+    def collisions(self, controls: Sequence[float]) -> list:
+        """The pairs (first, second, depth m) a control vector's configuration makes that a
+        control moves (module docstring), deepest first."""
+        self.checks += 1
+        poses = [pose for r, conf in zip(self.robots, self.configurations(controls))
+                 for pose in r.poses(conf)]
+        found = [(c.first, c.second, c.depth) for c in self.world.core.check_collision(poses)
+                 if c.first in self.moved or c.second in self.moved]
+        return sorted(found, key=lambda pair: -pair[2])
+
+    def valid(self, controls: Sequence[float]) -> bool:
+        return not self.collisions(controls)
+
+    def motion_points(self, a: Sequence[float], b: Sequence[float]) -> List[np.ndarray]:
+        """The configurations to check along the straight segment from ``a`` to ``b`` (both
+        ends excluded, ``b`` appended): consecutive ones move no link point farther than the
+        resolution (module docstring)."""
+        a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+        points, fractions = [], [0.0, 1.0]
+        configurations = {0.0: self.configurations(a), 1.0: self.configurations(b)}
+        k = 0
+        while k < len(fractions) - 1:
+            low, high = fractions[k], fractions[k + 1]
+            bound = max(r.motion_bound(ca, cb) for r, ca, cb in
+                        zip(self.robots, configurations[low], configurations[high]))
+            pieces = math.ceil(bound / self.resolution) if bound > self.resolution else 1
+            if pieces > 1:
+                inner = [low + (high - low) * j / pieces for j in range(1, pieces)]
+                for f in inner:
+                    configurations[f] = self.configurations(a + f * (b - a))
+                fractions[k + 1:k + 1] = inner
+                continue
+            k += 1
+        for f in fractions[1:]:
+            points.append(a + f * (b - a))
+        return points
+
+
+def _bisection_order(count: int) -> List[int]:
+    """0..count-1, the last first, then halves, quarters...: an invalid motion is found after
+    few checks (OMPL's DiscreteMotionValidator checks in this order too)."""
+    order, seen = [count - 1], {count - 1}
+    step = count
+    while len(order) < count:
+        step = max(1, step // 2)
+        for i in range(step - 1, count, step):
+            if i not in seen:
+                seen.add(i)
+                order.append(i)
+    return order
+
+
+# -- the search ---------------------------------------------------------------------------------
+def _ompl():
+    from ompl import base as ob, geometric as og, util as ou
+    return ob, og, ou
+
+
+class _Search:
+    """The OMPL objects of one search, kept together (OMPL holds raw pointers between them);
+    a callback's exception is kept and raised after the search (it must not cross into C++)."""
+
+    def __init__(self, world: GeometricWorld, settings: GeometricSettings,
+                 start: np.ndarray, goal: np.ndarray, over: Callable[[], bool]):
+        ob, og, ou = _ompl()
+        ou.setLogLevel(ou.LOG_WARN)
+        self.world = world
+        self.over = over
+        self.error: Optional[BaseException] = None
+        size = world.size
+        self.space = ob.RealVectorStateSpace(size)
+        unit = ob.RealVectorBounds(size)
+        unit.setLow(0.0)
+        unit.setHigh(1.0)
+        self.space.setBounds(unit)
+        self.setup = og.SimpleSetup(self.space)
+        self.si = self.setup.getSpaceInformation()
+        self.setup.setStateValidityChecker(self._valid)
+        self.validator = _motion_validator(ob, self.si, self)
+        self.si.setMotionValidator(self.validator)
+        self.start, self.goal = self.si.allocState(), self.si.allocState()
+        for i in range(size):
+            self.start[i], self.goal[i] = float(start[i]), float(goal[i])
+        self.setup.setStartAndGoalStates(self.start, self.goal)
+        self.planner = getattr(og, settings.planner)(self.si)
+        if settings.range is not None and hasattr(self.planner, "setRange"):
+            self.planner.setRange(settings.range)
+        if settings.goal_bias is not None and hasattr(self.planner, "setGoalBias"):
+            self.planner.setGoalBias(settings.goal_bias)
+        self.setup.setPlanner(self.planner)
+        self.setup.setup()
+
+    def vector(self, state) -> np.ndarray:
+        return np.fromiter((state[i] for i in range(self.world.size)), float, self.world.size)
+
+    def _valid(self, state) -> bool:
+        try:
+            return self.world.valid(self.vector(state))
+        except BaseException as error:      # noqa: B902 - raised by solve()
+            self.error = self.error or error
+            return False
+
+    def motion(self, s1, s2) -> bool:
+        try:
+            a, b = self.vector(s1), self.vector(s2)
+            points = self.world.motion_points(a, b)
+            for k, i in enumerate(_bisection_order(len(points))):
+                if k % CHECKS_BETWEEN_CLOCKS == 0 and self.over():
+                    return False        # the search is over: this motion is not taken
+                if not self.world.valid(points[i]):
+                    return False
+            return True
+        except BaseException as error:      # noqa: B902 - raised by solve()
+            self.error = self.error or error
+            return False
+
+
+def _motion_validator(ob, si, search: _Search):
+    class Motions(ob.MotionValidator):
+        """Every configuration along the motion checked at the world's resolution."""
+
+        def __init__(self, si):
+            super().__init__(si)
+
+        def checkMotion(self, s1, s2, *last_valid) -> bool:
+            return search.motion(s1, s2)
+
+    return Motions(si)
+
+
+def check_query(world: GeometricWorld, start: np.ndarray, goal: np.ndarray) -> None:
+    """PlanningError naming the deepest pair when the query's start or goal collides."""
+    for what, controls in (("start", start), ("goal", goal)):
+        pairs = world.collisions(controls)
+        if pairs:
+            first, second, depth = pairs[0]
+            more = f" (and {len(pairs) - 1} more pairs)" if len(pairs) > 1 else ""
+            raise PlanningError(f"the query's {what} collides: {first} is {depth * 1000:.1f} mm "
+                                f"into {second}{more}")
+
+
+def solve(plan: BuildPlan, settings: Optional[GeometricSettings] = None,
+          seed: Optional[int] = None, stop: Optional[Callable[[], bool]] = None
+          ) -> GeometricResult:
+    """Searches ``plan``'s query with ``settings`` (None: the problem's own,
+    ``GeometricSettings.of_problem``), OMPL seeded with ``seed`` (gui.planning.bridge
+    .seed_ompl: a process's first search only). ``stop()`` true ends the search at the
+    planner's next iteration and raises KeyboardInterrupt. PlanningError before the search
+    when the problem has no query, or its start or goal collides."""
+    from gui.planning.bridge import seed_ompl
+    settings = GeometricSettings.of_problem(plan) if settings is None else settings
+    settings.check()
+    start, goal = query(plan)
+    if seed is not None:
+        seed_ompl(seed)
+    world = GeometricWorld(plan, settings.resolution)
+    try:
+        check_query(world, start, goal)
+        return _search(world, settings, start, goal, seed, stop)
+    finally:
+        world.close()
+
+
+def _search(world: GeometricWorld, settings: GeometricSettings, start, goal, seed,
+            stop) -> GeometricResult:
+    ob, og, _ = _ompl()
+    deadline = time.monotonic() + settings.time_limit
+    search: Optional[_Search] = None
+
+    def over() -> bool:
+        """OMPL's termination condition, asked once per planner iteration (and during a
+        motion's checks)."""
+        return time.monotonic() >= deadline or (search is not None and search.error is not None) \
+            or (stop is not None and bool(stop()))
+
+    search = _Search(world, settings, start, goal, over)
+    checks_before = world.checks
+    started = time.perf_counter()
+
+    status = search.setup.solve(ob.PlannerTerminationCondition(over))
+    if stop is not None and stop():
+        raise KeyboardInterrupt
+    if search.error is not None:
+        raise PlanningError(f"collision checking failed: {search.error}") from search.error
+    solved = bool(search.setup.haveExactSolutionPath())
+    path = np.empty((0, world.size))
+    length = 0.0
+    if solved:
+        if settings.simplify:
+            _simplify(ob, search, deadline, stop)
+        geometric = search.setup.getSolutionPath()
+        path = np.array([search.vector(geometric.getState(i))
+                         for i in range(geometric.getStateCount())])
+        length = float(np.sum(np.linalg.norm(np.diff(path, axis=0), axis=1)))
+    elapsed = time.perf_counter() - started
+    return GeometricResult(settings.planner, seed, solved, path, elapsed,
+                           world.checks - checks_before, length, str(status))
+
+
+def _simplify(ob, search: _Search, deadline: float, stop) -> None:
+    """Shortcuts and smooths the solution (Kautham's Simplify Solution) in what is left of
+    the search's time, SIMPLIFY_MIN_S at least; a motion's checks run to their end here (a
+    motion cut short would look invalid to the simplifier, which keeps the path it had)."""
+    until = max(deadline, time.monotonic() + SIMPLIFY_MIN_S)
+    search.over = lambda: False
+    search.setup.simplifySolution(ob.PlannerTerminationCondition(
+        lambda: time.monotonic() >= until or (stop is not None and bool(stop()))))
+
+
+def solve_file(problem_file, seed: Optional[int] = None, time_limit: Optional[float] = None,
+               planner: Optional[str] = None) -> GeometricResult:
+    """``solve`` for a Kautham problem file, built as ``rosrun GUI load_problem`` builds it
+    (its warnings silenced); ``time_limit`` s and ``planner`` (OMPL's name) override the
+    problem's."""
+    from gui.core.kautham.problem import load_problem
+    from gui.core.translate import plan_problem
+    logging.disable(logging.WARNING)
+    try:
+        plan = plan_problem(load_problem(problem_file))
+    finally:
+        logging.disable(logging.NOTSET)
+    settings = GeometricSettings.of_problem(plan)
+    if time_limit is not None:
+        settings = replace(settings, time_limit=time_limit)
+    if planner is not None:
+        settings = replace(settings, planner=planner)
+    return solve(plan, settings, seed)
+
+
+def task_rows(plan: BuildPlan, path: np.ndarray) -> List[List[float]]:
+    """Each state of ``path`` as a Kautham task file's ``<Conf>`` row: per robot in the
+    problem's order, for one whose controls move its base its position x y z (m, world) and
+    orientation qx qy qz qw, then a value per link but the base (rad or m; 0 for a fixed
+    joint), as Kautham's GUI writes them (gui.core.kautham.solutions reads them back)."""
+    robots = _robots(plan)
+    rows = []
+    for controls in np.asarray(path, dtype=float):
+        row: List[float] = []
+        for robot in robots:
+            base, joints = robot.configuration(controls)
+            if robot.moves_base:
+                position, (w, x, y, z) = pose_to_position_quaternion(base)
+                row += [float(v) for v in position] + [float(x), float(y), float(z), float(w)]
+            values = dict(zip(robot.movable, joints))
+            row += [float(values.get(i, 0.0)) for i in range(1, len(robot.links))]
+        rows.append(row)
+    return rows
+
+
+def write_task(path, name: str, rows: Sequence[Sequence[float]]) -> None:
+    """Writes ``rows`` (``task_rows``) as a Kautham task file of one ``<Transit>``, through
+    a file beside it renamed into place (a reader never sees half a file)."""
+    import os
+    import pathlib
+    from xml.sax.saxutils import quoteattr
+    target = pathlib.Path(path)
+    text = f"<Task name={quoteattr(name)}>\n<Transit>\n" + "".join(
+        "<Conf> " + " ".join(repr(float(v)) for v in row) + " </Conf>\n" for row in rows) + \
+        "</Transit>\n</Task>\n"
+    part = target.with_name(f".{target.name}.part")
+    try:
+        part.write_text(text)
+        os.replace(part, target)
+    finally:
+        part.unlink(missing_ok=True)
+
+
+__all__ = ["GEOMETRIC_PLANNERS", "NEAREST_PLANNERS", "OMPL_PLANNERS", "RESOLUTION",
+           "GeometricResult", "GeometricSettings", "GeometricWorld", "check_query", "query",
+           "solve", "solve_file", "task_rows", "write_task"]
