@@ -3,7 +3,7 @@ SHELL := /bin/bash
 ROOT  := $(CURDIR)
 ENV   := set -eo pipefail; source $(ROOT)/setup.bash;
 
-.PHONY: setup bench-setup build demo test test-stress bench experiments lint mutants soak corpus clean
+.PHONY: setup bench-setup bench-kautham build demo test test-stress bench experiments lint mutants soak corpus clean
 
 setup:
 	@tools/install.sh
@@ -38,6 +38,13 @@ bench-setup:
 
 bench: setup bench-setup
 	@$(ENV) python tools/bench/run.py
+
+# Kautham 5.1.1, the peer of Odin's geometric planning in `make bench` (bench_geometric.py skips
+# it until it is built): its build.sh, from $ODIN_KAUTHAM_PEER_DIR (default
+# ../shared/peers/kautham), builds it once into build/kautham/; apt installs its Debian
+# dependencies; about 7 CPU minutes (JOBS=2 sets make's jobs). tools/bench/kautham_peer.py
+bench-kautham:
+	@python3 tools/bench/kautham_peer.py build
 
 experiments: setup
 	@$(ENV) python tools/experiments/run.py
