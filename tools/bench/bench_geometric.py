@@ -51,6 +51,8 @@ PROBLEMS = {
     "ur3e": GEO / "UR3e" / "ur3e_fib_upc.xml",
     "spassage": GEO / "Cube-sPassage_R2" / "OMPL_RRTconnect_bigcube-s-passage_R2_0.05.xml",
     "maze": GEO / "Cube_Maze_R2" / "OMPL_RRTconnect_bigcube-maze2D_R2.xml",
+    "chess": GEO / "chess" / "OMPL_RRTconnect_chess_ur3_gripper_2.xml",
+    "tiago": GEO / "Tiago_kitchen" / "tiago_counter_A_topgrasp_simple.xml",
 }
 """Slug -> the problem's path in the corpus (the issue's demos with a geometric planner)."""
 ODIN_MODULE = "gui.planning.geometric"
