@@ -61,8 +61,6 @@ OMPL_PLANNERS = ("RRTConnect", "RRT", "RRTstar", "PRM", "PRMstar", "KPIECE1", "B
 """The geometric planners ``--planner`` may name (OMPL's class names)."""
 DEFAULT_TIME_LIMIT = 10.0
 """s: a search's time when the problem gives none (Kautham's default _Max Planning Time)."""
-SIMPLIFY_MIN_S = 1.0
-"""s: the least a found path's simplification is given when the search used its time."""
 CHECKS_BETWEEN_CLOCKS = 16
 """A motion's checks between two readings of the search's clock (a check takes about 1 ms)."""
 RESOLUTION = 0.002
@@ -532,7 +530,7 @@ def _search(world: GeometricWorld, settings: GeometricSettings, start, goal, see
     length = 0.0
     if solved:
         if settings.simplify:
-            _simplify(ob, search, deadline, stop)
+            _simplify(og, search)
         geometric = search.setup.getSolutionPath()
         path = np.array([search.vector(geometric.getState(i))
                          for i in range(geometric.getStateCount())])
@@ -542,14 +540,17 @@ def _search(world: GeometricWorld, settings: GeometricSettings, start, goal, see
                            world.checks - checks_before, length, str(status))
 
 
-def _simplify(ob, search: _Search, deadline: float, stop) -> None:
-    """Shortcuts and smooths the solution (Kautham's Simplify Solution) in what is left of
-    the search's time, SIMPLIFY_MIN_S at least; a motion's checks run to their end here (a
-    motion cut short would look invalid to the simplifier, which keeps the path it had)."""
-    until = max(deadline, time.monotonic() + SIMPLIFY_MIN_S)
-    search.over = lambda: False
-    search.setup.simplifySolution(ob.PlannerTerminationCondition(
-        lambda: time.monotonic() >= until or (stop is not None and bool(stop()))))
+def _simplify(og, search: _Search) -> None:
+    """Shortcuts the solution (Kautham's Simplify Solution) in what is left of the search's
+    time: OMPL's reduceVertices, which only tries motions between states of the path that are
+    not neighbours and keeps the path's own motions (checked already), so a shortcut cut short
+    by the clock is one not taken (OMPL's whole simplification re-checks the path's motions,
+    and one cut short there looks invalid)."""
+    path = search.setup.getSolutionPath()
+    simplifier = og.PathSimplifier(search.si)
+    while not search.over() and path.getStateCount() > 2:
+        if not simplifier.reduceVertices(path):
+            break
 
 
 def solve_file(problem_file, seed: Optional[int] = None, time_limit: Optional[float] = None,
