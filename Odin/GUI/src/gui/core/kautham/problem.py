@@ -417,6 +417,8 @@ class _Loader:
             tag = child.tag.lower()
             if tag in ("init", "goal"):
                 values = parse_text_numbers(child)
+                if not self.current:
+                    _check_dim(child, len(values))
                 if len(values) != size:
                     raise child.error(f"<{child.tag}> has {len(values)} values, the controls "
                                       f"are {size} ({', '.join(names)})")
@@ -487,6 +489,18 @@ def parse_text_number(node: Node) -> float:
     if len(values) != 1:
         raise node.error(f"<{node.tag}> holds {len(values)} numbers, expected one")
     return values[0]
+
+
+def _check_dim(node: Node, count: int) -> None:
+    """Kautham 2012 reads a query's ``<Init>`` or ``<Goal>`` only when its dim= is its count
+    of values (``Problem::createCSpaceFromFile``; the count is then checked against the
+    controls). A dim= that is not a whole number is read past, as Odin reads the corpus's
+    other quirks in values nothing else uses, and so is a missing one (Kautham 2012 would
+    refuse it; problems written by hand leave it out)."""
+    declared = (node.get("dim") or "").strip()
+    if declared.isdigit() and int(declared) != count:
+        raise node.error(f'<{node.tag} dim="{declared}"> has {count} values (Kautham 2012 '
+                         "reads a query whose dim= is its count of values)")
 
 
 def parse_text_numbers(node: Node) -> list:
