@@ -5,7 +5,11 @@ from __future__ import annotations
 
 import pathlib
 
+import pytest
+
 from gui.core.kautham.problem import load_problem
+from gui.core.kautham.solutions import read_solution
+from gui.errors import PathFileError, ProblemError
 
 CUBE_IV = "#Inventor V2.1 ascii\n\nSeparator { Cube { width 100 height 100 depth 100 } }\n"
 
@@ -23,6 +27,24 @@ ARM_ROB = """<?xml version="1.0"?>
 </Robot>
 """
 """A 2012 arm of one revolute joint (+-90 degrees) moved by two controls."""
+
+CART_URDF = """<?xml version="1.0"?>
+<robot name="Cart">
+  <link name="base"><inertial><mass value="2.0"/>
+    <inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry>GEOMETRY</geometry></collision></link>
+  <link name="arm"><inertial><mass value="1.0"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><box size="0.1 0.1 0.5"/></geometry></collision></link>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="arm"/>
+    <origin xyz="0 0 0.1" rpy="0 0 0"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
+</robot>
+"""
+"""A URDF robot of two links; GEOMETRY is its base's collision geometry."""
+
+BOX = '<box size="0.2 0.2 0.2"/>'
+
 
 def _write(folder: pathlib.Path, name: str, text: str) -> pathlib.Path:
     path = folder / name
@@ -79,3 +101,28 @@ def test_a_2012_query_whose_dim_is_its_count_is_read(tmp_path):
     arm = loaded.instances[0]
     assert arm.start is not None and arm.goal is not None
     assert not [i for i in loaded.ignored if i.what == "<Query>"]
+
+
+# -- finding 9: the messages -------------------------------------------------------------------
+
+def test_a_control_of_no_robot_lists_each_robot_once_by_the_name_robot_takes(tmp_path):
+    """Two robots of one file are Cart and Cart_2; a .cntr DOF of neither is refused with the
+    robots listed once each, by their instance names, which a path's --robot accepts."""
+    _write(tmp_path, "cart.urdf", CART_URDF.replace("GEOMETRY", BOX))
+    def problem(robot: str) -> pathlib.Path:
+        _write(tmp_path, f"{robot}.cntr", f'<ControlSet><Control name="c"><DOF name='
+               f'"{robot}/arm" value="1"/></Control></ControlSet>')
+        return _write(tmp_path, f"{robot}.xml", _problem(
+            '<Robot robot="cart.urdf"/>\n<Robot robot="cart.urdf"><Home X="1"/></Robot>\n'
+            f'<Controls robot="{robot}.cntr"/>'))
+
+    with pytest.raises(ProblemError) as refused:
+        load_problem(problem("Crane"))
+    assert refused.value.reason.endswith('no robot named "Crane" in the problem '
+                                         "(robots: Cart, Cart_2)")
+    loaded = load_problem(problem("Cart_2"))
+    rows = _write(tmp_path, "path.txt", "0.1\n0.2\n")
+    for name in ("Cart", "Cart_2"):
+        assert list(read_solution(rows, loaded, robot=name).paths) == [name]
+    with pytest.raises(PathFileError, match=r"\(robots: Cart, Cart_2\)$"):
+        read_solution(rows, loaded, robot="Crane")

@@ -189,14 +189,15 @@ def base_pose(home: np.ndarray, limits: dict, p: Sequence[float]) -> np.ndarray:
 
 
 def control_map(instance: Instance, control_set: ControlSet, prefixed: bool,
-                names_of_robots: Optional[Sequence[str]] = None,
+                robots: Optional[Sequence[Instance]] = None,
                 offset_default: float = OFFSET_DEFAULT) -> Optional[ControlMap]:
     """``instance``'s share of ``control_set`` (None when no DOF of the set is the robot's).
     ``offset_default``: the offset of a DOF the set does not list (module docstring).
 
-    ``prefixed``: DOF names are "robot/dof" (a .cntr file; a name whose robot is not among
-    ``names_of_robots`` is an error, as in Kautham), else bare (a .rob's own set). A DOF name
-    that is neither a base DOF nor a link of the robot is an error naming the file and line."""
+    ``prefixed``: DOF names are "robot/dof" (a .cntr file; "robot" is an instance's name or
+    its model's, and one that is no robot of ``robots`` is an error, as in Kautham), else bare
+    (a .rob's own set). A DOF name that is neither a base DOF nor a link of the robot is an
+    error naming the file and line."""
     model = instance.model
     links = [link.name for link in model.links[1:]]
     dofs = BASE_DOFS + tuple(links)
@@ -213,9 +214,11 @@ def control_map(instance: Instance, control_set: ControlSet, prefixed: bool,
             if not slash:
                 raise ProblemError(f"DOF name \"{name}\" is not \"robot/dof\"",
                                    control_set.source, line)
-            if names_of_robots is not None and robot not in names_of_robots:
+            if robots is not None and all(robot not in (r.name, r.model.name)
+                                          for r in robots):
+                # listed by instance name, once each: the names a path's --robot takes
                 raise ProblemError(f"DOF \"{name}\": no robot named \"{robot}\" in the "
-                                   f"problem (robots: {', '.join(names_of_robots)})",
+                                   f"problem (robots: {', '.join(r.name for r in robots)})",
                                    control_set.source, line)
             if robot != model.name and robot != instance.name:
                 return None

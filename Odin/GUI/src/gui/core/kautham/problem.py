@@ -291,10 +291,8 @@ class _Loader:
     # -- controls and kinds ---------------------------------------------------------------
     def _assign_controls(self, robots: List[Instance]) -> None:
         if self.cntr is not None:
-            names = [r.name for r in robots] + [r.model.name for r in robots]
             for robot in robots:
-                robot.controls = control_map(robot, self.cntr, prefixed=True,
-                                             names_of_robots=names)
+                robot.controls = control_map(robot, self.cntr, prefixed=True, robots=robots)
                 robot.model.controls = self.cntr
             return
         if self.current:
