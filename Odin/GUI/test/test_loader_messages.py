@@ -126,3 +126,18 @@ def test_a_control_of_no_robot_lists_each_robot_once_by_the_name_robot_takes(tmp
         assert list(read_solution(rows, loaded, robot=name).paths) == [name]
     with pytest.raises(PathFileError, match=r"\(robots: Cart, Cart_2\)$"):
         read_solution(rows, loaded, robot="Crane")
+
+
+def test_a_missing_file_names_every_folder_looked_in_in_order(tmp_path):
+    """A current problem's file is looked for in models/ beside the problem and in every
+    folder above, then beside the problem (where the other files were found)."""
+    folder = tmp_path / "cell"
+    _write(folder, "cart.urdf", CART_URDF.replace("GEOMETRY", BOX))
+    problem = _write(folder, "p.xml", _problem('<Robot robot="cart.urdf"/>\n'
+                                               '<Obstacle obstacle="table.urdf"/>'))
+    with pytest.raises(ProblemError) as refused:
+        load_problem(problem)
+    searched = [f / "models" for f in (folder, *folder.parents)] + [folder]
+    assert refused.value.line == 4
+    assert refused.value.reason == ('file "table.urdf" not found (looked in: '
+                                    + ", ".join(map(str, searched)) + ")")

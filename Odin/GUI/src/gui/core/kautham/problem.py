@@ -546,9 +546,10 @@ def _resolve(rel: str, node: Node, problem: pathlib.Path, current: bool) -> path
     for c in candidates:
         if os.path.lexists(c):    # the first there, whatever it is: its reader says if it
             return c              # is not a file (a FIFO, a device, a link loop)
+    # every folder, in the order searched: the last one, beside the problem, is where a
+    # problem's other files usually are, so a shortened list would hide it
     raise node.error(f"file \"{rel}\" not found (looked in: "
-                     + ", ".join(str(c.parent) for c in candidates[:3])
-                     + (", ..." if len(candidates) > 3 else "") + ")")
+                     + ", ".join(str(c.parent) for c in candidates) + ")")
 
 
 def _pose(node: Optional[Node], units: Units, ignored: List[Ignored]) -> np.ndarray:
