@@ -9,7 +9,7 @@ import pytest
 
 from gui.core.kautham.problem import load_problem
 from gui.core.kautham.solutions import read_solution
-from gui.errors import PathFileError, ProblemError
+from gui.errors import PathFileError, ProblemError, ShapeError
 
 CUBE_IV = "#Inventor V2.1 ascii\n\nSeparator { Cube { width 100 height 100 depth 100 } }\n"
 
@@ -141,3 +141,15 @@ def test_a_missing_file_names_every_folder_looked_in_in_order(tmp_path):
     assert refused.value.line == 4
     assert refused.value.reason == ('file "table.urdf" not found (looked in: '
                                     + ", ".join(map(str, searched)) + ")")
+
+
+def test_a_missing_package_mesh_is_named_by_its_uri(tmp_path):
+    uri = "package://odin_cart/meshes/base.stl"
+    urdf = _write(tmp_path, "cart.urdf",
+                  CART_URDF.replace("GEOMETRY", f'<mesh filename="{uri}"/>'))
+    with pytest.raises(ShapeError) as refused:
+        load_problem(_write(tmp_path, "p.xml", _problem('<Robot robot="cart.urdf"/>')))
+    assert str(refused.value.path) == str(urdf)
+    assert refused.value.line == _line_of(urdf.read_text(), "<mesh")
+    assert refused.value.reason.startswith(f"<mesh filename='{uri}'>: "
+                                           f"{tmp_path / 'meshes' / 'base.stl'}")
