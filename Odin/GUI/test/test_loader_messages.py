@@ -4,11 +4,12 @@ a missing file was looked for in, and the URI of a mesh that is not there."""
 from __future__ import annotations
 
 import pathlib
+import re
 
 import pytest
 
 from gui.core.kautham.problem import load_problem
-from gui.core.kautham.solutions import read_solution
+from gui.core.kautham.solutions import KPS, OMPL, ROWS, TASK, read_solution
 from gui.errors import PathFileError, ProblemError, ShapeError
 
 CUBE_IV = "#Inventor V2.1 ascii\n\nSeparator { Cube { width 100 height 100 depth 100 } }\n"
@@ -153,3 +154,14 @@ def test_a_missing_package_mesh_is_named_by_its_uri(tmp_path):
     assert refused.value.line == _line_of(urdf.read_text(), "<mesh")
     assert refused.value.reason.startswith(f"<mesh filename='{uri}'>: "
                                            f"{tmp_path / 'meshes' / 'base.stl'}")
+
+
+def test_the_readme_describes_every_plan_format_tracked_reads():
+    """Each of read_solution's formats has its item in the README's list of what
+    `run_path --tracked` reads (the reader's docstring holds the details)."""
+    readme = (pathlib.Path(__file__).resolve().parents[3] / "README.md").read_text()
+    listed = readme[readme.index("The plans `--tracked` reads"):]
+    listed = listed[:listed.index("\n\n", listed.index("\n- "))]
+    headings = {KPS: "a Kautham 2012 solution", TASK: "a task file", OMPL: "OMPL rows",
+                ROWS: "raw rows"}
+    assert re.findall(r"^- \*\*(.+?)\*\*", listed, re.M) == list(headings.values())
