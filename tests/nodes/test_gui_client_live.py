@@ -103,8 +103,10 @@ def test_initial_position_and_paths_move_the_links(world, tmp_path, legacy):
 
     position = tmp_path / "position.txt"
     position.write_text("0 0 0\n10 10 0\n20 20 0\n")
+    # from the initial (30, 45) deg back to 0: a 45 deg first row, past MAX_ROW_JUMP, asked
     result = world.run(["rosrun", "GUI", "run_path", str(problem_file), "--position",
-                        str(position), "--double", "1", "--rate", "50"], timeout=60)
+                        str(position), "--double", "1", "--rate", "50", "--allow-jumps"],
+                       timeout=60)
     assert "5 rows" in result.stdout
     velocity = tmp_path / "velocity.txt"
     velocity.write_text("10 0 0\n10 0 0\n")

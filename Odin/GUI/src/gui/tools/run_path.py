@@ -20,6 +20,7 @@ from gui.tools.common import (ProblemFile, ToolParser, add_build_options, add_ti
 from odin_common.tool import stop_on_ctrl_c
 
 if TYPE_CHECKING:
+    from gui.core.paths import RobotPath
     from gui.core.plan import BuildPlan, RobotHandle
     from gui.ros.client import WorldClient
 
@@ -60,7 +61,9 @@ class PathRequest:
     the problem's (degrees and mm for 2012 problems); ``double``: precision doublings of a
     position path; ``rate``: rows per second, Hz (0: the world's publication rate);
     ``real_time``: control and tracked paths in real time, not as fast as the world steps;
-    ``timeout``: s to wait for the ROS master, then for each of the world's services."""
+    ``timeout``: s to wait for the ROS master, then for each of the world's services;
+    ``allow_jumps``: a position path may move a joint further than it could in one row
+    (``gui.core.paths.check_row_jumps``)."""
     problem: ProblemFile
     mode: PathMode
     path: str
@@ -71,6 +74,7 @@ class PathRequest:
     real_time: bool = True
     timeout: float = 10.0
     tracked: TrackedOptions = TrackedOptions()
+    allow_jumps: bool = False
 
 
 def run_path(request: PathRequest) -> int:
@@ -90,15 +94,43 @@ def run_path(request: PathRequest) -> int:
 
 # ------------------------------------------------------- initial, position and velocity rows
 
-def _read_rows(request: PathRequest, build_plan: BuildPlan, handle: RobotHandle) -> np.ndarray:
-    """The path file's rows in SI units, a position path's precision doubled as asked."""
-    from gui.core.paths import DEGREES, RADIANS, load_robot_path, refine
+def _read_rows(request: PathRequest, build_plan: BuildPlan, handle: RobotHandle) -> RobotPath:
+    """The path file read; a position path's rows checked for jumps between them (before any
+    doubling: the midpoints halve them) unless ``allow_jumps``, its doubling checked."""
+    from gui.core.paths import DEGREES, RADIANS, check_row_jumps, read_robot_path
     units = request.units or (DEGREES if build_plan.problem.format == "2012" else RADIANS)
     with reading("path file", request.path):
-        rows = load_robot_path(request.path, handle, units)
-    if request.mode is PathMode.POSITION and request.double:
-        rows = refine(rows, _doublings(request.double, len(rows)))
-    return rows
+        path = read_robot_path(request.path, handle, units)
+    if request.mode is PathMode.POSITION:
+        if not request.allow_jumps:
+            check_row_jumps(path)
+        if request.double:
+            _doublings(request.double, len(path.rows))
+    return path
+
+
+def _position_rows(request: PathRequest, path: RobotPath, client: WorldClient,
+                   handle: RobotHandle) -> np.ndarray:
+    """A position path's rows (SI) to send, its precision doubled as asked, once its first
+    row is checked against where the robot is in the world unless ``allow_jumps``."""
+    from gui.core.paths import check_first_row, refine
+    if not request.allow_jumps:
+        check_first_row(path, _present_joints(client, handle))
+    return refine(path.rows, request.double)
+
+
+def _present_joints(client: WorldClient, handle: RobotHandle) -> np.ndarray:
+    """Where the robot's movable joints are in the world (rad / m): ``built_at`` plus each
+    world joint's reading; NaN for a joint the world does not read as its first value (a
+    car's wheel spin) or holds no joint for."""
+    present = np.full(len(handle.built_at), np.nan)
+    ids = list(handle.joint_ids)
+    axes = list(handle.joint_axes) or [0] * len(ids)
+    readings = client.joint_positions(ids)
+    for j, (value, axis) in enumerate(zip(readings, axes)):
+        if axis == 0:
+            present[j] = handle.built_at[j] + value
+    return present
 
 
 def _doublings(times: int, rows: int) -> int:
@@ -111,8 +143,9 @@ def _doublings(times: int, rows: int) -> int:
 
 
 def _set_initial(request: PathRequest, build_plan: BuildPlan, handle: RobotHandle) -> int:
-    """--initial: the robot set at the file's first row, its speeds zeroed."""
-    rows = _read_rows(request, build_plan, handle)
+    """--initial: the robot set at the file's first row, its speeds zeroed (a placement, so
+    not checked for a jump from where the robot is)."""
+    rows = _read_rows(request, build_plan, handle).rows
     from gui.ros.client import WorldClient
     client = WorldClient(timeout=request.timeout)
     client.set_position(handle.situations(rows[0]), reset_velocity=True)
@@ -126,12 +159,13 @@ class _Stopped(Exception):
 
 def _run_rows(request: PathRequest, build_plan: BuildPlan, handle: RobotHandle) -> int:
     """--position, --velocity: a row per cycle at ``request.rate`` (the world's publication
-    rate when 0), a line per row."""
-    rows = _read_rows(request, build_plan, handle)
+    rate when 0), a line per row. A position path is checked for jumps before any is sent."""
+    path = _read_rows(request, build_plan, handle)
     from gui.ros.client import WorldClient, run_position_path, run_velocity_path
     client = WorldClient(timeout=request.timeout)
-    rate = request.rate if request.rate > 0 else client.publication_rate()
     velocity = request.mode is PathMode.VELOCITY
+    rows = path.rows if velocity else _position_rows(request, path, client, handle)
+    rate = request.rate if request.rate > 0 else client.publication_rate()
     done = [0]
     with stop_on_ctrl_c() as stop:
 
@@ -319,6 +353,7 @@ _RUNS: Dict[PathMode, Callable[[PathRequest, "BuildPlan", "RobotHandle"], int]] 
 
 
 def _parser() -> ToolParser:
+    from gui.core.paths import MAX_ROW_JUMP, MAX_ROW_SLIDE
     parser = ToolParser(
         prog=TOOL, description="Drive a robot built by load_problem with a path file.")
     parser.add_argument("problem", help="the problem XML file the scene was built from")
@@ -342,6 +377,12 @@ def _parser() -> ToolParser:
     parser.add_argument("--robot", help="robot name (default: the first robot)")
     parser.add_argument("--double", type=count(0, MAX_DOUBLINGS), default=0, metavar="N",
                         help="double the path precision N times (position paths)")
+    parser.add_argument("--allow-jumps", action="store_true",
+                        help=f"position paths: run rows that move a revolute joint more than "
+                        f"{MAX_ROW_JUMP:g} rad (MAX_ROW_JUMP) or a prismatic one more than "
+                        f"{MAX_ROW_SLIDE:g} m (MAX_ROW_SLIDE) from the row before, or the first "
+                        f"row from where the robot is [refused: a path read in the wrong unit, "
+                        f"said]")
     parser.add_argument("--rate", type=hertz, default=0.0,
                         help="rows per second (default: the world's publication rate)")
     parser.add_argument("--fast", action="store_true",
@@ -386,7 +427,8 @@ def _request(args) -> PathRequest:
         double=args.double, rate=args.rate, real_time=not args.fast, timeout=args.timeout,
         tracked=TrackedOptions(from_here=args.from_here, summary=args.summary,
                                plot=args.plot, solver=args.solver,
-                               kinematic=args.kinematic))
+                               kinematic=args.kinematic),
+        allow_jumps=args.allow_jumps)
 
 
 @one_line_errors(TOOL)
