@@ -64,6 +64,32 @@ def overlap_warning(source: str, overlaps: Sequence[Overlap], exempt: bool) -> s
             f"{named}{rest}; " + (EXEMPT if exempt else PUSHED))
 
 
+def goal_overlaps(world, plan) -> List[Overlap]:
+    """The pairs the query's goal would put inside each other, deeper than BUILT_OVERLAP
+    (where a part can move): every robot with a goal placed there at once by forward
+    kinematics, asked of ``world`` (a gui.core.world_port.WorldPort) by Check Collision, which
+    changes nothing; pairs already so where the problem builds them are not counted."""
+    poses = [pose for handle in plan.robots if handle.goal is not None
+             for pose in handle.situations(handle.goal.joints, handle.goal.base_pose)]
+    if not poses:
+        return []
+    built = {frozenset((a, b)) for a, b, depth in world.check_collision([])
+             if depth > BUILT_OVERLAP}
+    return built_overlaps(plan, [pair for pair in world.check_collision(poses)
+                                 if frozenset(pair[:2]) not in built])
+
+
+def goal_warning(source: str, overlaps: Sequence[Overlap]) -> str:
+    """One line for the user: ``source`` (the problem file) and the deepest pairs its goal
+    puts inside each other."""
+    named = ", ".join(f"{o.first} in {o.second} by {o.depth * 1000:.1f} mm"
+                      for o in overlaps[:PAIRS_NAMED])
+    more = len(overlaps) - PAIRS_NAMED
+    rest = f" and {more} more pair{'s' if more > 1 else ''}" if more > 0 else ""
+    return (f"{source}: the query's goal puts parts inside each other: {named}{rest}; a path "
+            "to it ends in collision")
+
+
 #: what the world does with the pairs of a problem Kautham never simulates
 EXEMPT = "they do not collide until they have moved apart (Kautham never simulates this problem)"
 #: ... and under Kautham's physics

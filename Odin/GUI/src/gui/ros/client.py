@@ -27,7 +27,7 @@ from typing import Callable, Dict, NamedTuple, Optional, Sequence, Tuple
 
 import numpy as np
 
-from gui.core.overlaps import overlap_warning
+from gui.core.overlaps import goal_overlaps, goal_warning, overlap_warning
 from gui.core.plan import BuildPlan, BuiltIds, RobotHandle
 from gui.core.world_port import Built, Progress, build
 from gui.core.robot_description import RobotDescription, describe_robot
@@ -448,16 +448,20 @@ class WorldClient:
         plan all or nothing, removes them). Parts built inside each other
         (``gui.core.overlaps``) are warned about once and answered as "overlaps": [Overlap];
         in a problem Kautham never simulates they are exempt until they have moved apart
-        ("overlaps_exempt": True)."""
+        ("overlaps_exempt": True). The pairs the query's goal would put inside each other are
+        warned about too and answered as "goal_overlaps" (gui.core.overlaps.goal_overlaps)."""
         ids, overlaps, exempt = build(ClientWorldPort(self), plan, progress, ids)
         folder = robot_mesh_dir() if mesh_dir is None else mesh_dir
         namespaces = {handle.name: self.set_robot(describe_robot(handle, folder))
                       for handle in plan.robots}
+        log = logging.getLogger("gui.core.overlaps")
         if overlaps:
-            logging.getLogger("gui.core.overlaps").warning(
-                overlap_warning(plan.problem.source, overlaps, exempt))
+            log.warning(overlap_warning(plan.problem.source, overlaps, exempt))
+        at_goal = goal_overlaps(self, plan)
+        if at_goal:
+            log.warning(goal_warning(plan.problem.source, at_goal))
         return {**ids.as_dict(), "robots": namespaces, "overlaps": overlaps,
-                "overlaps_exempt": exempt}
+                "overlaps_exempt": exempt, "goal_overlaps": at_goal}
 
 
 # -- requests whose meshes go out as numpy bytes -----------------------------------------
