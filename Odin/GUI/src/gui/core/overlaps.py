@@ -64,19 +64,18 @@ def overlap_warning(source: str, overlaps: Sequence[Overlap], exempt: bool) -> s
             f"{named}{rest}; " + (EXEMPT if exempt else PUSHED))
 
 
-def goal_overlaps(world, plan) -> List[Overlap]:
+def goal_overlaps(world, plan, built: Sequence[Overlap]) -> List[Overlap]:
     """The pairs the query's goal would put inside each other, deeper than BUILT_OVERLAP
     (where a part can move): every robot with a goal placed there at once by forward
     kinematics, asked of ``world`` (a gui.core.world_port.WorldPort) by Check Collision, which
-    changes nothing; pairs already so where the problem builds them are not counted."""
+    changes nothing; the pairs ``built`` so (``settle_overlaps``' answer) are not counted."""
     poses = [pose for handle in plan.robots if handle.goal is not None
              for pose in handle.situations(handle.goal.joints, handle.goal.base_pose)]
     if not poses:
         return []
-    built = {frozenset((a, b)) for a, b, depth in world.check_collision([])
-             if depth > BUILT_OVERLAP}
+    known = {frozenset((o.first, o.second)) for o in built}
     return built_overlaps(plan, [pair for pair in world.check_collision(poses)
-                                 if frozenset(pair[:2]) not in built])
+                                 if frozenset(pair[:2]) not in known])
 
 
 def goal_warning(source: str, overlaps: Sequence[Overlap]) -> str:

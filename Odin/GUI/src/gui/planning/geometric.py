@@ -330,7 +330,8 @@ class GeometricWorld:
         except Exception:
             self.world.close()
             raise
-        self.size = len(query(plan)[0])
+        # k: a 2012 problem's robots end to end, a current problem's one shared vector
+        self.size = max(r.part.stop or r.handle.instance.controls.size for r in self.robots)
         self.checks = 0
 
     def close(self) -> None:

@@ -457,7 +457,7 @@ class WorldClient:
         log = logging.getLogger("gui.core.overlaps")
         if overlaps:
             log.warning(overlap_warning(plan.problem.source, overlaps, exempt))
-        at_goal = goal_overlaps(self, plan)
+        at_goal = goal_overlaps(self, plan, overlaps)
         if at_goal:
             log.warning(goal_warning(plan.problem.source, at_goal))
         return {**ids.as_dict(), "robots": namespaces, "overlaps": overlaps,

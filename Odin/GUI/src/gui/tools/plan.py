@@ -117,11 +117,11 @@ class GeometricOutcome:
               "file: run_path --tracked runs it)")
 
 
-GEOMETRIC_ONLY_FOR_CONTROL = (("backend", Backend.CORE, "--backend"),
-                              ("goal_tolerance", None, "--goal-tolerance"),
-                              ("min_control_steps", None, "--min-control-steps"),
-                              ("max_control_steps", None, "--max-control-steps"),
-                              ("parallel", 1, "--parallel"), ("robot", None, "--robot"))
+CONTROL_SEARCH_OPTIONS = (("backend", Backend.CORE, "--backend"),
+                          ("goal_tolerance", None, "--goal-tolerance"),
+                          ("min_control_steps", None, "--min-control-steps"),
+                          ("max_control_steps", None, "--max-control-steps"),
+                          ("parallel", 1, "--parallel"), ("robot", None, "--robot"))
 """(request field, its value when not given, option): what only a control search takes (a
 geometric search plans every robot of the query together, in this process)."""
 
@@ -131,7 +131,7 @@ def _geometric_search(request: PlanRequest, build_plan, stop) -> GeometricOutcom
     from dataclasses import replace
 
     from gui.planning.geometric import RESOLUTION, GeometricSettings, solve
-    for name, unset, option in GEOMETRIC_ONLY_FOR_CONTROL:
+    for name, unset, option in CONTROL_SEARCH_OPTIONS:
         if getattr(request, name) != unset:
             raise GuiError(f"{option}: only a search of a problem for one of Kautham's ODE "
                            "planners takes it; this problem is planned geometrically")
