@@ -5,17 +5,9 @@ such warning; the world is built either way."""
 from __future__ import annotations
 
 import pytest
+from crane import CRANE_URDF
 
 pytestmark = pytest.mark.forked
-
-CRANE = """<?xml version="1.0"?><robot name="crane">
- <link name="mast"><collision><geometry><box size="0.2 0.2 1"/></geometry></collision></link>
- <link name="boom"><collision><origin xyz="0.5 0 0"/><geometry><box size="1 0.05 0.05"/>
-  </geometry></collision></link>
- <joint name="slew" type="revolute"><parent link="mast"/><child link="boom"/><origin
-  xyz="0 0 0.6"/><axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="30" velocity="1"/>
- </joint>
-</robot>"""
 
 CNTR = """<?xml version="1.0"?><ControlSet>
  <Offset><DOF name="crane/boom" value="0.5"/></Offset>
@@ -37,7 +29,7 @@ PROBLEM = """<?xml version="1.0"?><Problem>
 
 
 def _problem(folder, goal: str):
-    for name, text in (("crane.urdf", CRANE), ("crane.cntr", CNTR), ("post.urdf", POST)):
+    for name, text in (("crane.urdf", CRANE_URDF), ("crane.cntr", CNTR), ("post.urdf", POST)):
         (folder / name).write_text(text)
     problem = folder / "crane.xml"
     problem.write_text(PROBLEM.replace("GOAL", goal))

@@ -6,7 +6,6 @@ Core to the same place; the chain's servo controls answer the same through the p
 from __future__ import annotations
 
 import json
-import logging
 import subprocess
 
 import numpy as np
@@ -18,26 +17,13 @@ NAMESPACES = ["/w0/virtual_world", "/w1/virtual_world"]
 SPHERE = ("current_2025", "demos", "OMPL_ode_demos", "Sphere", "Sphere.xml")
 
 
-def _sphere_plan(kautham_dir):
-    return _plan(kautham_dir.joinpath(*SPHERE))
-
-
-def _plan(problem_file):
-    from gui.core.translate import plan_problem
-    from gui.core.kautham.problem import load_problem
-    logging.disable(logging.WARNING)
-    try:
-        return plan_problem(load_problem(problem_file))
-    finally:
-        logging.disable(logging.NOTSET)
-
-
 def _same(a, b) -> bool:
     return (a.state.tobytes() == b.state.tobytes() and a.position.tobytes() == b.position.tobytes()
             and a.velocity.tobytes() == b.velocity.tobytes() and a.collisions == b.collisions)
 
 
-def test_the_pool_answers_what_the_core_answers_and_plans_that_replay(ros_master, kautham_dir):
+def test_the_pool_answers_what_the_core_answers_and_plans_that_replay(ros_master, kautham_dir,
+                                                                      plan_of):
     for namespace in ("/w0", "/w1"):
         ros_master.rosrun("VirtualWorld", "virtualWorld", f"__ns:={namespace}")
     for namespace in NAMESPACES:
@@ -46,11 +32,11 @@ def test_the_pool_answers_what_the_core_answers_and_plans_that_replay(ros_master
     from gui.planning.bridge import plan, replay
     from gui.planning.problem import planning_problem
     from gui.planning.pool import PoolBackend
-    sphere = _sphere_plan(kautham_dir)
+    sphere_file = kautham_dir.joinpath(*SPHERE)
+    sphere = plan_of(sphere_file)
     problem = planning_problem(sphere)
     core = CoreBackend(sphere, problem)
-    pool = PoolBackend(_sphere_plan(kautham_dir), planning_problem(_sphere_plan(kautham_dir)),
-                       NAMESPACES)
+    pool = PoolBackend(plan_of(sphere_file), planning_problem(plan_of(sphere_file)), NAMESPACES)
     try:
         assert pool.size == 2
         assert pool.start_state().tobytes() == core.start_state().tobytes()
@@ -74,7 +60,7 @@ def test_the_pool_answers_what_the_core_answers_and_plans_that_replay(ros_master
 
 
 def test_servo_controls_through_the_pool_answer_what_the_core_answers(ros_master,
-                                                                      ode_demos_dir):
+                                                                      ode_demos_dir, plan_of):
     """The chain's controls are a Set Servo and a Propagate made by one world: whichever
     world serves a request, and whatever it served before, the answer is the Core's."""
     for namespace in ("/w0", "/w1"):
@@ -84,7 +70,7 @@ def test_servo_controls_through_the_pool_answer_what_the_core_answers(ros_master
     from gui.planning.backend import CoreBackend
     from gui.planning.problem import planning_problem
     from gui.planning.pool import PoolBackend
-    chain = _plan(ode_demos_dir / "demos" / "OMPL_ode_demos" / "Chain" / "k-PMPChain.xml")
+    chain = plan_of(ode_demos_dir / "demos" / "OMPL_ode_demos" / "Chain" / "k-PMPChain.xml")
     core = CoreBackend(chain, planning_problem(chain))
     pool = PoolBackend(chain, planning_problem(chain), NAMESPACES)
     try:

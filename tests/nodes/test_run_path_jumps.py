@@ -6,17 +6,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from crane import CRANE_URDF
 
 pytestmark = pytest.mark.forked
-
-CRANE = """<?xml version="1.0"?><robot name="crane">
- <link name="mast"><collision><geometry><box size="0.2 0.2 1"/></geometry></collision></link>
- <link name="boom"><collision><origin xyz="0.5 0 0"/><geometry><box size="1 0.05 0.05"/>
-  </geometry></collision></link>
- <joint name="slew" type="revolute"><parent link="mast"/><child link="boom"/><origin
-  xyz="0 0 0.6"/><axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="30" velocity="1"/>
- </joint>
-</robot>"""
 
 PROBLEM = """<?xml version="1.0"?><Problem>
  <Robot robot="crane.urdf"><Home X="0" Y="0" Z="0.5" WX="0" WY="0" WZ="1" TH="0"/></Robot>
@@ -31,7 +23,7 @@ def _slew(world_client) -> float:
 
 def test_a_radian_path_read_in_degrees_is_refused_where_the_robot_is(world, tmp_path):
     from gui.ros.client import WorldClient
-    (tmp_path / "crane.urdf").write_text(CRANE)
+    (tmp_path / "crane.urdf").write_text(CRANE_URDF)
     problem = tmp_path / "crane.xml"
     problem.write_text(PROBLEM)
     path = tmp_path / "slew.path"

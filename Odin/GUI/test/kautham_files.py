@@ -14,6 +14,27 @@ SHELF = """<?xml version="1.0"?><robot name="shelf"><link name="base"><collision
 """An obstacle without a mass: a 1 m x 0.4 m x 2 cm board."""
 
 
+TWO_LINK_URDF = """<?xml version="1.0"?>
+<robot name="{name}">
+  <link name="base"><inertial><mass value="2.0"/>
+    <inertia ixx="{ixx}" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry>{geometry}</geometry></collision></link>
+  <link name="arm"><inertial><mass value="1.0"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><box size="0.1 0.1 0.5"/></geometry></collision></link>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="arm"/>
+    <origin xyz="0 0 0.1" rpy="0 0 0"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
+</robot>
+"""
+
+
+def two_link_urdf(ixx="0.1", geometry='<box size="0.2 0.2 0.2"/>', name="r") -> str:
+    """A URDF robot ``name`` of two links (a base of ``geometry`` and inertia ``ixx`` kg m^2,
+    an arm turning +-1 rad about z)."""
+    return TWO_LINK_URDF.format(ixx=ixx, geometry=geometry, name=name)
+
+
 def default_parameters() -> dict:
     """Odin's documented world parameters, gravity as a tuple (as a plan carries it)."""
     return {**WorldParameters().as_dict(), "gravity": WorldParameters().gravity}

@@ -21,6 +21,7 @@ from gui.core.kautham.urdf import read_urdf
 from gui.core.model import FIXED_BASE, FREE_BODY, MOBILE
 from gui.core.shapes import read_shape
 from gui.errors import ProblemError
+from kautham_files import two_link_urdf as _urdf
 
 ROOT = pathlib.Path(__file__).resolve().parents[3]
 CUBE_IV = "#Inventor V2.1 ascii\n\nSeparator { Cube { width 100 height 100 depth 100 } }\n"
@@ -141,25 +142,6 @@ def test_joint_elements_both_inside_joints_and_under_robot_are_refused(tmp_path)
 
 
 # -- a rotation about a zero axis -------------------------------------------------------------
-
-URDF = """<?xml version="1.0"?>
-<robot name="{name}">
-  <link name="base"><inertial><mass value="2.0"/>
-    <inertia ixx="{ixx}" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial>
-    <collision><geometry>{geometry}</geometry></collision></link>
-  <link name="arm"><inertial><mass value="1.0"/>
-    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
-    <collision><geometry><box size="0.1 0.1 0.5"/></geometry></collision></link>
-  <joint name="j1" type="revolute"><parent link="base"/><child link="arm"/>
-    <origin xyz="0 0 0.1" rpy="0 0 0"/><axis xyz="0 0 1"/>
-    <limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
-</robot>
-"""
-
-
-def _urdf(ixx="0.1", geometry='<box size="0.2 0.2 0.2"/>', name="r") -> str:
-    return URDF.format(ixx=ixx, geometry=geometry, name=name)
-
 
 def test_a_home_rotation_about_a_zero_axis_is_no_rotation_and_is_warned_about(tmp_path):
     """Kautham's SE3Conf::fromAxisToQuaternion multiplies the axis by sin(TH/2): a zero axis

@@ -11,6 +11,7 @@ import pytest
 from gui.core.kautham.problem import load_problem
 from gui.core.kautham.solutions import KPS, OMPL, ROWS, TASK, read_solution
 from gui.errors import PathFileError, ProblemError, ShapeError
+from kautham_files import two_link_urdf
 
 CUBE_IV = "#Inventor V2.1 ascii\n\nSeparator { Cube { width 100 height 100 depth 100 } }\n"
 
@@ -29,20 +30,6 @@ ARM_ROB = """<?xml version="1.0"?>
 """
 """A 2012 arm of one revolute joint (+-90 degrees) moved by two controls."""
 
-CART_URDF = """<?xml version="1.0"?>
-<robot name="Cart">
-  <link name="base"><inertial><mass value="2.0"/>
-    <inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial>
-    <collision><geometry>GEOMETRY</geometry></collision></link>
-  <link name="arm"><inertial><mass value="1.0"/>
-    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
-    <collision><geometry><box size="0.1 0.1 0.5"/></geometry></collision></link>
-  <joint name="j1" type="revolute"><parent link="base"/><child link="arm"/>
-    <origin xyz="0 0 0.1" rpy="0 0 0"/><axis xyz="0 0 1"/>
-    <limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
-</robot>
-"""
-"""A URDF robot of two links; GEOMETRY is its base's collision geometry."""
 
 BOX = '<box size="0.2 0.2 0.2"/>'
 
@@ -109,7 +96,7 @@ def test_a_2012_query_whose_dim_is_its_count_is_read(tmp_path):
 def test_a_control_of_no_robot_lists_each_robot_once_by_the_name_robot_takes(tmp_path):
     """Two robots of one file are Cart and Cart_2; a .cntr DOF of neither is refused with the
     robots listed once each, by their instance names, which a path's --robot accepts."""
-    _write(tmp_path, "cart.urdf", CART_URDF.replace("GEOMETRY", BOX))
+    _write(tmp_path, "cart.urdf", two_link_urdf(geometry=BOX, name="Cart"))
     def problem(robot: str) -> pathlib.Path:
         _write(tmp_path, f"{robot}.cntr", f'<ControlSet><Control name="c"><DOF name='
                f'"{robot}/arm" value="1"/></Control></ControlSet>')
@@ -133,7 +120,7 @@ def test_a_missing_file_names_every_folder_looked_in_in_order(tmp_path):
     """A current problem's file is looked for in models/ beside the problem and in every
     folder above, then beside the problem (where the other files were found)."""
     folder = tmp_path / "cell"
-    _write(folder, "cart.urdf", CART_URDF.replace("GEOMETRY", BOX))
+    _write(folder, "cart.urdf", two_link_urdf(geometry=BOX, name="Cart"))
     problem = _write(folder, "p.xml", _problem('<Robot robot="cart.urdf"/>\n'
                                                '<Obstacle obstacle="table.urdf"/>'))
     with pytest.raises(ProblemError) as refused:
@@ -147,7 +134,7 @@ def test_a_missing_file_names_every_folder_looked_in_in_order(tmp_path):
 def test_a_missing_package_mesh_is_named_by_its_uri(tmp_path):
     uri = "package://odin_cart/meshes/base.stl"
     urdf = _write(tmp_path, "cart.urdf",
-                  CART_URDF.replace("GEOMETRY", f'<mesh filename="{uri}"/>'))
+                  two_link_urdf(geometry=f'<mesh filename="{uri}"/>', name="Cart"))
     with pytest.raises(ShapeError) as refused:
         load_problem(_write(tmp_path, "p.xml", _problem('<Robot robot="cart.urdf"/>')))
     assert str(refused.value.path) == str(urdf)
