@@ -152,6 +152,7 @@ def test_plan_writes_the_same_task_file_for_the_same_seed(tmp_path):
                              capture_output=True, text=True, timeout=300)
         assert run.returncode == 0, run.stderr
         assert "RRTConnect searching" in run.stdout and '"solved": true' in run.stdout
+        assert "leaked" not in run.stderr     # no OMPL object outlives the search (nanobind)
         outputs.append(out.read_text())
     assert outputs[0] == outputs[1] and outputs[0].startswith("<Task name=")
 

@@ -400,44 +400,22 @@ def _ompl():
     return ob, og, ou
 
 
-class _Search:
-    """The OMPL objects of one search, kept together (OMPL holds raw pointers between them);
-    a callback's exception is kept and raised after the search (it must not cross into C++)."""
+class _Checks:
+    """OMPL's callbacks of one search: a state's and a motion's validity. A callback's
+    exception is kept and raised after the search (it must not cross into C++). They hold the
+    world and the search's clock (``over``), never the OMPL objects: OMPL holds them, and a
+    cycle through C++ would keep every object of the search alive to the interpreter's end
+    (nanobind reporting them leaked after the tool's last line)."""
 
-    def __init__(self, world: GeometricWorld, settings: GeometricSettings,
-                 start: np.ndarray, goal: np.ndarray, over: Callable[[], bool]):
-        ob, og, ou = _ompl()
-        ou.setLogLevel(ou.LOG_WARN)
+    def __init__(self, world: GeometricWorld, over: Callable[[], bool]):
         self.world = world
         self.over = over
         self.error: Optional[BaseException] = None
-        size = world.size
-        self.space = ob.RealVectorStateSpace(size)
-        unit = ob.RealVectorBounds(size)
-        unit.setLow(0.0)
-        unit.setHigh(1.0)
-        self.space.setBounds(unit)
-        self.setup = og.SimpleSetup(self.space)
-        self.si = self.setup.getSpaceInformation()
-        self.setup.setStateValidityChecker(self._valid)
-        self.validator = _motion_validator(ob, self.si, self)
-        self.si.setMotionValidator(self.validator)
-        self.start, self.goal = self.si.allocState(), self.si.allocState()
-        for i in range(size):
-            self.start[i], self.goal[i] = float(start[i]), float(goal[i])
-        self.setup.setStartAndGoalStates(self.start, self.goal)
-        self.planner = getattr(og, settings.planner)(self.si)
-        if settings.range is not None and hasattr(self.planner, "setRange"):
-            self.planner.setRange(settings.range)
-        if settings.goal_bias is not None and hasattr(self.planner, "setGoalBias"):
-            self.planner.setGoalBias(settings.goal_bias)
-        self.setup.setPlanner(self.planner)
-        self.setup.setup()
 
     def vector(self, state) -> np.ndarray:
         return np.fromiter((state[i] for i in range(self.world.size)), float, self.world.size)
 
-    def _valid(self, state) -> bool:
+    def valid(self, state) -> bool:
         try:
             return self.world.valid(self.vector(state))
         except BaseException as error:      # noqa: B902 - raised by solve()
@@ -459,7 +437,40 @@ class _Search:
             return False
 
 
-def _motion_validator(ob, si, search: _Search):
+class _Search:
+    """The OMPL objects of one search, kept together (OMPL holds raw pointers between them),
+    with its callbacks (``checks``)."""
+
+    def __init__(self, checks: _Checks, settings: GeometricSettings,
+                 start: np.ndarray, goal: np.ndarray):
+        ob, og, ou = _ompl()
+        ou.setLogLevel(ou.LOG_WARN)
+        self.checks = checks
+        size = checks.world.size
+        self.space = ob.RealVectorStateSpace(size)
+        unit = ob.RealVectorBounds(size)
+        unit.setLow(0.0)
+        unit.setHigh(1.0)
+        self.space.setBounds(unit)
+        self.setup = og.SimpleSetup(self.space)
+        self.si = self.setup.getSpaceInformation()
+        self.setup.setStateValidityChecker(checks.valid)
+        self.validator = _motion_validator(ob, self.si, checks)
+        self.si.setMotionValidator(self.validator)
+        self.start, self.goal = self.si.allocState(), self.si.allocState()
+        for i in range(size):
+            self.start[i], self.goal[i] = float(start[i]), float(goal[i])
+        self.setup.setStartAndGoalStates(self.start, self.goal)
+        self.planner = getattr(og, settings.planner)(self.si)
+        if settings.range is not None and hasattr(self.planner, "setRange"):
+            self.planner.setRange(settings.range)
+        if settings.goal_bias is not None and hasattr(self.planner, "setGoalBias"):
+            self.planner.setGoalBias(settings.goal_bias)
+        self.setup.setPlanner(self.planner)
+        self.setup.setup()
+
+
+def _motion_validator(ob, si, checks: _Checks):
     class Motions(ob.MotionValidator):
         """Every configuration along the motion checked at the world's resolution."""
 
@@ -467,7 +478,7 @@ def _motion_validator(ob, si, search: _Search):
             super().__init__(si)
 
         def checkMotion(self, s1, s2, *last_valid) -> bool:
-            return search.motion(s1, s2)
+            return checks.motion(s1, s2)
 
     return Motions(si)
 
@@ -507,41 +518,45 @@ def solve(plan: BuildPlan, settings: Optional[GeometricSettings] = None,
 
 def _search(world: GeometricWorld, settings: GeometricSettings, start, goal, seed,
             stop) -> GeometricResult:
-    ob, og, _ = _ompl()
+    ob, _, _ = _ompl()
     deadline = time.monotonic() + settings.time_limit
-    search: Optional[_Search] = None
+    checks_before = world.checks
+    started = time.perf_counter()
 
     def over() -> bool:
         """OMPL's termination condition, asked once per planner iteration (and during a
         motion's checks)."""
-        return time.monotonic() >= deadline or (search is not None and search.error is not None) \
+        return time.monotonic() >= deadline or checks.error is not None \
             or (stop is not None and bool(stop()))
 
-    search = _Search(world, settings, start, goal, over)
-    checks_before = world.checks
-    started = time.perf_counter()
-
-    status = search.setup.solve(ob.PlannerTerminationCondition(over))
+    checks = _Checks(world, over)
+    status, path = _run(_Search(checks, settings, start, goal), settings.simplify, over)
+    # the search's OMPL objects are gone here, before anything is raised: a traceback holding
+    # them would keep them to the interpreter's end
     if stop is not None and stop():
         raise KeyboardInterrupt
-    if search.error is not None:
-        raise PlanningError(f"collision checking failed: {search.error}") from search.error
-    solved = bool(search.setup.haveExactSolutionPath())
-    path = np.empty((0, world.size))
-    length = 0.0
-    if solved:
-        if settings.simplify:
-            _simplify(og, search)
-        geometric = search.setup.getSolutionPath()
-        path = np.array([search.vector(geometric.getState(i))
-                         for i in range(geometric.getStateCount())])
-        length = float(np.sum(np.linalg.norm(np.diff(path, axis=0), axis=1)))
-    elapsed = time.perf_counter() - started
-    return GeometricResult(settings.planner, seed, solved, path, elapsed,
-                           world.checks - checks_before, length, str(status))
+    if checks.error is not None:
+        raise PlanningError(f"collision checking failed: {checks.error}") from checks.error
+    length = float(np.sum(np.linalg.norm(np.diff(path, axis=0), axis=1))) if len(path) else 0.0
+    return GeometricResult(settings.planner, seed, bool(len(path)), path,
+                           time.perf_counter() - started, world.checks - checks_before, length,
+                           status)
 
 
-def _simplify(og, search: _Search) -> None:
+def _run(search: _Search, simplify: bool, over: Callable[[], bool]) -> Tuple[str, np.ndarray]:
+    """(OMPL's status, the exact solution's states (n, k), empty when none) of ``search``."""
+    ob, og, _ = _ompl()
+    status = str(search.setup.solve(ob.PlannerTerminationCondition(over)))
+    if not search.setup.haveExactSolutionPath():
+        return status, np.empty((0, search.checks.world.size))
+    if simplify:
+        _simplify(og, search, over)
+    geometric = search.setup.getSolutionPath()
+    return status, np.array([search.checks.vector(geometric.getState(i))
+                             for i in range(geometric.getStateCount())])
+
+
+def _simplify(og, search: _Search, over: Callable[[], bool]) -> None:
     """Shortcuts the solution (Kautham's Simplify Solution) in what is left of the search's
     time: OMPL's reduceVertices, which only tries motions between states of the path that are
     not neighbours and keeps the path's own motions (checked already), so a shortcut cut short
@@ -549,7 +564,7 @@ def _simplify(og, search: _Search) -> None:
     and one cut short there looks invalid)."""
     path = search.setup.getSolutionPath()
     simplifier = og.PathSimplifier(search.si)
-    while not search.over() and path.getStateCount() > 2:
+    while not over() and path.getStateCount() > 2:
         if not simplifier.reduceVertices(path):
             break
 
