@@ -33,7 +33,7 @@ import logging
 import math
 import time
 from dataclasses import dataclass, replace
-from typing import Callable, Dict, List, Optional, Sequence, Tuple
+from typing import Callable, Dict, List, NamedTuple, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -126,7 +126,10 @@ class GeometricResult:
     ``configurations``: per state, each robot's (base pose (4, 4), joints (rad or m));
     ``time_s``: wall-clock seconds of the search; ``states``: the states of the path;
     ``checks``: configurations checked for collision during the search; ``length``: the
-    path's length in the control space; ``status``: OMPL's planner status."""
+    path's length in the control space; ``status``: OMPL's planner status;
+    ``unsimplified_length``: the length of the path the planner found, before simplification;
+    ``simplify_s``: wall seconds of the simplification (part of ``time_s``); ``graph_states``:
+    the states of the planner's graph or trees when it stopped."""
     planner: str
     seed: Optional[int]
     solved: bool
@@ -135,6 +138,9 @@ class GeometricResult:
     checks: int
     length: float
     status: str
+    unsimplified_length: float = 0.0
+    simplify_s: float = 0.0
+    graph_states: int = 0
 
     @property
     def states(self) -> int:
@@ -147,7 +153,9 @@ class GeometricResult:
                 "states": self.states, "collision_checks": self.checks,
                 "collision_checks_per_s": round(self.checks / self.time_s, 1)
                 if self.time_s > 0 else None,
-                "path_length": round(self.length, 9), "status": self.status}
+                "path_length": round(self.length, 9), "status": self.status,
+                "unsimplified_path_length": round(self.unsimplified_length, 9),
+                "simplify_s": round(self.simplify_s, 6), "graph_states": self.graph_states}
 
 
 # -- the robots as the control space moves them ---------------------------------------------
@@ -530,30 +538,58 @@ def _search(world: GeometricWorld, settings: GeometricSettings, start, goal, see
             or (stop is not None and bool(stop()))
 
     checks = _Checks(world, over)
-    status, path = _run(_Search(checks, settings, start, goal), settings.simplify, over)
+    found = _run(_Search(checks, settings, start, goal), settings.simplify, over)
     # the search's OMPL objects are gone here, before anything is raised: a traceback holding
     # them would keep them to the interpreter's end
     if stop is not None and stop():
         raise KeyboardInterrupt
     if checks.error is not None:
         raise PlanningError(f"collision checking failed: {checks.error}") from checks.error
-    length = float(np.sum(np.linalg.norm(np.diff(path, axis=0), axis=1))) if len(path) else 0.0
-    return GeometricResult(settings.planner, seed, bool(len(path)), path,
-                           time.perf_counter() - started, world.checks - checks_before, length,
-                           status)
+    return GeometricResult(settings.planner, seed, bool(len(found.path)), found.path,
+                           time.perf_counter() - started, world.checks - checks_before,
+                           _length(found.path), found.status, _length(found.unsimplified),
+                           found.simplify_s, found.graph_states)
 
 
-def _run(search: _Search, simplify: bool, over: Callable[[], bool]) -> Tuple[str, np.ndarray]:
-    """(OMPL's status, the exact solution's states (n, k), empty when none) of ``search``."""
+def _length(path: np.ndarray) -> float:
+    """A path's length in the control space (0 for none)."""
+    return float(np.sum(np.linalg.norm(np.diff(path, axis=0), axis=1))) if len(path) else 0.0
+
+
+class _Found(NamedTuple):
+    """What one search ended with: OMPL's ``status``; the exact solution's states (n, k) as
+    found (``unsimplified``) and as returned (``path``), both empty when none; the wall
+    seconds of the simplification; the states of the planner's graph."""
+    status: str
+    path: np.ndarray
+    unsimplified: np.ndarray
+    simplify_s: float
+    graph_states: int
+
+
+def _run(search: _Search, simplify: bool, over: Callable[[], bool]) -> _Found:
+    """What ``search`` finds (its solution simplified when ``simplify``)."""
     ob, og, _ = _ompl()
     status = str(search.setup.solve(ob.PlannerTerminationCondition(over)))
+    data = ob.PlannerData(search.si)
+    search.setup.getPlannerData(data)
+    graph_states = int(data.numVertices())
     if not search.setup.haveExactSolutionPath():
-        return status, np.empty((0, search.checks.world.size))
+        none = np.empty((0, search.checks.world.size))
+        return _Found(status, none, none, 0.0, graph_states)
+    unsimplified = _states(search)
+    started = time.perf_counter()
     if simplify:
         _simplify(og, search, over)
+    return _Found(status, _states(search), unsimplified, time.perf_counter() - started,
+                  graph_states)
+
+
+def _states(search: _Search) -> np.ndarray:
+    """The search's solution path's states (n, k)."""
     geometric = search.setup.getSolutionPath()
-    return status, np.array([search.checks.vector(geometric.getState(i))
-                             for i in range(geometric.getStateCount())])
+    return np.array([search.checks.vector(geometric.getState(i))
+                     for i in range(geometric.getStateCount())])
 
 
 def _simplify(og, search: _Search, over: Callable[[], bool]) -> None:
