@@ -24,7 +24,7 @@ from odin_common.limits import ResourceLimits, shown
 from odin_common.specs import CompositeSpec, EntitySpec, JointSpec, MotorSpec, ObjectSpec
 from odin_common.world_parameters import WorldParameters
 from virtual_world.core import (actuation, exemptions, forces, guard, joints, long_calls,
-                                motors, objects, propagation, readout, snapshots,
+                                motors, objects, probe, propagation, readout, snapshots,
                                 validation as check)
 from virtual_world.core.requests import changes_contents, changes_state, disturbs, locked
 from virtual_world.core.records import (Built, BuiltEntity, Collision, Divergence,
@@ -474,6 +474,27 @@ class Core:
             for g, pose in zip(statics, saved_statics):
                 bodies.set_static_geom_pose(g.owner.ptr, pose)
         return found
+
+    @locked
+    def collision_probe(self, moved: Sequence[str], apart: Sequence[str] = ()
+                        ) -> probe.CollisionProbe:
+        """A geometric planner's probe (virtual_world.core.probe) of the objects ``moved``
+        (each with a body), whose ``clearances`` do not ask against the objects ``apart``."""
+        return probe.CollisionProbe(self._scene, moved, apart)
+
+    @changes_state
+    def probe_touching(self, collision_probe: probe.CollisionProbe, poses
+                       ) -> Optional[Tuple[str, str]]:
+        """The probe's objects put at ``poses`` ((n, 4, 4) object frames, m, world; they stay
+        there): the first pair of geometry names touching one of them, or None."""
+        return collision_probe.touching(self._scene, poses)
+
+    @locked
+    def probe_clearances(self, collision_probe: probe.CollisionProbe, capsules, tiers
+                         ) -> np.ndarray:
+        """Lower bounds (m) of capsules' distances to the world but the probe's ``apart``
+        objects (CollisionProbe.clearances)."""
+        return collision_probe.clearances(self._scene, capsules, tiers)
 
     # ------------------------------------------------------------------ step and read-out
 

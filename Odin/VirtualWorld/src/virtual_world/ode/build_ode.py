@@ -6,6 +6,7 @@ Layers, each in its own file (pymunk's layout):
   * ``odin_step.c`` -- Odin's own C code compiled into the extension: the per-step hot work;
   * ``odin_state.c`` -- bodies' state read and written bit for bit (snapshots);
   * ``odin_kinematic.c`` -- the kinematic drive's forward kinematics, every step;
+  * ``odin_query.c`` -- the geometric planner's collision queries;
   * this module     -- the build; ``bindings.py`` only re-exports ``ffi, lib``.
 
 Usage: ``python build_ode.py --out DIR [--tmp DIR]`` (CMake runs it during the catkin build).
@@ -46,7 +47,7 @@ def make_builder() -> cffi.FFI:
         "_odin_ode",
         '#include <ode/ode.h>\n#include "odin_step.h"\n',
         sources=[str(HERE / "odin_step.c"), str(HERE / "odin_state.c"),
-                 str(HERE / "odin_kinematic.c")],
+                 str(HERE / "odin_kinematic.c"), str(HERE / "odin_query.c")],
         include_dirs=[str(HERE)],
         extra_compile_args=["-O2", "-DdDOUBLE"] + _pkg_config("--cflags"),
         libraries=["ode"],

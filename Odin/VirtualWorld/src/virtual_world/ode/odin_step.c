@@ -362,17 +362,23 @@ static void part_exempt_pairs(OdinWorld *w) {
 
 /* ---------------------------------------------------------------- near-callback */
 
+int odin_pair_never_touches(dGeomID o1, dGeomID o2) {
+    const OdinGeomInfo *i1 = info_of(o1), *i2 = info_of(o2);
+    if (i1->tag && i1->tag == i2->tag) return 1; /* same entity, no internal collisions */
+    dBodyID b1 = dGeomGetBody(o1), b2 = dGeomGetBody(o2);
+    if (b1 == b2) return 1; /* parts of one composite, or two static geoms */
+    return b1 && b2 && dAreConnectedExcluding(b1, b2, dJointTypeContact);
+}
+
 static void near_callback(void *data, dGeomID o1, dGeomID o2) {
     OdinWorld *w = (OdinWorld *)data;
+    if (odin_pair_never_touches(o1, o2)) return;
     const OdinGeomInfo *i1 = info_of(o1), *i2 = info_of(o2);
-    if (i1->tag && i1->tag == i2->tag) return; /* same entity, no internal collisions */
     if (i1->serial > i2->serial) { /* collide in serial order: the same contacts every time */
         dGeomID g = o1; o1 = o2; o2 = g;
         const OdinGeomInfo *i = i1; i1 = i2; i2 = i;
     }
     dBodyID b1 = dGeomGetBody(o1), b2 = dGeomGetBody(o2);
-    if (b1 == b2) return; /* parts of one composite, or two static geoms */
-    if (b1 && b2 && dAreConnectedExcluding(b1, b2, dJointTypeContact)) return;
     if (w->n_exempt) {
         int e = live_exempt(w, (uint64_t)i1->serial << 32 | (uint64_t)(uint32_t)i2->serial);
         if (e >= 0 && collide_exempt(w, o1, o2, e)) return;

@@ -260,6 +260,25 @@ int odin_world_record_pairs(const OdinWorld *w, uintptr_t *out, int max);
 /* Records the pairs touching now, without stepping and without contacts: under the contact-less
  * policy always; under the contact policy only when any_policy (a collision query). */
 void odin_world_detect(OdinWorld *w, int any_policy);
+/* Whether a step never collides geoms o1 and o2, whatever their poses: the same entity without
+ * internal collisions, the same body (or both static), or bodies joined by a joint. */
+int odin_pair_never_touches(dGeomID o1, dGeomID o2);
+
+/* The geometric planner's queries (odin_query.c); nothing recorded, no contact made. */
+/* 1 when one of the n geoms touches a geom the step may collide it with (not
+ * odin_pair_never_touches), on the present poses, with that pair in hit[0], hit[1]; else 0. */
+int odin_geoms_touching(OdinWorld *w, const dGeomID *geoms, int n, dGeomID *hit);
+/* For each of the n capsules (7 values each: end a (3), end b (3), radius r; m, world), the
+ * first of the n_tiers growths `tiers` (m, descending) by which the capsule (radius r + tier)
+ * touches none of the space's geoms but the n_skip geoms of `skip` (their addresses, sorted),
+ * else 0.0, into out: each a lower bound of the capsule's distance to them. A geom no capsule
+ * collider of ODE takes (a cylinder, a convex) counts as touching when the boxes overlap. */
+void odin_capsules_clearance(OdinWorld *w, const double *capsules, int n, const double *tiers,
+                             int n_tiers, const uintptr_t *skip, int n_skip, double *out);
+/* Puts n bodies at poses (12 values each: centre of mass (3, m, world), then the rotation
+ * matrix (3 x 3, row by row; orthonormal: ODE makes its quaternion of it)). */
+void odin_place_bodies(dBodyID *bodies, int n, const double *poses);
+
 /* Forgets the collision records (contact-less: after a read). */
 void odin_world_clear_records(OdinWorld *w);
 /* Frees the record and contact buffers (close/new scene). */

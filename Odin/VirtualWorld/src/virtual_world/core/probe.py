@@ -1,0 +1,117 @@
+"""Collision queries for a geometric planner (gui.planning.geometric), ROS-free: a
+``CollisionProbe`` is made once for a scene's robots and then asked, thousands of times a
+second, whether their links touch anything at given poses, and how far capsules bounding them
+are from everything else. Each call costs one C call (odin_query.c), not a Check Collision
+request's: the poses are checked as arrays, and nothing is put back (the links stay where the
+last call put them; a planner's world is its own).
+
+Which pairs may touch is the step's rule (odin_pair_never_touches: not two geoms of one entity
+without internal collisions, of one body, or of bodies a joint joins). A probe is bound to the
+objects the scene held when it was made: once any is removed or added (or the scene is new), it
+refuses every call.
+"""
+from __future__ import annotations
+
+from typing import Optional, Sequence, Tuple
+
+import numpy as np
+
+from odin_common.limits import shown
+from virtual_world.core.scene import Scene
+from virtual_world.errors import InvalidArgument
+from virtual_world.ode.queries import GeomQuery
+
+MAX_TIERS = 64
+"""The most growths a clearance query takes (each costs a probe per capsule at most)."""
+ORTHONORMAL_TOLERANCE = 1e-6
+"""How far a pose's rotation may be from orthonormal (largest entry of R R^T - I)."""
+
+
+class CollisionProbe:
+    """The objects ``moved`` (with bodies) placed and asked about; the objects ``apart``
+    (their geometries) not asked against by ``clearances`` (a robot's own links, whose pairs
+    the planner bounds itself)."""
+
+    def __init__(self, scene: Scene, moved: Sequence[str], apart: Sequence[str] = ()):
+        moved, apart = _object_ids("moved", scene, moved), _object_ids("apart", scene, apart)
+        records = [scene.object(object_id) for object_id in moved]
+        static = [r.id for r in records if r.body is None]
+        if static:
+            raise InvalidArgument(f"moved: {shown(static[0])} has no body to move")
+        self.moved: Tuple[str, ...] = tuple(moved)
+        self._scene = scene
+        self._objects = dict(scene.objects)
+        self._com = np.array([r.com for r in records], dtype=float).reshape(-1, 3)
+        self._query = GeomQuery(
+            scene.c.struct, [r.body.ptr for r in records],
+            [g.owner.ptr for r in records for g in r.geometries],
+            [g.owner.address for i in apart for g in scene.object(i).geometries])
+
+    def _same_scene(self, scene: Scene) -> None:
+        objects = scene.objects
+        if scene is not self._scene or len(objects) != len(self._objects) or any(
+                objects.get(k) is not v for k, v in self._objects.items()):
+            raise InvalidArgument("the world's objects changed since this collision probe "
+                                  "was made: make a new one")
+
+    def touching(self, scene: Scene, poses) -> Optional[Tuple[str, str]]:
+        """Puts the moved objects at ``poses`` ((n, 4, 4): each object's frame, m, world, in
+        ``moved``'s order) and answers the first pair (geometry names) touching one of them,
+        or None."""
+        self._same_scene(scene)
+        poses = _poses(poses, len(self.moved), scene.parameters.world_extent)
+        rotations = poses[:, :3, :3]
+        centres = poses[:, :3, 3] + np.einsum("nij,nj->ni", rotations, self._com)
+        self._query.place(np.hstack([centres, rotations.reshape(-1, 9)]))
+        hit = self._query.touching()
+        if hit is None:
+            return None
+        return scene.geometry_names[hit[0]], scene.geometry_names[hit[1]]
+
+    def clearances(self, scene: Scene, capsules, tiers) -> np.ndarray:
+        """Per capsule ((m, 7): ends a and b, radius; m, world), the first of ``tiers`` (m,
+        descending) by which it can grow without touching any geometry but those of
+        ``apart``, else 0: a lower bound of its distance to them (m)."""
+        self._same_scene(scene)
+        extent = scene.parameters.world_extent
+        capsules = _finite_array("capsules", capsules, (-1, 7), extent)
+        if np.any(capsules[:, 6] < 0.0):
+            raise InvalidArgument("capsules: a radius is negative")
+        tiers = _finite_array("tiers", tiers, (-1,), extent)
+        if not 1 <= len(tiers) <= MAX_TIERS or np.any(tiers <= 0.0) or np.any(
+                np.diff(tiers) >= 0.0):
+            raise InvalidArgument(f"tiers: 1 to {MAX_TIERS} positive values, descending")
+        return self._query.clearances(capsules, tiers)
+
+
+def _object_ids(what: str, scene: Scene, ids: Sequence[str]) -> Tuple[str, ...]:
+    ids = tuple(ids)
+    if len(ids) > len(scene.objects) or len(set(ids)) != len(ids):
+        raise InvalidArgument(f"{what}: each of the world's objects at most once")
+    for object_id in ids:
+        scene.object(object_id)         # InvalidArgument naming an unknown one
+    return ids
+
+
+def _finite_array(what: str, values, shape, extent: float) -> np.ndarray:
+    try:
+        array = np.asarray(values, dtype=float).reshape(shape)
+    except (TypeError, ValueError):
+        raise InvalidArgument(f"{what}: not an array of shape {shape}") from None
+    if not np.all(np.isfinite(array)) or np.any(np.abs(array) > extent):
+        raise InvalidArgument(f"{what}: every value finite and within the world's extent "
+                              f"({extent:g} m)")
+    return array
+
+
+def _poses(poses, count: int, extent: float) -> np.ndarray:
+    poses = _finite_array("poses", poses, (-1, 4, 4), extent)
+    if len(poses) != count:
+        raise InvalidArgument(f"poses: {len(poses)} given for {count} moved objects")
+    rotations = poses[:, :3, :3]
+    error = np.einsum("nij,nkj->nik", rotations, rotations) - np.eye(3)
+    if count and float(np.max(np.abs(error))) > ORTHONORMAL_TOLERANCE:
+        raise InvalidArgument("poses: a rotation is not orthonormal")
+    return poses
+
+

@@ -1,0 +1,134 @@
+/* The geometric planner's collision queries (gui.planning.geometric through
+ * virtual_world.core.probe): whether the geoms of some objects touch anything on their present
+ * poses, with the step's rules for which pairs may touch (odin_pair_never_touches), and how far
+ * capsules bounding them can grow before they touch anything else. Nothing is recorded, no
+ * contact joint is made, nothing is stepped; the world's records are not touched. */
+#include <ode/ode.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include "odin_step.h"
+
+/* One query's state, passed to ODE's near-callback through dSpaceCollide2's data. */
+typedef struct {
+    dGeomID geom;            /* the geom asked about (a listed geom, or the probe) */
+    const uintptr_t *skip;   /* sorted addresses of geoms the query does not ask against */
+    int n_skip;
+    int probe;               /* 1: geom is a probe of no object (every other geom may touch it) */
+    int touching;            /* set at the first touching pair; later pairs are not asked */
+    dGeomID other;
+} Ask;
+
+static int skipped(const Ask *ask, dGeomID g) {
+    uintptr_t key = (uintptr_t)g;
+    int low = 0, high = ask->n_skip - 1;
+    while (low <= high) {
+        int mid = low + (high - low) / 2;
+        if (ask->skip[mid] == key) return 1;
+        if (ask->skip[mid] < key) low = mid + 1;
+        else high = mid - 1;
+    }
+    return 0;
+}
+
+/* ODE's capsule colliders: a probe meeting a geom of another class (a cylinder, a convex, a
+ * heightfield) cannot be asked, and is taken to touch it whenever their boxes overlap (a
+ * clearance is a lower bound: too small is safe, too large is not). */
+static int capsule_collides_with(dGeomID g) {
+    switch (dGeomGetClass(g)) {
+    case dSphereClass: case dBoxClass: case dCapsuleClass: case dPlaneClass:
+    case dTriMeshClass:
+        return 1;
+    default:
+        return 0;
+    }
+}
+
+static void ask_pair(void *data, dGeomID o1, dGeomID o2) {
+    Ask *ask = (Ask *)data;
+    if (ask->touching) return;
+    dGeomID other = o1 == ask->geom ? o2 : o1;
+    if (dGeomIsSpace(other)) { /* a space inside the world's: asked through */
+        dSpaceCollide2(ask->geom, other, ask, &ask_pair);
+        return;
+    }
+    if (other == ask->geom || (ask->n_skip && skipped(ask, other))) return;
+    if (!ask->probe && odin_pair_never_touches(ask->geom, other)) return;
+    if (ask->probe && !capsule_collides_with(other)) {
+        ask->touching = 1;
+        ask->other = other;
+        return;
+    }
+    dContactGeom contact[1];
+    if (dCollide(ask->geom, other, 1, contact, sizeof(dContactGeom)) > 0) {
+        ask->touching = 1;
+        ask->other = other;
+    }
+}
+
+int odin_geoms_touching(OdinWorld *w, const dGeomID *geoms, int n, dGeomID *hit) {
+    Ask ask;
+    memset(&ask, 0, sizeof ask);
+    for (int i = 0; i < n; ++i) {
+        ask.geom = geoms[i];
+        dSpaceCollide2(geoms[i], (dGeomID)w->space, &ask, &ask_pair);
+        if (ask.touching) {
+            hit[0] = geoms[i];
+            hit[1] = ask.other;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* Puts the probe along the segment a-b (m, world), its radius r + grown. */
+static void place_probe(dGeomID probe, const double *capsule, double grown) {
+    const double *a = capsule, *b = capsule + 3;
+    double axis[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    double length = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
+    dMatrix3 R;
+    if (length > 1e-12) dRFromZAxis(R, axis[0], axis[1], axis[2]);
+    else dRSetIdentity(R);
+    dGeomCapsuleSetParams(probe, capsule[6] + grown, length);
+    dGeomSetPosition(probe, (a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2);
+    dGeomSetRotation(probe, R);
+}
+
+static int probe_touches(OdinWorld *w, Ask *ask, const double *capsule, double grown) {
+    place_probe(ask->geom, capsule, grown);
+    ask->touching = 0;
+    dSpaceCollide2(ask->geom, (dGeomID)w->space, ask, &ask_pair);
+    return ask->touching;
+}
+
+void odin_capsules_clearance(OdinWorld *w, const double *capsules, int n, const double *tiers,
+                             int n_tiers, const uintptr_t *skip, int n_skip, double *out) {
+    Ask ask;
+    memset(&ask, 0, sizeof ask);
+    ask.geom = dCreateCapsule(0, 1.0, 1.0);
+    ask.probe = 1;
+    ask.skip = skip;
+    ask.n_skip = n_skip;
+    for (int i = 0; i < n; ++i) {
+        const double *capsule = capsules + 7 * i;
+        /* tiers descend: the first clear one is the answer; clear at k means clear beyond k */
+        int low = 0, high = n_tiers; /* the answer's index is in [low, high]; n_tiers: none */
+        while (low < high) {
+            int mid = low + (high - low) / 2;
+            if (probe_touches(w, &ask, capsule, tiers[mid])) low = mid + 1;
+            else high = mid;
+        }
+        out[i] = low < n_tiers ? tiers[low] : 0.0;
+    }
+    dGeomDestroy(ask.geom);
+}
+
+void odin_place_bodies(dBodyID *bodies, int n, const double *poses) {
+    for (int i = 0; i < n; ++i) {
+        const double *p = poses + 12 * i, *r = p + 3;
+        dMatrix3 R = {r[0], r[1], r[2], 0.0, r[3], r[4], r[5], 0.0, r[6], r[7], r[8], 0.0};
+        dBodySetPosition(bodies[i], p[0], p[1], p[2]);
+        dBodySetRotation(bodies[i], R);
+    }
+}

@@ -1,0 +1,67 @@
+"""The geometric planner's collision queries in C (odin_query.c) over one scene's world:
+``GeomQuery`` holds, in C arrays, the bodies it places, the geoms it asks about and the geoms
+its capsules do not ask against, for as long as the scene holds them (its owner,
+``virtual_world.core.probe.CollisionProbe``, checks that before every call: C must never see a
+freed handle). Arguments are the caller's to check (finite, within the world): this layer only
+converts them.
+"""
+from __future__ import annotations
+
+from typing import Optional, Sequence, Tuple
+
+import numpy as np
+
+from virtual_world.ode.bindings import ffi, lib
+from virtual_world.ode.runtime import drains_ode_messages
+
+POSE_VALUES = 12
+"""A placed body's values: centre of mass (3, m, world), rotation matrix row by row (9)."""
+CAPSULE_VALUES = 7
+"""A capsule's values: its segment's ends a and b (3 each, m, world), its radius (m)."""
+
+
+def _doubles(array: np.ndarray):
+    return ffi.cast("double *", ffi.from_buffer(array))
+
+
+class GeomQuery:
+    """``bodies`` placed by ``place``; ``geoms`` asked by ``touching``; ``apart`` (geom
+    addresses) not asked against by ``clearances``. ``world``: the scene's CWorld struct."""
+
+    def __init__(self, world, bodies: Sequence, geoms: Sequence, apart: Sequence[int]):
+        self._world = world
+        self._bodies = ffi.new("dBodyID[]", list(bodies) or 1)
+        self._body_count = len(bodies)
+        self._geoms = ffi.new("dGeomID[]", list(geoms) or 1)
+        self._geom_count = len(geoms)
+        self._apart = ffi.new("uintptr_t[]", sorted(apart) or 1)
+        self._apart_count = len(apart)
+        self._hit = ffi.new("dGeomID[2]")
+
+    @drains_ode_messages
+    def place(self, poses: np.ndarray) -> None:
+        """Puts the bodies at ``poses`` (n, POSE_VALUES), in their order."""
+        poses = np.ascontiguousarray(poses, dtype=float)
+        lib.odin_place_bodies(self._bodies, self._body_count, _doubles(poses))
+
+    @drains_ode_messages
+    def touching(self) -> Optional[Tuple[int, int]]:
+        """(geom address, geom address) of the first touching pair one of the geoms is in,
+        with the step's rules for which pairs may touch; None when none touches."""
+        if not lib.odin_geoms_touching(self._world, self._geoms, self._geom_count, self._hit):
+            return None
+        return (int(ffi.cast("uintptr_t", self._hit[0])),
+                int(ffi.cast("uintptr_t", self._hit[1])))
+
+    @drains_ode_messages
+    def clearances(self, capsules: np.ndarray, tiers: np.ndarray) -> np.ndarray:
+        """Per capsule (m, CAPSULE_VALUES), the first of ``tiers`` (m, descending) it can
+        grow by and touch none of the world's geoms but ``apart``, else 0 (m)."""
+        capsules = np.ascontiguousarray(capsules, dtype=float)
+        tiers = np.ascontiguousarray(tiers, dtype=float)
+        out = np.empty(len(capsules))
+        if len(capsules):
+            lib.odin_capsules_clearance(self._world, _doubles(capsules), len(capsules),
+                                        _doubles(tiers), len(tiers), self._apart,
+                                        self._apart_count, _doubles(out))
+        return out
