@@ -13,6 +13,7 @@ import sys
 import tempfile
 import time
 import traceback
+from typing import Optional
 
 from odin_common.blas import use_reference_blas
 
@@ -65,7 +66,7 @@ def problem_info(corpus: pathlib.Path, relative: str) -> dict:
         description = json.loads(stdout)
         return dict(status="ok", info_s=seconds, bodies=len(description["bodies"]),
                     robot_kinds=[r["kind"] for r in description["robots"]],
-                    physics=description["physics"])
+                    physics=description["physics"], planner=description["planner"])
     if code == 2 and len(errors) == 1 and errors[0].startswith("problem_info: error: ") \
             and "Traceback" not in stderr:
         reason = errors[0][len("problem_info: error: "):]
@@ -84,33 +85,45 @@ def _run_forked(main, timeout: float):
     """(exit code or None when it ran past ``timeout`` s and was killed, stdout, stderr) of
     ``main()`` run in a forked child whose file descriptors 1 and 2 are files of its own."""
     with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
-        sys.stdout.flush()
-        sys.stderr.flush()
-        pid = os.fork()
-        if pid == 0:                    # the child: never returns
-            code = 1
-            try:
-                os.dup2(out.fileno(), 1)
-                os.dup2(err.fileno(), 2)
-                code = main()
-            except SystemExit as exit_:
-                code = exit_.code if isinstance(exit_.code, int) else 1
-            except BaseException:       # as the interpreter reports an uncaught exception
-                traceback.print_exc()
-            finally:
-                sys.stdout.flush()
-                sys.stderr.flush()
-                os._exit(code)
-        code = _wait(pid, timeout)
+        deadline = time.monotonic() + timeout
+        code = wait(fork(main, out, err), lambda: deadline)
         out.seek(0)
         err.seek(0)
         return code, out.read().decode(errors="replace"), err.read().decode(errors="replace")
 
 
-def _wait(pid: int, timeout: float):
-    deadline = time.monotonic() + timeout
+def fork(main, out, err) -> int:
+    """The process ID of a forked child that runs ``main()`` with its file descriptors 1 and 2
+    on the files ``out`` and ``err`` and exits with its status (an exception that escapes
+    printed as Python prints it, status 1)."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    pid = os.fork()
+    if pid == 0:                    # the child: never returns
+        code = 1
+        try:
+            os.dup2(out.fileno(), 1)
+            os.dup2(err.fileno(), 2)
+            # Python's streams onto them too, whatever the parent had put there (pytest's)
+            sys.stdout = open(1, "w", closefd=False)
+            sys.stderr = open(2, "w", closefd=False)
+            code = main()
+        except SystemExit as exit_:
+            code = exit_.code if isinstance(exit_.code, int) else 1
+        except BaseException:       # as the interpreter reports an uncaught exception
+            traceback.print_exc()
+        finally:
+            sys.stdout.flush()
+            sys.stderr.flush()
+            os._exit(code)
+    return pid
+
+
+def wait(pid: int, deadline) -> Optional[int]:
+    """The exit status of child ``pid`` (negative: the signal that ended it), or None when it
+    ran past ``deadline()`` (time.monotonic() s, asked as it runs) and was killed."""
     try:
-        while time.monotonic() < deadline:
+        while time.monotonic() < deadline():
             done, status = os.waitpid(pid, os.WNOHANG)
             if done:
                 return os.waitstatus_to_exitcode(status)

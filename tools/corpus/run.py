@@ -2,7 +2,7 @@
 would run it, with a report (issue 31). Not part of `make test` (about an hour here).
 
     python tools/corpus/run.py [--corpus DIR] [--only TEXT] [--seconds 2] [--no-simulation]
-                               [--no-readme]
+                               [--no-planning] [--plan-seconds S] [--no-readme] [--out DIR]
 
 The corpus is what ``tools/get_kautham.sh --all`` lays out (``$ODIN_KAUTHAM_ALL_DIR``, else
 ``../shared/kautham_all`` beside the clone: ``gui.core.kautham.corpus``). Its problem files
@@ -30,14 +30,23 @@ files do too).
    each robot's links is reported for every robot kind, and the largest drop of any body
    (in a problem without a ground, a dynamic body falls for as long as it is simulated).
 
-3. The tests over the whole corpus (``WHOLE_CORPUS_TESTS``, skipped by `make test`): the fuzz
+3. Each problem problem_info accepts that names a planner other than Kautham's ODE planners is
+   planned as ``rosrun GUI plan`` plans it: ``gui.planning.geometric.solve``, the problem's
+   own planner and time limit (``--plan-seconds``: at most that), seed 1, in a process of its
+   own (tools/corpus/corpus_plan.py): solved | not solved | refused (one line: no query, start
+   or goal collides, planner unknown...) | failed (a traceback, a crash, a hang), the search's
+   time, states and collision checks (``--no-planning``: not run).
+
+4. The tests over the whole corpus (``WHOLE_CORPUS_TESTS``, skipped by `make test`): the fuzz
    of every file problem_info opens (mutated, truncated, wrong encodings: one clear error or a
    plan, never a traceback or a hang), and the forward kinematics of every URDF robot against
    robot_state_publisher's (KDL) on /tf (``--no-tests``: not run).
 
-Writes ``out/corpus/report.json`` and ``report.md`` and the counts between the README's corpus
-markers (``--no-readme``: not; ``--only``: a partial run never rewrites it). Exit status 0 when
-no file failed and every refusal is expected, 1 otherwise, 2 when the corpus is missing.
+Writes ``out/corpus/report.json`` and ``report.md`` (``--out``: elsewhere) and the counts between
+the README's corpus markers (``--no-readme``: not; ``--only`` or ``--no-simulation``: a partial
+run never rewrites them; a run with ``--plan-seconds`` says there that it was capped). Exit
+status 0 when no file failed (a search not solved, or refused with its reason, is no failure)
+and every refusal of problem_info is expected, 1 otherwise, 2 when the corpus is missing.
 """
 from __future__ import annotations
 
@@ -54,6 +63,7 @@ HERE = pathlib.Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
 import corpus_checks as checks  # noqa: E402
+import corpus_plan as planning  # noqa: E402
 import corpus_report as report  # noqa: E402
 
 from gui.core.kautham.corpus import (WHOLE_CORPUS_TESTS, WHOLE_ENVIRONMENT,  # noqa: E402
@@ -83,9 +93,15 @@ def main(argv=None) -> int:
                         help="simulated seconds per problem [2]")
     parser.add_argument("--no-simulation", action="store_true",
                         help="problem_info only, no world")
+    parser.add_argument("--no-planning", action="store_true",
+                        help="not the planning of the geometric problems")
+    parser.add_argument("--plan-seconds", type=_positive, default=None, metavar="S",
+                        help="each search's time limit at most S s [the problem's own]")
     parser.add_argument("--no-tests", action="store_true",
                         help="not the tests over the whole corpus")
     parser.add_argument("--no-readme", action="store_true")
+    parser.add_argument("--out", type=pathlib.Path, default=OUT,
+                        help="the report's folder [out/corpus]")
     args = parser.parse_args(argv)
     if args.corpus is None or not (args.corpus / "ALL.md").is_file():
         print(f"corpus: {whole_missing_message()}", file=sys.stderr)
@@ -99,17 +115,25 @@ def main(argv=None) -> int:
         accepted = [f for f in files if results[f]["status"] == "ok"]
         for f, simulated in checks.simulate_all(args.corpus, accepted, args.seconds).items():
             results[f].update(simulated)
-    tests = None if args.no_tests or args.only else whole_corpus_tests(args.corpus)
+    if not args.no_planning:
+        planning.preload()
+        accepted = {f: r for f, r in results.items() if r["status"] == "ok"}
+        for f, planned in planning.plan_all(args.corpus, accepted, args.plan_seconds).items():
+            results[f].update(planned)
+    tests = None if args.no_tests or args.only else whole_corpus_tests(args.corpus, args.out)
     run = dict(corpus=str(args.corpus), started=started, minutes=(time.time() - started) / 60,
                seconds=args.seconds, simulated=not args.no_simulation, only=args.only,
-               tests=tests)
-    OUT.mkdir(parents=True, exist_ok=True)
-    (OUT / "report.json").write_text(json.dumps(dict(run=run, files=results), indent=1) + "\n")
+               tests=tests, planned=not args.no_planning, plan_seconds=args.plan_seconds)
+    args.out.mkdir(parents=True, exist_ok=True)
+    (args.out / "report.json").write_text(json.dumps(dict(run=run, files=results), indent=1)
+                                          + "\n")
     counts = report.counts(results)
-    (OUT / "report.md").write_text(report.markdown(run, results, counts))
+    (args.out / "report.md").write_text(report.markdown(run, results, counts))
     if not (args.no_readme or args.only or args.no_simulation):
         report.rewrite_readme(report.readme_block(run, counts))
-    print(report.summary_line(counts) + f"; {OUT / 'report.md'}", flush=True)
+    print(report.summary_line(counts) + f"; {args.out / 'report.md'}", flush=True)
+    if run["planned"]:
+        print(report.plan_summary_line(counts), flush=True)
     if tests is not None:
         print(f"corpus: tests over the whole corpus: {tests['summary']}", flush=True)
     ok = counts["failed"] == 0 and counts["refused_unexpected"] == 0
@@ -120,7 +144,14 @@ WHOLE_CORPUS_TEST_FILES = ("Odin/GUI/test/test_hostile_files.py",
                            "tests/nodes/test_urdf_kinematics.py")
 
 
-def whole_corpus_tests(corpus: pathlib.Path) -> dict:
+def _positive(text: str) -> float:
+    value = float(text)
+    if not (value > 0 and value < float("inf")):
+        raise argparse.ArgumentTypeError(f"{text!r} s: must be a positive number")
+    return value
+
+
+def whole_corpus_tests(corpus: pathlib.Path, out: pathlib.Path) -> dict:
     """Runs the tests over the whole corpus; {"status": pytest's exit status, "summary": its
     last line}."""
     env = dict(os.environ, **{WHOLE_CORPUS_TESTS: "1", WHOLE_ENVIRONMENT: str(corpus)})
@@ -128,7 +159,8 @@ def whole_corpus_tests(corpus: pathlib.Path) -> dict:
     done = subprocess.run([sys.executable, "-m", "pytest", "-p", "no:cacheprovider", "-q",
                            "-k", "whole_corpus", *WHOLE_CORPUS_TEST_FILES], cwd=ROOT, env=env,
                           capture_output=True, text=True)
-    (OUT / "tests.log").write_text(done.stdout + done.stderr)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "tests.log").write_text(done.stdout + done.stderr)
     lines = done.stdout.strip().splitlines()
     return dict(status=done.returncode, summary=lines[-1] if lines else "no output")
 
