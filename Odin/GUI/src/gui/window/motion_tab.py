@@ -11,11 +11,14 @@ Kautham's ODE environment does: ``gui.core.control_path``, docs/INTERFACE.md), a
 paths (a Kautham plan: .kps solution, task file, OMPL or raw rows, timed within the joints'
 limits and followed by the joint servos under full physics, ``gui.core.execution``; its
 target against actual per joint is plotted below); a path runs on a worker of its own (Stop
-ends it) so the other tabs stay usable meanwhile.
+ends it) so the other tabs stay usable meanwhile. Solve query (shown while a problem without
+physics is open): its query solved with OMPL's geometric planners, the path shown and run
+(``gui.window.solve_panel``).
 """
 from __future__ import annotations
 
 import pathlib
+from typing import Optional
 
 from PyQt5.QtWidgets import (QCheckBox, QComboBox, QFileDialog, QLabel, QListWidget,
                              QPushButton, QToolBox, QVBoxLayout, QWidget)
@@ -24,6 +27,7 @@ from gui.errors import GuiError
 from gui.window.fields import ChoiceButtons, VectorRow, int_spin
 from gui.window.forms import form_grid, growing, span
 from gui.window.scene import JOINT_TYPE_NAMES
+from gui.window.solve_panel import SolvePanel
 from gui.window.tracking_plot import TrackingPlot
 from odin_common.interface import JOINT_FORCE_MAGNITUDES, ForceKind
 from odin_common.step_values import StepValues
@@ -32,6 +36,7 @@ ACTIONS = ["force", "torque", "angular velocity", "linear velocity"]
 #: the actions that add a persistent force (by their index in ACTIONS)
 FORCE_ACTIONS = {0: ForceKind.FORCE, 1: ForceKind.TORQUE}
 ANGULAR_VELOCITY = 2
+SOLVE_TITLE = "Solve query"
 
 
 class MotionTab(QWidget):
@@ -44,6 +49,8 @@ class MotionTab(QWidget):
                             (self._motor_page(), "Move motor"),
                             (self._robot_page(), "Move robot")]:
             self.toolbox.addItem(page, title)
+        self.solve = SolvePanel(window, self)       # a page while a geometric problem is open
+        self.solve.hide()
         layout = QVBoxLayout(self)
         layout.addWidget(self.toolbox)
         self._connect(window)
@@ -180,6 +187,19 @@ class MotionTab(QWidget):
             self._refill(self.robot, list(scene.robots))
             if scene.problem_format is not None:
                 self.units.setCurrentIndex(0 if scene.problem_format == "2012" else 1)
+            self._show_solve(scene.plan)
+
+    def _show_solve(self, plan) -> None:
+        """The Solve query page for ``plan`` when it has no physics, else no such page (a
+        physics problem is planned by ``rosrun GUI plan``)."""
+        geometric = plan if plan is not None and not plan.physics else None
+        self.solve.set_plan(geometric)
+        index = self.toolbox.indexOf(self.solve)
+        if geometric is not None and index < 0:
+            self.toolbox.addItem(self.solve, SOLVE_TITLE)
+        elif geometric is None and index >= 0:
+            self.toolbox.removeItem(index)
+            self.solve.hide()
 
     def _action_changed(self) -> None:
         action = self.action_group.checkedId()
@@ -336,8 +356,8 @@ class MotionTab(QWidget):
                 raise
             return total
 
-        self._submit_path(f"{kind} path", pathlib.Path(path).name, handle.name, total, work,
-                          f" at {rate:g} Hz")
+        self.submit_path(f"{kind} path", pathlib.Path(path).name, handle.name, total, work,
+                         f" at {rate:g} Hz")
 
     def run_control_path(self, handle, path: str) -> None:
         """The control path file ``path`` for ``handle``'s robot, in real time on the path
@@ -355,14 +375,12 @@ class MotionTab(QWidget):
                           sleep=job.sleep)
             return len(rows)
 
-        self._submit_path("control path", pathlib.Path(path).name, handle.name, len(rows),
-                          work)
+        self.submit_path("control path", pathlib.Path(path).name, handle.name, len(rows),
+                         work)
 
     def run_tracked_path(self, handle, path: str, units: str) -> None:
         """The plan in ``path`` (raw rows drive ``handle``'s robot, in ``units``), read and
-        checked whole here, then executed in real time on the path worker (the world paused
-        meanwhile, running again afterwards if it was); a robot away from the path's start is
-        moved there first, which the status line says; the report is plotted."""
+        checked whole here, then run tracked (``run_tracked``)."""
         from gui.core.kautham.solutions import read_solution
         plan = self.window.scene.plan
         if plan is None:
@@ -373,8 +391,13 @@ class MotionTab(QWidget):
         except GuiError as error:  # a bad file is the user's: say what and where
             self.window.show_error(f"Move robot: {error}")
             return
-        name = pathlib.Path(path).name
+        self.run_tracked(plan, solution, pathlib.Path(path).name, handle.name)
 
+    def run_tracked(self, plan, solution, name: str, robots: str) -> None:
+        """``solution`` (gui.core.kautham.solutions) of ``plan``'s robots (``robots``: how the
+        log names them), called ``name``, executed in real time on the path worker (the world
+        paused meanwhile, running again afterwards if it was); a robot away from the path's
+        start is moved there first, which the status line says; the report is plotted."""
         def work(client, job):
             from gui.ros.world_port import run_tracked_on_client
             from gui.window.worker import Cancelled
@@ -388,47 +411,50 @@ class MotionTab(QWidget):
 
         def progress(value):
             t, total = value
-            self.path_status.setText(f"tracked path {name}: {t:.2f}/{total:.2f} s")
+            self._path_state(f"tracked path {name}: {t:.2f}/{total:.2f} s")
 
         def finished(report):
-            self.stop_button.setEnabled(False)
             self.tracking_plot.show_report(report)
             text = (f"tracked path {name}{report.start_move()}: goal error "
                     f"{report.goal_error:.3g}, tracking error "
                     f"max {report.tracking_error_max:.3g}, {report.duration_s:.2f} s, "
                     f"{len(report.collisions)} colliding pairs")
-            self.path_status.setText(text)
-            self.window.show_info(f"{handle.name}: {text}")
+            self._path_state(text, False)
+            self.window.show_info(f"{robots}: {text}")
 
         def failed(message):
-            self.stop_button.setEnabled(False)
-            self.path_status.setText(f"tracked path {name}: {message}")
+            self._path_state(f"tracked path {name}: {message}", False)
             self.window.show_error(message)
 
-        self.stop_button.setEnabled(True)
-        self.path_status.setText(f"tracked path {name}: starting ({solution.format}, "
-                                 f"{solution.waypoint_count} waypoints)")
+        self._path_state(f"tracked path {name}: starting ({solution.format}, "
+                         f"{solution.waypoint_count} waypoints)", True)
         self.window.path_worker.submit("tracked path", work, finished, failed, progress)
 
-    def _submit_path(self, label: str, name: str, robot: str, total: int, work,
-                     pace: str = "") -> None:
+    def submit_path(self, label: str, name: str, robot: str, total: int, work,
+                    pace: str = "") -> None:
         """Runs ``work`` on the path worker, its progress (rows done) in the status line."""
         def progress(k):
-            self.path_status.setText(f"{label} {name}: row {k}/{total}{pace}")
+            self._path_state(f"{label} {name}: row {k}/{total}{pace}")
 
         def finished(_):
-            self.stop_button.setEnabled(False)
-            self.path_status.setText(f"{label} {name}: {total} rows done")
+            self._path_state(f"{label} {name}: {total} rows done", False)
             self.window.show_info(f"{robot}: {label} done ({total} rows)")
 
         def failed(message):
-            self.stop_button.setEnabled(False)
-            self.path_status.setText(f"{label} {name}: {message}")
+            self._path_state(f"{label} {name}: {message}", False)
             self.window.show_error(message)
 
-        self.stop_button.setEnabled(True)
-        self.path_status.setText(f"{label} {name}: starting ({total} rows)")
+        self._path_state(f"{label} {name}: starting ({total} rows)", True)
         self.window.path_worker.submit(label, work, finished, failed, progress)
+
+    def _path_state(self, text: str, running: Optional[bool] = None) -> None:
+        """The path worker's state in the Move robot page's status line and Stop button, and
+        in the Solve query page's (its paths run there too); ``running`` None: unchanged."""
+        for label, button in ((self.path_status, self.stop_button),
+                              (self.solve.path_status, self.solve.stop_button)):
+            label.setText(text)
+            if running is not None:
+                button.setEnabled(running)
 
     def stop_path(self) -> None:
         self.window.path_worker.cancel()

@@ -15,6 +15,10 @@ connection when a call breaks.
 
 Long jobs (paths) look at ``job.cancelled`` / call ``job.sleep(seconds)``, which raises
 ``Cancelled`` as soon as ``cancel()`` is called.
+
+Given ``node=None`` the worker serves no node: its jobs are work of this process (a geometric
+search, gui.window.solve_panel) run with ``client`` None, off the GUI thread and off the
+world's queue; it never polls a master.
 """
 from __future__ import annotations
 
@@ -103,7 +107,7 @@ class WorldWorker(QThread):
     progressed = pyqtSignal(int, object)
 
     def __init__(self, namespace: str = WORLD_NAMESPACE, poll_period: float = 0.5,
-                 name: str = "world", parent=None, node: NodeKind = WORLD):
+                 name: str = "world", parent=None, node: Optional[NodeKind] = WORLD):
         super().__init__(parent)
         self.namespace = namespace.rstrip("/")
         self.node = node
@@ -182,7 +186,7 @@ class WorldWorker(QThread):
         last_check = 0.0
         while not self._stopping:
             now = time.monotonic()
-            if now - last_check >= self.poll_period:
+            if self.node is not None and now - last_check >= self.poll_period:
                 last_check = now
                 self._check_connection()
             try:
@@ -197,7 +201,7 @@ class WorldWorker(QThread):
     def _run_job(self, job: Job) -> None:
         if job.cancelled:
             return
-        if job.needs_world and not self._connected:
+        if job.needs_world and self.node is not None and not self._connected:
             self._check_connection()
             if not self._connected:
                 self.failed_job.emit(job.id, f"{job.label}: the {self.node.title} is not "
