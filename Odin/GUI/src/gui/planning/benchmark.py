@@ -1,15 +1,18 @@
-"""Planning benchmarks: many seeded searches of Kautham physics problems, here or on a Dask
-cluster, written as OMPL's benchmark log (ROS-free; ``rosrun GUI benchmark``, docs/PLANNING.md).
+"""Planning benchmarks: many seeded searches of Kautham problems, here or on a Dask cluster,
+written as OMPL's benchmark log (ROS-free; ``rosrun GUI benchmark``, docs/PLANNING.md): a
+physics problem by OMPL's control planners through Odin's world, a problem without physics by
+OMPL's geometric planners over Odin's collision checks (``gui.planning.geometric_benchmark``).
 
 ``prepare`` turns experiments (``gui.planning.benchmark_spec``) into ``RunTask``s after checking
 everything a run needs (every problem loads and plans, every planner exists): bad input is one
-``OdinError`` before any run starts. Run k of every planner of an experiment has seed
-``seed + k``, so the planners meet the same draws and ``rosrun GUI plan PROBLEM --planner P
---seed S`` repeats any run. ``execute`` runs the tasks serially (``workers=0``) or on Dask
-(``DaskRunner``: a local cluster of worker processes, or an existing scheduler), hands each
-result to ``on_result`` as it arrives, and stops every run when ``should_stop()`` turns true.
-``ResultStore`` keeps the results as they come (``runs.jsonl``), so that ``--resume`` runs only
-the runs still missing.
+``OdinError`` before any run starts; a geometric problem whose query collides is not bad input
+but a finding, recorded in each of its runs (status and reason) without a search. Run k of every
+planner of an experiment has seed ``seed + k``, so the planners meet the same draws and ``rosrun
+GUI plan PROBLEM --planner P --seed S`` repeats any run. ``execute`` runs the tasks serially
+(``workers=0``) or on Dask (``DaskRunner``: a local cluster of worker processes, or an existing
+scheduler), hands each result to ``on_result`` as it arrives, and stops every run when
+``should_stop()`` turns true. ``ResultStore`` keeps the results as they come (``runs.jsonl``),
+so that ``--resume`` runs only the runs still missing.
 """
 from __future__ import annotations
 
@@ -42,12 +45,18 @@ giving up (``--scheduler-timeout``)."""
 @dataclass(frozen=True)
 class PlannedEntry:
     """One planner configuration as it runs: its name in the log, the OMPL planner, the time
-    limit (s) and the problem (path)."""
+    limit (s) and the problem (path); ``geometric``: a geometric planner's search
+    (``gui.planning.geometric_benchmark``); ``refusal``: (OMPL's status, the reason) when its
+    problem's query collides (its runs are recorded unsearched); ``common``: the settings its
+    planner runs with, (name, value) pairs for the log."""
     name: str
     planner: str
     time_limit: float
     problem: str
     problem_planner: str
+    geometric: bool = False
+    refusal: Tuple[str, ...] = ()
+    common: Tuple[Tuple[str, str], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -71,23 +80,80 @@ class Prepared:
 # --------------------------------------------------------------------------------- preparing
 
 def _load_for_planning(problem: str, overrides: dict):
-    """Loads and builds ``problem`` as a run does, and its world once: (its BuildPlan)."""
+    """Loads and builds ``problem`` as a run does, and its world once: (its BuildPlan, the
+    refusal of a geometric problem whose query collides: (status, reason), else ())."""
     from gui.core.kautham.problem import load_problem
     from gui.core.translate import BuildDefaults, plan_problem
+    from gui.planning import geometric_benchmark as geometric
     from gui.planning.backend import CoreBackend
     from gui.planning.problem import SearchSettings, planning_problem
     build = plan_problem(load_problem(problem), BuildDefaults())
+    if geometric.is_geometric(build):
+        geometric.run_settings(build, None, DEFAULT_TIME_S, overrides)
+        return build, geometric.check_problem(build) or ()
     settings = SearchSettings.of_problem(build, **overrides)
     CoreBackend(build, planning_problem(build, None, settings)).close()
-    return build
+    return build, ()
+
+
+def _load(row, overrides: dict, loaded: Dict[str, tuple]) -> tuple:
+    """(BuildPlan, refusal, bundle path, bundle files) of ``row``'s problem, loaded once."""
+    if row.problem not in loaded:
+        if not os.path.isfile(row.problem):
+            raise PlanningError(f"{row.where}: problem {row.problem}: no such file")
+        built = []
+        try:
+            relative, files = problem_bundle(
+                lambda: built.append(_load_for_planning(row.problem, overrides)), row.problem)
+        except OdinError as error:
+            raise PlanningError(f"{row.where}: {error}") from None
+        loaded[row.problem] = (*built[0], relative, files)
+    return loaded[row.problem]
+
+
+def _control_entry(row, build, max_time: Optional[float]) -> PlannedEntry:
+    """``row``'s entry for a physics problem: an OMPL control planner."""
+    from gui.planning.bridge import PLANNERS, UNCONSTRUCTIBLE
+    own = build.problem.planner
+    planner = row.planner or OMPL_PLANNER_OF.get(own.name if own else "")
+    if planner is None:
+        raise PlanningError(
+            f"{row.where}: problem {row.problem}: its planner "
+            f"{own.name if own else '(none)'!s} is not one Odin runs: choose with "
+            f"--planners (one or more of {', '.join(PLANNERS)})")
+    if planner not in PLANNERS:
+        why = "OMPL's Python wheel cannot construct it" if planner in UNCONSTRUCTIBLE \
+            else "unknown planner"
+        raise PlanningError(f"{row.where}: planner {planner!r}: {why}; one of "
+                            f"{', '.join(PLANNERS)}")
+    own_time = own.search.time_limit if own is not None else None
+    limit = max_time or own_time or DEFAULT_TIME_S
+    return PlannedEntry(row.name(planner), planner, float(limit), row.problem,
+                        own.name if own else "")
+
+
+def _geometric_entry(row, build, max_time: Optional[float], refusal: tuple,
+                     overrides: dict) -> PlannedEntry:
+    """``row``'s entry for a problem without physics: an OMPL geometric planner with the
+    problem's own parameters (``gui.planning.geometric_benchmark``)."""
+    from gui.planning import geometric_benchmark as geometric
+    own = build.problem.planner
+    limit = float(max_time or geometric.own_time_limit(build) or DEFAULT_TIME_S)
+    try:
+        settings = geometric.run_settings(build, row.planner, limit, overrides)
+    except PlanningError as error:
+        raise PlanningError(f"{row.where}: {error}") from None
+    return PlannedEntry(row.name(settings.planner), settings.planner, limit, row.problem,
+                        own.name if own else "", True, tuple(refusal),
+                        tuple(geometric.common_properties(settings).items()))
 
 
 def prepare(experiments: Sequence[Experiment], seed: int = 1,
             overrides: Optional[dict] = None) -> Prepared:
     """Checks and expands ``experiments`` into tasks (module docstring). PlanningError or
     ProblemError, naming the row, for a problem that does not load or plan, an unknown
-    planner, or two entries of an experiment with one name."""
-    from gui.planning.bridge import PLANNERS, UNCONSTRUCTIBLE
+    planner, two entries of an experiment with one name, or an experiment of both physics
+    and geometric problems (Kautham benchmarks one family of planners at a time)."""
     overrides = dict(overrides or {})
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 1:
         raise PlanningError(f"seed {seed!r}: a whole number, at least 1")
@@ -96,41 +162,22 @@ def prepare(experiments: Sequence[Experiment], seed: int = 1,
     for experiment in experiments:
         entries: List[PlannedEntry] = []
         for row in experiment.rows:
-            if row.problem not in loaded:
-                if not os.path.isfile(row.problem):
-                    raise PlanningError(f"{row.where}: problem {row.problem}: no such file")
-                build = []
-                try:
-                    relative, files = problem_bundle(
-                        lambda: build.append(_load_for_planning(row.problem, overrides)),
-                        row.problem)
-                except OdinError as error:
-                    raise PlanningError(f"{row.where}: {error}") from None
-                loaded[row.problem] = (build[0], relative, files)
-            build, relative, files = loaded[row.problem]
-            own = build.problem.planner
-            planner = row.planner or OMPL_PLANNER_OF.get(own.name if own else "")
-            if planner is None:
-                raise PlanningError(
-                    f"{row.where}: problem {row.problem}: its planner "
-                    f"{own.name if own else '(none)'!s} is not one Odin runs: choose with "
-                    f"--planners (one or more of {', '.join(PLANNERS)})")
-            if planner not in PLANNERS:
-                why = "OMPL's Python wheel cannot construct it" if planner in UNCONSTRUCTIBLE \
-                    else "unknown planner"
-                raise PlanningError(f"{row.where}: planner {planner!r}: {why}; one of "
-                                    f"{', '.join(PLANNERS)}")
-            own_time = own.search.time_limit if own is not None else None
-            limit = experiment.request.max_time or own_time or DEFAULT_TIME_S
-            entry = PlannedEntry(row.name(planner), planner, float(limit), row.problem,
-                                 own.name if own else "")
+            build, refusal, relative, files = _load(row, overrides, loaded)
+            max_time = experiment.request.max_time
+            entry = _geometric_entry(row, build, max_time, refusal, overrides) \
+                if not build.physics else _control_entry(row, build, max_time)
             if any(e.name == entry.name for e in entries):
                 raise PlanningError(f"{row.where}: experiment {experiment.name!r} already has "
                                     f"a planner named {entry.name!r} (PlannerAlias)")
+            if entries and entries[0].geometric != entry.geometric:
+                raise PlanningError(f"{row.where}: experiment {experiment.name!r} has physics "
+                                    "and geometric problems: one family of planners per "
+                                    "<Benchmark>, as in Kautham")
             entries.append(entry)
-            tasks += [RunTask(experiment.name, entry.name, k, planner, seed + k, entry.time_limit,
-                              relative, files, tuple(sorted(overrides.items())),
-                              experiment.request.max_mem)
+            tasks += [RunTask(experiment.name, entry.name, k, entry.planner, seed + k,
+                              entry.time_limit, relative, files,
+                              tuple(sorted(overrides.items())), experiment.request.max_mem,
+                              entry.geometric, entry.refusal)
                       for k in range(experiment.request.run_count)]
         planned.append((experiment, tuple(entries)))
     names = [e.name for e in experiments]
@@ -384,8 +431,11 @@ class Progress:
 # -------------------------------------------------------------------------------- summary
 
 def summary(prepared: Prepared, results: Dict[tuple, RunResult]) -> dict:
-    """Per experiment and planner: runs done, solved, success rate, the solved runs' times
-    (s: median, mean, min, max) and the median propagations per second."""
+    """Per experiment (``geometric``: of geometric planners) and planner: runs done, solved,
+    failed, success rate, the solved runs' times (s: median, mean, min, max), the distinct
+    reasons of the runs that failed or were not searched (``errors``), and the median
+    propagations per second (control) or collision checks per second and simplified path
+    length (geometric)."""
     out = []
     for experiment, entries in prepared.experiments:
         planners = []
@@ -393,15 +443,26 @@ def summary(prepared: Prepared, results: Dict[tuple, RunResult]) -> dict:
             runs = [r for r in results.values()
                     if r.experiment == experiment.name and r.entry == entry.name]
             times = sorted(r.time_s for r in runs if r.solved)
-            rates = sorted(r.propagations_per_s for r in runs if r.propagations_per_s)
-            planners.append(dict(
+            planner = dict(
                 name=entry.name, planner=entry.planner, problem=entry.problem,
                 time_limit_s=entry.time_limit, runs=len(runs),
                 runs_asked=experiment.request.run_count,
                 solved=sum(r.solved for r in runs), failed=sum(bool(r.error) for r in runs),
                 success_rate=round(sum(r.solved for r in runs) / len(runs), 4) if runs else None,
-                time_s=_stats(times), propagations_per_s_median=_median(rates)))
-        out.append(dict(name=experiment.name, log=experiment.log_name, planners=planners))
+                time_s=_stats(times), errors=sorted({r.error for r in runs if r.error}))
+            if entry.geometric:
+                planner.update(
+                    collision_checks_per_s_median=_median(sorted(
+                        r.collision_checks_per_s for r in runs if r.collision_checks_per_s)),
+                    simplified_length_median=_median(sorted(
+                        r.geometric.simplified_length for r in runs
+                        if r.solved and r.geometric is not None)))
+            else:
+                planner.update(propagations_per_s_median=_median(sorted(
+                    r.propagations_per_s for r in runs if r.propagations_per_s)))
+            planners.append(planner)
+        out.append(dict(name=experiment.name, log=experiment.log_name,
+                        geometric=any(e.geometric for e in entries), planners=planners))
     return dict(seed=prepared.seed, experiments=out)
 
 

@@ -21,7 +21,7 @@ The format as OMPL's ``Benchmark::saveResultsToStream`` writes it and its
     1 enum types
     status|Unknown status|Invalid start|...
     <k> planners
-    control_<planner name>
+    control_<planner name>   (geometric_<planner name> for a geometric planner)
     <c> common properties
     <name> = <value>
     <p> properties for each run
@@ -30,16 +30,21 @@ The format as OMPL's ``Benchmark::saveResultsToStream`` writes it and its
     <value>; <value>; ...;          (one run a line, in the order of the properties; empty:
     .                                 not measured)
 
-Each run writes what OMPL's control planners report (time, solved, approximate solution,
-solution difference and length, memory, status) and Odin's own: propagations, propagations
-per second, and the run's seed (``rosrun GUI plan ... --seed S`` repeats it).
+A control planner (``control_<name>``) writes what OMPL's control benchmark reports (time,
+solved, approximate solution, solution difference and length, memory, status) and Odin's own:
+propagations, propagations per second, and the run's seed (``rosrun GUI plan ... --seed S``
+repeats it). A geometric planner (``geometric_<name>``) writes what OMPL's geometric benchmark
+reports of it (``Benchmark::benchmark``: time, memory, status, solved, approximate solution,
+solution length, simplification time, simplified solution length and segments, graph states),
+the ``collision checks`` Kautham's benchmark adds (``apps/console/benchmark.cpp``), and Odin's
+collision checks per second and seed.
 """
 from __future__ import annotations
 
 import datetime
 import platform
 import socket
-from typing import Dict, Sequence
+from typing import Callable, Dict, Sequence
 
 from gui.planning.benchmark_run import RunResult
 
@@ -66,6 +71,40 @@ RUN_PROPERTIES = (
 sorts them. Units: time s, memory MB, solution length s (simulated), solution difference m."""
 
 
+def _path(value) -> Callable[[RunResult], str]:
+    """A property of a geometric run's path: empty without one (as OMPL writes it only for a
+    run with a solution)."""
+    return lambda r: value(r) if r.digest and r.geometric is not None else ""
+
+
+def _measure(value) -> Callable[[RunResult], str]:
+    """A geometric measure: empty for a run that was not searched."""
+    return lambda r: value(r) if r.geometric is not None else ""
+
+
+GEOMETRIC_RUN_PROPERTIES = (
+    ("approximate solution", "BOOLEAN",
+     lambda r: _flag(r.status == "Approximate solution") if r.geometric is not None else ""),
+    ("collision checks", "INTEGER", _measure(lambda r: str(r.geometric.collision_checks))),
+    ("collision checks per second", "REAL", lambda r: _real(r.collision_checks_per_s)),
+    ("graph states", "INTEGER", _measure(lambda r: str(r.geometric.graph_states))),
+    ("memory", "REAL", lambda r: _real(r.memory_mb) if r.memory_mb > 0 else ""),
+    ("seed", "INTEGER", lambda r: str(r.seed)),
+    ("simplification time", "REAL", _path(lambda r: _real(r.geometric.simplification_s))),
+    ("simplified solution length", "REAL",
+     _path(lambda r: _real(r.geometric.simplified_length))),
+    ("simplified solution segments", "INTEGER",
+     _path(lambda r: str(r.geometric.simplified_segments))),
+    ("solution length", "REAL", _path(lambda r: _real(r.geometric.solution_length))),
+    ("solved", "BOOLEAN", lambda r: _flag(r.solved)),
+    ("status", "ENUM", lambda r: str(STATUS.index(r.status) if r.status in STATUS else 0)),
+    ("time", "REAL", lambda r: _real(r.time_s)),
+)
+"""A geometric planner's run properties, sorted by name. Units: time (the planner's, without
+the simplification) and simplification time s, memory MB, solution lengths in the control
+space's units (Kautham's [0, 1] per control: OMPL's path length there)."""
+
+
 def _flag(value: bool) -> str:
     return "1" if value else "0"
 
@@ -77,10 +116,13 @@ def _real(value) -> str:
 def write_log(path: str, experiment: str, planners: Sequence[tuple],
               results: Dict[str, Sequence[RunResult]], *, seed: int, max_time: float,
               max_mem: float, run_count: int, total_s: float, setup: str,
-              started: datetime.datetime) -> None:
+              started: datetime.datetime, geometric: bool = False) -> None:
     """Writes the log of one experiment to ``path``. ``planners``: (name in the log, common
     properties {name: value}) in order; ``results``: each planner's runs (by its name), in run
-    order; ``max_time`` s and ``max_mem`` MB per run; ``total_s``: s spent collecting."""
+    order; ``max_time`` s and ``max_mem`` MB per run; ``total_s``: s spent collecting;
+    ``geometric``: the planners are geometric ones (module docstring)."""
+    prefix, properties = ("geometric_", GEOMETRIC_RUN_PROPERTIES) if geometric else \
+        ("control_", RUN_PROPERTIES)
     lines = [f"OMPL version {OMPL_VERSION}",
              f"Experiment {experiment}",
              f"Running on {socket.gethostname()}",
@@ -97,12 +139,12 @@ def write_log(path: str, experiment: str, planners: Sequence[tuple],
              f"{len(planners)} planners"]
     for name, common in planners:
         runs = results.get(name, ())
-        lines += [f"control_{name}", f"{len(common)} common properties"]
+        lines += [f"{prefix}{name}", f"{len(common)} common properties"]
         lines += [f"{key} = {common[key]}" for key in sorted(common)]
-        lines += [f"{len(RUN_PROPERTIES)} properties for each run"]
-        lines += [f"{prop} {kind}" for prop, kind, _ in RUN_PROPERTIES]
+        lines += [f"{len(properties)} properties for each run"]
+        lines += [f"{prop} {kind}" for prop, kind, _ in properties]
         lines += [f"{len(runs)} runs"]
-        lines += ["".join(f"{value(run)}; " for _, _, value in RUN_PROPERTIES) for run in runs]
+        lines += ["".join(f"{value(run)}; " for _, _, value in properties) for run in runs]
         lines += ["."]
     with open(path, "w") as f:
         f.write("\n".join(lines) + "\n")
@@ -124,4 +166,5 @@ def _cpu_info() -> str:
     return f"{platform.machine()} {model}".strip()
 
 
-__all__ = ["OMPL_VERSION", "RUN_PROPERTIES", "STATUS", "write_log"]
+__all__ = ["GEOMETRIC_RUN_PROPERTIES", "OMPL_VERSION", "RUN_PROPERTIES", "STATUS",
+           "write_log"]

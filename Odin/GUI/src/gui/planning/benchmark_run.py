@@ -2,13 +2,15 @@
 own, from files it carries with it (ROS-free).
 
 A ``RunTask`` holds everything a run needs: the bytes of every file its problem reads (the
-problem, robots, obstacles, controls, meshes: ``problem_bundle`` records what a load opens),
-the planner, the seed and the time limit. ``run_task`` writes the files to a temporary folder
-and starts ``python -m gui.planning.benchmark_run``, which loads the problem from there, seeds
-OMPL and plans exactly as ``rosrun GUI plan PROBLEM --planner P --seed S --time T`` does
-(the Core back end), and answers a ``RunResult`` as one JSON line. A fresh process per run
-because OMPL seeds its generators once per process; with the same files, planner and seed a
-search grows the same tree on any machine, so a run that solves gives bit-identical rows
+problem, robots, obstacles, controls, meshes: ``problem_bundle`` records what a load opens), the
+planner, the seed and the time limit. ``run_task`` writes the files to a temporary folder and
+starts ``python -m gui.planning.benchmark_run``, which loads the problem from there, seeds OMPL
+and plans exactly as ``rosrun GUI plan PROBLEM --planner P --seed S --time T`` does (a physics
+problem: the Core back end; a geometric one: ``gui.planning.geometric_benchmark``), and answers
+a ``RunResult`` as one JSON line. A geometric problem whose query collides is not searched: its
+runs are answered at once with the reason the benchmark found before any run. A fresh process
+per run because OMPL seeds its generators once per process; with the same files, planner and
+seed a search grows the same tree on any machine, so a run that solves gives bit-identical rows
 anywhere (``RunResult.digest``); a run the time limit cuts stops where the clock says.
 
 Stopping: ``should_stop()`` is asked every ``POLL_S``; when true the run's process gets SIGINT
@@ -52,7 +54,9 @@ class RunTask:
     ``run`` (0-based); ``planner``: OMPL's; ``seed``: OMPL's; ``time_limit``: s of wall clock;
     ``problem``: the problem file's path within ``files`` ((relative path, bytes) pairs);
     ``overrides``: SearchSettings fields to change ((name, value) pairs); ``memory_limit_mb``:
-    MB the run's process may grow by during its search (the benchmark's maxMem)."""
+    MB the run's process may grow by during its search (the benchmark's maxMem);
+    ``geometric``: searched by a geometric planner (``gui.planning.geometric_benchmark``);
+    ``refusal``: (OMPL's status, the reason) when the problem's query collides: not searched."""
     experiment: str
     entry: str
     run: int
@@ -63,6 +67,8 @@ class RunTask:
     files: Tuple[Tuple[str, bytes], ...]
     overrides: Tuple[Tuple[str, object], ...] = ()
     memory_limit_mb: float = 4096.0
+    geometric: bool = False
+    refusal: Tuple[str, ...] = ()
 
     @property
     def key(self) -> Tuple[str, str, int]:
@@ -70,15 +76,39 @@ class RunTask:
 
 
 @dataclass(frozen=True)
+class GeometricMeasures:
+    """What a geometric run measures beyond the common fields (OMPL's geometric benchmark's
+    properties): ``collision_checks`` (configurations checked by the search); in the control
+    space's units, ``solution_length`` (the path as the planner found it) and
+    ``simplified_length``; ``simplified_segments`` (the simplified path's states - 1);
+    ``simplification_s`` (s of wall clock); ``graph_states`` (the planner's graph or trees
+    when it stopped)."""
+    collision_checks: int
+    solution_length: float
+    simplified_length: float
+    simplified_segments: int
+    simplification_s: float
+    graph_states: int
+
+    def outcome(self) -> tuple:
+        """Everything but the simplification's time (RunResult.outcome)."""
+        return (self.collision_checks, self.solution_length, self.simplified_length,
+                self.simplified_segments, self.graph_states)
+
+
+@dataclass(frozen=True)
 class RunResult:
     """What one run measured. ``solved``: an exact solution (OMPL's "solved"); ``approximate``:
     a path that ends outside the goal region; ``status``: OMPL's planner status; ``time_s``: s
-    of wall clock in the search; ``solution_length_s``: s, the plan's simulated duration (OMPL's
-    PathControl length: the sum of its control durations; 0 without a path);
+    of wall clock in the search (a geometric run's: the planner's, without the simplification);
+    ``solution_length_s``: s, the plan's simulated duration (OMPL's PathControl length: the sum
+    of its control durations; 0 without a path or for a geometric run);
     ``solution_difference_m``: m, where the plan ends from the goal, in the plane;
     ``propagations``: propagation steps run; ``memory_mb``: MB, the run process's peak resident
-    memory; ``digest``: sha256 of the plan's rows (controls and durations, exactly), equal for
-    equal plans; ``host``: where it ran; ``error``: why the run failed ("" when it did not)."""
+    memory; ``digest``: sha256 of the plan's rows (controls and durations, or a geometric
+    path's states, exactly), equal for equal plans; ``host``: where it ran; ``error``: why the
+    run failed or was not searched ("" when it did not); ``geometric``: a geometric run's own
+    measures (None for a control run)."""
     experiment: str
     entry: str
     run: int
@@ -95,6 +125,7 @@ class RunResult:
     digest: str
     host: str
     error: str = ""
+    geometric: Optional[GeometricMeasures] = None
 
     @property
     def key(self) -> Tuple[str, str, int]:
@@ -102,7 +133,17 @@ class RunResult:
 
     @property
     def propagations_per_s(self) -> Optional[float]:
+        if self.geometric is not None:
+            return None
         return self.propagations / self.time_s if self.time_s > 0 else None
+
+    @property
+    def collision_checks_per_s(self) -> Optional[float]:
+        """A geometric run's collision checks per second of its search and simplification."""
+        if self.geometric is None:
+            return None
+        spent = self.time_s + self.geometric.simplification_s
+        return self.geometric.collision_checks / spent if spent > 0 else None
 
     def outcome(self) -> tuple:
         """What is the same wherever and whenever the run is repeated, for a run that solved
@@ -110,14 +151,19 @@ class RunResult:
         memory and host."""
         return (self.key, self.planner, self.seed, self.solved, self.approximate, self.status,
                 self.solution_length_s, self.solution_difference_m, self.propagations,
-                self.digest, self.error)
+                self.digest, self.error,
+                self.geometric.outcome() if self.geometric is not None else None)
 
     def to_json(self) -> dict:
         return asdict(self)
 
     @classmethod
     def from_json(cls, data: dict) -> "RunResult":
-        return cls(**data)
+        """The result ``to_json`` wrote (a results file of before geometric runs too)."""
+        fields = dict(data)
+        measures = fields.pop("geometric", None)
+        return cls(**fields, geometric=GeometricMeasures(**measures)
+                   if measures is not None else None)
 
 
 # ---------------------------------------------------------------------- the files a load reads
@@ -183,8 +229,14 @@ def problem_bundle(load: Callable[[], object], problem: str
 
 def run_task(task: RunTask, should_stop: Callable[[], bool] = lambda: False) -> RunResult:
     """Runs ``task`` in a process of its own (module docstring) and answers its result; a run
-    whose process fails answers a result with ``error`` set and status "Crash". Raises
-    ``RunStopped`` when ``should_stop()`` turns true first."""
+    whose process fails answers a result with ``error`` set and status "Crash", a refused
+    one (``RunTask.refusal``) its status and reason at once. Raises ``RunStopped`` when
+    ``should_stop()`` turns true first."""
+    if task.refusal:
+        status, why = task.refusal
+        return RunResult(task.experiment, task.entry, task.run, task.planner, task.seed,
+                         False, False, status, 0.0, 0.0, None, 0, 0.0, "",
+                         socket.gethostname(), error=why)
     with tempfile.TemporaryDirectory(prefix="odin-bench-") as folder:
         for relative, data in task.files:
             path = os.path.join(folder, relative)
@@ -194,7 +246,8 @@ def run_task(task: RunTask, should_stop: Callable[[], bool] = lambda: False) -> 
         order = dict(problem=os.path.join(folder, task.problem), planner=task.planner,
                      seed=task.seed, time_limit=task.time_limit,
                      memory_limit_mb=task.memory_limit_mb,
-                     overrides=dict(task.overrides), parent=os.getpid())
+                     overrides=dict(task.overrides), geometric=task.geometric,
+                     parent=os.getpid())
         child = subprocess.Popen(
             [sys.executable, "-m", "gui.planning.benchmark_run"], stdin=subprocess.PIPE,
             stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True, cwd=folder)
@@ -203,8 +256,9 @@ def run_task(task: RunTask, should_stop: Callable[[], bool] = lambda: False) -> 
     if child.returncode == 0 and lines:
         try:
             answer = json.loads(lines[-1])
-            return RunResult(task.experiment, task.entry, task.run, task.planner, task.seed,
-                             **answer)
+            return RunResult.from_json(dict(experiment=task.experiment, entry=task.entry,
+                                            run=task.run, planner=task.planner,
+                                            seed=task.seed, **answer))
         except (ValueError, TypeError) as error:
             why = f"unreadable answer ({error})"
     else:
@@ -310,10 +364,14 @@ def main() -> int:
     order = json.loads(sys.stdin.read())
     _die_with_parent(order["parent"])
     try:
+        if order.get("geometric"):
+            from gui.planning.geometric_benchmark import search as run_search
+        else:
+            run_search = search
         with stop_on_ctrl_c() as stop:
-            answer = search(order["problem"], order["planner"], order["seed"],
-                            order["time_limit"], order["overrides"], stop,
-                            order["memory_limit_mb"])
+            answer = run_search(order["problem"], order["planner"], order["seed"],
+                                order["time_limit"], order["overrides"], stop,
+                                order["memory_limit_mb"])
     except KeyboardInterrupt:
         return 130
     except (OdinError, OSError) as error:
@@ -327,4 +385,5 @@ if __name__ == "__main__":
     sys.exit(main())
 
 
-__all__ = ["RunResult", "RunStopped", "RunTask", "problem_bundle", "run_task", "search"]
+__all__ = ["GeometricMeasures", "RunResult", "RunStopped", "RunTask", "problem_bundle",
+           "run_task", "search"]

@@ -1,7 +1,8 @@
-"""``rosrun GUI benchmark``: Kautham benchmark files (or the same from the command line) run
-as seeded searches through Odin's physics, here or on a Dask cluster; OMPL's logs, a JSON
-summary and plots (docs/PLANNING.md). Exit status: 0 done, 2 with one line on bad input or a
-failure, 130 on Ctrl-C (the finished runs kept: ``--resume`` goes on from them)."""
+"""``rosrun GUI benchmark``: Kautham benchmark files (or the same from the command line) run as
+seeded searches, through Odin's physics (a problem for one of Kautham's ODE planners) or over
+Odin's geometry (any other: OMPL's geometric planners), here or on a Dask cluster; OMPL's logs,
+a JSON summary and plots (docs/PLANNING.md). Exit status: 0 done, 2 with one line on bad input
+or a failure, 130 on Ctrl-C (the finished runs kept: ``--resume`` goes on from them)."""
 from __future__ import annotations
 
 import argparse
@@ -26,18 +27,22 @@ MAX_RUNS = 1_000_000
 
 
 def _parser() -> argparse.ArgumentParser:
-    from gui.planning.bridge import MAX_SEED
+    from gui.planning.bridge import MAX_SEED, PLANNERS
+    from gui.planning.geometric import OMPL_PLANNERS
     from gui.planning.parallel import MAX_SEARCHES
     from gui.planning.problem import MAX_CONTROL_STEPS
     parser = ToolParser(
-        prog=TOOL, description="Benchmark OMPL control planners on Kautham physics problems "
-        "through Odin's world: a Kautham <Benchmark> file, or --problem ... --planners ...; "
-        "OMPL benchmark logs, summary.json and plots in --out.")
+        prog=TOOL, description="Benchmark OMPL planners on Kautham problems: control "
+        "planners through Odin's physics (problems for Kautham's ODE planners), geometric "
+        "planners over Odin's collision checks (any other); a Kautham <Benchmark> file, or "
+        "--problem ... --planners ...; OMPL benchmark logs, summary.json and plots in --out.")
     parser.add_argument("file", nargs="?", help="Kautham benchmark file (<Benchmark> rows)")
     parser.add_argument("--problem", action="append", default=[], metavar="P",
                         help="a problem file instead of a benchmark file (repeatable)")
-    parser.add_argument("--planners", metavar="A,B", help="OMPL control planners for every "
-                        "problem (KPIECE1, RRT, EST) [each problem's own <Planner>]")
+    parser.add_argument("--planners", metavar="A,B", help="OMPL planners for every problem: "
+                        f"control ({', '.join(PLANNERS)}) for a physics problem, geometric "
+                        f"({', '.join(OMPL_PLANNERS)}) for any other [each problem's own "
+                        "<Planner>]")
     parser.add_argument("--runs", type=count(1, MAX_RUNS), metavar="N",
                         help="runs per planner [the file's runCount; 10 with --problem]")
     parser.add_argument("--time", type=seconds, metavar="S", help="wall-clock seconds per run "
@@ -64,13 +69,15 @@ def _parser() -> argparse.ArgumentParser:
                         f"[{SCHEDULER_TIMEOUT_S:g}]")
     parser.add_argument("--no-plots", action="store_true", help="no PNG figures")
     search = parser.add_argument_group(
-        "search settings", "change every problem's own (as rosrun GUI plan's options do)")
+        "search settings", "change every problem's own (as rosrun GUI plan's options do); "
+        "a geometric search takes --goal-bias only")
     search.add_argument("--min-control-steps", type=count(1, MAX_CONTROL_STEPS), metavar="N",
                         help="a control is held at least N propagation steps")
     search.add_argument("--max-control-steps", type=count(1, MAX_CONTROL_STEPS), metavar="N",
                         help="and at most N")
     search.add_argument("--goal-bias", type=float, metavar="F",
-                        help="KPIECE1's and RRT's fraction of expansions aimed at the goal")
+                        help="the fraction of expansions aimed at the goal (KPIECE1's, RRT's "
+                        "and the geometric planners that take one)")
     search.add_argument("--goal-tolerance", type=float, metavar="M",
                         help="goal region radius in the plane, m [0.25]")
     return parser
@@ -262,6 +269,30 @@ def _run(request: BenchmarkRequest, prepared, out: str) -> int:
     return 0
 
 
+SETUP = {
+    False: "Odin: OMPL control planners searching through Odin's ODE world (rosrun GUI "
+           "benchmark)",
+    True: "Odin: OMPL geometric planners searching Kautham's control space over Odin's "
+          "collision checks (rosrun GUI benchmark; gui.planning.geometric), every solution "
+          "simplified as OMPL's Benchmark does",
+}
+"""The first line of a log's setup text, for control (False) and geometric (True) planners."""
+
+
+def _setup_text(prepared, entries, hosts) -> str:
+    """A log's free setup text: how its planners searched, each entry's planner and problem
+    (and why a refused one was not searched), where the workers ran."""
+    geometric = any(e.geometric for e in entries)
+    lines = [f"{SETUP[geometric]}; run k has seed {prepared.seed}+k; rosrun GUI plan PROBLEM "
+             "--planner P --seed S --time T repeats a run"]
+    for e in entries:
+        line = f"{e.name}: {e.planner} on {e.problem} (its planner: {e.problem_planner})"
+        if e.refusal:
+            line += f"; not searched ({e.refusal[0]}): {e.refusal[1]}"
+        lines.append(line)
+    return "\n".join(lines + ([f"workers on: {', '.join(hosts)}"] if hosts else []))
+
+
 def _write_outputs(request, prepared, store, out, started, total_s, hosts) -> None:
     from gui.planning.benchmark import summary
     from gui.planning.benchmark_log import write_log
@@ -272,21 +303,16 @@ def _write_outputs(request, prepared, store, out, started, total_s, hosts) -> No
         by_entry = {e.name: sorted((r for r in store.results.values()
                                     if r.experiment == experiment.name and r.entry == e.name),
                                    key=lambda r: r.run) for e in entries}
-        setup = "\n".join(
-            [f"Odin: OMPL control planners searching through Odin's ODE world (rosrun GUI "
-             f"benchmark); run k has seed {prepared.seed}+k; rosrun GUI plan PROBLEM "
-             "--planner P --seed S --time T repeats a run"]
-            + [f"{e.name}: {e.planner} on {e.problem} (its planner: {e.problem_planner})"
-               for e in entries]
-            + ([f"workers on: {', '.join(hosts)}"] if hosts else []))
         write_log(os.path.join(out, experiment.log_name), experiment.name,
                   [(e.name, {"planner": e.planner, "problem": e.problem,
-                             "time limit": repr(e.time_limit), **changed}) for e in entries],
+                             "time limit": repr(e.time_limit), **dict(e.common), **changed})
+                   for e in entries],
                   by_entry, seed=prepared.seed,
                   max_time=max(e.time_limit for e in entries),
                   max_mem=experiment.request.max_mem,
-                  run_count=experiment.request.run_count, total_s=total_s, setup=setup,
-                  started=started)
+                  run_count=experiment.request.run_count, total_s=total_s,
+                  setup=_setup_text(prepared, entries, hosts), started=started,
+                  geometric=any(e.geometric for e in entries))
     if request.plots and store.results:
         from gui.planning.benchmark_plots import write_plots
         data["plots"] = [os.path.basename(p) for p in write_plots(out, data, store.results)]
