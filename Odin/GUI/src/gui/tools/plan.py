@@ -2,10 +2,14 @@
 problem's query. A problem for one of Kautham's ODE planners is searched by one of OMPL's
 control planners through Odin's physics (``gui.planning.bridge``) and written as a Kautham
 control path (``run_path --controls`` runs it); any other by one of OMPL's geometric planners
-over Odin's geometry (``gui.planning.geometric``: the problem's own planner and parameters)
-and written as a Kautham task file (``run_path --tracked`` runs it). The search's statistics
-are printed as JSON. Exits 1 with one line when no solution was found in time, 2 on bad input,
-130 on Ctrl-C (nothing written)."""
+over Odin's geometry (``gui.planning.geometric``: the problem's own planner and parameters),
+interpolated as Kautham does (``gui.planning.geometric_output``) and written as a Kautham task
+file or, ``--format ompl``, as OMPL rows (``run_path --tracked`` runs either). The search's
+statistics are printed as JSON. ``--execute`` then runs the plan in the running world as
+run_path would (``gui.tools.run_path.run_path``), its lines and summary printed. Exits 1 with
+one line when no solution was found in time, 2 on bad input or when the plan written cannot
+run (no world, a world without the problem), 130 on Ctrl-C (nothing written during the
+search; the robot held where it got to during the run)."""
 from __future__ import annotations
 
 import enum
@@ -22,6 +26,8 @@ from odin_common.errors import OdinError
 from odin_common.tool import stop_on_ctrl_c
 
 if TYPE_CHECKING:
+    import numpy as np
+
     from gui.planning.bridge import PlanResult
     from gui.planning.geometric import GeometricResult
 
@@ -30,6 +36,13 @@ TOOL = "plan"
 DEFAULT_TIME_LIMIT_S = 10.0
 """s: a search's time limit when neither --time nor the problem ("_Max Planning Time") gives
 one."""
+
+
+class OutputFormat(enum.Enum):
+    """How a geometric plan is written (a control search's plan is a control path): as
+    Kautham's GUI writes a task file, or as OMPL's printAsMatrix rows."""
+    KAUTHAM = "kautham"
+    OMPL = "ompl"
 
 
 class Backend(enum.Enum):
@@ -47,7 +60,12 @@ class PlanRequest:
     ``goal_tolerance`` (m), ``min_control_steps``, ``max_control_steps``: a control search's
     settings (None: the problem's, ``gui.planning.problem.SearchSettings``); ``resolution``
     (m): a geometric search's (None: ``gui.planning.geometric.RESOLUTION``). ``planner``:
-    None, the problem's (a control search's: KPIECE1). ``out``: the file to write."""
+    None, the problem's (a control search's: KPIECE1). ``out``: the file to write, as
+    ``format`` says (a geometric plan), its states interpolated as Kautham does unless not
+    ``interpolate``. ``execute``: run the plan in the running world once written, as
+    run_path does (``from_here``: a robot away from the path's start moved there first;
+    ``real_time``: not as fast as the world steps), waiting ``world_timeout`` s for the
+    master, then for each of the world's answers."""
     problem: ProblemFile
     out: str
     planner: Optional[str] = None
@@ -62,6 +80,11 @@ class PlanRequest:
     max_control_steps: Optional[int] = None
     parallel: int = 1
     resolution: Optional[float] = None
+    format: OutputFormat = OutputFormat.KAUTHAM
+    interpolate: bool = True
+    execute: bool = False
+    from_here: bool = False
+    real_time: bool = True
 
     def searches(self) -> str:
         """How the tool's lines name the searches after the first."""
@@ -94,27 +117,62 @@ class PlanOutcome:
         print(f"plan: {len(result.rows)} rows ({result.duration:.3f} s) written to "
               f"{request.out}")
 
+    def execute(self, request: PlanRequest) -> int:
+        """--execute: the control path run as ``run_path --controls`` runs it."""
+        from gui.tools.run_path import PathMode
+        return _execute(request, PathMode.CONTROLS)
+
 
 @dataclass(frozen=True)
 class GeometricOutcome:
-    """A geometric search's result, its time limit (s), its seed and the build plan it
-    searched (the path's configurations are the plan's robots')."""
+    """A geometric search's result, its time limit (s), its seed, the build plan it
+    searched (the path's configurations are the plan's robots') and the states to write
+    (n, k) in the control space: the result's path, interpolated as the request asks."""
     result: GeometricResult
     time_limit: float
     seed: int
     build_plan: object
+    written: np.ndarray
 
     def failure(self, request: PlanRequest) -> str:
         return (f"{request.problem.path}: no solution within {self.time_limit:g} s "
                 f"({self.result.planner}, seed {self.seed})")
 
     def write(self, request: PlanRequest) -> None:
-        """The path written to ``request.out`` as a Kautham task file."""
+        """The path written to ``request.out`` as ``request.format`` says."""
         from gui.planning.geometric import task_rows, write_task
-        rows = task_rows(self.build_plan, self.result.path)
-        write_task(request.out, f"{self.result.planner} seed {self.seed}", rows)
-        print(f"plan: {len(rows)} configurations written to {request.out} (a Kautham task "
-              "file: run_path --tracked runs it)")
+        from gui.planning.geometric_output import write_ompl_rows
+        rows = task_rows(self.build_plan, self.written)
+        if request.format is OutputFormat.OMPL:
+            write_ompl_rows(request.out, rows)
+            what = "OMPL rows"
+        else:
+            write_task(request.out, f"{self.result.planner} seed {self.seed}", rows)
+            what = "a Kautham task file"
+        print(f"plan: {len(rows)} configurations written to {request.out} ({what}: "
+              "run_path --tracked runs it)", flush=True)
+
+    def execute(self, request: PlanRequest) -> int:
+        """--execute: the path run as ``run_path --tracked`` runs it."""
+        from gui.tools.run_path import PathMode
+        return _execute(request, PathMode.TRACKED)
+
+
+def _execute(request: PlanRequest, mode) -> int:
+    """The plan written to ``request.out`` run in the running world by run_path in ``mode``
+    (a ``gui.tools.run_path.PathMode``): its exit status, its failure as one line saying
+    where the plan stays."""
+    from gui.tools.run_path import PathRequest, TrackedOptions, run_path
+    run = PathRequest(request.problem, mode, request.out, robot=request.robot,
+                      real_time=request.real_time, timeout=request.world_timeout,
+                      tracked=TrackedOptions(from_here=request.from_here))
+    try:
+        return run_path(run)
+    except OdinError as error:
+        robot = f" --robot {request.robot}" if request.robot else ""
+        raise GuiError(f"--execute: {error} (the plan stays in {request.out}: rosrun GUI "
+                       f"run_path {request.problem.path}{robot} --{mode.value} {request.out} "
+                       "runs it)") from None
 
 
 CONTROL_SEARCH_OPTIONS = (("backend", Backend.CORE, "--backend"),
@@ -127,14 +185,20 @@ geometric search plans every robot of the query together, in this process)."""
 
 
 def _geometric_search(request: PlanRequest, build_plan, stop) -> GeometricOutcome:
-    """The problem's query searched over Odin's geometry (gui.planning.geometric)."""
+    """The problem's query searched over Odin's geometry (gui.planning.geometric); the
+    statistics say how many states are written when the interpolation changed their count."""
     from dataclasses import replace
 
     from gui.planning.geometric import RESOLUTION, GeometricSettings, solve
+    from gui.planning.geometric_output import kautham_path
     for name, unset, option in CONTROL_SEARCH_OPTIONS:
         if getattr(request, name) != unset:
             raise GuiError(f"{option}: only a search of a problem for one of Kautham's ODE "
                            "planners takes it; this problem is planned geometrically")
+    if request.format is OutputFormat.OMPL and build_plan.problem.format == "2012":
+        raise GuiError("--format ompl: run_path reads a 2012 problem's plain rows as one "
+                       "robot's joints in degrees, not as OMPL rows; --format kautham writes "
+                       "this problem's plan")
     settings = GeometricSettings.of_problem(build_plan)
     settings = replace(settings, planner=request.planner or settings.planner,
                        time_limit=request.time if request.time is not None
@@ -144,8 +208,13 @@ def _geometric_search(request: PlanRequest, build_plan, stop) -> GeometricOutcom
     print(f"plan: {settings.planner} searching for up to {settings.time_limit:g} s, seed "
           f"{seed} (--seed {seed} repeats it)", flush=True)
     result = solve(build_plan, settings, seed, stop)
-    print(json.dumps(result.statistics(), indent=1), flush=True)
-    return GeometricOutcome(result, settings.time_limit, seed, build_plan)
+    written = kautham_path(result.path, settings.planner, settings.range) \
+        if request.interpolate else result.path
+    statistics = result.statistics()
+    if len(written) != result.states:
+        statistics["states_written"] = len(written)
+    print(json.dumps(statistics, indent=1), flush=True)
+    return GeometricOutcome(result, settings.time_limit, seed, build_plan, written)
 
 
 def search(request: PlanRequest, stop: Callable[[], bool]):
@@ -159,9 +228,13 @@ def search(request: PlanRequest, stop: Callable[[], bool]):
     build_plan = request.problem.read()
     if not build_plan.physics:
         return _geometric_search(request, build_plan, stop)
-    if request.resolution is not None:
-        raise GuiError("--resolution: only a geometric search takes it; this problem is "
-                       "for one of Kautham's ODE planners")
+    for option, given in (("--resolution", request.resolution is not None),
+                          ("--format ompl", request.format is OutputFormat.OMPL),
+                          ("--no-interpolate", not request.interpolate)):
+        if given:
+            raise GuiError(f"{option}: only a geometric search takes it; this problem is "
+                           "for one of Kautham's ODE planners (its plan is a control path: "
+                           "rows of controls and a duration)")
     planner = request.planner or "KPIECE1"
     make_backend, time_limit = _backends(request, build_plan)
     seed = request.seed if request.seed is not None else _fresh_seed(request.parallel)
@@ -243,8 +316,9 @@ def _parser() -> ToolParser:
     parser = ToolParser(
         prog=TOOL, description="Plan a Kautham problem's query: a physics problem with an "
         "OMPL control planner through Odin's world (written as a control path), any other "
-        "with an OMPL geometric planner over Odin's geometry (written as a Kautham task "
-        "file).")
+        "with an OMPL geometric planner over Odin's geometry (interpolated as Kautham does, "
+        "written as a Kautham task file or OMPL rows); --execute then runs the plan in the "
+        "running world, as run_path would.")
     parser.add_argument("problem", help="the problem XML file")
     parser.add_argument("--planner", default=None,
                         help=f"OMPL planner: for a physics problem a control planner, "
@@ -254,7 +328,8 @@ def _parser() -> ToolParser:
                         help="wall-clock seconds the planner may search [the problem's "
                         "\"_Max Planning Time\", else 10]")
     parser.add_argument("--out", required=True, metavar="PATH",
-                        help="control path file to write (rows: controls, duration s)")
+                        help="the plan file to write: a physics problem's control path (rows: "
+                        "controls, duration s), any other's path as --format says")
     parser.add_argument("--seed", type=count(1, MAX_SEED), default=None,
                         help="OMPL's random seed [drawn at random, printed and written with "
                         "the path: --seed repeats a run]")
@@ -264,7 +339,8 @@ def _parser() -> ToolParser:
     parser.add_argument("--worlds", default="/virtual_world", metavar="NS[,NS...]",
                         help="--backend pool: the world nodes' namespaces [/virtual_world]")
     parser.add_argument("--world-timeout", type=seconds, default=30.0, metavar="S",
-                        help="--backend pool: how long to wait for each world [30]")
+                        help="--backend pool: how long to wait for each world; --execute: "
+                        "for the master, then for each of the world's answers [30]")
     parser.add_argument("--robot", help="robot name (default: the first robot)")
     parser.add_argument("--goal-tolerance", type=float, default=None, metavar="M",
                         help="goal region radius in the plane, m [0.25]")
@@ -283,8 +359,32 @@ def _parser() -> ToolParser:
                         help="a geometric search: no link moves more than M between two "
                         "checked configurations of a motion, so none goes deeper than M/2 "
                         f"into anything [{RESOLUTION}]")
+    _output_options(parser)
     add_build_options(parser)
     return parser
+
+
+def _output_options(parser: ToolParser) -> None:
+    """How the plan is written and run (``PlanRequest.format`` ... ``real_time``)."""
+    parser.add_argument("--format", choices=[f.value for f in OutputFormat],
+                        default=OutputFormat.KAUTHAM.value,
+                        help="a geometric plan: kautham, a task file as Kautham's GUI writes "
+                        "it (<Task><Transit><Conf> rows); ompl, OMPL's printAsMatrix rows "
+                        "of the same configurations [kautham]")
+    parser.add_argument("--no-interpolate", dest="interpolate", action="store_false",
+                        help="a geometric plan: write the planner's states only [interpolated "
+                        "as Kautham does: no two states farther apart than 1%% of the "
+                        "control space's diagonal, or a fifth of a shorter RRT or RRTConnect "
+                        "Range]")
+    parser.add_argument("--execute", action="store_true",
+                        help="then run the plan in the running world, built by load_problem, "
+                        "as run_path does (--tracked, or --controls for a physics problem), "
+                        "within --world-timeout")
+    parser.add_argument("--from-here", action="store_true",
+                        help="--execute: a robot away from the path's start is moved there "
+                        "first [it is refused]")
+    parser.add_argument("--fast", action="store_true",
+                        help="--execute: as fast as the world steps, not in real time")
 
 
 def _request(args) -> PlanRequest:
@@ -294,7 +394,9 @@ def _request(args) -> PlanRequest:
         world_timeout=args.world_timeout, robot=args.robot,
         goal_tolerance=args.goal_tolerance, min_control_steps=args.min_control_steps,
         max_control_steps=args.max_control_steps, parallel=args.parallel,
-        resolution=args.resolution)
+        resolution=args.resolution, format=OutputFormat(args.format),
+        interpolate=args.interpolate, execute=args.execute, from_here=args.from_here,
+        real_time=not args.fast)
 
 
 @one_line_errors(TOOL)
@@ -302,16 +404,27 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     request = _request(_parser().parse_args(argv))
     warnings_to_stderr(TOOL)
     try:
+        _check_execute_options(request)
         check_output("--out", request.out)
         with stop_on_ctrl_c() as stop:
             outcome = search(request, stop)
         if not outcome.result.solved:
             return fail(TOOL, GuiError(outcome.failure(request))) - 1
         outcome.write(request)
+        if request.execute:
+            return outcome.execute(request)
     except (OdinError, OSError) as error:   # an OSError as it is, not by its class
         return fail(TOOL, error)
     return 0
 
 
-__all__ = ["DEFAULT_TIME_LIMIT_S", "Backend", "GeometricOutcome", "PlanOutcome", "PlanRequest",
-           "main", "search"]
+def _check_execute_options(request: PlanRequest) -> None:
+    """The options of --execute alone are refused without it."""
+    for option, given in (("--from-here", request.from_here),
+                          ("--fast", not request.real_time)):
+        if given and not request.execute:
+            raise GuiError(f"{option}: only with --execute (it says how the plan is run)")
+
+
+__all__ = ["DEFAULT_TIME_LIMIT_S", "Backend", "GeometricOutcome", "OutputFormat", "PlanOutcome",
+           "PlanRequest", "main", "search"]
