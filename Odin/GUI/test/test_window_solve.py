@@ -152,9 +152,14 @@ def test_run_hands_the_tracked_runner_what_the_saved_task_file_reads_as(tab, tmp
     _open(tab, plan)
     page = _solve(tab)
     runs = []
-    monkeypatch.setattr(tab, "run_tracked", lambda *a: runs.append(a))
+    monkeypatch.setattr(tab, "run_tracked", lambda *a, **k: runs.append((*a, k)))
     click(page.run_button)
-    run_plan, solution, name, robots = runs[0]
+    run_plan, solution, name, robots, options = runs[0]
+    # placed at the path's start first (a straight move there from the goal hits the post)
+    arm = plan.robot("arm")
+    placed = {body: p for body, p, _q in options["place"]}
+    for body, position, _q in arm.situations(np.array([-1.5, 0.0])):
+        assert placed[body] == pytest.approx(position, abs=1e-9)
     assert run_plan is plan and robots == "arm" and name == "RRTConnect seed " + \
         str(page.solved.result.seed)
     page.save_task(str(tmp_path / "arm_task.xml"))

@@ -393,14 +393,19 @@ class MotionTab(QWidget):
             return
         self.run_tracked(plan, solution, pathlib.Path(path).name, handle.name)
 
-    def run_tracked(self, plan, solution, name: str, robots: str) -> None:
+    def run_tracked(self, plan, solution, name: str, robots: str,
+                    place: Optional[list] = None) -> None:
         """``solution`` (gui.core.kautham.solutions) of ``plan``'s robots (``robots``: how the
         log names them), called ``name``, executed in real time on the path worker (the world
-        paused meanwhile, running again afterwards if it was); a robot away from the path's
-        start is moved there first, which the status line says; the report is plotted."""
+        paused meanwhile, running again afterwards if it was); ``place``: situations (body ID,
+        position, quaternion wxyz) the links are set to first (Set Position); a robot away
+        from the path's start is moved there first, which the status line says; the report
+        is plotted."""
         def work(client, job):
             from gui.ros.world_port import run_tracked_on_client
             from gui.window.worker import Cancelled
+            if place is not None:
+                client.set_position(place, reset_velocity=True)
 
             def progress(t: float, total: float) -> None:
                 if job.cancelled:
@@ -426,7 +431,8 @@ class MotionTab(QWidget):
             self._path_state(f"tracked path {name}: {message}", False)
             self.window.show_error(message)
 
-        self._path_state(f"tracked path {name}: starting ({solution.format}, "
+        placed = "placed at its start, " if place is not None else ""
+        self._path_state(f"tracked path {name}: starting ({placed}{solution.format}, "
                          f"{solution.waypoint_count} waypoints)", True)
         self.window.path_worker.submit("tracked path", work, finished, failed, progress)
 

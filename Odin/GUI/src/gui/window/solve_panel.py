@@ -12,8 +12,9 @@ A start or goal in collision is refused before the search, in the window's error
 After a solved search: Show places the world's robots along the path by forward kinematics,
 one Set Position of every link per frame (the path's straight segments of the control space,
 what the search checked, cut into frames in proportion to their lengths, SHOW_SECONDS in all);
-Run executes the path's states tracked, as a Kautham task file run by "Tracked path..." is
-(the rows of ``geometric.task_rows``: ``MotionTab.run_tracked``); Save writes that task file.
+Run places the robots at the path's start (Set Position) and executes the path's states
+tracked, as a Kautham task file run by "Tracked path..." is (the rows of
+``geometric.task_rows``: ``MotionTab.run_tracked``); Save writes that task file.
 Both run on the window's path worker, so Stop path ends them.
 """
 from __future__ import annotations
@@ -259,7 +260,7 @@ class SolvePanel(QWidget):
             text = (f"No solution within {settings.time_limit:g} s ({result.planner}, "
                     f"{seed}): {result.checks:,} collision checks ({rate}).")
         self.result_label.setText(text)
-        self.window.show_info(f"Solve: {text}")
+        self.window.show_info(f"Solve: {text[0].lower()}{text[1:]}")
         self._enable()
 
     def _failed(self, message: str) -> None:
@@ -312,17 +313,22 @@ class SolvePanel(QWidget):
                              f" at {rate:g} Hz")
 
     def run_path(self) -> None:
-        """The path's states run tracked (``MotionTab.run_tracked``)."""
+        """The robots placed at the path's start, then its states run tracked
+        (``MotionTab.run_tracked``): from wherever they are (the goal, after Show) the
+        tracked run's own move to the start is a straight one, which the path exists to
+        avoid."""
         if self.solved is None or not self._robots_here():
             return
         solved = self.solved
         try:
             solution = solution_of(solved.plan, solved.result.path, solved.name())
+            start = frame_situations(solved.plan, solution_of(
+                solved.plan, solved.result.path[:1], solved.name()))[0]
         except GuiError as error:
             self.window.show_error(f"Run: {error}")
             return
         self.tab.run_tracked(solved.plan, solution, solved.name(),
-                             ", ".join(solution.paths))
+                             ", ".join(solution.paths), place=start)
 
     def choose_task_file(self) -> None:
         path, _ = QFileDialog.getSaveFileName(self, "Save the path as a Kautham task file", "",
