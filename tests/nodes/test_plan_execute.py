@@ -69,3 +69,19 @@ def test_without_a_world_the_plan_is_written_and_the_run_refused_in_one_line(ros
     assert errors[0].endswith(f"(the plan stays in {out}: rosrun GUI run_path {problem} "
                               f"--tracked {out} runs it)")
     assert out.read_text().startswith("<Task name=")
+
+
+def test_a_physics_plan_is_run_as_a_control_path_ending_where_plan_said(world, kautham_dir,
+                                                                         tmp_path):
+    problem = kautham_dir / "current_2025" / "demos" / "OMPL_ode_demos" / "Sphere" / "Sphere.xml"
+    world.run(["rosrun", "GUI", "load_problem", str(problem)], timeout=120)
+    run = world.run(["rosrun", "GUI", "plan", str(problem), "--planner", "KPIECE1", "--time",
+                     "30", "--seed", "2", "--execute", "--fast", "--out",
+                     str(tmp_path / "sphere.path")], check=False, timeout=180)
+    assert run.returncode == 0, run.stderr
+    statistics = _statistics(run.stdout)
+    last = re.match(r"^SphereDE: (\d+) control rows done \([0-9.]+ s simulated\), ends "
+                    r"([0-9.]+) m from the goal$", run.stdout.splitlines()[-1])
+    assert last, run.stdout[-500:]
+    assert int(last.group(1)) == statistics["rows"]
+    assert abs(float(last.group(2)) - statistics["goal_distance_m"]) < 1e-3
