@@ -6,23 +6,12 @@ The space is Kautham's: the problem's control space [0, 1]^k (the query's ``<Ini
 (``gui.core.kautham.controls``; a 2012 problem's robots each take their own slice of it, a
 current problem's robots the whole vector). Distances are Euclidean there, as in Kautham.
 
-A state is valid when no link the controls move touches anything (``GeometricWorld``): the
-problem's scene is built in a VirtualWorld Core of this process and asked Check Collision with
-the robots' links placed by forward kinematics (ODE's collision detection, no contacts made,
-nothing stepped). Pairs of parts that no control moves relative to each other (a fixed base on
-its table) are not asked about: they are as the problem built them whatever the path does;
-bodies joined by a joint (adjacent links) never collide in the world, and parts built inside
-each other are exempt there (gui.core.overlaps).
-
-A motion is valid when every configuration along it is (``GeometricWorld.motion_checks``):
-along a straight segment of the control space each joint value changes monotonically (linear,
-then clamped to its limits), so no point of a link moves farther than
-``sum_j |delta q_j| r_j`` (revolute joints: r_j bounds the distance from the joint to any point
-beyond it; prismatic joints and a base's translation: their own change), plus, for a base that
-turns, the turn's angle times the robot's reach. The segment is checked at enough points that
-no link moves more than ``resolution`` between two of them: a link at any configuration of a
-valid motion is then within ``resolution / 2`` of a collision-free placement, so no link goes
-deeper than that into anything (1 mm with the default 2 mm).
+A state is valid when no link the controls move touches anything, a motion when every
+configuration along it is, with no link deeper than half the resolution (1 mm by default) into
+anything: the problem's scene is built in a VirtualWorld Core of this process and asked by
+ODE's collision detection, no contacts made, nothing stepped (gui.planning.geometric_world,
+which says how clearances and the resolution guarantee it; the robots and their bounds:
+gui.planning.geometric_robots).
 
 ``solve(plan, settings)`` answers a ``GeometricResult``; ``solve_file(problem_file, ...)``
 loads and plans a Kautham file first.
@@ -33,14 +22,15 @@ import logging
 import math
 import time
 from dataclasses import dataclass, replace
-from typing import Callable, Dict, List, NamedTuple, Optional, Sequence, Tuple
+from typing import Callable, List, NamedTuple, Optional, Sequence, Tuple
 
 import numpy as np
 
 from gui.core.kinematics import pose_to_position_quaternion
-from gui.core.model import PRISMATIC
 from gui.core.plan import BuildPlan
 from gui.errors import PlanningError
+from gui.planning.geometric_robots import planned_robots, robot_parts
+from gui.planning.geometric_world import RESOLUTION, GeometricWorld
 
 GEOMETRIC_PLANNERS = {
     "omplRRTConnect": "RRTConnect", "omplRRT": "RRT", "omplPRM": "PRM",
@@ -61,11 +51,6 @@ OMPL_PLANNERS = ("RRTConnect", "RRT", "RRTstar", "PRM", "PRMstar", "KPIECE1", "B
 """The geometric planners ``--planner`` may name (OMPL's class names)."""
 DEFAULT_TIME_LIMIT = 10.0
 """s: a search's time when the problem gives none (Kautham's default _Max Planning Time)."""
-CHECKS_BETWEEN_CLOCKS = 16
-"""A motion's checks between two readings of the search's clock (a check takes about 1 ms)."""
-RESOLUTION = 0.002
-"""m: the largest motion of any link point between two checked configurations of a motion:
-no link goes deeper than half of it into anything along a valid motion (module docstring)."""
 RESOLUTION_RANGE = (1e-4, 0.1)
 """m: the resolutions a search takes (finer: a motion of a metre would be 10,000 checks)."""
 
@@ -158,166 +143,9 @@ class GeometricResult:
                 "simplify_s": round(self.simplify_s, 6), "graph_states": self.graph_states}
 
 
-# -- the robots as the control space moves them ---------------------------------------------
-class _Robot:
-    """One robot of the plan: its slice of the control vector and the bodies it moves, with
-    the bounds of how far a change of its joints or base moves any point of them."""
-
-    def __init__(self, handle, part: slice, specs: Dict[str, object]):
-        self.handle = handle
-        self.part = part
-        model = handle.instance.model
-        self.links = model.links
-        self.movable = model.movable_links()
-        self.moves_base = bool(handle.instance.controls.se3)
-        self.radii = _body_radii(handle, specs)
-        self.reach = _reach(model, self.radii)          # m, from the base frame's origin
-        self.arms = [_joint_arm(model, i, self.radii) for i in self.movable]
-        moved = set(self.movable)
-        for i, link in enumerate(self.links):         # a child of a moved link moves too
-            if link.parent in moved:
-                moved.add(i)
-        if self.moves_base:
-            moved = set(range(len(self.links)))
-        self.moved_bodies = {handle.bodies[i].body_id for i in moved}
-
-    def configuration(self, controls: np.ndarray):
-        """(base pose (4, 4), joint values) the control vector puts this robot in."""
-        c = self.handle.instance.controls.configuration(self.handle.instance,
-                                                        controls[self.part])
-        return c.base_pose, c.joints
-
-    def object_poses(self, configuration, indices: Sequence[int]) -> List[np.ndarray]:
-        """The world poses (4, 4) of the bodies ``indices`` (of ``handle.bodies``) at
-        ``configuration``: their objects' frames."""
-        base, joints = configuration
-        links = self.handle.instance.model.link_poses(base, joints)
-        bodies = self.handle.bodies
-        return [links[k] @ bodies[k].offset for k in indices]
-
-    def poses(self, configuration) -> list:
-        base, joints = configuration
-        return self.handle.situations(joints, base)
-
-    def motion_bound(self, a, b) -> float:
-        """m: no point of this robot's links moves farther than this along the straight
-        segment of the control space from configuration ``a`` to ``b`` (module docstring)."""
-        (base_a, q_a), (base_b, q_b) = a, b
-        bound = 0.0
-        for arm, i, da in zip(self.arms, self.movable, np.abs(q_b - q_a)):
-            bound += da if self.links[i].joint == PRISMATIC else da * arm
-        if self.moves_base:
-            bound += float(np.linalg.norm(base_b[:3, 3] - base_a[:3, 3]))
-            bound += _angle(base_a[:3, :3], base_b[:3, :3]) * self.reach
-        return bound
-
-
-def _body_radii(handle, specs: Dict[str, object]) -> List[float]:
-    """Per link, m: the largest distance from the link frame's origin to any point of its
-    body's geometry (``specs``: the plan's body specs by ID)."""
-    return [float(np.linalg.norm(body.offset[:3, 3])) + _spec_radius(specs[body.body_id])
-            for body in handle.bodies]
-
-
-def _spec_radius(spec) -> float:
-    parts = getattr(spec, "parts", None)
-    if parts is None:
-        return _shape_radius(spec)
-    return max((float(np.linalg.norm(p.position)) + _shape_radius(p) for p in parts),
-               default=0.0)
-
-
-def _shape_radius(shape) -> float:
-    """m: the largest distance from a shape's frame origin to a point of it."""
-    from odin_common.interface import Shape, shape_of
-    values = np.asarray(shape.parameters, dtype=float)
-    kind = shape_of(len(values), shape.shape)
-    if kind == Shape.SPHERE:
-        return float(values[0])
-    if kind == Shape.CYLINDER:
-        return float(math.hypot(values[0], values[1] / 2))
-    if kind == Shape.CAPSULE:
-        return float(values[0] + values[1] / 2)
-    if kind == Shape.BOX:
-        return float(np.linalg.norm(values[:3]) / 2)
-    if kind == Shape.MESH and values.size:
-        return float(np.max(np.linalg.norm(values.reshape(-1, 3), axis=1)))
-    return 0.0
-
-
-def _chain_length(model, ancestor: int, link: int) -> float:
-    """m: an upper bound of the distance from link ``ancestor``'s joint frame to link
-    ``link``'s frame, whatever the joints between them (the lengths of their offsets, a
-    prismatic joint's full travel)."""
-    total = 0.0
-    i = link
-    while i is not None and i != ancestor:
-        current = model.links[i]
-        total += _offset_length(current)
-        i = current.parent
-    return total + float(np.linalg.norm(model.links[ancestor].post[:3, 3]))
-
-
-def _offset_length(link) -> float:
-    length = float(np.linalg.norm(link.pre[:3, 3]) + np.linalg.norm(link.post[:3, 3]))
-    if link.movable and link.joint == PRISMATIC and link.limits is not None:
-        length += max(abs(link.limits[0]), abs(link.limits[1]))
-    return length
-
-
-def _descendants(model, index: int) -> List[int]:
-    out, frontier = [index], [index]
-    while frontier:
-        parent = frontier.pop()
-        children = [i for i, link in enumerate(model.links) if link.parent == parent]
-        out += children
-        frontier += children
-    return out
-
-
-def _joint_arm(model, index: int, radii: Sequence[float]) -> float:
-    """m: bounds the distance from movable joint ``index``'s axis to any point of the links it
-    moves (its link and all beyond it)."""
-    return max(_chain_length(model, index, i) + radii[i] for i in _descendants(model, index))
-
-
-def _reach(model, radii: Sequence[float]) -> float:
-    """m: bounds the distance from the base frame's origin to any point of the robot."""
-    return max(_chain_length(model, 0, i) + _offset_length(model.links[0]) + radii[i]
-               for i in range(len(model.links)))
-
-
-def _angle(a: np.ndarray, b: np.ndarray) -> float:
-    """rad: the angle of the rotation from ``a`` to ``b`` (3, 3)."""
-    cosine = (np.trace(a.T @ b) - 1.0) / 2.0
-    return float(math.acos(max(-1.0, min(1.0, cosine))))
-
-
-def _robot_parts(plan: BuildPlan) -> List[Tuple[object, slice]]:
-    """Each robot with controls and its slice of the query's control vector: a current
-    problem's robots all map the whole vector, a 2012 problem's robots each the next
-    ``size`` values in robot order (gui.core.kautham.problem's query)."""
-    robots = [h for h in plan.robots if h.instance.controls is not None]
-    if not robots:
-        raise PlanningError("no robot of the problem has controls to plan with")
-    if plan.problem.format != "2012":
-        return [(h, slice(None)) for h in robots]
-    parts, end = [], 0
-    for handle in robots:
-        size = handle.instance.controls.size
-        parts.append((handle, slice(end, end + size)))
-        end += size
-    return parts
-
-
-def _robots(plan: BuildPlan) -> List[_Robot]:
-    specs = {spec.id: spec for spec in plan.bodies()}
-    return [_Robot(h, part, specs) for h, part in _robot_parts(plan)]
-
-
 def query(plan: BuildPlan) -> Tuple[np.ndarray, np.ndarray]:
     """The query's start and goal in the control space (k,): PlanningError without one."""
-    parts = _robot_parts(plan)
+    parts = robot_parts(plan)
     if any(h.start is None or h.goal is None or h.start.controls is None
            or h.goal.controls is None for h, _ in parts):
         raise PlanningError("the problem has no query (<Init> and <Goal>) to plan")
@@ -326,98 +154,6 @@ def query(plan: BuildPlan) -> Tuple[np.ndarray, np.ndarray]:
         return np.array(handle.start.controls, float), np.array(handle.goal.controls, float)
     return (np.concatenate([np.array(h.start.controls, float) for h, _ in parts]),
             np.concatenate([np.array(h.goal.controls, float) for h, _ in parts]))
-
-
-# -- the scene and its collision queries ------------------------------------------------------
-class GeometricWorld:
-    """The problem's scene in a Core of this process, asked whether configurations of the
-    control space collide (module docstring). ``checks``: configurations asked so far."""
-
-    def __init__(self, plan: BuildPlan, resolution: float = RESOLUTION):
-        from gui.planning.core_world import CoreWorld
-        self.resolution = resolution
-        self.robots = _robots(plan)
-        self.world = CoreWorld()
-        try:
-            self.world.execute(plan)
-            core = self.world.core
-            self.moved = {name for r in self.robots for body in r.moved_bodies
-                          for name in core.geometry_names(body)}
-            self._placed = [(r, [k for k, body in enumerate(r.handle.bodies)
-                                 if body.body_id in r.moved_bodies]) for r in self.robots]
-            self.probe = core.collision_probe(
-                [r.handle.bodies[k].body_id for r, ks in self._placed for k in ks])
-        except Exception:
-            self.world.close()
-            raise
-        # k: a 2012 problem's robots end to end, a current problem's one shared vector
-        self.size = max(r.part.stop or r.handle.instance.controls.size for r in self.robots)
-        self.checks = 0
-
-    def close(self) -> None:
-        self.world.close()
-
-    def configurations(self, controls: Sequence[float]) -> list:
-        """Each robot's (base pose, joints) for the control vector."""
-        c = np.asarray(controls, dtype=float)
-        return [r.configuration(c) for r in self.robots]
-
-    def collisions(self, controls: Sequence[float]) -> list:
-        """The pairs (first, second, depth m) a control vector's configuration makes that a
-        control moves (module docstring), deepest first."""
-        self.checks += 1
-        poses = [pose for r, conf in zip(self.robots, self.configurations(controls))
-                 for pose in r.poses(conf)]
-        found = [(c.first, c.second, c.depth) for c in self.world.core.check_collision(poses)
-                 if c.first in self.moved or c.second in self.moved]
-        return sorted(found, key=lambda pair: -pair[2])
-
-    def valid(self, controls: Sequence[float]) -> bool:
-        """Whether no link a control moves touches anything at the control vector's
-        configuration (the pairs ``collisions`` reports, asked through the Core's collision
-        probe: one C call, stopping at the first)."""
-        self.checks += 1
-        poses = [pose for (r, ks), conf in zip(self._placed, self.configurations(controls))
-                 for pose in r.object_poses(conf, ks)]
-        return self.world.core.probe_touching(self.probe, np.array(poses)) is None
-
-    def motion_points(self, a: Sequence[float], b: Sequence[float]) -> List[np.ndarray]:
-        """The configurations to check along the straight segment from ``a`` to ``b`` (both
-        ends excluded, ``b`` appended): consecutive ones move no link point farther than the
-        resolution (module docstring)."""
-        a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
-        points, fractions = [], [0.0, 1.0]
-        configurations = {0.0: self.configurations(a), 1.0: self.configurations(b)}
-        k = 0
-        while k < len(fractions) - 1:
-            low, high = fractions[k], fractions[k + 1]
-            bound = max(r.motion_bound(ca, cb) for r, ca, cb in
-                        zip(self.robots, configurations[low], configurations[high]))
-            pieces = math.ceil(bound / self.resolution) if bound > self.resolution else 1
-            if pieces > 1:
-                inner = [low + (high - low) * j / pieces for j in range(1, pieces)]
-                for f in inner:
-                    configurations[f] = self.configurations(a + f * (b - a))
-                fractions[k + 1:k + 1] = inner
-                continue
-            k += 1
-        for f in fractions[1:]:
-            points.append(a + f * (b - a))
-        return points
-
-
-def _bisection_order(count: int) -> List[int]:
-    """0..count-1, the last first, then halves, quarters...: an invalid motion is found after
-    few checks (OMPL's DiscreteMotionValidator checks in this order too)."""
-    order, seen = [count - 1], {count - 1}
-    step = count
-    while len(order) < count:
-        step = max(1, step // 2)
-        for i in range(step - 1, count, step):
-            if i not in seen:
-                seen.add(i)
-                order.append(i)
-    return order
 
 
 # -- the search ---------------------------------------------------------------------------------
@@ -450,14 +186,7 @@ class _Checks:
 
     def motion(self, s1, s2) -> bool:
         try:
-            a, b = self.vector(s1), self.vector(s2)
-            points = self.world.motion_points(a, b)
-            for k, i in enumerate(_bisection_order(len(points))):
-                if k % CHECKS_BETWEEN_CLOCKS == 0 and self.over():
-                    return False        # the search is over: this motion is not taken
-                if not self.world.valid(points[i]):
-                    return False
-            return True
+            return self.world.motion_valid(self.vector(s1), self.vector(s2), self.over)
         except BaseException as error:      # noqa: B902 - raised by solve()
             self.error = self.error or error
             return False
@@ -648,7 +377,7 @@ def task_rows(plan: BuildPlan, path: np.ndarray) -> List[List[float]]:
     problem's order, for one whose controls move its base its position x y z (m, world) and
     orientation qx qy qz qw, then a value per link but the base (rad or m; 0 for a fixed
     joint), as Kautham's GUI writes them (gui.core.kautham.solutions reads them back)."""
-    robots = _robots(plan)
+    robots = planned_robots(plan)
     rows = []
     for controls in np.asarray(path, dtype=float):
         row: List[float] = []

@@ -12,14 +12,14 @@ refuses every call.
 """
 from __future__ import annotations
 
-from typing import Optional, Sequence, Tuple
+from typing import List, Optional, Sequence, Tuple
 
 import numpy as np
 
 from odin_common.limits import shown
 from virtual_world.core.scene import Scene
 from virtual_world.errors import InvalidArgument
-from virtual_world.ode.queries import GeomQuery
+from virtual_world.ode.queries import GeomQuery, never_touch
 
 MAX_TIERS = 64
 """The most growths a clearance query takes (each costs a probe per capsule at most)."""
@@ -82,6 +82,16 @@ class CollisionProbe:
                 np.diff(tiers) >= 0.0):
             raise InvalidArgument(f"tiers: 1 to {MAX_TIERS} positive values, descending")
         return self._query.clearances(capsules, tiers)
+
+
+def pairs_that_may_touch(scene: Scene, object_ids: Sequence[str]) -> List[Tuple[str, str]]:
+    """The pairs of the objects ``object_ids`` (in that order within a pair) that a step may
+    collide: some geometry of one and some of the other are not of one body, one entity
+    without internal collisions, or bodies a joint joins."""
+    records = [scene.object(i) for i in _object_ids("objects", scene, object_ids)]
+    return [(a.id, b.id) for n, a in enumerate(records) for b in records[n + 1:]
+            if any(not never_touch(g.owner.ptr, h.owner.ptr)
+                   for g in a.geometries for h in b.geometries)]
 
 
 def _object_ids(what: str, scene: Scene, ids: Sequence[str]) -> Tuple[str, ...]:

@@ -482,6 +482,12 @@ class Core:
         (each with a body), whose ``clearances`` do not ask against the objects ``apart``."""
         return probe.CollisionProbe(self._scene, moved, apart)
 
+    @locked
+    def pairs_that_may_touch(self, object_ids: Sequence[str]) -> List[Tuple[str, str]]:
+        """The pairs of the objects ``object_ids`` a step may collide (not of one body, one
+        entity without internal collisions, or bodies a joint joins), whatever their poses."""
+        return probe.pairs_that_may_touch(self._scene, object_ids)
+
     @changes_state
     def probe_touching(self, collision_probe: probe.CollisionProbe, poses
                        ) -> Optional[Tuple[str, str]]:

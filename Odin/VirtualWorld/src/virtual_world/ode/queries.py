@@ -20,6 +20,12 @@ CAPSULE_VALUES = 7
 """A capsule's values: its segment's ends a and b (3 each, m, world), its radius (m)."""
 
 
+def never_touch(first, second) -> bool:
+    """Whether a step never collides geoms ``first`` and ``second`` (C pointers), whatever
+    their poses (odin_pair_never_touches)."""
+    return bool(lib.odin_pair_never_touches(first, second))
+
+
 def _doubles(array: np.ndarray):
     return ffi.cast("double *", ffi.from_buffer(array))
 
