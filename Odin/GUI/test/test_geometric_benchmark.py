@@ -259,3 +259,12 @@ def test_kautham_s_own_geometric_benchmark_file_runs_briefly(tmp_path):
     assert "geometric_RRTconnect_002" in log and "range = 0.02" in log
     subprocess.run([shutil.which("ompl_benchmark_statistics"), out / "resultRRTconnect.log",
                     "-d", tmp_path / "db.sqlite"], check=True, capture_output=True, timeout=60)
+
+
+def test_a_failed_run_s_reason_is_its_own_line_not_what_follows_it():
+    from gui.planning.benchmark_run import _failure
+    stderr = "not used: x\nrun: collision checking failed: why\nnanobind: leaked 3 types!\n" \
+        "See https://nanobind.readthedocs.io/en/latest/refleaks.html\n"
+    assert _failure(stderr, 2) == "run: collision checking failed: why"
+    assert _failure("Segmentation fault\n", -11) == "Segmentation fault"
+    assert _failure("", -9) == "exit status -9"

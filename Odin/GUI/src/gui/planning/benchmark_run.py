@@ -262,11 +262,18 @@ def run_task(task: RunTask, should_stop: Callable[[], bool] = lambda: False) -> 
         except (ValueError, TypeError) as error:
             why = f"unreadable answer ({error})"
     else:
-        tail = err.decode(errors="replace").strip().splitlines()
-        why = tail[-1] if tail else f"exit status {child.returncode}"
+        why = _failure(err.decode(errors="replace"), child.returncode)
     return RunResult(task.experiment, task.entry, task.run, task.planner, task.seed,
                      False, False, "Crash", 0.0, 0.0, None, 0, 0.0, "", socket.gethostname(),
                      error=why)
+
+
+def _failure(stderr: str, status: int) -> str:
+    """Why a run's process failed: its own one line ("run: ..."), else its stderr's last line
+    (what a library printed at exit may follow the run's line), else its exit status."""
+    lines = stderr.strip().splitlines()
+    ours = [line for line in lines if line.startswith("run: ")]
+    return ours[-1] if ours else lines[-1] if lines else f"exit status {status}"
 
 
 def _wait(child: subprocess.Popen, order: bytes, time_limit: float,
