@@ -4,7 +4,7 @@ statistics script reads the logs with the geometric benchmark's properties, a ru
 `rosrun GUI plan` with its seed, the same runs on a 2-worker Dask cluster as serially, a query
 that collides is one line in the log and summary, and bad input is one line before any run.
 Our own puck problem (a 5 cm box in a 1 m square, a wall between start and goal) solves in
-about a second per run."""
+well under a second of search per run."""
 from __future__ import annotations
 
 import json
