@@ -374,8 +374,8 @@ def _output_options(parser: ToolParser) -> None:
     parser.add_argument("--no-interpolate", dest="interpolate", action="store_false",
                         help="a geometric plan: write the planner's states only [interpolated "
                         "as Kautham does: no two states farther apart than 1%% of the "
-                        "control space's diagonal, or a fifth of a shorter RRT or RRTConnect "
-                        "Range]")
+                        "control space's diagonal (RRT, RRTConnect: a fifth of a Range below "
+                        "4%%)]")
     parser.add_argument("--execute", action="store_true",
                         help="then run the plan in the running world, built by load_problem, "
                         "as run_path does (--tracked, or --controls for a physics problem), "
