@@ -213,6 +213,20 @@ def test_a_physics_problem_keeps_the_tab_as_it_was(tab, tmp_path):
     assert tab.toolbox.count() == 4 and tab.solve.plan is None
 
 
+def test_a_problem_without_a_query_says_so_and_cannot_be_solved(tab, tmp_path):
+    from kautham_files import write_problem
+    from test_geometric_planning import ARM, CNTR, POST, PROBLEM
+    text = PROBLEM.replace("<Queries><Query><Init>INIT</Init><Goal>GOAL</Goal></Query></Queries>",
+                           "")
+    problem = write_problem(tmp_path, {"arm.urdf": ARM, "arm.cntr": CNTR, "post.urdf": POST},
+                            "arm.xml", text)
+    _open(tab, plan_problem(load_problem(problem)))
+    assert tab.toolbox.indexOf(tab.solve) == 4
+    assert "the problem has no query (<Init> and <Goal>) to plan" in \
+        tab.solve.problem_label.text()
+    assert not tab.solve.solve_button.isEnabled()
+
+
 def test_show_frames_cut_each_segment_by_its_length_and_keep_every_state():
     from gui.window.solve_panel import show_frames
     path = np.array([[0.0, 0.0], [0.3, 0.0], [0.3, 0.1]])

@@ -33,7 +33,7 @@ from gui.core.kautham.solutions import TASK, RowLayout, Solution
 from gui.core.plan import BuildPlan
 from gui.errors import GuiError
 from gui.planning.geometric import (OMPL_PLANNERS, GeometricResult, GeometricSettings,
-                                    task_rows, write_task)
+                                    query, task_rows, write_task)
 from gui.window.fields import spin
 from gui.window.forms import form_grid, growing, span
 from gui.window.worker import Cancelled, WorldWorker
@@ -116,6 +116,7 @@ class SolvePanel(QWidget):
         self._started = 0.0
         self._time_limit = 0.0
         self._settings = GeometricSettings()
+        self._unsolvable = ""       # why the opened problem has nothing to solve
         self.solver = WorldWorker(name="planning", parent=self, node=None)
         self._build()
         self._clock = QTimer(self)
@@ -177,6 +178,7 @@ class SolvePanel(QWidget):
             return
         self.plan, self.solved = plan, None
         self._settings = GeometricSettings()
+        self._unsolvable = ""
         if plan is None:
             self.problem_label.setText("Open a problem without physics (one of Kautham's "
                                        "geometric planners) to solve its query here.")
@@ -188,6 +190,10 @@ class SolvePanel(QWidget):
                     else "it names no planner"
             except GuiError as error:   # a planner Odin does not run: the user picks one
                 said = str(error)
+            try:
+                query(plan)
+            except GuiError as error:   # nothing to solve: said here, Solve disabled
+                self._unsolvable = said = str(error)
             self.problem_label.setText(f"{pathlib.Path(plan.problem.source).name}: {said}.")
         self.planner.setCurrentText(self._settings.planner)
         self.time_limit.setValue(self._settings.time_limit)
@@ -195,7 +201,7 @@ class SolvePanel(QWidget):
         self._enable()
 
     def _enable(self) -> None:
-        ready = self.plan is not None
+        ready = self.plan is not None and not self._unsolvable
         self.solve_button.setEnabled(ready and not self.solving)
         self.cancel_button.setEnabled(self.solving)
         self.seed.setEnabled(not _OMPL_SEEDED and not self.solving)
