@@ -25,10 +25,11 @@ from typing import Dict, List, Sequence, Tuple
 import numpy as np
 
 from gui.core.kautham.controls import home_frame_limits, joint_limits, kuffner_quaternion
-from gui.core.model import PRISMATIC
+from gui.core.model import PRISMATIC, REVOLUTE
 from gui.core.plan import BuildPlan
 from gui.errors import PlanningError
 from odin_common.rotations import quaternion_to_matrix
+from virtual_world.core.probe import BOUND_BOX, BOUND_CAPSULE, BOUND_VALUES
 
 
 class PlannedRobot:
@@ -56,6 +57,9 @@ class PlannedRobot:
         self.moved = sorted(moved)
         self.moved_bodies = {handle.bodies[i].body_id for i in moved}
         self.capsules = np.array([_capsule(specs[body.body_id]) for body in handle.bodies])
+        self.boxes = np.array([_box(specs[body.body_id]) for body in handle.bodies])
+        self._offsets = np.array([body.offset for body in handle.bodies])
+        self._chain()
         self._map_controls()
 
     def _map_controls(self) -> None:
@@ -85,13 +89,46 @@ class PlannedRobot:
         local[:3, :3] = quaternion_to_matrix(kuffner_quaternion(*p[3:6]))
         return instance.base_pose @ local, joints
 
-    def object_poses(self, configuration, indices: Sequence[int]) -> List[np.ndarray]:
-        """The world poses (4, 4) of the bodies ``indices`` (of ``handle.bodies``) at
-        ``configuration``: their objects' frames."""
+    def _chain(self) -> None:
+        """Each link's motion from its parent's frame as A + v1 B + v2 C (4, 4 each), with
+        (v1, v2) = (sin q, 1 - cos q) for a revolute joint (Rodrigues' formula between its
+        ``pre`` and ``post``), (q, 0) for a prismatic one, (0, 0) for a fixed one: what
+        gui.core.model's link_poses multiplies, in one array expression."""
+        count = len(self.links)
+        self._fixed_part = np.empty((count, 4, 4))
+        self._first_part = np.zeros((count, 4, 4))
+        self._second_part = np.zeros((count, 4, 4))
+        self._rotational = np.zeros(count, dtype=bool)
+        for i, link in enumerate(self.links):
+            self._fixed_part[i] = link.pre @ link.post
+            if not link.movable:
+                continue
+            axis = np.asarray(link.axis, dtype=float)
+            first = np.zeros((4, 4))
+            if link.joint == REVOLUTE:
+                self._rotational[i] = True
+                x, y, z = axis / np.linalg.norm(axis)
+                first[:3, :3] = [[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]]
+                self._second_part[i] = link.pre @ (first @ first) @ link.post
+            else:
+                first[:3, 3] = axis
+            self._first_part[i] = link.pre @ first @ link.post
+        self._parents = [link.parent for link in self.links]
+
+    def object_frames(self, configuration) -> np.ndarray:
+        """(links, 4, 4): the world pose of each body's object frame at ``configuration``
+        (gui.core.model's link_poses, then each body's offset)."""
         base, joints = configuration
-        links = self.handle.instance.model.link_poses(base, joints)
-        bodies = self.handle.bodies
-        return [links[k] @ bodies[k].offset for k in indices]
+        q = np.zeros(len(self.links))
+        q[self.movable] = joints
+        first = np.where(self._rotational, np.sin(q), q)
+        second = np.where(self._rotational, 1.0 - np.cos(q), 0.0)
+        local = self._fixed_part + first[:, None, None] * self._first_part \
+            + second[:, None, None] * self._second_part
+        frames = np.empty_like(local)
+        for i, parent in enumerate(self._parents):
+            frames[i] = (base if parent is None else frames[parent]) @ local[i]
+        return frames @ self._offsets
 
     def poses(self, configuration) -> list:
         """(body ID, position m, quaternion wxyz) of every link at ``configuration``."""
@@ -114,16 +151,33 @@ class PlannedRobot:
         ``b`` (link_bounds)."""
         return float(np.max(self.link_bounds(a, b), initial=0.0))
 
-    def world_capsules(self, object_poses: Sequence[np.ndarray], indices: Sequence[int]
-                       ) -> np.ndarray:
+    def world_capsules(self, frames: np.ndarray, indices: Sequence[int]) -> np.ndarray:
         """(len(indices), 7): the capsules of the bodies ``indices`` with their objects at
-        ``object_poses`` (4, 4 each): end a, end b (m, world), radius (m)."""
-        out = np.empty((len(indices), 7))
-        for row, (T, k) in enumerate(zip(object_poses, indices)):
-            capsule = self.capsules[k]
-            out[row, :3] = T[:3, :3] @ capsule[:3] + T[:3, 3]
-            out[row, 3:6] = T[:3, :3] @ capsule[3:6] + T[:3, 3]
-            out[row, 6] = capsule[6]
+        ``frames`` (their (4, 4) world poses, in that order): end a, end b (m, world),
+        radius (m)."""
+        capsules = self.capsules[indices]
+        rotations, origins = frames[:, :3, :3], frames[:, :3, 3]
+        out = np.empty((len(capsules), 7))
+        out[:, :3] = np.einsum("nij,nj->ni", rotations, capsules[:, :3]) + origins
+        out[:, 3:6] = np.einsum("nij,nj->ni", rotations, capsules[:, 3:6]) + origins
+        out[:, 6] = capsules[:, 6]
+        return out
+
+    def world_bounds(self, frames: np.ndarray, indices: Sequence[int]) -> np.ndarray:
+        """(2 len(indices), BOUND_VALUES): the capsules of the bodies ``indices``, then their
+        boxes (virtual_world.core.probe's layout, m, world), with their objects at ``frames``
+        (as in world_capsules): both hold a body, so the larger of their clearances is one
+        of its own."""
+        count = len(indices)
+        boxes = self.boxes[indices]
+        rotations = frames[:, :3, :3]
+        out = np.zeros((2 * count, BOUND_VALUES))
+        out[:count, 0] = BOUND_CAPSULE
+        out[:count, 1:8] = self.world_capsules(frames, indices)
+        out[count:, 0] = BOUND_BOX
+        out[count:, 1:4] = np.einsum("nij,nj->ni", rotations, boxes[:, :3]) + frames[:, :3, 3]
+        out[count:, 4:13] = (rotations @ boxes[:, 3:12].reshape(-1, 3, 3)).reshape(-1, 9)
+        out[count:, 13:16] = boxes[:, 12:15]
         return out
 
 
@@ -195,6 +249,25 @@ def _capsule(spec) -> np.ndarray:
     ends = centre + np.outer([low, high], axis)
     radius = max(radius, float(np.max(_segment_distances(points, ends[0], ends[1]))))
     return np.concatenate([ends[0], ends[1], [radius]])
+
+
+def _box(spec) -> np.ndarray:
+    """(15,): centre (3, m), rotation (3 x 3 row by row: the box's axes are its columns) and
+    half sides (3, m) of a box holding the body's geometry, in the object's frame: the
+    smaller of the box along the object's axes and the one along the points' principal
+    axes."""
+    points = _spec_points(spec)
+    candidates = [np.eye(3)]
+    if len(points) > 1:
+        candidates.append(np.linalg.svd(points - points.mean(axis=0), full_matrices=False)[2].T)
+    best = None
+    for axes in candidates:
+        local = points @ axes
+        low, high = local.min(axis=0), local.max(axis=0)
+        half = (high - low) / 2
+        if best is None or np.prod(half) < np.prod(best[12:15]):
+            best = np.concatenate([axes @ ((low + high) / 2), axes.ravel(), half])
+    return best
 
 
 def _segment_distances(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -14,9 +14,9 @@ its start in steps, each as long as two guarantees allow, link by link, from the
 gui.planning.geometric_robots (how far a change of configuration moves any point of a link):
 
 * Clearance: at the step's start, a lower bound of each moved link's distance to everything
-  but the robots (its capsule's, gui.planning.geometric_robots: how far the capsule can grow
-  before the Core's probe finds it touching anything, among ``CLEARANCE_TIERS``), and of the
-  distance between each pair of robot links that may touch (their capsules'). A link that
+  but the robots (its bounding box's or capsule's, gui.planning.geometric_robots: how far it
+  can grow before the Core's probe finds it touching anything, among ``CLEARANCE_TIERS``), and
+  of the distance between each pair of robot links that may touch (their capsules'). A link that
   moves less than its clearance touches nothing on the way; a pair whose two motions together
   are less than their distance does not touch.
 * Resolution: a link (a pair) too near something for a useful step may move no more than
@@ -31,7 +31,7 @@ is the classic discrete check at the resolution, for the links that are near.
 from __future__ import annotations
 
 import math
-from typing import Callable, List, Sequence, Tuple
+from typing import Callable, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -87,7 +87,7 @@ class GeometricWorld:
         ids = [body.body_id for r in self.robots for body in r.handle.bodies]
         moved = [body.body_id for r in self.robots for k, body in enumerate(r.handle.bodies)
                  if k in r.moved]
-        self.probe = core.collision_probe(moved, apart=ids)
+        self.probe = core.collision_probe(moved, apart=ids, tiers=CLEARANCE_TIERS)
         self._moved_mask = np.array([i in set(moved) for i in ids])
         index = {body_id: n for n, body_id in enumerate(ids)}
         pairs = [(index[a], index[b]) for a, b in core.pairs_that_may_touch(ids)
@@ -97,10 +97,16 @@ class GeometricWorld:
     def close(self) -> None:
         self.world.close()
 
-    def configurations(self, controls: Sequence[float]) -> list:
+    def configurations(self, controls: Sequence[float]) -> "Placement":
         """Each robot's (base pose, joints) for the control vector."""
         c = np.asarray(controls, dtype=float)
-        return [r.configuration(c) for r in self.robots]
+        return Placement(r.configuration(c) for r in self.robots)
+
+    def _frames(self, placement: "Placement") -> List[np.ndarray]:
+        """Each robot's (links, 4, 4) object frames at ``placement`` (computed once)."""
+        if placement.frames is None:
+            placement.frames = [r.object_frames(conf) for r, conf in zip(self.robots, placement)]
+        return placement.frames
 
     def collisions(self, controls: Sequence[float]) -> list:
         """The pairs (first, second, depth m) a control vector's configuration makes that a
@@ -118,31 +124,33 @@ class GeometricWorld:
         probe: one C call, stopping at the first)."""
         return self._valid(self.configurations(controls))
 
-    def _valid(self, configurations: list) -> bool:
+    def _valid(self, placement: "Placement") -> bool:
         self.checks += 1
-        poses = [pose for r, conf in zip(self.robots, configurations)
-                 for pose in r.object_poses(conf, r.moved)]
-        return self.world.core.probe_touching(self.probe, np.array(poses)) is None
+        poses = np.concatenate([frames[r.moved] for r, frames in
+                                zip(self.robots, self._frames(placement))])
+        return self.world.core.probe_touching(self.probe, poses) is None
 
     def _bounds(self, a: list, b: list) -> np.ndarray:
         """(robot links,) m: how far each link of every robot moves at most from
         configurations ``a`` to ``b`` (PlannedRobot.link_bounds)."""
         return np.concatenate([r.link_bounds(ca, cb) for r, ca, cb in zip(self.robots, a, b)])
 
-    def clearances(self, configurations: list) -> Tuple[np.ndarray, np.ndarray]:
+    def clearances(self, placement: "Placement") -> Tuple[np.ndarray, np.ndarray]:
         """(per robot link, m: how far each moved link is at least from everything but the
         robots' links, inf for a link no control moves; per pair of robot links that may
-        touch (``_pairs``), m: how far apart they are at least), from their capsules (module
-        docstring)."""
+        touch (``_pairs``), m: how far apart they are at least), from their capsules and
+        boxes (module docstring)."""
         self.clearance_checks += 1
-        capsules = np.vstack([r.world_capsules(r.object_poses(conf, range(len(r.links))),
-                                               range(len(r.links)))
-                              for r, conf in zip(self.robots, configurations)])
-        obstacles = np.full(len(capsules), np.inf)
-        obstacles[self._moved_mask] = self.world.core.probe_clearances(
-            self.probe, capsules[self._moved_mask], CLEARANCE_TIERS)
+        frames = self._frames(placement)
+        bounds = np.concatenate([r.world_bounds(f[r.moved], r.moved)
+                                 for r, f in zip(self.robots, frames)])
+        grown = self.world.core.probe_clearances(self.probe, bounds)
+        obstacles = np.full(len(self._moved_mask), np.inf)
+        obstacles[self._moved_mask] = _larger_of_pairs(grown, [len(r.moved) for r in self.robots])
         if not len(self._pairs):
             return obstacles, np.empty(0)
+        capsules = np.concatenate([r.world_capsules(f, range(len(r.links)))
+                                   for r, f in zip(self.robots, frames)])
         first, second = self._pairs[:, 0], self._pairs[:, 1]
         pairs = _segment_distances(capsules[first], capsules[second]) \
             - capsules[first, 6] - capsules[second, 6]
@@ -233,6 +241,22 @@ class GeometricWorld:
                 continue
             k += 1
         return [a + f * (b - a) for f in fractions[1:]]
+
+
+class Placement(list):
+    """Each robot's (base pose (4, 4), joints) for one control vector, with their object
+    frames once asked (GeometricWorld._frames)."""
+    frames: Optional[List[np.ndarray]] = None
+
+
+def _larger_of_pairs(grown: np.ndarray, counts: Sequence[int]) -> np.ndarray:
+    """Per moved link, the larger of its capsule's and its box's clearance: ``grown`` holds
+    each robot's capsules' then boxes' (PlannedRobot.world_bounds), robot after robot."""
+    out, start = [], 0
+    for count in counts:
+        out.append(np.maximum(grown[start:start + count], grown[start + count:start + 2 * count]))
+        start += 2 * count
+    return np.concatenate(out) if out else np.empty(0)
 
 
 def _fraction_along(a: np.ndarray, b: np.ndarray, point: np.ndarray) -> float:

@@ -1,9 +1,9 @@
 """Collision queries for a geometric planner (gui.planning.geometric), ROS-free: a
 ``CollisionProbe`` is made once for a scene's robots and then asked, thousands of times a
-second, whether their links touch anything at given poses, and how far capsules bounding them
-are from everything else. Each call costs one C call (odin_query.c), not a Check Collision
-request's: the poses are checked as arrays, and nothing is put back (the links stay where the
-last call put them; a planner's world is its own).
+second, whether their links touch anything at given poses, and how far capsules or boxes
+bounding them are from everything else. Each call costs one C call (odin_query.c), not a
+Check Collision request's: the poses are checked as arrays, and nothing is put back (the links
+stay where the last call put them; a planner's world is its own).
 
 Which pairs may touch is the step's rule (odin_pair_never_touches: not two geoms of one entity
 without internal collisions, of one body, or of bodies a joint joins). A probe is bound to the
@@ -19,10 +19,11 @@ import numpy as np
 from odin_common.limits import shown
 from virtual_world.core.scene import Scene
 from virtual_world.errors import InvalidArgument
-from virtual_world.ode.queries import GeomQuery, never_touch
+from virtual_world.ode.queries import (BOUND_BOX, BOUND_CAPSULE, BOUND_VALUES, GeomQuery,
+                                       never_touch)
 
 MAX_TIERS = 64
-"""The most growths a clearance query takes (each costs a probe per capsule at most)."""
+"""The most growths a clearance query takes (each costs a probe per bound at most)."""
 ORTHONORMAL_TOLERANCE = 1e-6
 """How far a pose's rotation may be from orthonormal (largest entry of R R^T - I)."""
 
@@ -30,10 +31,13 @@ ORTHONORMAL_TOLERANCE = 1e-6
 class CollisionProbe:
     """The objects ``moved`` (with bodies) placed and asked about; the objects ``apart``
     (their geometries) not asked against by ``clearances`` (a robot's own links, whose pairs
-    the planner bounds itself)."""
+    the planner bounds itself); ``tiers`` (m, descending, at most MAX_TIERS): the growths
+    ``clearances`` finds the largest clear one among."""
 
-    def __init__(self, scene: Scene, moved: Sequence[str], apart: Sequence[str] = ()):
+    def __init__(self, scene: Scene, moved: Sequence[str], apart: Sequence[str] = (),
+                 tiers: Sequence[float] = (0.1,)):
         moved, apart = _object_ids("moved", scene, moved), _object_ids("apart", scene, apart)
+        self.tiers = _tiers(tiers, scene.parameters.world_extent)
         records = [scene.object(object_id) for object_id in moved]
         static = [r.id for r in records if r.body is None]
         if static:
@@ -68,20 +72,45 @@ class CollisionProbe:
             return None
         return scene.geometry_names[hit[0]], scene.geometry_names[hit[1]]
 
-    def clearances(self, scene: Scene, capsules, tiers) -> np.ndarray:
-        """Per capsule ((m, 7): ends a and b, radius; m, world), the first of ``tiers`` (m,
-        descending) by which it can grow without touching any geometry but those of
-        ``apart``, else 0: a lower bound of its distance to them (m)."""
+    def clearances(self, scene: Scene, bounds) -> np.ndarray:
+        """Per bound ((m, BOUND_VALUES): a capsule or a box, m, world:
+        virtual_world.ode.queries), the first of the probe's ``tiers`` (m, descending) by
+        which it can grow without touching any geometry but those of ``apart``, else 0: a
+        lower bound of its distance to them (m)."""
         self._same_scene(scene)
         extent = scene.parameters.world_extent
-        capsules = _finite_array("capsules", capsules, (-1, 7), extent)
-        if np.any(capsules[:, 6] < 0.0):
-            raise InvalidArgument("capsules: a radius is negative")
-        tiers = _finite_array("tiers", tiers, (-1,), extent)
-        if not 1 <= len(tiers) <= MAX_TIERS or np.any(tiers <= 0.0) or np.any(
-                np.diff(tiers) >= 0.0):
-            raise InvalidArgument(f"tiers: 1 to {MAX_TIERS} positive values, descending")
-        return self._query.clearances(capsules, tiers)
+        bounds = _bounds(_finite_array("bounds", bounds, (-1, BOUND_VALUES), extent))
+        return self._query.clearances(bounds, self.tiers)
+
+
+def _tiers(tiers, extent: float) -> np.ndarray:
+    tiers = _finite_array("tiers", tiers, (-1,), extent)
+    if not 1 <= len(tiers) <= MAX_TIERS or np.any(tiers <= 0.0) or np.any(
+            np.diff(tiers) >= 0.0):
+        raise InvalidArgument(f"tiers: 1 to {MAX_TIERS} positive values, descending")
+    return np.ascontiguousarray(tiers)
+
+
+def _bounds(bounds: np.ndarray) -> np.ndarray:
+    """Capsules and boxes, checked: a known kind, sizes not negative, a box's rotation
+    orthonormal."""
+    box = bounds[:, 0] == BOUND_BOX
+    if not np.all(box | (bounds[:, 0] == BOUND_CAPSULE)):
+        raise InvalidArgument(f"bounds: a kind is neither {BOUND_CAPSULE} (capsule) nor "
+                              f"{BOUND_BOX} (box)")
+    boxes = bounds[box]
+    if np.any(bounds[~box, 7] < 0.0) or np.any(boxes[:, 13:16] < 0.0):
+        raise InvalidArgument("bounds: a radius or a half side is negative")
+    _orthonormal("bounds", boxes[:, 4:13].reshape(-1, 3, 3))
+    return bounds
+
+
+def _orthonormal(what: str, rotations: np.ndarray) -> None:
+    if not len(rotations):
+        return
+    error = np.einsum("nij,nkj->nik", rotations, rotations) - np.eye(3)
+    if not float(np.max(np.abs(error))) <= ORTHONORMAL_TOLERANCE:
+        raise InvalidArgument(f"{what}: a rotation is not orthonormal")
 
 
 def pairs_that_may_touch(scene: Scene, object_ids: Sequence[str]) -> List[Tuple[str, str]]:
@@ -108,7 +137,8 @@ def _finite_array(what: str, values, shape, extent: float) -> np.ndarray:
         array = np.asarray(values, dtype=float).reshape(shape)
     except (TypeError, ValueError):
         raise InvalidArgument(f"{what}: not an array of shape {shape}") from None
-    if not np.all(np.isfinite(array)) or np.any(np.abs(array) > extent):
+    largest = float(np.max(np.abs(array))) if array.size else 0.0
+    if not largest <= extent:       # NaN and inf too
         raise InvalidArgument(f"{what}: every value finite and within the world's extent "
                               f"({extent:g} m)")
     return array
@@ -118,10 +148,7 @@ def _poses(poses, count: int, extent: float) -> np.ndarray:
     poses = _finite_array("poses", poses, (-1, 4, 4), extent)
     if len(poses) != count:
         raise InvalidArgument(f"poses: {len(poses)} given for {count} moved objects")
-    rotations = poses[:, :3, :3]
-    error = np.einsum("nij,nkj->nik", rotations, rotations) - np.eye(3)
-    if count and float(np.max(np.abs(error))) > ORTHONORMAL_TOLERANCE:
-        raise InvalidArgument("poses: a rotation is not orthonormal")
+    _orthonormal("poses", poses[:, :3, :3])
     return poses
 
 

@@ -476,11 +476,12 @@ class Core:
         return found
 
     @locked
-    def collision_probe(self, moved: Sequence[str], apart: Sequence[str] = ()
-                        ) -> probe.CollisionProbe:
+    def collision_probe(self, moved: Sequence[str], apart: Sequence[str] = (),
+                        tiers: Sequence[float] = (0.1,)) -> probe.CollisionProbe:
         """A geometric planner's probe (virtual_world.core.probe) of the objects ``moved``
-        (each with a body), whose ``clearances`` do not ask against the objects ``apart``."""
-        return probe.CollisionProbe(self._scene, moved, apart)
+        (each with a body), whose ``clearances`` do not ask against the objects ``apart``
+        and find the largest clear growth among ``tiers`` (m, descending)."""
+        return probe.CollisionProbe(self._scene, moved, apart, tiers)
 
     @locked
     def pairs_that_may_touch(self, object_ids: Sequence[str]) -> List[Tuple[str, str]]:
@@ -496,11 +497,10 @@ class Core:
         return collision_probe.touching(self._scene, poses)
 
     @locked
-    def probe_clearances(self, collision_probe: probe.CollisionProbe, capsules, tiers
-                         ) -> np.ndarray:
-        """Lower bounds (m) of capsules' distances to the world but the probe's ``apart``
-        objects (CollisionProbe.clearances)."""
-        return collision_probe.clearances(self._scene, capsules, tiers)
+    def probe_clearances(self, collision_probe: probe.CollisionProbe, bounds) -> np.ndarray:
+        """Lower bounds (m) of the distances of capsules and boxes to the world but the
+        probe's ``apart`` objects (CollisionProbe.clearances)."""
+        return collision_probe.clearances(self._scene, bounds)
 
     # ------------------------------------------------------------------ step and read-out
 

@@ -1,7 +1,7 @@
 /* The geometric planner's collision queries (gui.planning.geometric through
  * virtual_world.core.probe): whether the geoms of some objects touch anything on their present
  * poses, with the step's rules for which pairs may touch (odin_pair_never_touches), and how far
- * capsules bounding them can grow before they touch anything else. Nothing is recorded, no
+ * capsules or boxes bounding them can grow before they touch anything else. Nothing is recorded, no
  * contact joint is made, nothing is stepped; the world's records are not touched. */
 #include <ode/ode.h>
 #include <math.h>
@@ -32,10 +32,11 @@ static int skipped(const Ask *ask, dGeomID g) {
     return 0;
 }
 
-/* ODE's capsule colliders: a probe meeting a geom of another class (a cylinder, a convex, a
- * heightfield) cannot be asked, and is taken to touch it whenever their boxes overlap (a
- * clearance is a lower bound: too small is safe, too large is not). */
-static int capsule_collides_with(dGeomID g) {
+/* The classes ODE collides a probe with (a box's or a capsule's colliders): a probe meeting a
+ * geom of another class (a cylinder, a convex, a heightfield) cannot be asked, and is taken to
+ * touch it whenever their boxes overlap (a clearance is a lower bound: too small is safe, too
+ * large is not). */
+static int probe_collides_with(dGeomID g) {
     switch (dGeomGetClass(g)) {
     case dSphereClass: case dBoxClass: case dCapsuleClass: case dPlaneClass:
     case dTriMeshClass:
@@ -55,7 +56,7 @@ static void ask_pair(void *data, dGeomID o1, dGeomID o2) {
     }
     if (other == ask->geom || (ask->n_skip && skipped(ask, other))) return;
     if (!ask->probe && odin_pair_never_touches(ask->geom, other)) return;
-    if (ask->probe && !capsule_collides_with(other)) {
+    if (ask->probe && !probe_collides_with(other)) {
         ask->touching = 1;
         ask->other = other;
         return;
@@ -82,8 +83,8 @@ int odin_geoms_touching(OdinWorld *w, const dGeomID *geoms, int n, dGeomID *hit)
     return 0;
 }
 
-/* Puts the probe along the segment a-b (m, world), its radius r + grown. */
-static void place_probe(dGeomID probe, const double *capsule, double grown) {
+/* Puts the capsule probe along the segment a-b (m, world), its radius r + grown. */
+static void place_capsule(dGeomID probe, const double *capsule, double grown) {
     const double *a = capsule, *b = capsule + 3;
     double axis[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
     double length = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
@@ -95,33 +96,52 @@ static void place_probe(dGeomID probe, const double *capsule, double grown) {
     dGeomSetRotation(probe, R);
 }
 
-static int probe_touches(OdinWorld *w, Ask *ask, const double *capsule, double grown) {
-    place_probe(ask->geom, capsule, grown);
+/* Puts the box probe at its centre and rotation (row by row), its half sides + grown. */
+static void place_box(dGeomID probe, const double *box, double grown) {
+    const double *c = box, *r = box + 3, *half = box + 12;
+    dMatrix3 R = {r[0], r[1], r[2], 0.0, r[3], r[4], r[5], 0.0, r[6], r[7], r[8], 0.0};
+    dGeomBoxSetLengths(probe, 2 * (half[0] + grown), 2 * (half[1] + grown),
+                       2 * (half[2] + grown));
+    dGeomSetPosition(probe, c[0], c[1], c[2]);
+    dGeomSetRotation(probe, R);
+}
+
+/* Whether bound (ODIN_BOUND_VALUES values) grown by `grown` touches anything asked. */
+static int bound_touches(OdinWorld *w, Ask *ask, dGeomID capsule, dGeomID box,
+                         const double *bound, double grown) {
+    if (bound[0] == ODIN_BOUND_BOX) {
+        ask->geom = box;
+        place_box(box, bound + 1, grown);
+    } else {
+        ask->geom = capsule;
+        place_capsule(capsule, bound + 1, grown);
+    }
     ask->touching = 0;
     dSpaceCollide2(ask->geom, (dGeomID)w->space, ask, &ask_pair);
     return ask->touching;
 }
 
-void odin_capsules_clearance(OdinWorld *w, const double *capsules, int n, const double *tiers,
-                             int n_tiers, const uintptr_t *skip, int n_skip, double *out) {
+void odin_bounds_clearance(OdinWorld *w, const double *bounds, int n, const double *tiers,
+                           int n_tiers, const uintptr_t *skip, int n_skip, double *out) {
     Ask ask;
     memset(&ask, 0, sizeof ask);
-    ask.geom = dCreateCapsule(0, 1.0, 1.0);
+    dGeomID capsule = dCreateCapsule(0, 1.0, 1.0), box = dCreateBox(0, 1.0, 1.0, 1.0);
     ask.probe = 1;
     ask.skip = skip;
     ask.n_skip = n_skip;
     for (int i = 0; i < n; ++i) {
-        const double *capsule = capsules + 7 * i;
+        const double *bound = bounds + ODIN_BOUND_VALUES * i;
         /* tiers descend: the first clear one is the answer; clear at k means clear beyond k */
         int low = 0, high = n_tiers; /* the answer's index is in [low, high]; n_tiers: none */
         while (low < high) {
             int mid = low + (high - low) / 2;
-            if (probe_touches(w, &ask, capsule, tiers[mid])) low = mid + 1;
+            if (bound_touches(w, &ask, capsule, box, bound, tiers[mid])) low = mid + 1;
             else high = mid;
         }
         out[i] = low < n_tiers ? tiers[low] : 0.0;
     }
-    dGeomDestroy(ask.geom);
+    dGeomDestroy(capsule);
+    dGeomDestroy(box);
 }
 
 void odin_place_bodies(dBodyID *bodies, int n, const double *poses) {

@@ -268,13 +268,20 @@ int odin_pair_never_touches(dGeomID o1, dGeomID o2);
 /* 1 when one of the n geoms touches a geom the step may collide it with (not
  * odin_pair_never_touches), on the present poses, with that pair in hit[0], hit[1]; else 0. */
 int odin_geoms_touching(OdinWorld *w, const dGeomID *geoms, int n, dGeomID *hit);
-/* For each of the n capsules (7 values each: end a (3), end b (3), radius r; m, world), the
- * first of the n_tiers growths `tiers` (m, descending) by which the capsule (radius r + tier)
- * touches none of the space's geoms but the n_skip geoms of `skip` (their addresses, sorted),
- * else 0.0, into out: each a lower bound of the capsule's distance to them. A geom no capsule
- * collider of ODE takes (a cylinder, a convex) counts as touching when the boxes overlap. */
-void odin_capsules_clearance(OdinWorld *w, const double *capsules, int n, const double *tiers,
-                             int n_tiers, const uintptr_t *skip, int n_skip, double *out);
+/* A bound of a link's geometry for odin_bounds_clearance: ODIN_BOUND_VALUES values, the first
+ * its kind. A capsule: ODIN_BOUND_CAPSULE, end a (3), end b (3), radius (m, world), unused
+ * values. A box: ODIN_BOUND_BOX, centre (3, m, world), rotation (3 x 3, row by row: its axes
+ * are the columns), half sides (3, m). */
+#define ODIN_BOUND_VALUES 16
+#define ODIN_BOUND_CAPSULE 0
+#define ODIN_BOUND_BOX 1
+/* For each of the n bounds, the first of the n_tiers growths `tiers` (m, descending) by which
+ * the bound (a capsule's radius + tier, a box's half sides + tier) touches none of the space's
+ * geoms but the n_skip geoms of `skip` (their addresses, sorted), else 0.0, into out: each a
+ * lower bound of the bound's distance to them. A geom of a class ODE has no collider with
+ * both for (a cylinder, a convex) counts as touching when the boxes overlap. */
+void odin_bounds_clearance(OdinWorld *w, const double *bounds, int n, const double *tiers,
+                           int n_tiers, const uintptr_t *skip, int n_skip, double *out);
 /* Puts n bodies at poses (12 values each: centre of mass (3, m, world), then the rotation
  * matrix (3 x 3, row by row; orthonormal: ODE makes its quaternion of it)). */
 void odin_place_bodies(dBodyID *bodies, int n, const double *poses);

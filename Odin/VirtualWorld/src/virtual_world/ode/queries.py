@@ -16,8 +16,11 @@ from virtual_world.ode.runtime import drains_ode_messages
 
 POSE_VALUES = 12
 """A placed body's values: centre of mass (3, m, world), rotation matrix row by row (9)."""
-CAPSULE_VALUES = 7
-"""A capsule's values: its segment's ends a and b (3 each, m, world), its radius (m)."""
+BOUND_VALUES = int(lib.ODIN_BOUND_VALUES)
+"""A bound's values (odin_step.h): its kind (BOUND_CAPSULE: ends a and b (3 each), radius; or
+BOUND_BOX: centre (3), rotation row by row (9), half sides (3); m, world), zeros after."""
+BOUND_CAPSULE = int(lib.ODIN_BOUND_CAPSULE)
+BOUND_BOX = int(lib.ODIN_BOUND_BOX)
 
 
 def never_touch(first, second) -> bool:
@@ -60,14 +63,14 @@ class GeomQuery:
                 int(ffi.cast("uintptr_t", self._hit[1])))
 
     @drains_ode_messages
-    def clearances(self, capsules: np.ndarray, tiers: np.ndarray) -> np.ndarray:
-        """Per capsule (m, CAPSULE_VALUES), the first of ``tiers`` (m, descending) it can
-        grow by and touch none of the world's geoms but ``apart``, else 0 (m)."""
-        capsules = np.ascontiguousarray(capsules, dtype=float)
+    def clearances(self, bounds: np.ndarray, tiers: np.ndarray) -> np.ndarray:
+        """Per bound (m, BOUND_VALUES), the first of ``tiers`` (m, descending) it can grow
+        by and touch none of the world's geoms but ``apart``, else 0 (m)."""
+        bounds = np.ascontiguousarray(bounds, dtype=float)
         tiers = np.ascontiguousarray(tiers, dtype=float)
-        out = np.empty(len(capsules))
-        if len(capsules):
-            lib.odin_capsules_clearance(self._world, _doubles(capsules), len(capsules),
-                                        _doubles(tiers), len(tiers), self._apart,
-                                        self._apart_count, _doubles(out))
+        out = np.empty(len(bounds))
+        if len(bounds):
+            lib.odin_bounds_clearance(self._world, _doubles(bounds), len(bounds),
+                                      _doubles(tiers), len(tiers), self._apart,
+                                      self._apart_count, _doubles(out))
         return out
