@@ -1,0 +1,106 @@
+"""The motion checks of a geometric search (gui.planning.geometric_world): a motion they pass
+takes no link deeper than half the resolution into anything, checked four times finer on
+random motions of our own arm around its post; far from everything they certify long steps
+by clearance and check few configurations exactly; the robots' bounds hold their links."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from gui.planning.geometric import GeometricWorld, query
+from gui.planning.geometric_robots import planned_robots
+from gui.planning.geometric_world import _segment_distances
+from test_geometric_planning import _plan, _problem
+
+
+def _deepest(world, a, b, fine):
+    deepest = 0.0
+    for point in fine.motion_points(a, b):
+        deepest = max([deepest] + [depth for _, _, depth in fine.collisions(point)])
+    return deepest
+
+
+def test_every_motion_passed_goes_no_deeper_than_half_the_resolution(tmp_path):
+    plan = _plan(_problem(tmp_path))
+    world = GeometricWorld(plan, resolution=0.004)
+    fine = GeometricWorld(plan, resolution=0.001)
+    rng = np.random.default_rng(11)
+    try:
+        passed = failed = 0
+        while passed < 15:
+            a, b = rng.random(2), rng.random(2)
+            if not world.valid(a):
+                continue
+            if world.motion_valid(a, b):
+                passed += 1
+                assert _deepest(world, a, b, fine) <= 0.002
+            else:
+                failed += 1
+        assert failed >= 5                     # the post was met too: not a vacuous test
+    finally:
+        world.close()
+        fine.close()
+
+
+def test_a_motion_far_from_everything_is_certified_not_walked(tmp_path):
+    """The arm swung 3 rad away from the post (start and goal both at x < 0) is certified by
+    clearances in a few steps, where the resolution alone would check hundreds of points."""
+    plan = _plan(_problem(tmp_path, init="0.2 0.5", goal="0.2 0.9"))
+    world = GeometricWorld(plan)
+    try:
+        start, goal = query(plan)
+        walked = len(world.motion_points(start, goal))
+        assert walked > 200
+        assert world.motion_valid(start, goal)
+        assert world.checks + world.clearance_checks < walked / 10
+    finally:
+        world.close()
+
+
+def test_a_motion_into_the_post_fails(tmp_path):
+    plan = _plan(_problem(tmp_path))
+    world = GeometricWorld(plan)
+    try:
+        start, goal = query(plan)
+        assert not world.motion_valid(start, goal)
+    finally:
+        world.close()
+
+
+def test_each_link_stays_within_its_capsule_and_box_and_moves_within_its_bound(tmp_path):
+    """At random configurations every vertex of a link's box geometry lies in its capsule and
+    its box; between two, no link frame corner moves farther than its bound."""
+    plan = _plan(_problem(tmp_path))
+    robot = planned_robots(plan)[0]
+    rng = np.random.default_rng(2)
+    corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)])
+    half = {1: np.array([0.25, 0.025, 0.025]), 2: np.array([0.2, 0.02, 0.02])}
+    centre = {1: np.array([0.25, 0.0, 0.0]), 2: np.array([0.2, 0.0, 0.0])}
+    for _ in range(50):
+        a, b = robot.configuration(rng.random(2)), robot.configuration(rng.random(2))
+        frames_a, frames_b = robot.object_frames(a), robot.object_frames(b)
+        bounds = robot.link_bounds(a, b)
+        capsules = robot.world_capsules(frames_a, range(3))
+        for k in (1, 2):
+            local = corners * half[k] + centre[k] - robot.handle.bodies[k].offset[:3, 3]
+            world_a = local @ frames_a[k][:3, :3].T + frames_a[k][:3, 3]
+            world_b = local @ frames_b[k][:3, :3].T + frames_b[k][:3, 3]
+            assert np.max(np.linalg.norm(world_b - world_a, axis=1)) <= bounds[k] + 1e-12
+            distances = _segment_distances(np.repeat(capsules[k:k + 1], 8, 0),
+                                           np.hstack([world_a, world_a]))
+            assert np.all(distances <= capsules[k, 6] + 1e-12)
+            box = robot.world_bounds(frames_a[k:k + 1], [k])[1]
+            axes = box[4:13].reshape(3, 3)
+            inside = (world_a - box[1:4]) @ axes
+            assert np.all(np.abs(inside) <= box[13:16] + 1e-12)
+
+
+@pytest.mark.parametrize("p, q, expected", [
+    ((0, 0, 0, 1, 0, 0), (0, 1, 0, 1, 1, 0), 1.0),          # parallel
+    ((0, 0, 0, 1, 0, 0), (0.5, -1, 1, 0.5, 1, 1), 1.0),     # crossing, 1 m above
+    ((0, 0, 0, 0, 0, 0), (2, 0, 0, 3, 0, 0), 2.0),          # a point and a segment
+    ((0, 0, 0, 1, 0, 0), (3, 0, 0, 3, 0, 0), 2.0),          # a segment and a point
+])
+def test_segment_distances(p, q, expected):
+    assert _segment_distances(np.array([p], float), np.array([q], float))[0] \
+        == pytest.approx(expected)
