@@ -203,6 +203,21 @@ def test_cancel_ends_a_search_at_once_and_says_so(tab, tmp_path):
     assert page.solved is None and page.solve_button.isEnabled()
 
 
+def test_the_window_shut_down_mid_search_stops_the_search(tab, tmp_path):
+    """The window stops its path worker as it closes: the search's worker stops with it (a
+    QThread running past the window would end the process with an abort)."""
+    import time
+    from gui.window.testing import click, wait_for
+    _open(tab, plan_problem(load_problem(_problem(tmp_path))))
+    page = tab.solve
+    page.planner.setCurrentText("RRTstar")
+    click(page.solve_button)
+    wait_for(lambda: page.solver.current is not None, 10, "the search to start")
+    stopped = time.monotonic()
+    tab.window.path_worker.stop()
+    assert not page.solver.isRunning() and time.monotonic() - stopped < 3.0
+
+
 def test_a_physics_problem_keeps_the_tab_as_it_was(tab, tmp_path):
     plan = plan_problem(load_problem(_problem(tmp_path)))
     _open(tab, replace(plan, physics=True))
