@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import replace
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -30,6 +31,8 @@ class _Window:
         self.scene = SceneModel()
         self.path_worker = WorldWorker(name="paths", node=None)
         self.path_worker.start()
+        self.worker = WorldWorker(name="world", node=None)       # its busy signal only
+        self.simulation = SimpleNamespace(building=False)
         self.publication_rate = 25.0
         self.errors, self.infos = [], []
 
@@ -201,6 +204,25 @@ def test_cancel_ends_a_search_at_once_and_says_so(tab, tmp_path):
     assert page.result_label.text() == "Solve: cancelled"
     assert tab.window.infos[-1] == "Solve: cancelled" and tab.window.errors == []
     assert page.solved is None and page.solve_button.isEnabled()
+
+
+def test_a_problem_opened_mid_search_ends_the_search_and_none_starts_while_one_builds(
+        tab, tmp_path):
+    """The Simulation tab rehearses a problem it opens in a Core of the window's process: no
+    search may run beside it (this ODE collides in one thread at a time)."""
+    from gui.window.testing import click, wait_for
+    _open(tab, plan_problem(load_problem(_problem(tmp_path))))
+    page, window = tab.solve, tab.window
+    page.planner.setCurrentText("RRTstar")
+    click(page.solve_button)
+    wait_for(lambda: page.solver.current is not None, 10, "the search to start")
+    window.simulation.building = True
+    window.worker.busy.emit("Open other.xml")
+    wait_for(lambda: not page.solving, 5, "the search to stop")
+    assert window.infos[-2] == "Solve: cancelled (Open other.xml: another problem)"
+    page.solve()
+    assert window.errors == ["Solve: a problem is being opened; solve once it is built"]
+    assert not page.solving
 
 
 def test_the_window_shut_down_mid_search_stops_the_search(tab, tmp_path):

@@ -124,6 +124,7 @@ class SolvePanel(QWidget):
         # the window stops its workers when it closes: the search's stops with them (a
         # running QThread must not outlive the window)
         window.path_worker.finished.connect(self.shutdown, Qt.DirectConnection)
+        window.worker.busy.connect(self._world_busy)
         self.solver.start()
         self.set_plan(None)
 
@@ -219,6 +220,9 @@ class SolvePanel(QWidget):
         """Searches the query on the panel's worker with the fields' settings."""
         if self.plan is None or self.solving:
             return
+        if self.window.simulation.building:
+            self.window.show_error("Solve: a problem is being opened; solve once it is built")
+            return
         plan, settings = self.plan, self.settings()
         seed = None
         if not _OMPL_SEEDED:
@@ -280,6 +284,15 @@ class SolvePanel(QWidget):
 
     def cancel(self) -> None:
         self.solver.cancel()
+
+    def _world_busy(self, label: str) -> None:
+        """A problem opened while a search runs ends the search: the Simulation tab rehearses
+        it in a Core of this process, and this process's ODE (built without its per-thread
+        collision data, ODE_EXT_mt_collisions) must not collide in two threads at once; the
+        search's path would be of the problem replaced anyway."""
+        if self.solving and self.window.simulation.building:
+            self.window.show_info(f"Solve: cancelled ({label}: another problem)")
+            self.cancel()
 
     def shutdown(self) -> None:
         self._clock.stop()
