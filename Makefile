@@ -66,8 +66,9 @@ soak: setup
 	@$(ENV) python tools/soak/run.py
 
 # every problem file of Kautham's whole public corpus (tools/get_kautham.sh --all) through
-# problem_info, then built into a world with the Viewer and simulated 2 s; not part of `make
-# test`; writes out/corpus/report.md and .json and the README's corpus figures
+# problem_info, then built into a world with the Viewer and simulated 2 s, and each geometric
+# problem's query planned in its own time limit; not part of `make test`; writes
+# out/corpus/report.md and .json and the README's corpus figures
 corpus: setup
 	@$(ENV) python tools/corpus/run.py
 
