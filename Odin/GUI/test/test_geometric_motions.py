@@ -104,3 +104,78 @@ def test_each_link_stays_within_its_capsule_and_box_and_moves_within_its_bound(t
 def test_segment_distances(p, q, expected):
     assert _segment_distances(np.array([p], float), np.array([q], float))[0] \
         == pytest.approx(expected)
+
+
+PLATE = """<?xml version="1.0"?><robot name="plate"><link name="base"><collision><geometry>
+ <box size="0.05 0.01 0.05"/></geometry></collision></link></robot>"""
+PLATE_CNTR = """<?xml version="1.0"?><ControlSet>
+ <Offset><DOF name="plate/X" value="0.5"/><DOF name="plate/Y" value="0.5"/></Offset>
+ <Control name="plate/x" eigValue="1.0"><DOF name="plate/X" value="1.0"/></Control>
+ <Control name="plate/y" eigValue="1.0"><DOF name="plate/Y" value="1.0"/></Control>
+</ControlSet>"""
+CORRIDOR = """<?xml version="1.0"?><robot name="corridor">
+ <link name="floor"><collision><origin xyz="0.5 0.5 -0.05"/><geometry><box size="1 1 0.1"/>
+  </geometry></collision></link>
+ <link name="wall"><collision><origin xyz="0.5 0.5 0.05"/><geometry><box size="0.04 0.7 0.1"/>
+  </geometry></collision></link>
+ <joint name="f" type="fixed"><parent link="floor"/><child link="wall"/></joint></robot>"""
+PLATE_PROBLEM = """<?xml version="1.0"?><Problem>
+ <Robot robot="plate.urdf"><Limits name="X" min="0" max="1"/><Limits name="Y" min="0" max="1"/>
+  <Limits name="Z" min="0.006" max="0.006"/>
+  <Home X="0" Y="0" Z="0.006" WX="0" WY="0" WZ="1" TH="0"/></Robot>
+ <Obstacle obstacle="corridor.urdf"><Home X="0" Y="0" Z="0" WX="0" WY="0" WZ="1" TH="0"/>
+ </Obstacle>
+ <Controls robot="plate.cntr"/>
+ <Planner><Parameters><Name>omplRRTConnect</Name>
+  <Parameter name="_Max Planning Time">10</Parameter></Parameters>
+  <Queries><Query><Init>0.2 0.2</Init><Goal>0.8 0.2</Goal></Query></Queries></Planner>
+</Problem>"""
+# the plate (5 cm square, 1 cm thick: Kautham turns its y up, as it turns its demos' bigcube, by
+# the rotation its controls leave at their offsets) slides 1 mm above the floor; a wall x in
+# [0.48, 0.52], y in [0.15, 0.85] stands between start and goal
+
+
+def _plate_plan(folder):
+    from kautham_files import write_problem
+    return _plan(write_problem(folder, {"plate.urdf": PLATE, "plate.cntr": PLATE_CNTR,
+                                        "corridor.urdf": CORRIDOR}, "plate.xml",
+                               PLATE_PROBLEM))
+
+
+def test_a_plate_sliding_1_mm_above_the_floor_is_swept_not_walked(tmp_path):
+    """Its clearance is 1 mm everywhere (the floor), so the clearance walk would go at the
+    resolution; what it sweeps translating is free of the floor, and a motion along the wall
+    takes a few sweeps. Through the wall it fails."""
+    plan = _plate_plan(tmp_path)
+    world = GeometricWorld(plan)
+    try:
+        along = (np.array([0.2, 0.1]), np.array([0.8, 0.1]))     # south of the wall's end
+        walked = len(world.motion_points(*along))
+        assert walked > 200
+        assert world.motion_valid(*along)
+        assert world.checks + world.clearance_checks < 10
+        assert not world.motion_valid(np.array([0.2, 0.5]), np.array([0.8, 0.5]))
+    finally:
+        world.close()
+
+
+def test_every_swept_motion_passed_goes_no_deeper_than_half_the_resolution(tmp_path):
+    plan = _plate_plan(tmp_path)
+    world = GeometricWorld(plan, resolution=0.004)
+    fine = GeometricWorld(plan, resolution=0.001)
+    rng = np.random.default_rng(4)
+    try:
+        passed = failed = 0
+        while passed < 15:
+            a, b = rng.random(2), rng.random(2)
+            if not world.valid(a):
+                continue
+            if world.motion_valid(a, b):
+                passed += 1
+                assert _deepest(world, a, b, fine) <= 0.002
+            else:
+                failed += 1
+        assert failed >= 5
+    finally:
+        world.close()
+        fine.close()

@@ -74,20 +74,33 @@ class PlannedRobot:
         self._joint_span = np.array([high - low for low, high in limits], dtype=float)
         self._base_box = home_frame_limits(instance.base_pose, instance.limits) \
             if self.moves_base else None
+        # a base the controls move but never turn (an R2 or R3 robot): its orientation once
+        self._base_turns = bool(np.any(controls.matrix[3:6] != 0.0))
+        p = np.clip(controls.offset, 0.0, 1.0)
+        self._base_rotation = instance.base_pose[:3, :3] @ quaternion_to_matrix(
+            kuffner_quaternion(*p[3:6]))
 
     def configuration(self, controls: np.ndarray):
         """(base pose (4, 4), joint values) the control vector puts this robot in."""
         instance = self.handle.instance
         c = np.asarray(controls, dtype=float)[self.part]
-        p = np.clip(instance.controls.offset + instance.controls.matrix @ (c - 0.5), 0.0, 1.0)
+        p = np.minimum(np.maximum(
+            instance.controls.offset + instance.controls.matrix @ (c - 0.5), 0.0), 1.0)
         joints = self._joint_low + p[self._dof_of_joint] * self._joint_span
         if not self.moves_base:
             return instance.base_pose, joints
         box = self._base_box
-        local = np.eye(4)
-        local[:3, 3] = box[:, 0] + p[:3] * (box[:, 1] - box[:, 0])
-        local[:3, :3] = quaternion_to_matrix(kuffner_quaternion(*p[3:6]))
-        return instance.base_pose @ local, joints
+        position = box[:, 0] + p[:3] * (box[:, 1] - box[:, 0])
+        if self._base_turns:
+            local = np.eye(4)
+            local[:3, 3] = position
+            local[:3, :3] = quaternion_to_matrix(kuffner_quaternion(*p[3:6]))
+            return instance.base_pose @ local, joints
+        base = np.empty((4, 4))
+        base[:3, :3] = self._base_rotation
+        base[:3, 3] = instance.base_pose[:3, :3] @ position + instance.base_pose[:3, 3]
+        base[3] = (0.0, 0.0, 0.0, 1.0)
+        return base, joints
 
     def _chain(self) -> None:
         """Each link's motion from its parent's frame as A + v1 B + v2 C (4, 4 each), with
@@ -146,6 +159,41 @@ class PlannedRobot:
             bounds = bounds + _angle(base_a[:3, :3], base_b[:3, :3]) * self.reaches
         return bounds
 
+    def turns(self, a, b) -> bool:
+        """Whether some link turns from configuration ``a`` to ``b`` (a revolute joint or the
+        base's orientation changes): else every link only translates."""
+        (base_a, q_a), (base_b, q_b) = a, b
+        revolute = self._rotational[self.movable]
+        if np.any(np.asarray(q_a)[revolute] != np.asarray(q_b)[revolute]):
+            return True
+        return self.moves_base and not np.array_equal(base_a[:3, :3], base_b[:3, :3])
+
+    def unclamped(self, controls: np.ndarray) -> bool:
+        """Whether no DOF of the control vector's configuration is clamped to its limits (so
+        along a straight segment between two such vectors every DOF changes linearly)."""
+        controls = np.asarray(controls, dtype=float)[self.part]
+        p = self.handle.instance.controls.offset + self.handle.instance.controls.matrix @ (
+            controls - 0.5)
+        return bool(np.all((p >= 0.0) & (p <= 1.0)))
+
+    def swept_boxes(self, frames_a: np.ndarray, frames_b: np.ndarray, indices: Sequence[int]
+                    ) -> np.ndarray:
+        """(len(indices), BOUND_VALUES) boxes (virtual_world.core.probe's layout, m, world)
+        each holding what a body's box sweeps as its object moves from ``frames_a`` to
+        ``frames_b`` (4, 4 each, in ``indices``' order) along a straight line, turning not:
+        the two boxes' convex hull, boxed along the box's axes or along the motion,
+        whichever is smaller."""
+        out = np.zeros((len(indices), BOUND_VALUES))
+        for row, (Ta, Tb, k) in enumerate(zip(frames_a, frames_b, indices)):
+            box = self.boxes[k]
+            axes = Ta[:3, :3] @ box[3:12].reshape(3, 3)
+            local = _CORNERS * box[12:15]
+            corners = np.vstack([local @ (T[:3, :3] @ box[3:12].reshape(3, 3)).T
+                                 + T[:3, :3] @ box[:3] + T[:3, 3] for T in (Ta, Tb)])
+            out[row] = _smallest_box(corners, [axes, _motion_axes(Tb[:3, 3] - Ta[:3, 3],
+                                                                  axes)])
+        return out
+
     def motion_bound(self, a, b) -> float:
         """m: no point of any of this robot's links moves farther than this from ``a`` to
         ``b`` (link_bounds)."""
@@ -179,6 +227,42 @@ class PlannedRobot:
         out[count:, 4:13] = (rotations @ boxes[:, 3:12].reshape(-1, 3, 3)).reshape(-1, 9)
         out[count:, 13:16] = boxes[:, 12:15]
         return out
+
+
+_CORNERS = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float)
+
+
+def _motion_axes(motion: np.ndarray, axes: np.ndarray) -> np.ndarray:
+    """(3, 3) orthonormal columns: the motion's direction, then the box axis (``axes``'
+    columns) most across it made square to it, then their cross product (``axes`` when the
+    motion is nil)."""
+    length = float(np.linalg.norm(motion))
+    if length == 0.0:
+        return axes
+    u = motion / length
+    v = axes[:, int(np.argmin(np.abs(u @ axes)))]
+    v = v - (v @ u) * u
+    v /= np.linalg.norm(v)
+    return np.column_stack([u, v, np.cross(u, v)])
+
+
+def _smallest_box(points: np.ndarray, candidates: Sequence[np.ndarray]) -> np.ndarray:
+    """(BOUND_VALUES,): the smallest of the boxes along each candidate's axes (columns)
+    holding ``points`` (n, 3)."""
+    best, volume = None, np.inf
+    for axes in candidates:
+        local = points @ axes
+        low, high = local.min(axis=0), local.max(axis=0)
+        size = float(np.prod(high - low))
+        if size < volume:
+            best, volume = (axes, low, high), size
+    axes, low, high = best
+    bound = np.zeros(BOUND_VALUES)
+    bound[0] = BOUND_BOX
+    bound[1:4] = axes @ ((low + high) / 2)
+    bound[4:13] = axes.ravel()
+    bound[13:16] = (high - low) / 2
+    return bound
 
 
 def _arm_matrix(model, movable: Sequence[int], radii: Sequence[float]) -> np.ndarray:

@@ -45,6 +45,9 @@ CLEARANCE_TIERS = 0.002 * 2.0 ** np.arange(8, -1, -1)
 """m, descending (0.512 ... 0.002): the growths a clearance is found among (the largest each
 capsule can grow by without touching anything; a binary search over them, about four probes
 per link)."""
+SWEEP_GAP = 1e-6
+"""m: a translating link's sweep (GeometricWorld._sweep_valid) is free when it can grow by
+this and touch nothing."""
 CHECKS_BETWEEN_CLOCKS = 16
 """A motion's steps between two readings of the search's clock."""
 PROBES = (0.5, 0.25, 0.75, 0.125, 0.375, 0.625, 0.875)
@@ -88,6 +91,7 @@ class GeometricWorld:
         moved = [body.body_id for r in self.robots for k, body in enumerate(r.handle.bodies)
                  if k in r.moved]
         self.probe = core.collision_probe(moved, apart=ids, tiers=CLEARANCE_TIERS)
+        self.sweep_probe = core.collision_probe(moved, apart=ids, tiers=(SWEEP_GAP,))
         self._moved_mask = np.array([i in set(moved) for i in ids])
         index = {body_id: n for n, body_id in enumerate(ids)}
         pairs = [(index[a], index[b]) for a, b in core.pairs_that_may_touch(ids)
@@ -164,6 +168,8 @@ class GeometricWorld:
         a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
         end = self.configurations(b)
         here = self.configurations(a)
+        if self._sweeps(a, b, here, end):
+            return self._valid(end) and self._sweep_valid(a, b, here, end, over)
         if not self._probes_valid(a, b, here, end):
             return False
         t = 0.0
@@ -176,6 +182,46 @@ class GeometricWorld:
             if unproven and t < 1.0 and not self._valid(there):
                 return False
             here = there
+        return True
+
+    def _sweeps(self, a, b, here: list, end: list) -> bool:
+        """Whether the segment's motion is one the sweep walk takes: every link only
+        translates, linearly (no DOF clamped at either end), and no pair of robot links may
+        touch."""
+        return not len(self._pairs) and all(
+            not r.turns(ca, cb) and r.unclamped(a) and r.unclamped(b)
+            for r, ca, cb in zip(self.robots, here, end))
+
+    def _swept_free(self, start: "Placement", end: "Placement") -> bool:
+        """Whether nothing is in what the moved links sweep from ``start`` to ``end``
+        (translating along straight lines: PlannedRobot.swept_boxes)."""
+        self.clearance_checks += 1
+        boxes = np.concatenate([r.swept_boxes(fa[r.moved], fb[r.moved], r.moved) for r, fa, fb
+                                in zip(self.robots, self._frames(start), self._frames(end))])
+        return bool(np.all(self.world.core.probe_clearances(self.sweep_probe, boxes) > 0.0))
+
+    def _sweep_valid(self, a, b, here: list, end: list, over: Callable[[], bool]) -> bool:
+        """The segment of a translating motion split in halves until each piece's sweep is
+        free, or moves no link more than the resolution with both its ends valid (module
+        docstring); pieces are taken from the start on."""
+        pieces = [(0.0, here, 1.0, end)]
+        known = {0.0: True, 1.0: True}          # the start is valid, the end was checked
+        while pieces:
+            if (len(pieces) + self.clearance_checks) % CHECKS_BETWEEN_CLOCKS == 0 and over():
+                return False
+            t0, start, t1, stop = pieces.pop()
+            if self._swept_free(start, stop):
+                continue
+            if float(np.max(self._bounds(start, stop), initial=0.0)) <= self.resolution:
+                for t, placement in ((t0, start), (t1, stop)):
+                    if t not in known:
+                        known[t] = self._valid(placement)
+                    if not known[t]:
+                        return False
+                continue
+            middle = (t0 + t1) / 2
+            between = self.configurations(a + middle * (b - a))
+            pieces += [(middle, between, t1, stop), (t0, start, middle, between)]
         return True
 
     def _probes_valid(self, a, b, here: list, end: list) -> bool:
