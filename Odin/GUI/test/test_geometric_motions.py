@@ -89,10 +89,10 @@ def test_each_link_stays_within_its_capsule_and_box_and_moves_within_its_bound(t
             distances = _segment_distances(np.repeat(capsules[k:k + 1], 8, 0),
                                            np.hstack([world_a, world_a]))
             assert np.all(distances <= capsules[k, 6] + 1e-12)
-            box = robot.world_bounds(frames_a[k:k + 1], [k])[1]
-            axes = box[4:13].reshape(3, 3)
-            inside = (world_a - box[1:4]) @ axes
-            assert np.all(np.abs(inside) <= box[13:16] + 1e-12)
+            box, pose = robot.boxes[k], frames_a[k]
+            axes = pose[:3, :3] @ box[3:12].reshape(3, 3)
+            inside = (world_a - pose[:3, :3] @ box[:3] - pose[:3, 3]) @ axes
+            assert np.all(np.abs(inside) <= box[12:15] + 1e-12)
 
 
 @pytest.mark.parametrize("p, q, expected", [

@@ -58,6 +58,8 @@ class PlannedRobot:
         self.moved_bodies = {handle.bodies[i].body_id for i in moved}
         self.capsules = np.array([_capsule(specs[body.body_id]) for body in handle.bodies])
         self.boxes = np.array([_box(specs[body.body_id]) for body in handle.bodies])
+        self.boxed = np.array([_box_volume(b) < _capsule_volume(c)
+                               for b, c in zip(self.boxes, self.capsules)])
         self._offsets = np.array([body.offset for body in handle.bodies])
         self._chain()
         self._map_controls()
@@ -212,20 +214,20 @@ class PlannedRobot:
         return out
 
     def world_bounds(self, frames: np.ndarray, indices: Sequence[int]) -> np.ndarray:
-        """(2 len(indices), BOUND_VALUES): the capsules of the bodies ``indices``, then their
-        boxes (virtual_world.core.probe's layout, m, world), with their objects at ``frames``
-        (as in world_capsules): both hold a body, so the larger of their clearances is one
-        of its own."""
-        count = len(indices)
-        boxes = self.boxes[indices]
+        """(len(indices), BOUND_VALUES): the bound of each body ``indices`` that holds it
+        more tightly, its box or its capsule (virtual_world.core.probe's layout, m, world),
+        with their objects at ``frames`` (as in world_capsules)."""
+        indices = np.asarray(indices, dtype=int)
+        boxed = self.boxed[indices]
+        out = np.zeros((len(indices), BOUND_VALUES))
+        out[~boxed, 0] = BOUND_CAPSULE
+        out[~boxed, 1:8] = self.world_capsules(frames[~boxed], indices[~boxed])
+        boxes, frames = self.boxes[indices[boxed]], frames[boxed]
         rotations = frames[:, :3, :3]
-        out = np.zeros((2 * count, BOUND_VALUES))
-        out[:count, 0] = BOUND_CAPSULE
-        out[:count, 1:8] = self.world_capsules(frames, indices)
-        out[count:, 0] = BOUND_BOX
-        out[count:, 1:4] = np.einsum("nij,nj->ni", rotations, boxes[:, :3]) + frames[:, :3, 3]
-        out[count:, 4:13] = (rotations @ boxes[:, 3:12].reshape(-1, 3, 3)).reshape(-1, 9)
-        out[count:, 13:16] = boxes[:, 12:15]
+        out[boxed, 0] = BOUND_BOX
+        out[boxed, 1:4] = np.einsum("nij,nj->ni", rotations, boxes[:, :3]) + frames[:, :3, 3]
+        out[boxed, 4:13] = (rotations @ boxes[:, 3:12].reshape(-1, 3, 3)).reshape(-1, 9)
+        out[boxed, 13:16] = boxes[:, 12:15]
         return out
 
 
@@ -352,6 +354,15 @@ def _box(spec) -> np.ndarray:
         if best is None or np.prod(half) < np.prod(best[12:15]):
             best = np.concatenate([axes @ ((low + high) / 2), axes.ravel(), half])
     return best
+
+
+def _box_volume(box: np.ndarray) -> float:
+    return float(8.0 * np.prod(box[12:15]))
+
+
+def _capsule_volume(capsule: np.ndarray) -> float:
+    radius, length = capsule[6], float(np.linalg.norm(capsule[3:6] - capsule[:3]))
+    return float(math.pi * radius ** 2 * (length + 4.0 * radius / 3.0))
 
 
 def _segment_distances(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -150,7 +150,7 @@ class GeometricWorld:
                                  for r, f in zip(self.robots, frames)])
         grown = self.world.core.probe_clearances(self.probe, bounds)
         obstacles = np.full(len(self._moved_mask), np.inf)
-        obstacles[self._moved_mask] = _larger_of_pairs(grown, [len(r.moved) for r in self.robots])
+        obstacles[self._moved_mask] = grown
         if not len(self._pairs):
             return obstacles, np.empty(0)
         capsules = np.concatenate([r.world_capsules(f, range(len(r.links)))
@@ -293,16 +293,6 @@ class Placement(list):
     """Each robot's (base pose (4, 4), joints) for one control vector, with their object
     frames once asked (GeometricWorld._frames)."""
     frames: Optional[List[np.ndarray]] = None
-
-
-def _larger_of_pairs(grown: np.ndarray, counts: Sequence[int]) -> np.ndarray:
-    """Per moved link, the larger of its capsule's and its box's clearance: ``grown`` holds
-    each robot's capsules' then boxes' (PlannedRobot.world_bounds), robot after robot."""
-    out, start = [], 0
-    for count in counts:
-        out.append(np.maximum(grown[start:start + count], grown[start + count:start + 2 * count]))
-        start += 2 * count
-    return np.concatenate(out) if out else np.empty(0)
 
 
 def _fraction_along(a: np.ndarray, b: np.ndarray, point: np.ndarray) -> float:

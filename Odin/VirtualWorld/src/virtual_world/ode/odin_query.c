@@ -121,8 +121,40 @@ static int bound_touches(OdinWorld *w, Ask *ask, dGeomID capsule, dGeomID box,
     return ask->touching;
 }
 
+/* The index in [0, n_tiers] of the first tier (descending) at which the bound touches nothing
+ * asked (n_tiers: none), searched from the index `hint` outwards (a bound's clearance changes
+ * little from one query to the next: about two probes), then by halves. */
+static int first_clear_tier(OdinWorld *w, Ask *ask, dGeomID capsule, dGeomID box,
+                            const double *bound, const double *tiers, int n_tiers, int hint) {
+    int low = 0, high = n_tiers; /* the answer is in [low, high] */
+    if (hint < 0) hint = 0;
+    if (hint >= n_tiers) hint = n_tiers - 1;
+    if (bound_touches(w, ask, capsule, box, bound, tiers[hint])) {
+        low = hint + 1;          /* clear, if anywhere, at a smaller tier */
+        for (int step = 1; low + step - 1 < n_tiers; step *= 2) {
+            int at = low + step - 1;
+            if (!bound_touches(w, ask, capsule, box, bound, tiers[at])) { high = at; break; }
+            low = at + 1;
+        }
+    } else {
+        high = hint;             /* clear here: maybe at a larger tier too */
+        for (int step = 1; high - step >= 0; step *= 2) {
+            int at = high - step;
+            if (bound_touches(w, ask, capsule, box, bound, tiers[at])) { low = at + 1; break; }
+            high = at;
+        }
+    }
+    while (low < high) {
+        int mid = low + (high - low) / 2;
+        if (bound_touches(w, ask, capsule, box, bound, tiers[mid])) low = mid + 1;
+        else high = mid;
+    }
+    return low;
+}
+
 void odin_bounds_clearance(OdinWorld *w, const double *bounds, int n, const double *tiers,
-                           int n_tiers, const uintptr_t *skip, int n_skip, double *out) {
+                           int n_tiers, const uintptr_t *skip, int n_skip, int *hints,
+                           double *out) {
     Ask ask;
     memset(&ask, 0, sizeof ask);
     dGeomID capsule = dCreateCapsule(0, 1.0, 1.0), box = dCreateBox(0, 1.0, 1.0, 1.0);
@@ -130,15 +162,10 @@ void odin_bounds_clearance(OdinWorld *w, const double *bounds, int n, const doub
     ask.skip = skip;
     ask.n_skip = n_skip;
     for (int i = 0; i < n; ++i) {
-        const double *bound = bounds + ODIN_BOUND_VALUES * i;
-        /* tiers descend: the first clear one is the answer; clear at k means clear beyond k */
-        int low = 0, high = n_tiers; /* the answer's index is in [low, high]; n_tiers: none */
-        while (low < high) {
-            int mid = low + (high - low) / 2;
-            if (bound_touches(w, &ask, capsule, box, bound, tiers[mid])) low = mid + 1;
-            else high = mid;
-        }
-        out[i] = low < n_tiers ? tiers[low] : 0.0;
+        int found = first_clear_tier(w, &ask, capsule, box, bounds + ODIN_BOUND_VALUES * i, tiers,
+                                     n_tiers, hints[i]);
+        out[i] = found < n_tiers ? tiers[found] : 0.0;
+        hints[i] = found;
     }
     dGeomDestroy(capsule);
     dGeomDestroy(box);

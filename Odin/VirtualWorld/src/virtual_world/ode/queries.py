@@ -46,6 +46,9 @@ class GeomQuery:
         self._apart = ffi.new("uintptr_t[]", sorted(apart) or 1)
         self._apart_count = len(apart)
         self._hit = ffi.new("dGeomID[2]")
+        # where each bound's clearance search starts: the last answer for the same row (a
+        # caller asks about the same bounds in the same order, query after query)
+        self._hints = np.zeros(0, dtype=np.intc)
 
     @drains_ode_messages
     def place(self, poses: np.ndarray) -> None:
@@ -69,8 +72,12 @@ class GeomQuery:
         bounds = np.ascontiguousarray(bounds, dtype=float)
         tiers = np.ascontiguousarray(tiers, dtype=float)
         out = np.empty(len(bounds))
+        if len(bounds) > len(self._hints):
+            self._hints = np.zeros(len(bounds), dtype=np.intc)
         if len(bounds):
             lib.odin_bounds_clearance(self._world, _doubles(bounds), len(bounds),
                                       _doubles(tiers), len(tiers), self._apart,
-                                      self._apart_count, _doubles(out))
+                                      self._apart_count,
+                                      ffi.cast("int *", ffi.from_buffer(self._hints)),
+                                      _doubles(out))
         return out
