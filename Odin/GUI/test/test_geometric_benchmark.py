@@ -177,6 +177,22 @@ def test_a_two_worker_dask_cluster_gives_exactly_the_serial_geometric_runs(tmp_p
     assert all(r.geometric.collision_checks > 0 for r in on_dask)
 
 
+def test_a_stopped_geometric_run_ends_its_search_at_once(tmp_path):
+    """SIGINT ends the run's search (solve's stop) well before STOP_GRACE_S would kill it: a
+    wall across the whole square, so the search would go on for its 60 s."""
+    import time
+
+    from gui.planning.benchmark_run import STOP_GRACE_S, RunStopped
+    (tmp_path / "across.urdf").write_text(WALL.replace("0.02 0.5 0.1", "0.02 2.2 0.1"))
+    problem = _puck(tmp_path, "closed.xml")       # the wall from y = -0.85 to 1.35 m
+    problem.write_text(problem.read_text().replace("wall.urdf", "across.urdf"))
+    task = prepare(command_line_experiments([str(problem)], None, 1, 60.0)).tasks[0]
+    started = time.monotonic()
+    with pytest.raises(RunStopped):
+        run_task(task, lambda: time.monotonic() - started > 3.0)
+    assert time.monotonic() - started < 3.0 + STOP_GRACE_S / 2
+
+
 def test_a_query_that_collides_is_recorded_without_a_search(tmp_path):
     problem = _puck(tmp_path, init="0.5 0.3")
     prepared = prepare(command_line_experiments([str(problem)], None, 2, 4.0))
