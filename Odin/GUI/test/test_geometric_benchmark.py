@@ -284,3 +284,13 @@ def test_a_failed_run_s_reason_is_its_own_line_not_what_follows_it():
     assert _failure(stderr, 2) == "run: collision checking failed: why"
     assert _failure("Segmentation fault\n", -11) == "Segmentation fault"
     assert _failure("", -9) == "exit status -9"
+
+
+def test_max_mem_ends_a_geometric_search_with_its_reason(tmp_path):
+    """maxMem as OMPL's Benchmark applies it ends the search; solve keeps nothing of a search
+    it was asked to stop, so the run says why and has no measures (not a crash)."""
+    task = prepare(command_line_experiments([str(_puck(tmp_path))], None, 1, 30.0,
+                                            max_mem=0.25)).tasks[0]
+    result = run_task(task)
+    assert (result.status, result.solved, result.geometric) == ("Timeout", False, None)
+    assert result.error == "ended by maxMem: the search grew by more than 0.25 MB"
