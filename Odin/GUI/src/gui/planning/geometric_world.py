@@ -139,16 +139,19 @@ class GeometricWorld:
         configurations ``a`` to ``b`` (PlannedRobot.link_bounds)."""
         return np.concatenate([r.link_bounds(ca, cb) for r, ca, cb in zip(self.robots, a, b)])
 
-    def clearances(self, placement: "Placement") -> Tuple[np.ndarray, np.ndarray]:
+    def clearances(self, placement: "Placement", needed: Optional[np.ndarray] = None
+                   ) -> Tuple[np.ndarray, np.ndarray]:
         """(per robot link, m: how far each moved link is at least from everything but the
         robots' links, inf for a link no control moves; per pair of robot links that may
         touch (``_pairs``), m: how far apart they are at least), from their capsules and
-        boxes (module docstring)."""
+        boxes (module docstring). ``needed`` (per robot link, m): a clearance beyond it is of
+        no use to the caller, and is not sought."""
         self.clearance_checks += 1
         frames = self._frames(placement)
         bounds = np.concatenate([r.world_bounds(f[r.moved], r.moved)
                                  for r, f in zip(self.robots, frames)])
-        grown = self.world.core.probe_clearances(self.probe, bounds)
+        grown = self.world.core.probe_clearances(
+            self.probe, bounds, None if needed is None else needed[self._moved_mask])
         obstacles = np.full(len(self._moved_mask), np.inf)
         obstacles[self._moved_mask] = grown
         if not len(self._pairs):
@@ -239,11 +242,11 @@ class GeometricWorld:
         <= 1 of the segment such that every link stays within its clearance, or moves no
         more than the resolution (then t' is checked: module docstring); each pair of robot
         links likewise by their sum."""
-        obstacles, pairs = self.clearances(here)
+        rest = self._bounds(here, end)
+        obstacles, pairs = self.clearances(here, rest)
         allowed = np.maximum(obstacles, self.resolution)
         allowed_pairs = np.maximum(pairs, self.resolution)
         first, second = self._pairs[:, 0], self._pairs[:, 1]
-        rest = self._bounds(here, end)
         with np.errstate(divide="ignore", invalid="ignore"):
             fraction = min(1.0, float(np.min(allowed / rest, initial=np.inf)),
                            float(np.min(allowed_pairs / (rest[first] + rest[second]),

@@ -72,15 +72,23 @@ class CollisionProbe:
             return None
         return scene.geometry_names[hit[0]], scene.geometry_names[hit[1]]
 
-    def clearances(self, scene: Scene, bounds) -> np.ndarray:
+    def clearances(self, scene: Scene, bounds, needed=None) -> np.ndarray:
         """Per bound ((m, BOUND_VALUES): a capsule or a box, m, world:
         virtual_world.ode.queries), the first of the probe's ``tiers`` (m, descending) by
         which it can grow without touching any geometry but those of ``apart``, else 0: a
-        lower bound of its distance to them (m)."""
+        lower bound of its distance to them (m). ``needed`` (m, per bound; None: all inf):
+        the most of use to the caller: no tier beyond the smallest one that reaches it is
+        asked (a larger growth meets more of a large mesh, and costs more)."""
         self._same_scene(scene)
         extent = scene.parameters.world_extent
         bounds = _bounds(_finite_array("bounds", bounds, (-1, BOUND_VALUES), extent))
-        return self._query.clearances(bounds, self.tiers)
+        needed = np.full(len(bounds), np.inf) if needed is None else \
+            np.asarray(needed, dtype=float).reshape(-1)
+        if len(needed) != len(bounds) or np.any(np.isnan(needed)):
+            raise InvalidArgument(f"needed: one value (m, not NaN) per bound, {len(bounds)}")
+        # the index of the smallest tier >= needed (tiers descend); 0 when none reaches it
+        reaching = len(self.tiers) - np.searchsorted(self.tiers[::-1], needed, side="left")
+        return self._query.clearances(bounds, self.tiers, np.maximum(reaching - 1, 0))
 
 
 def _tiers(tiers, extent: float) -> np.ndarray:

@@ -497,10 +497,11 @@ class Core:
         return collision_probe.touching(self._scene, poses)
 
     @locked
-    def probe_clearances(self, collision_probe: probe.CollisionProbe, bounds) -> np.ndarray:
+    def probe_clearances(self, collision_probe: probe.CollisionProbe, bounds, needed=None
+                         ) -> np.ndarray:
         """Lower bounds (m) of the distances of capsules and boxes to the world but the
-        probe's ``apart`` objects (CollisionProbe.clearances)."""
-        return collision_probe.clearances(self._scene, bounds)
+        probe's ``apart`` objects, up to ``needed`` (CollisionProbe.clearances)."""
+        return collision_probe.clearances(self._scene, bounds, needed)
 
     # ------------------------------------------------------------------ step and read-out
 

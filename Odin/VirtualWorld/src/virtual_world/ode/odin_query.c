@@ -121,13 +121,15 @@ static int bound_touches(OdinWorld *w, Ask *ask, dGeomID capsule, dGeomID box,
     return ask->touching;
 }
 
-/* The index in [0, n_tiers] of the first tier (descending) at which the bound touches nothing
- * asked (n_tiers: none), searched from the index `hint` outwards (a bound's clearance changes
- * little from one query to the next: about two probes), then by halves. */
+/* The index in [first, n_tiers] of the first tier (descending) from `first` on at which the
+ * bound touches nothing asked (n_tiers: none), searched from the index `hint` outwards (a
+ * bound's clearance changes little from one query to the next: about two probes), then by
+ * halves. */
 static int first_clear_tier(OdinWorld *w, Ask *ask, dGeomID capsule, dGeomID box,
-                            const double *bound, const double *tiers, int n_tiers, int hint) {
-    int low = 0, high = n_tiers; /* the answer is in [low, high] */
-    if (hint < 0) hint = 0;
+                            const double *bound, const double *tiers, int n_tiers, int hint,
+                            int first) {
+    int low = first, high = n_tiers; /* the answer is in [low, high] */
+    if (hint < first) hint = first;
     if (hint >= n_tiers) hint = n_tiers - 1;
     if (bound_touches(w, ask, capsule, box, bound, tiers[hint])) {
         low = hint + 1;          /* clear, if anywhere, at a smaller tier */
@@ -138,7 +140,7 @@ static int first_clear_tier(OdinWorld *w, Ask *ask, dGeomID capsule, dGeomID box
         }
     } else {
         high = hint;             /* clear here: maybe at a larger tier too */
-        for (int step = 1; high - step >= 0; step *= 2) {
+        for (int step = 1; high - step >= first; step *= 2) {
             int at = high - step;
             if (bound_touches(w, ask, capsule, box, bound, tiers[at])) { low = at + 1; break; }
             high = at;
@@ -153,8 +155,8 @@ static int first_clear_tier(OdinWorld *w, Ask *ask, dGeomID capsule, dGeomID box
 }
 
 void odin_bounds_clearance(OdinWorld *w, const double *bounds, int n, const double *tiers,
-                           int n_tiers, const uintptr_t *skip, int n_skip, int *hints,
-                           double *out) {
+                           int n_tiers, const uintptr_t *skip, int n_skip, const int *firsts,
+                           int *hints, double *out) {
     Ask ask;
     memset(&ask, 0, sizeof ask);
     dGeomID capsule = dCreateCapsule(0, 1.0, 1.0), box = dCreateBox(0, 1.0, 1.0, 1.0);
@@ -163,7 +165,7 @@ void odin_bounds_clearance(OdinWorld *w, const double *bounds, int n, const doub
     ask.n_skip = n_skip;
     for (int i = 0; i < n; ++i) {
         int found = first_clear_tier(w, &ask, capsule, box, bounds + ODIN_BOUND_VALUES * i, tiers,
-                                     n_tiers, hints[i]);
+                                     n_tiers, hints[i], firsts[i]);
         out[i] = found < n_tiers ? tiers[found] : 0.0;
         hints[i] = found;
     }

@@ -279,12 +279,13 @@ int odin_geoms_touching(OdinWorld *w, const dGeomID *geoms, int n, dGeomID *hit)
  * the bound (a capsule's radius + tier, a box's half sides + tier) touches none of the space's
  * geoms but the n_skip geoms of `skip` (their addresses, sorted), else 0.0, into out: each a
  * lower bound of the bound's distance to them. A geom of a class ODE has no collider with
- * both for (a cylinder, a convex) counts as touching when the boxes overlap. hints (n): where
- * each search starts (any index; the answer is the same), written back with the answer's index
- * (n_tiers: none) for the next query to start from. */
+ * both for (a cylinder, a convex) counts as touching when the boxes overlap. firsts (n): the
+ * largest tier each bound is asked about is tiers[firsts[i]] (a larger clearance would be of no
+ * use to the caller). hints (n): where each search starts (any index; the answer is the same),
+ * written back with the answer's index (n_tiers: none) for the next query to start from. */
 void odin_bounds_clearance(OdinWorld *w, const double *bounds, int n, const double *tiers,
-                           int n_tiers, const uintptr_t *skip, int n_skip, int *hints,
-                           double *out);
+                           int n_tiers, const uintptr_t *skip, int n_skip, const int *firsts,
+                           int *hints, double *out);
 /* Puts n bodies at poses (12 values each: centre of mass (3, m, world), then the rotation
  * matrix (3 x 3, row by row; orthonormal: ODE makes its quaternion of it)). */
 void odin_place_bodies(dBodyID *bodies, int n, const double *poses);

@@ -66,11 +66,14 @@ class GeomQuery:
                 int(ffi.cast("uintptr_t", self._hit[1])))
 
     @drains_ode_messages
-    def clearances(self, bounds: np.ndarray, tiers: np.ndarray) -> np.ndarray:
-        """Per bound (m, BOUND_VALUES), the first of ``tiers`` (m, descending) it can grow
-        by and touch none of the world's geoms but ``apart``, else 0 (m)."""
+    def clearances(self, bounds: np.ndarray, tiers: np.ndarray, firsts: np.ndarray
+                   ) -> np.ndarray:
+        """Per bound (m, BOUND_VALUES), the first of ``tiers`` (m, descending) from index
+        ``firsts`` (one per bound) on it can grow by and touch none of the world's geoms but
+        ``apart``, else 0 (m)."""
         bounds = np.ascontiguousarray(bounds, dtype=float)
         tiers = np.ascontiguousarray(tiers, dtype=float)
+        firsts = np.ascontiguousarray(firsts, dtype=np.intc)
         out = np.empty(len(bounds))
         if len(bounds) > len(self._hints):
             self._hints = np.zeros(len(bounds), dtype=np.intc)
@@ -78,6 +81,7 @@ class GeomQuery:
             lib.odin_bounds_clearance(self._world, _doubles(bounds), len(bounds),
                                       _doubles(tiers), len(tiers), self._apart,
                                       self._apart_count,
+                                      ffi.cast("int *", ffi.from_buffer(firsts)),
                                       ffi.cast("int *", ffi.from_buffer(self._hints)),
                                       _doubles(out))
         return out
