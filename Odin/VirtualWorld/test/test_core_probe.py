@@ -148,3 +148,14 @@ def test_a_plane_is_asked_like_any_geometry(core):
     clearance = core.probe_clearances(probe, np.array([_capsule((0, 0, 0.3), (0, 0, 0.5),
                                                                 0.1)]))[0]
     assert 0.1 <= clearance <= 0.2
+
+
+def test_a_clearance_is_sought_no_further_than_needed(core):
+    """A capsule 0.3 m from the block: asked for up to 0.05 m, it answers the smallest tier
+    that reaches 0.05 (0.064 m), still a lower bound; a NaN need is refused."""
+    probe = _scene(core)
+    capsule = _capsule((0.85, 0.0, -0.2), (0.85, 0.0, 0.2), 0.05)
+    assert core.probe_clearances(probe, np.array([capsule]), [0.05])[0] == 0.064
+    assert 0.15 <= core.probe_clearances(probe, np.array([capsule]), [np.inf])[0] <= 0.3
+    with pytest.raises(InvalidArgument, match="needed"):
+        core.probe_clearances(probe, np.array([capsule]), [np.nan])
