@@ -4,6 +4,10 @@ random motions of our own arm around its post; far from everything they certify 
 by clearance and check few configurations exactly; the robots' bounds hold their links."""
 from __future__ import annotations
 
+import pathlib
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
@@ -179,3 +183,29 @@ def test_every_swept_motion_passed_goes_no_deeper_than_half_the_resolution(tmp_p
     finally:
         world.close()
         fine.close()
+
+
+PRM_RUN = """
+import logging, pathlib, sys
+from dataclasses import replace
+logging.disable(logging.WARNING)
+sys.path.insert(0, {here!r})
+from gui.planning.geometric import GeometricSettings, solve
+from test_geometric_motions import _plate_plan
+plan = _plate_plan(pathlib.Path({folder!r}))
+settings = replace(GeometricSettings.of_problem(plan), planner="PRM", time_limit=2.0)
+print("solved", solve(plan, settings, seed={seed}).solved)
+"""
+
+
+@pytest.mark.parametrize("seed", [1, 4])
+def test_prm_solves_and_ends_in_its_time(tmp_path, seed):
+    """PRM looks for a solution on a thread of its own, which asks the termination condition:
+    a Python one there waited for the interpreter's lock the planner's thread held (a hang, or
+    no solution ever found). In a process of its own, so that a hang fails the test."""
+    here = str(pathlib.Path(__file__).resolve().parent)
+    code = PRM_RUN.format(here=here, folder=str(tmp_path), seed=seed)
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=30)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.split()[-2:] == ["solved", "True"]

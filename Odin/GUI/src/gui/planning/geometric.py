@@ -114,7 +114,9 @@ class GeometricResult:
     path's length in the control space; ``status``: OMPL's planner status;
     ``unsimplified_length``: the length of the path the planner found, before simplification;
     ``simplify_s``: wall seconds of the simplification (part of ``time_s``); ``graph_states``:
-    the states of the planner's graph or trees when it stopped."""
+    the states of the planner's graph or trees when it stopped; ``clearance_checks``: the
+    clearance and sweep queries of its motion checks (gui.planning.geometric_world), apart
+    from ``checks``, the configurations checked exactly."""
     planner: str
     seed: Optional[int]
     solved: bool
@@ -126,6 +128,7 @@ class GeometricResult:
     unsimplified_length: float = 0.0
     simplify_s: float = 0.0
     graph_states: int = 0
+    clearance_checks: int = 0
 
     @property
     def states(self) -> int:
@@ -140,7 +143,8 @@ class GeometricResult:
                 if self.time_s > 0 else None,
                 "path_length": round(self.length, 9), "status": self.status,
                 "unsimplified_path_length": round(self.unsimplified_length, 9),
-                "simplify_s": round(self.simplify_s, 6), "graph_states": self.graph_states}
+                "simplify_s": round(self.simplify_s, 6), "graph_states": self.graph_states,
+                "clearance_checks": self.clearance_checks}
 
 
 def query(plan: BuildPlan) -> Tuple[np.ndarray, np.ndarray]:
@@ -167,29 +171,49 @@ class _Checks:
     exception is kept and raised after the search (it must not cross into C++). They hold the
     world and the search's clock (``over``), never the OMPL objects: OMPL holds them, and a
     cycle through C++ would keep every object of the search alive to the interpreter's end
-    (nanobind reporting them leaked after the tool's last line)."""
+    (nanobind reporting them leaked after the tool's last line); only while the planner runs,
+    ``end_search`` ends it (its termination condition's ``terminate``).
+
+    The planner's termination condition is OMPL's own clock, never a Python callable: a
+    planner that checks it on a thread of its own (PRM's solution thread) would wait for the
+    interpreter's lock, which the thread that runs the planner holds while it waits for that
+    thread to end (a deadlock). So the search's end by Ctrl-C or a callback's error is asked
+    here, on the planner's own thread, at every callback."""
 
     def __init__(self, world: GeometricWorld, over: Callable[[], bool]):
         self.world = world
         self.over = over
         self.error: Optional[BaseException] = None
+        self.end_search: Callable[[], None] = _nothing
+
+    def _ended(self) -> bool:
+        """Whether the search is over (then its planner is told to end)."""
+        if self.over():
+            self.end_search()
+            return True
+        return False
 
     def vector(self, state) -> np.ndarray:
         return np.fromiter((state[i] for i in range(self.world.size)), float, self.world.size)
 
     def valid(self, state) -> bool:
         try:
-            return self.world.valid(self.vector(state))
+            return not self._ended() and self.world.valid(self.vector(state))
         except BaseException as error:      # noqa: B902 - raised by solve()
             self.error = self.error or error
             return False
 
     def motion(self, s1, s2) -> bool:
         try:
-            return self.world.motion_valid(self.vector(s1), self.vector(s2), self.over)
+            return not self._ended() and self.world.motion_valid(
+                self.vector(s1), self.vector(s2), self.over)
         except BaseException as error:      # noqa: B902 - raised by solve()
             self.error = self.error or error
             return False
+
+
+def _nothing() -> None:
+    """What ``_Checks.end_search`` does when no planner runs."""
 
 
 class _Search:
@@ -275,17 +299,18 @@ def _search(world: GeometricWorld, settings: GeometricSettings, start, goal, see
             stop) -> GeometricResult:
     ob, _, _ = _ompl()
     deadline = time.monotonic() + settings.time_limit
-    checks_before = world.checks
+    checks_before, clearances_before = world.checks, world.clearance_checks
     started = time.perf_counter()
 
     def over() -> bool:
-        """OMPL's termination condition, asked once per planner iteration (and during a
-        motion's checks)."""
+        """Whether the search is over: its time is up, a callback failed, or ``stop()``
+        (asked at every callback and during a motion's checks: _Checks)."""
         return time.monotonic() >= deadline or checks.error is not None \
             or (stop is not None and bool(stop()))
 
     checks = _Checks(world, over)
-    found = _run(_Search(checks, settings, start, goal), settings.simplify, over)
+    found = _run(_Search(checks, settings, start, goal), settings.simplify, over,
+                 max(0.0, deadline - time.monotonic()))
     # the search's OMPL objects are gone here, before anything is raised: a traceback holding
     # them would keep them to the interpreter's end
     if stop is not None and stop():
@@ -295,7 +320,8 @@ def _search(world: GeometricWorld, settings: GeometricSettings, start, goal, see
     return GeometricResult(settings.planner, seed, bool(len(found.path)), found.path,
                            time.perf_counter() - started, world.checks - checks_before,
                            _length(found.path), found.status, _length(found.unsimplified),
-                           found.simplify_s, found.graph_states)
+                           found.simplify_s, found.graph_states,
+                           world.clearance_checks - clearances_before)
 
 
 def _length(path: np.ndarray) -> float:
@@ -314,10 +340,17 @@ class _Found(NamedTuple):
     graph_states: int
 
 
-def _run(search: _Search, simplify: bool, over: Callable[[], bool]) -> _Found:
-    """What ``search`` finds (its solution simplified when ``simplify``)."""
+def _run(search: _Search, simplify: bool, over: Callable[[], bool], seconds: float
+         ) -> _Found:
+    """What ``search`` finds in ``seconds`` (its solution simplified when ``simplify``, in
+    what is left of them)."""
     ob, og, _ = _ompl()
-    status = str(search.setup.solve(ob.PlannerTerminationCondition(over)))
+    condition = ob.timedPlannerTerminationCondition(seconds)   # _Checks says why not over
+    search.checks.end_search = condition.terminate
+    try:
+        status = str(search.setup.solve(condition))
+    finally:
+        search.checks.end_search = _nothing
     data = ob.PlannerData(search.si)
     search.setup.getPlannerData(data)
     graph_states = int(data.numVertices())
