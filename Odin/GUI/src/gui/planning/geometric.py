@@ -116,7 +116,8 @@ class GeometricResult:
     ``simplify_s``: wall seconds of the simplification (part of ``time_s``); ``graph_states``:
     the states of the planner's graph or trees when it stopped; ``clearance_checks``: the
     clearance and sweep queries of its motion checks (gui.planning.geometric_world), apart
-    from ``checks``, the configurations checked exactly."""
+    from ``checks``, the configurations checked exactly; ``unsimplified_states``: the states
+    of the path the planner found, before simplification (OMPL's solution segments + 1)."""
     planner: str
     seed: Optional[int]
     solved: bool
@@ -129,6 +130,7 @@ class GeometricResult:
     simplify_s: float = 0.0
     graph_states: int = 0
     clearance_checks: int = 0
+    unsimplified_states: int = 0
 
     @property
     def states(self) -> int:
@@ -144,7 +146,8 @@ class GeometricResult:
                 "path_length": round(self.length, 9), "status": self.status,
                 "unsimplified_path_length": round(self.unsimplified_length, 9),
                 "simplify_s": round(self.simplify_s, 6), "graph_states": self.graph_states,
-                "clearance_checks": self.clearance_checks}
+                "clearance_checks": self.clearance_checks,
+                "unsimplified_states": self.unsimplified_states}
 
 
 def query(plan: BuildPlan) -> Tuple[np.ndarray, np.ndarray]:
@@ -321,7 +324,7 @@ def _search(world: GeometricWorld, settings: GeometricSettings, start, goal, see
                            time.perf_counter() - started, world.checks - checks_before,
                            _length(found.path), found.status, _length(found.unsimplified),
                            found.simplify_s, found.graph_states,
-                           world.clearance_checks - clearances_before)
+                           world.clearance_checks - clearances_before, len(found.unsimplified))
 
 
 def _length(path: np.ndarray) -> float:
