@@ -165,3 +165,25 @@ def test_plan_refuses_a_control_search_option_for_a_geometric_problem(tmp_path):
     assert run.returncode == 2 and len(errors) == 1
     assert errors[0].startswith("plan: error: --parallel: only a search of a problem for one")
     assert not (tmp_path / "p.xml").exists()
+
+
+@pytest.mark.parametrize("given, expected", [(0.0, 0), (1.0, 1), (2.0, 2), (None, 2), (5.0, 2)])
+def test_kautham_simplify_solution_values(given, expected):
+    """Kautham's omplplanner reads 0 as none, 1 as B-spline smoothing, anything else (its
+    default 2) as shortening."""
+    from gui.planning.geometric import Simplification
+    assert Simplification.of_kautham(given) == expected
+
+
+def test_a_path_not_simplified_is_the_path_found(tmp_path):
+    problem = _problem(tmp_path)
+    problem.write_text(problem.read_text().replace(
+        '<Parameter name="Range">0.1</Parameter>',
+        '<Parameter name="Range">0.1</Parameter><Parameter name="_Simplify Solution">0'
+        '</Parameter>'))
+    plan = _plan(problem)
+    settings = replace(GeometricSettings.of_problem(plan), resolution=0.01)
+    assert settings.simplify == 0
+    result = solve(plan, settings, seed=1)
+    assert result.solved and result.simplify_s == 0.0
+    assert result.states == result.unsimplified_states

@@ -22,6 +22,7 @@ import logging
 import math
 import time
 from dataclasses import dataclass, replace
+from enum import IntEnum
 from typing import Callable, List, NamedTuple, Optional, Sequence, Tuple
 
 import numpy as np
@@ -57,18 +58,33 @@ RESOLUTION_RANGE = (1e-4, 0.1)
 log = logging.getLogger("gui.planning.geometric")
 
 
+class Simplification(IntEnum):
+    """What is done to a path found, by Kautham's ``_Simplify Solution`` values (omplplanner's
+    trySolve): nothing; B-spline smoothing (OMPL's smoothBSpline, 5 steps); shortening (its
+    simplifySolution: here OMPL's reduceVertices until it finds no shortcut, in what is left
+    of the search's time)."""
+    NONE = 0
+    SMOOTH = 1
+    SHORTEN = 2
+
+    @classmethod
+    def of_kautham(cls, value: Optional[float]) -> "Simplification":
+        """Kautham's reading: 0 none, 1 smooth, anything else (or none given) shorten."""
+        return cls.NONE if value == 0 else cls.SMOOTH if value == 1 else cls.SHORTEN
+
+
 @dataclass(frozen=True)
 class GeometricSettings:
     """How one search runs: ``planner`` (an OMPL class name of ``OMPL_PLANNERS``),
     ``time_limit`` s of wall clock, ``range`` (Kautham's Range: the longest motion a tree
     extends by, in control-space units; None: OMPL's default), ``goal_bias`` (None: OMPL's),
-    ``simplify`` (shortcut and smooth the path found, as Kautham's Simplify Solution),
+    ``simplify`` (Kautham's Simplify Solution: ``Simplification``),
     ``resolution`` m (module docstring)."""
     planner: str = "RRTConnect"
     time_limit: float = DEFAULT_TIME_LIMIT
     range: Optional[float] = None
     goal_bias: Optional[float] = None
-    simplify: bool = True
+    simplify: int = 2           # Simplification.SHORTEN, Kautham's default
     resolution: float = RESOLUTION
 
     @classmethod
@@ -88,7 +104,7 @@ class GeometricSettings:
         given = dict(planner.geometric)
         return cls(planner=name, time_limit=given.get("time_limit", DEFAULT_TIME_LIMIT),
                    range=given.get("range"), goal_bias=given.get("goal_bias"),
-                   simplify=bool(given.get("simplify", 1.0)))
+                   simplify=Simplification.of_kautham(given.get("simplify")))
 
     def check(self) -> None:
         if self.planner not in OMPL_PLANNERS:
@@ -343,10 +359,10 @@ class _Found(NamedTuple):
     graph_states: int
 
 
-def _run(search: _Search, simplify: bool, over: Callable[[], bool], seconds: float
+def _run(search: _Search, simplify: int, over: Callable[[], bool], seconds: float
          ) -> _Found:
-    """What ``search`` finds in ``seconds`` (its solution simplified when ``simplify``, in
-    what is left of them)."""
+    """What ``search`` finds in ``seconds`` (its solution simplified as ``simplify`` says, a
+    Simplification, in what is left of them)."""
     ob, og, _ = _ompl()
     condition = ob.timedPlannerTerminationCondition(seconds)   # _Checks says why not over
     search.checks.end_search = condition.terminate
@@ -362,7 +378,9 @@ def _run(search: _Search, simplify: bool, over: Callable[[], bool], seconds: flo
         return _Found(status, none, none, 0.0, graph_states)
     unsimplified = _states(search)
     started = time.perf_counter()
-    if simplify:
+    if simplify == Simplification.SMOOTH:
+        og.PathSimplifier(search.si).smoothBSpline(search.setup.getSolutionPath(), 5)
+    elif simplify == Simplification.SHORTEN:
         _simplify(og, search, over)
     return _Found(status, _states(search), unsimplified, time.perf_counter() - started,
                   graph_states)
@@ -376,11 +394,11 @@ def _states(search: _Search) -> np.ndarray:
 
 
 def _simplify(og, search: _Search, over: Callable[[], bool]) -> None:
-    """Shortcuts the solution (Kautham's Simplify Solution) in what is left of the search's
-    time: OMPL's reduceVertices, which only tries motions between states of the path that are
-    not neighbours and keeps the path's own motions (checked already), so a shortcut cut short
-    by the clock is one not taken (OMPL's whole simplification re-checks the path's motions,
-    and one cut short there looks invalid)."""
+    """Shortcuts the solution (Simplification.SHORTEN) in what is left of the search's time:
+    OMPL's reduceVertices, which only tries motions between states of the path that are not
+    neighbours and keeps the path's own motions (checked already), so a shortcut cut short by
+    the clock is one not taken (OMPL's whole simplification re-checks the path's motions, and
+    one cut short there looks invalid)."""
     path = search.setup.getSolutionPath()
     simplifier = og.PathSimplifier(search.si)
     while not over() and path.getStateCount() > 2:
@@ -447,5 +465,5 @@ def write_task(path, name: str, rows: Sequence[Sequence[float]]) -> None:
 
 
 __all__ = ["GEOMETRIC_PLANNERS", "NEAREST_PLANNERS", "OMPL_PLANNERS", "RESOLUTION",
-           "GeometricResult", "GeometricSettings", "GeometricWorld", "check_query", "query",
-           "solve", "solve_file", "task_rows", "write_task"]
+           "GeometricResult", "GeometricSettings", "GeometricWorld", "Simplification",
+           "check_query", "query", "solve", "solve_file", "task_rows", "write_task"]

@@ -40,7 +40,7 @@ def run_settings(build, planner: Optional[str], time_limit: float, overrides: di
     ``overrides`` (SearchSettings fields by name) and the solution simplified (module
     docstring). PlanningError for a planner Odin does not run or an override a geometric
     search does not take."""
-    from gui.planning.geometric import GeometricSettings
+    from gui.planning.geometric import GeometricSettings, Simplification
     refused = sorted(set(overrides) & set(CONTROL_ONLY))
     if refused:
         raise PlanningError(f"--{refused[0].replace('_', '-')}: only a search of a problem for "
@@ -48,7 +48,7 @@ def run_settings(build, planner: Optional[str], time_limit: float, overrides: di
                             "geometrically")
     settings = GeometricSettings.of_problem(build)
     settings = replace(settings, planner=planner or settings.planner,
-                       time_limit=float(time_limit), simplify=True,
+                       time_limit=float(time_limit), simplify=Simplification.SHORTEN,
                        goal_bias=overrides.get("goal_bias", settings.goal_bias))
     settings.check()
     return settings
