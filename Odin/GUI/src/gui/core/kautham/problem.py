@@ -86,7 +86,7 @@ PLANNER_SEARCH = {"Min Control Steps": "min_control_steps",
 """The ODE planners' parameters Odin's planning bridge uses (PlannerSearch field names)."""
 PLANNER_GEOMETRIC = {"Range": "range", "Goal Bias": "goal_bias",
                      "_Max Planning Time": "time_limit", "Max Planning Time": "time_limit",
-                     "Simplify Solution": "simplify"}
+                     "Simplify Solution": "simplify", "_Simplify Solution": "simplify"}
 """The geometric planners' parameters Odin's geometric planning uses (gui.planning.geometric:
 GeometricSettings field names)."""
 _WHOLE_PARAMETERS = ("max_contacts", "min_control_steps", "max_control_steps")
