@@ -377,10 +377,12 @@ def _run(search: _Search, simplify: int, over: Callable[[], bool], seconds: floa
         none = np.empty((0, search.checks.world.size))
         return _Found(status, none, none, 0.0, graph_states)
     unsimplified = _states(search)
+    if simplify == Simplification.NONE:
+        return _Found(status, unsimplified, unsimplified, 0.0, graph_states)
     started = time.perf_counter()
     if simplify == Simplification.SMOOTH:
         og.PathSimplifier(search.si).smoothBSpline(search.setup.getSolutionPath(), 5)
-    elif simplify == Simplification.SHORTEN:
+    else:
         _simplify(og, search, over)
     return _Found(status, _states(search), unsimplified, time.perf_counter() - started,
                   graph_states)
