@@ -12,9 +12,10 @@ A start or goal in collision is refused before the search, in the window's error
 After a solved search: Show places the world's robots along the path by forward kinematics,
 one Set Position of every link per frame (the path's straight segments of the control space,
 what the search checked, cut into frames in proportion to their lengths, SHOW_SECONDS in all);
-Run places the robots at the path's start (Set Position) and executes the path's states
-tracked, as a Kautham task file run by "Tracked path..." is (the rows of
-``geometric.task_rows``: ``MotionTab.run_tracked``); Save writes that task file.
+Run places the robots at the path's start (Set Position) and executes the path tracked, as a
+Kautham task file run by "Tracked path..." is (``MotionTab.run_tracked``): the path as
+``rosrun GUI plan`` writes it, interpolated as Kautham does (``geometric_output.kautham_path``),
+each state a row of ``geometric.task_rows``; Save writes that task file.
 Both run on the window's path worker, so Stop path ends them.
 """
 from __future__ import annotations
@@ -57,6 +58,12 @@ class Solved(NamedTuple):
     settings: GeometricSettings
     result: GeometricResult
 
+    def written(self) -> np.ndarray:
+        """The path (n, k) as Kautham hands it on and ``rosrun GUI plan`` writes it:
+        interpolated (gui.planning.geometric_output)."""
+        from gui.planning.geometric_output import kautham_path
+        return kautham_path(self.result.path, self.settings.planner, self.settings.range)
+
     def name(self) -> str:
         """How the path is named in the status lines and the task file."""
         seed = self.result.seed
@@ -67,15 +74,10 @@ def show_frames(path: np.ndarray, count: int) -> np.ndarray:
     """``path`` (n, k) in the control space cut into about ``count`` frames along its straight
     segments, each segment's share in proportion to its length; every state of the path is a
     frame (at least one frame per segment)."""
+    from gui.planning.geometric_output import interpolate
     path = np.asarray(path, dtype=float)
-    lengths = np.linalg.norm(np.diff(path, axis=0), axis=1)
-    total = float(lengths.sum())
-    frames = [path[:1]]
-    for a, b, length in zip(path, path[1:], lengths):
-        pieces = max(1, round(count * length / total)) if total > 0 else 1
-        f = np.arange(1, pieces + 1)[:, None] / pieces
-        frames.append(a + f * (b - a))
-    return np.concatenate(frames)
+    total = float(np.sum(np.linalg.norm(np.diff(path, axis=0), axis=1)))
+    return interpolate(path, total / count) if total > 0 else path.copy()
 
 
 def solution_of(plan: BuildPlan, path: np.ndarray, name: str) -> Solution:
@@ -340,7 +342,7 @@ class SolvePanel(QWidget):
             return
         solved = self.solved
         try:
-            solution = solution_of(solved.plan, solved.result.path, solved.name())
+            solution = solution_of(solved.plan, solved.written(), solved.name())
             start = frame_situations(solved.plan, solution_of(
                 solved.plan, solved.result.path[:1], solved.name()))[0]
         except GuiError as error:
@@ -360,10 +362,11 @@ class SolvePanel(QWidget):
         if self.solved is None or not self.solved.result.solved:
             return
         solved = self.solved
+        rows = task_rows(solved.plan, solved.written())
         try:
-            write_task(path, solved.name(), task_rows(solved.plan, solved.result.path))
+            write_task(path, solved.name(), rows)
         except OSError as error:
             self.window.show_error(f"Save task file: {path}: {error.strerror or error}")
             return
-        self.window.show_info(f"Saved {solved.result.states} configurations to {path} "
-                              "(a Kautham task file)")
+        self.window.show_info(f"Saved {len(rows)} configurations to {path} (a Kautham task "
+                              "file)")
