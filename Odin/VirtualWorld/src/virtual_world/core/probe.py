@@ -44,7 +44,7 @@ class CollisionProbe:
             raise InvalidArgument(f"moved: {shown(static[0])} has no body to move")
         self.moved: Tuple[str, ...] = tuple(moved)
         self._scene = scene
-        self._objects = dict(scene.objects)
+        self._revision = scene.revision
         self._com = np.array([r.com for r in records], dtype=float).reshape(-1, 3)
         self._query = GeomQuery(
             scene.c.struct, [r.body.ptr for r in records],
@@ -52,9 +52,7 @@ class CollisionProbe:
             [g.owner.address for i in apart for g in scene.object(i).geometries])
 
     def _same_scene(self, scene: Scene) -> None:
-        objects = scene.objects
-        if scene is not self._scene or len(objects) != len(self._objects) or any(
-                objects.get(k) is not v for k, v in self._objects.items()):
+        if scene is not self._scene or scene.revision != self._revision:
             raise InvalidArgument("the world's objects changed since this collision probe "
                                   "was made: make a new one")
 
@@ -113,10 +111,13 @@ def _bounds(bounds: np.ndarray) -> np.ndarray:
     return bounds
 
 
+_IDENTITY = np.eye(3)
+
+
 def _orthonormal(what: str, rotations: np.ndarray) -> None:
     if not len(rotations):
         return
-    error = np.einsum("nij,nkj->nik", rotations, rotations) - np.eye(3)
+    error = np.einsum("nij,nkj->nik", rotations, rotations) - _IDENTITY
     if not float(np.max(np.abs(error))) <= ORTHONORMAL_TOLERANCE:
         raise InvalidArgument(f"{what}: a rotation is not orthonormal")
 

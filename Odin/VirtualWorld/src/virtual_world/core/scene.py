@@ -45,6 +45,7 @@ class Scene:
         self.entities: Dict[str, List[str]] = {}
         self.next_tag = 1                               # geom tag of the next entity
         self.next_serial = 1                            # serial of the next geom
+        self.revision = 0                               # objects or geometries added/dropped
         self.entity_counter = 0                         # n of the last "entity<n>"
         self.carried: Dict[Tuple[str, str], Collision] = {}   # collisions kept in Python
         self.sim_time = 0.0                             # s since the scene began
@@ -102,10 +103,12 @@ class Scene:
     def add_object(self, record: ObjectRecord) -> None:
         self.objects[record.id] = record
         self._bodies = None
+        self.revision += 1
 
     def drop_object(self, object_id: str) -> None:
         del self.objects[object_id]
         self._bodies = None
+        self.revision += 1
 
     def body_array(self) -> BodyArray:
         """Every object's body, in object order (a body state vector's order), rebuilt after
@@ -124,12 +127,14 @@ class Scene:
         return serial
 
     def add_geometry(self, record: GeometryRecord) -> None:
+        self.revision += 1
         self.geometries[record.name] = record
         self.geometry_names[record.owner.address] = record.name
         self._pose_reader = None
         self._pair_names = {}
 
     def drop_geometry(self, record: GeometryRecord) -> None:
+        self.revision += 1
         del self.geometry_names[record.owner.address]
         del self.geometries[record.name]
         self._pose_reader = None
