@@ -55,6 +55,13 @@ DEFAULT_TIME_LIMIT = 10.0
 RESOLUTION_RANGE = (1e-4, 0.1)
 """m: the resolutions a search takes (finer: a motion of a metre would be 10,000 checks)."""
 
+SHORTCUT_ROUNDS = 20
+"""At most this many rounds of OMPL's reduceVertices shorten a path (each tries as many
+shortcuts as the path has states; Kautham's simplifyMax goes on while any round helps, which
+from Python would take the rest of the search's time)."""
+SHORTER_ENOUGH = 0.99
+"""A round that leaves the path longer than this fraction of its length before is the last."""
+
 log = logging.getLogger("gui.planning.geometric")
 
 
@@ -396,15 +403,19 @@ def _states(search: _Search) -> np.ndarray:
 
 
 def _simplify(og, search: _Search, over: Callable[[], bool]) -> None:
-    """Shortcuts the solution (Simplification.SHORTEN) in what is left of the search's time:
-    OMPL's reduceVertices, which only tries motions between states of the path that are not
+    """Shortcuts the solution (Simplification.SHORTEN) in what is left of the search's time,
+    for at most SHORTCUT_ROUNDS rounds while each shortens it by 1 % or more: OMPL's
+    reduceVertices, which only tries motions between states of the path that are not
     neighbours and keeps the path's own motions (checked already), so a shortcut cut short by
     the clock is one not taken (OMPL's whole simplification re-checks the path's motions, and
     one cut short there looks invalid)."""
     path = search.setup.getSolutionPath()
     simplifier = og.PathSimplifier(search.si)
-    while not over() and path.getStateCount() > 2:
-        if not simplifier.reduceVertices(path):
+    for _ in range(SHORTCUT_ROUNDS):
+        if over() or path.getStateCount() <= 2:
+            break
+        before = path.length()
+        if not simplifier.reduceVertices(path) or path.length() > before * SHORTER_ENOUGH:
             break
 
 
