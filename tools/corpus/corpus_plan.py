@@ -58,8 +58,9 @@ def preload() -> None:
     import gui.planning.core_world  # noqa: F401
     import gui.planning.bridge  # noqa: F401
     import gui.tools.common  # noqa: F401
-    from gui.planning.geometric import _ompl
-    _ompl()
+    # the Core each search builds its world in (core_world imports it when a world is made)
+    import virtual_world.core  # noqa: F401
+    from ompl import base, geometric, util  # noqa: F401
 
 
 def skipped(info: dict) -> Optional[dict]:
