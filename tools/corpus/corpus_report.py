@@ -90,8 +90,9 @@ def _when(run: dict) -> str:
 def readme_block(run: dict, c: dict) -> str:
     return (f"Last run: {_when(run)}; `make corpus` took {run['minutes']:.0f} min, "
             f"{run['seconds']:g} s simulated per problem.\n\n"
-            "| problem files | ok (loads, builds, stands) | refused: not a problem | refused: "
-            "names a file the repository lacks | refused: other | failed | tracebacks |\n"
+            "| problem files | ok (loads, builds, stands, plans or says why not) | refused: "
+            "not a problem | refused: names a file the repository lacks | refused: other | "
+            "failed | tracebacks |\n"
             "|---|---|---|---|---|---|---|\n"
             f"| {c['files']} | {c['ok']} | {c['refused_not_problem']} | {c['refused_missing']} "
             f"| {c['refused_unexpected']} | {c['failed']} | {c['tracebacks']} |\n\n"
@@ -104,7 +105,7 @@ def readme_block(run: dict, c: dict) -> str:
 def _how_planned(run: dict) -> str:
     capped = run.get("plan_seconds")
     return ("OMPL seed 1, each search in the problem's own time limit"
-            + (f" capped at {capped:g} s (a quick run: the figures are not the problems' own)"
+            + (f", capped at {capped:g} s: a quick run, not the problems' own figures"
                if capped else ""))
 
 
