@@ -105,6 +105,10 @@ def _crashes():
     os.kill(os.getpid(), signal.SIGSEGV)
 
 
+def _hangs_loading():
+    time.sleep(60)
+
+
 def _hangs():
     print(json.dumps(dict(ompl_planner="RRT", time_limit=0.1)), flush=True)
     time.sleep(60)
@@ -114,10 +118,12 @@ def _hangs():
     (_raises, "exit 1: KeyError: 'Base'"),
     (_crashes, "crashed: SIGSEGV"),
     (_hangs, "hung: still searching 0.5 s past its 0.1 s time limit"),
+    (_hangs_loading, "hung loading the problem (no search after 1 s)"),
 ])
 def test_a_search_that_raises_crashes_or_hangs_is_a_failure_with_its_reason(
         monkeypatch, child, reason):
     monkeypatch.setattr(planning, "PLAN_MARGIN", 0.5)
+    monkeypatch.setattr(planning, "LOAD_TIMEOUT", 1.0)
     started = time.monotonic()
     result = planning.plan_one("unused.xml", child=child)
     assert (result["plan"], result["plan_reason"]) == ("failed", reason)
