@@ -83,7 +83,8 @@ class Simplification(IntEnum):
 @dataclass(frozen=True)
 class GeometricSettings:
     """How one search runs: ``planner`` (an OMPL class name of ``OMPL_PLANNERS``),
-    ``time_limit`` s of wall clock, ``range`` (Kautham's Range: the longest motion a tree
+    ``time_limit`` s of wall clock for the planner (the solution's simplification comes after,
+    as in Kautham), ``range`` (Kautham's Range: the longest motion a tree
     extends by, in control-space units; None: OMPL's default), ``goal_bias`` (None: OMPL's),
     ``simplify`` (Kautham's Simplify Solution: ``Simplification``),
     ``resolution`` m (module docstring)."""
@@ -323,20 +324,12 @@ def solve(plan: BuildPlan, settings: Optional[GeometricSettings] = None,
 
 def _search(world: GeometricWorld, settings: GeometricSettings, start, goal, seed,
             stop) -> GeometricResult:
-    ob, _, _ = _ompl()
-    deadline = time.monotonic() + settings.time_limit
     checks_before, clearances_before = world.checks, world.clearance_checks
     started = time.perf_counter()
-
-    def over() -> bool:
-        """Whether the search is over: its time is up, a callback failed, or ``stop()``
-        (asked at every callback and during a motion's checks: _Checks)."""
-        return time.monotonic() >= deadline or checks.error is not None \
-            or (stop is not None and bool(stop()))
-
-    checks = _Checks(world, over)
-    found = _run(_Search(checks, settings, start, goal), settings.simplify, over,
-                 max(0.0, deadline - time.monotonic()))
+    clock = _Clock(time.monotonic() + settings.time_limit, stop)
+    checks = _Checks(world, clock.over)
+    clock.checks = checks
+    found = _run(_Search(checks, settings, start, goal), settings.simplify, clock)
     # the search's OMPL objects are gone here, before anything is raised: a traceback holding
     # them would keep them to the interpreter's end
     if stop is not None and stop():
@@ -348,6 +341,26 @@ def _search(world: GeometricWorld, settings: GeometricSettings, start, goal, see
                            _length(found.path), found.status, _length(found.unsimplified),
                            found.simplify_s, found.graph_states,
                            world.clearance_checks - clearances_before, len(found.unsimplified))
+
+
+class _Clock:
+    """When a search is over: its ``deadline`` (time.monotonic() s) passed, one of its
+    ``checks``' callbacks failed, or ``stop()``. The planner has the time limit; a solution's
+    simplification comes after, as Kautham's does, with no deadline (_run lifts it)."""
+
+    def __init__(self, deadline: float, stop: Optional[Callable[[], bool]]):
+        self.deadline = deadline
+        self.stop = stop
+        self.checks: Optional[_Checks] = None
+
+    def over(self) -> bool:
+        """(asked at every callback and during a motion's checks: _Checks)"""
+        return time.monotonic() >= self.deadline \
+            or (self.checks is not None and self.checks.error is not None) \
+            or (self.stop is not None and bool(self.stop()))
+
+    def seconds_left(self) -> float:
+        return max(0.0, self.deadline - time.monotonic())
 
 
 def _length(path: np.ndarray) -> float:
@@ -366,12 +379,11 @@ class _Found(NamedTuple):
     graph_states: int
 
 
-def _run(search: _Search, simplify: int, over: Callable[[], bool], seconds: float
-         ) -> _Found:
-    """What ``search`` finds in ``seconds`` (its solution simplified as ``simplify`` says, a
-    Simplification, in what is left of them)."""
+def _run(search: _Search, simplify: int, clock: _Clock) -> _Found:
+    """What ``search`` finds in the clock's time (its solution then simplified as
+    ``simplify`` says, a Simplification, with no deadline)."""
     ob, og, _ = _ompl()
-    condition = ob.timedPlannerTerminationCondition(seconds)   # _Checks says why not over
+    condition = ob.timedPlannerTerminationCondition(clock.seconds_left())   # _Checks: why
     search.checks.end_search = condition.terminate
     try:
         status = str(search.setup.solve(condition))
@@ -384,6 +396,8 @@ def _run(search: _Search, simplify: int, over: Callable[[], bool], seconds: floa
         none = np.empty((0, search.checks.world.size))
         return _Found(status, none, none, 0.0, graph_states)
     unsimplified = _states(search)
+    clock.deadline = math.inf
+    over = clock.over
     if simplify == Simplification.NONE:
         return _Found(status, unsimplified, unsimplified, 0.0, graph_states)
     started = time.perf_counter()
@@ -403,8 +417,8 @@ def _states(search: _Search) -> np.ndarray:
 
 
 def _simplify(og, search: _Search, over: Callable[[], bool]) -> None:
-    """Shortcuts the solution (Simplification.SHORTEN) in what is left of the search's time,
-    for at most SHORTCUT_ROUNDS rounds while each shortens it by 1 % or more: OMPL's
+    """Shortcuts the solution (Simplification.SHORTEN) until ``over()`` (a stop), for at most
+    SHORTCUT_ROUNDS rounds while each shortens it by 1 % or more: OMPL's
     reduceVertices, which only tries motions between states of the path that are not
     neighbours and keeps the path's own motions (checked already), so a shortcut cut short by
     the clock is one not taken (OMPL's whole simplification re-checks the path's motions, and
