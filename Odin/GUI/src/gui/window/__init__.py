@@ -1,7 +1,8 @@
 """Odin's GUI window (thesis chapter 7): ``rosrun GUI gui``.
 
 Modules: ``main_window`` (the window, message log, connection state), one module per tab
-(``simulation_tab``, ``settings_tab``, ``objects_tab``, ``motion_tab``, ``joints_tab``),
+(``simulation_tab``, ``settings_tab``, ``objects_tab``, ``motion_tab`` with its
+``solve_panel`` (a geometric query solved, shown and run), ``joints_tab``),
 ``plot_panel`` (joint positions and speeds from the world's ~joint_states), ``viewer_panel``
 (the Viewer's image), ``worker`` (service calls on a QThread, never the GUI thread),
 ``ros_link`` (topics -> Qt signals), ``scene`` (what the window knows of the scene), ``fields``
