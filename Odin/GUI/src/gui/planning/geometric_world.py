@@ -175,15 +175,17 @@ class GeometricWorld:
             return self._valid(end) and self._sweep_valid(a, b, here, end, over)
         if not self._probes_valid(a, b, here, end):
             return False
-        t = 0.0
-        steps = 0
+        t, steps, budget = 0.0, 0, None
         while t < 1.0:
             steps += 1
             if steps % CHECKS_BETWEEN_CLOCKS == 0 and over():
                 return False
-            t, there, unproven = self._advance(a, b, t, here, end)
+            if budget is None or budget.stale():
+                budget = _Budget(*self.clearances(here, self._bounds(here, end)))
+            t, there, unproven, moves = self._advance(a, b, t, here, end, budget)
             if unproven and t < 1.0 and not self._valid(there):
                 return False
+            budget.spend(moves, self._pairs)
             here = there
         return True
 
@@ -237,13 +239,15 @@ class GeometricWorld:
         fractions = PROBES[:int(resolutions // PROBE_SPACING)]
         return all(self._valid(self.configurations(a + f * (b - a))) for f in fractions)
 
-    def _advance(self, a, b, t: float, here: list, end: list) -> Tuple[float, list, bool]:
-        """(t', its configurations, whether they must be checked) of the farthest point t'
-        <= 1 of the segment such that every link stays within its clearance, or moves no
-        more than the resolution (then t' is checked: module docstring); each pair of robot
-        links likewise by their sum."""
+    def _advance(self, a, b, t: float, here: list, end: list, budget: "_Budget"
+                 ) -> Tuple[float, list, bool, np.ndarray]:
+        """(t', its configurations, whether they must be checked, how far each link moves at
+        most to them) of the farthest point t' <= 1 of the segment such that every link stays
+        within what is left of its clearance (``budget``), or moves no more than the
+        resolution (then t' is checked: module docstring); each pair of robot links likewise
+        by their sum."""
         rest = self._bounds(here, end)
-        obstacles, pairs = self.clearances(here, rest)
+        obstacles, pairs = budget.obstacles, budget.pairs
         allowed = np.maximum(obstacles, self.resolution)
         allowed_pairs = np.maximum(pairs, self.resolution)
         first, second = self._pairs[:, 0], self._pairs[:, 1]
@@ -258,16 +262,18 @@ class GeometricWorld:
             together = moves[first] + moves[second]
             if np.all(moves <= allowed) and np.all(together <= allowed_pairs):
                 return t_next, there, bool(np.any(moves > obstacles)
-                                           or np.any(together > pairs))
+                                           or np.any(together > pairs)), moves
             fraction /= 2.0
-        return self._resolution_step(a, b, t)
+        return self._resolution_step(a, b, t, here)
 
-    def _resolution_step(self, a, b, t: float) -> Tuple[float, list, bool]:
+    def _resolution_step(self, a, b, t: float, here: list
+                         ) -> Tuple[float, list, bool, np.ndarray]:
         """The next point of the segment from ``t`` as motion_points places them (each
         within the resolution of the one before), to be checked."""
         start = a + t * (b - a)
         t_next = t + (1.0 - t) * _fraction_along(start, b, self.motion_points(start, b)[0])
-        return t_next, self.configurations(a + t_next * (b - a)), True
+        there = self.configurations(a + t_next * (b - a))
+        return t_next, there, True, self._bounds(here, there)
 
     def motion_points(self, a: Sequence[float], b: Sequence[float]) -> List[np.ndarray]:
         """The configurations along the straight segment from ``a`` to ``b`` (``a``
@@ -290,6 +296,27 @@ class GeometricWorld:
                 continue
             k += 1
         return [a + f * (b - a) for f in fractions[1:]]
+
+
+class _Budget:
+    """Clearances found at a configuration of a motion (GeometricWorld.clearances), less how
+    far the links have moved since: still lower bounds of their distances, so a walk asks
+    again only once some link or pair has used half of what it had (asking then may find
+    more room; a link found touching, at 0, never asks again)."""
+
+    def __init__(self, obstacles: np.ndarray, pairs: np.ndarray):
+        self.found_obstacles, self.found_pairs = obstacles, pairs
+        self.obstacles, self.pairs = obstacles.copy(), pairs.copy()
+
+    def spend(self, moves: np.ndarray, pairs: np.ndarray) -> None:
+        """``moves`` (per robot link, m) taken; ``pairs``: the robot link pairs' indices."""
+        self.obstacles = np.maximum(self.obstacles - moves, 0.0)
+        if len(pairs):
+            self.pairs = np.maximum(self.pairs - moves[pairs[:, 0]] - moves[pairs[:, 1]], 0.0)
+
+    def stale(self) -> bool:
+        return bool(np.any(self.obstacles < self.found_obstacles / 2)
+                    or np.any(self.pairs < self.found_pairs / 2))
 
 
 class Placement(list):
