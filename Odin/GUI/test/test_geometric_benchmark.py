@@ -155,8 +155,6 @@ def test_a_run_is_the_search_plan_makes_with_its_seed(tmp_path):
     assert result.geometric.simplified_length == pytest.approx(statistics["path_length"])
     assert result.geometric.solution_length == pytest.approx(
         statistics["unsimplified_path_length"])
-    assert result.time_s == pytest.approx(statistics["time_s"] - statistics["simplify_s"],
-                                          abs=0.05)
 
 
 @pytest.mark.slow
