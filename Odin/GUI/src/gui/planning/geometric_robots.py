@@ -173,10 +173,8 @@ class PlannedRobot:
     def unclamped(self, controls: np.ndarray) -> bool:
         """Whether no DOF of the control vector's configuration is clamped to its limits (so
         along a straight segment between two such vectors every DOF changes linearly)."""
-        controls = np.asarray(controls, dtype=float)[self.part]
-        p = self.handle.instance.controls.offset + self.handle.instance.controls.matrix @ (
-            controls - 0.5)
-        return bool(np.all((p >= 0.0) & (p <= 1.0)))
+        return self.handle.instance.controls.parameters(
+            np.asarray(controls, dtype=float)[self.part])[1]
 
     def swept_boxes(self, frames_a: np.ndarray, frames_b: np.ndarray, indices: Sequence[int]
                     ) -> np.ndarray:
@@ -333,7 +331,7 @@ def _capsule(spec) -> np.ndarray:
     if low > high:                   # one point of the axis meets every window
         low = high = (low + high) / 2
     ends = centre + np.outer([low, high], axis)
-    radius = max(radius, float(np.max(_segment_distances(points, ends[0], ends[1]))))
+    radius = max(radius, float(np.max(_point_distances(points, ends[0], ends[1]))))
     return np.concatenate([ends[0], ends[1], [radius]])
 
 
@@ -365,7 +363,7 @@ def _capsule_volume(capsule: np.ndarray) -> float:
     return float(math.pi * radius ** 2 * (length + 4.0 * radius / 3.0))
 
 
-def _segment_distances(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def _point_distances(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """(n,) m: each point's distance to the segment a-b."""
     ab = b - a
     length2 = float(ab @ ab)
