@@ -275,7 +275,8 @@ def test_joints_tab_rows_create_parameters_remove(window):
     click(tab.set_button)
     wait_for(lambda: "Parameters of" in window.last_info, 5, "parameters set")
     click(tab.motor_button)
-    wait_for(lambda: "motor:" + hinge in window.scene.motors, 5, "motor")
+    wait_for(lambda: "motor:" + hinge in window.scene.motors, 5, "motor",
+             lambda: window.last_error)
     screenshot(window, SHOTS / "joints.png")
 
     tab.list.setCurrentRow([tab.list.item(i).text() for i in range(2)].index(hinge))

@@ -169,24 +169,27 @@ class MainWindow(QMainWindow):
             self._read_again = True
             return
         self._reading_world, self._read_again = True, False
-        known = set(self.scene.motors)
+        known_motors = set(self.scene.motors)
+        typed_joints = {j for j, kind in self.scene.joints.items() if kind is not None}
 
         def read(client, job):
             inventory = client.world()
-            new = [m for m in inventory.motors if m not in known]
-            axes = {}
-            if new:     # a motor's axes are in Get State only
-                state = client.call("get_state", motors=new)
+            motors = [m for m in inventory.motors if m not in known_motors]
+            joints = [j for j in inventory.joints if j not in typed_joints]
+            axes, types = {}, {}
+            if motors or joints:    # a motor's axes and a joint's type are in Get State only
+                state = client.call("get_state", motors=motors, joints=joints)
                 axes = dict(zip(state.motors, (int(a) for a in state.motor_axes)))
-            return inventory, axes
+                types = {j.id: int(j.type) for j in state.joints}
+            return inventory, axes, types
 
         self.worker.submit(READ_WORLD, read, self._world_read, self._world_unread)
 
     def _world_read(self, answer) -> None:
-        inventory, axes = answer
+        inventory, axes, types = answer
         self._reading_world = False
         self.world_reads += 1
-        self.scene.on_inventory(inventory, axes)
+        self.scene.on_inventory(inventory, axes, types)
         self.simulation.show_world(inventory)
         if self._read_again:
             self.refresh_world()

@@ -3,7 +3,8 @@
 The world is the authority, whoever built what it holds. Get World (``on_inventory``, a
 ``gui.ros.client.WorldInventory``) gives the IDs of the objects, joints, motors and forces and
 the robots declared with Set Robot (their links and their own joint names); ``joint_data`` gives
-each joint's type and ``world_update`` the poses. The 25 Hz topics also tell when the world
+each joint's type (Get State gives the type of a joint the topic has not yet named: the window
+can motor a joint it has just built) and ``world_update`` the poses. The 25 Hz topics also tell when the world
 changed under the window (a geometry or a joint came or went: ``stale`` is emitted, and the
 window asks Get World again). ``SceneModel`` emits ``changed(str what)`` with ``what`` one of
 "objects", "joints", "motors", "forces", "robots" only when that set really changes, so the
@@ -51,11 +52,14 @@ class SceneModel(QObject):
         self._joint_types: dict = {}    # joint ID -> JointType value, from joint_data
 
     # -- from Get World ----------------------------------------------------------------------
-    def on_inventory(self, inventory, motor_axes: dict) -> None:
-        """Get World's answer; ``motor_axes``: motor ID -> axes of motors not known before."""
+    def on_inventory(self, inventory, motor_axes: dict, joint_types: dict = None) -> None:
+        """Get World's answer; ``motor_axes``: motor ID -> axes of motors not known before;
+        ``joint_types``: joint ID -> JointType value of joints whose type was not known (Get
+        State's answer: a new joint's type must not wait for the ``joint_data`` topic, whose
+        subscription may connect late)."""
         self.inventory = inventory
         self._set("objects", sorted(inventory.objects))
-        self._set("joints", {j: self._joint_types.get(j) for j in inventory.joints})
+        self._set("joints", {j: self._type_of(j, joint_types or {}) for j in inventory.joints})
         self._set("motors", {m: self.motors.get(m) or motor_axes.get(m, 1)
                              for m in inventory.motors})
         self._set("forces", (list(inventory.body_forces), list(inventory.joint_forces)))
@@ -67,6 +71,14 @@ class SceneModel(QObject):
             if not handles:       # the robots this window built are gone: so is their plan
                 self.problem_format, self.plan = None, None
             self.changed.emit("robots")
+
+    def _type_of(self, joint_id: str, asked: dict):
+        """A joint's type: from the topic, else from Get State, else as known before (None:
+        not known yet). Ball is 0: hence no ``or`` here."""
+        for source in (self._joint_types, asked, self.joints):
+            if source.get(joint_id) is not None:
+                return source[joint_id]
+        return None
 
     def _set(self, what: str, value) -> None:
         if what == "forces":
@@ -96,7 +108,7 @@ class SceneModel(QObject):
         self._joint_types = types
         if set(types) != set(self.joints):
             self.stale.emit()
-        self._set("joints", {j: types.get(j) for j in self.joints})
+        self._set("joints", {j: self._type_of(j, {}) for j in self.joints})
 
     # -- what this window built (shown at once; the next Get World confirms it) --------------
     def add_motor(self, motor_id: str, axes: int = 1) -> None:
