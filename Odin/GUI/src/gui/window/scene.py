@@ -4,8 +4,8 @@ The world is the authority, whoever built what it holds. Get World (``on_invento
 ``gui.ros.client.WorldInventory``) gives the IDs of the objects, joints, motors and forces and
 the robots declared with Set Robot (their links and their own joint names); ``joint_data`` gives
 each joint's type (Get State gives the type of a joint the topic has not yet named: the window
-can motor a joint it has just built) and ``world_update`` the poses. The 25 Hz topics also tell when the world
-changed under the window (a geometry or a joint came or went: ``stale`` is emitted, and the
+can motor a joint it has just built) and ``world_update`` the poses. The 25 Hz topics also tell
+when the world changed under the window (a geometry or a joint came or went: ``stale`` is emitted, and the
 window asks Get World again). ``SceneModel`` emits ``changed(str what)`` with ``what`` one of
 "objects", "joints", "motors", "forces", "robots" only when that set really changes, so the
 topics cost the GUI thread a set comparison, not a list rebuild.
