@@ -5,10 +5,10 @@ The world is the authority, whoever built what it holds. Get World (``on_invento
 the robots declared with Set Robot (their links and their own joint names); ``joint_data`` gives
 each joint's type (Get State gives the type of a joint the topic has not yet named: the window
 can motor a joint it has just built) and ``world_update`` the poses. The 25 Hz topics also tell
-when the world changed under the window (a geometry or a joint came or went: ``stale`` is emitted, and the
-window asks Get World again). ``SceneModel`` emits ``changed(str what)`` with ``what`` one of
-"objects", "joints", "motors", "forces", "robots" only when that set really changes, so the
-topics cost the GUI thread a set comparison, not a list rebuild.
+when the world changed under the window (a geometry or a joint came or went: ``stale`` is
+emitted, and the window asks Get World again). ``SceneModel`` emits ``changed(str what)`` with
+``what`` one of "objects", "joints", "motors", "forces", "robots" only when that set really
+changes, so the topics cost the GUI thread a set comparison, not a list rebuild.
 
 ``robots`` are the kinematic handles (``gui.core.plan.RobotHandle``) of the robots this window
 built (paths need them); ``world_robots`` every robot the world holds.
