@@ -12,8 +12,7 @@ import numpy as np
 import pytest
 
 from gui.planning.geometric import GeometricWorld, query
-from gui.planning.geometric_robots import planned_robots
-from gui.planning.geometric_world import _segment_distances
+from gui.planning.geometric_robots import _point_distances, planned_robots
 from test_geometric_planning import _plan, _problem
 
 
@@ -90,30 +89,18 @@ def test_each_link_stays_within_its_capsule_and_box_and_moves_within_its_bound(t
         a, b = robot.configuration(rng.random(2)), robot.configuration(rng.random(2))
         frames_a, frames_b = robot.object_frames(a), robot.object_frames(b)
         bounds = robot.link_bounds(a, b)
-        capsules = robot.world_capsules(frames_a, range(3))
         for k in (1, 2):
             local = corners * half[k] + centre[k] - robot.handle.bodies[k].offset[:3, 3]
             world_a = local @ frames_a[k][:3, :3].T + frames_a[k][:3, 3]
             world_b = local @ frames_b[k][:3, :3].T + frames_b[k][:3, 3]
             assert np.max(np.linalg.norm(world_b - world_a, axis=1)) <= bounds[k] + 1e-12
-            distances = _segment_distances(np.repeat(capsules[k:k + 1], 8, 0),
-                                           np.hstack([world_a, world_a]))
-            assert np.all(distances <= capsules[k, 6] + 1e-12)
+            capsule, pose = robot.capsules[k], frames_a[k]
+            ends = capsule[:6].reshape(2, 3) @ pose[:3, :3].T + pose[:3, 3]
+            assert np.all(_point_distances(world_a, *ends) <= capsule[6] + 1e-12)
             box, pose = robot.boxes[k], frames_a[k]
             axes = pose[:3, :3] @ box[3:12].reshape(3, 3)
             inside = (world_a - pose[:3, :3] @ box[:3] - pose[:3, 3]) @ axes
             assert np.all(np.abs(inside) <= box[12:15] + 1e-12)
-
-
-@pytest.mark.parametrize("p, q, expected", [
-    ((0, 0, 0, 1, 0, 0), (0, 1, 0, 1, 1, 0), 1.0),          # parallel
-    ((0, 0, 0, 1, 0, 0), (0.5, -1, 1, 0.5, 1, 1), 1.0),     # crossing, 1 m above
-    ((0, 0, 0, 0, 0, 0), (2, 0, 0, 3, 0, 0), 2.0),          # a point and a segment
-    ((0, 0, 0, 1, 0, 0), (3, 0, 0, 3, 0, 0), 2.0),          # a segment and a point
-])
-def test_segment_distances(p, q, expected):
-    assert _segment_distances(np.array([p], float), np.array([q], float))[0] \
-        == pytest.approx(expected)
 
 
 PLATE = """<?xml version="1.0"?><robot name="plate"><link name="base"><collision><geometry>

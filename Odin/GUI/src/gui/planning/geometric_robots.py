@@ -15,7 +15,11 @@ configuration a control vector puts it in, its links' world poses, and
 * a capsule bounding each link's geometry (``capsules``, in its object's frame): a segment
   along the geometry's principal axis and the least radius that holds every vertex (a mesh's;
   a box's corners; the corners of a cylinder's, a sphere's or a capsule's bounding box), so it
-  holds the convex hull of them, and so the whole geometry.
+  holds the convex hull of them, and so the whole geometry; and a box (``boxes``), the
+  smaller of the one along the object's axes and the one along the points' principal axes.
+
+``kinematics`` hands all of it to the Core's motion checker (virtual_world.core.motion), which
+walks whole motions in C with the same arithmetic.
 """
 from __future__ import annotations
 
@@ -29,7 +33,7 @@ from gui.core.model import PRISMATIC, REVOLUTE
 from gui.core.plan import BuildPlan
 from gui.errors import PlanningError
 from odin_common.rotations import quaternion_to_matrix
-from virtual_world.core.probe import BOUND_BOX, BOUND_CAPSULE, BOUND_VALUES
+from virtual_world.core.motion import RobotKinematics
 
 
 class PlannedRobot:
@@ -81,6 +85,29 @@ class PlannedRobot:
         p = np.clip(controls.offset, 0.0, 1.0)
         self._base_rotation = instance.base_pose[:3, :3] @ quaternion_to_matrix(
             kuffner_quaternion(*p[3:6]))
+
+    def kinematics(self, size: int) -> RobotKinematics:
+        """The tables the Core's motion checker computes with (virtual_world.core.motion):
+        this robot's controls, chain, bounds and capsules as ``configuration``,
+        ``object_frames`` and ``link_bounds`` use them; ``size``: the control vector's."""
+        controls = self.handle.instance.controls
+        start = self.part.start or 0
+        stop = size if self.part.stop is None else self.part.stop
+        return RobotKinematics(
+            links=tuple(body.body_id for body in self.handle.bodies), part=(start, stop - start),
+            offset=controls.offset, matrix=controls.matrix, dof_of_joint=self._dof_of_joint,
+            joint_low=self._joint_low, joint_span=self._joint_span,
+            joint_link=np.array(self.movable, dtype=int),
+            base_pose=self.handle.instance.base_pose,
+            base_box=self._base_box if self.moves_base else None,
+            base_rotation=self._base_rotation if self.moves_base else None,
+            base_turns=self._base_turns, fixed_part=self._fixed_part,
+            first_part=self._first_part, second_part=self._second_part,
+            rotational=self._rotational,
+            parent=np.array([-1 if p is None else p for p in self._parents], dtype=int),
+            offsets=self._offsets, arms=self.arms, reaches=self.reaches,
+            capsules=self.capsules, boxes=self.boxes, boxed=self.boxed,
+            moved=np.array(self.moved, dtype=int))
 
     def configuration(self, controls: np.ndarray):
         """(base pose (4, 4), joint values) the control vector puts this robot in."""
@@ -160,110 +187,6 @@ class PlannedRobot:
             bounds = bounds + float(np.linalg.norm(base_b[:3, 3] - base_a[:3, 3]))
             bounds = bounds + _angle(base_a[:3, :3], base_b[:3, :3]) * self.reaches
         return bounds
-
-    def turns(self, a, b) -> bool:
-        """Whether some link turns from configuration ``a`` to ``b`` (a revolute joint or the
-        base's orientation changes): else every link only translates."""
-        (base_a, q_a), (base_b, q_b) = a, b
-        revolute = self._rotational[self.movable]
-        if np.any(np.asarray(q_a)[revolute] != np.asarray(q_b)[revolute]):
-            return True
-        return self.moves_base and not np.array_equal(base_a[:3, :3], base_b[:3, :3])
-
-    def unclamped(self, controls: np.ndarray) -> bool:
-        """Whether no DOF of the control vector's configuration is clamped to its limits (so
-        along a straight segment between two such vectors every DOF changes linearly)."""
-        return self.handle.instance.controls.parameters(
-            np.asarray(controls, dtype=float)[self.part])[1]
-
-    def swept_boxes(self, frames_a: np.ndarray, frames_b: np.ndarray, indices: Sequence[int]
-                    ) -> np.ndarray:
-        """(len(indices), BOUND_VALUES) boxes (virtual_world.core.probe's layout, m, world)
-        each holding what a body's box sweeps as its object moves from ``frames_a`` to
-        ``frames_b`` (4, 4 each, in ``indices``' order) along a straight line, turning not:
-        the two boxes' convex hull, boxed along the box's axes or along the motion,
-        whichever is smaller."""
-        out = np.zeros((len(indices), BOUND_VALUES))
-        for row, (Ta, Tb, k) in enumerate(zip(frames_a, frames_b, indices)):
-            box = self.boxes[k]
-            axes = Ta[:3, :3] @ box[3:12].reshape(3, 3)
-            local = _CORNERS * box[12:15]
-            corners = np.vstack([local @ (T[:3, :3] @ box[3:12].reshape(3, 3)).T
-                                 + T[:3, :3] @ box[:3] + T[:3, 3] for T in (Ta, Tb)])
-            out[row] = _smallest_box(corners, [axes, _motion_axes(Tb[:3, 3] - Ta[:3, 3],
-                                                                  axes)])
-        return out
-
-    def motion_bound(self, a, b) -> float:
-        """m: no point of any of this robot's links moves farther than this from ``a`` to
-        ``b`` (link_bounds)."""
-        return float(np.max(self.link_bounds(a, b), initial=0.0))
-
-    def world_capsules(self, frames: np.ndarray, indices: Sequence[int]) -> np.ndarray:
-        """(len(indices), 7): the capsules of the bodies ``indices`` with their objects at
-        ``frames`` (their (4, 4) world poses, in that order): end a, end b (m, world),
-        radius (m)."""
-        capsules = self.capsules[indices]
-        rotations, origins = frames[:, :3, :3], frames[:, :3, 3]
-        out = np.empty((len(capsules), 7))
-        out[:, :3] = np.einsum("nij,nj->ni", rotations, capsules[:, :3]) + origins
-        out[:, 3:6] = np.einsum("nij,nj->ni", rotations, capsules[:, 3:6]) + origins
-        out[:, 6] = capsules[:, 6]
-        return out
-
-    def world_bounds(self, frames: np.ndarray, indices: Sequence[int]) -> np.ndarray:
-        """(len(indices), BOUND_VALUES): the bound of each body ``indices`` that holds it
-        more tightly, its box or its capsule (virtual_world.core.probe's layout, m, world),
-        with their objects at ``frames`` (as in world_capsules)."""
-        indices = np.asarray(indices, dtype=int)
-        boxed = self.boxed[indices]
-        out = np.zeros((len(indices), BOUND_VALUES))
-        out[~boxed, 0] = BOUND_CAPSULE
-        out[~boxed, 1:8] = self.world_capsules(frames[~boxed], indices[~boxed])
-        boxes, frames = self.boxes[indices[boxed]], frames[boxed]
-        rotations = frames[:, :3, :3]
-        out[boxed, 0] = BOUND_BOX
-        out[boxed, 1:4] = np.einsum("nij,nj->ni", rotations, boxes[:, :3]) + frames[:, :3, 3]
-        out[boxed, 4:13] = (rotations @ boxes[:, 3:12].reshape(-1, 3, 3)).reshape(-1, 9)
-        out[boxed, 13:16] = boxes[:, 12:15]
-        return out
-
-
-_CORNERS = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float)
-
-
-def _motion_axes(motion: np.ndarray, axes: np.ndarray) -> np.ndarray:
-    """(3, 3) orthonormal columns: the motion's direction, then the box axis (``axes``'
-    columns) most across it made square to it, then their cross product (``axes`` when the
-    motion is nil)."""
-    length = float(np.linalg.norm(motion))
-    if length == 0.0:
-        return axes
-    u = motion / length
-    v = axes[:, int(np.argmin(np.abs(u @ axes)))]
-    v = v - (v @ u) * u
-    v /= np.linalg.norm(v)
-    return np.column_stack([u, v, np.cross(u, v)])
-
-
-def _smallest_box(points: np.ndarray, candidates: Sequence[np.ndarray]) -> np.ndarray:
-    """(BOUND_VALUES,): the smallest of the boxes along each candidate's axes (columns)
-    holding ``points`` (n, 3)."""
-    best, volume = None, np.inf
-    for axes in candidates:
-        local = points @ axes
-        low, high = local.min(axis=0), local.max(axis=0)
-        size = float(np.prod(high - low))
-        if size < volume:
-            best, volume = (axes, low, high), size
-    axes, low, high = best
-    bound = np.zeros(BOUND_VALUES)
-    bound[0] = BOUND_BOX
-    bound[1:4] = axes @ ((low + high) / 2)
-    bound[4:13] = axes.ravel()
-    bound[13:16] = (high - low) / 2
-    return bound
-
 
 def _arm_matrix(model, movable: Sequence[int], radii: Sequence[float]) -> np.ndarray:
     """(links, movable): a_ij of the module docstring, 0 where joint j does not move link i."""

@@ -24,8 +24,8 @@ from odin_common.limits import ResourceLimits, shown
 from odin_common.specs import CompositeSpec, EntitySpec, JointSpec, MotorSpec, ObjectSpec
 from odin_common.world_parameters import WorldParameters
 from virtual_world.core import (actuation, exemptions, forces, guard, joints, long_calls,
-                                motors, objects, probe, propagation, readout, snapshots,
-                                validation as check)
+                                motion, motors, objects, probe, propagation, readout,
+                                snapshots, validation as check)
 from virtual_world.core.requests import changes_contents, changes_state, disturbs, locked
 from virtual_world.core.records import (Built, BuiltEntity, Collision, Divergence,
                                         JointReaction, JointState, MotorState, ObjectState,
@@ -502,6 +502,23 @@ class Core:
         """Lower bounds (m) of the distances of capsules and boxes to the world but the
         probe's ``apart`` objects, up to ``needed`` (CollisionProbe.clearances)."""
         return collision_probe.clearances(self._scene, bounds, needed)
+
+    @locked
+    def motion_checker(self, robots: Sequence[motion.RobotKinematics], size: int,
+                       tiers: Sequence[float], sweep_gap: float, resolution: float
+                       ) -> motion.MotionChecker:
+        """A geometric planner's motion checker (virtual_world.core.motion) of ``robots``
+        over ``size`` controls: clearances among ``tiers`` (m, descending), a translating
+        link's sweep free when it can grow by ``sweep_gap`` (m), no link moving more than
+        ``resolution`` (m) between configurations checked exactly."""
+        return motion.MotionChecker(self._scene, robots, size, tiers, sweep_gap, resolution)
+
+    @changes_state
+    def motion_valid(self, checker: motion.MotionChecker, a, b) -> Tuple[bool, int, int]:
+        """(whether the straight segment of the control space from ``a`` (valid) to ``b``
+        is collision-free; configurations checked exactly; clearance queries). The moved
+        links stay where the check last put them."""
+        return checker.motion_valid(self._scene, a, b)
 
     # ------------------------------------------------------------------ step and read-out
 

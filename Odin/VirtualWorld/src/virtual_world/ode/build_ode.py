@@ -7,6 +7,7 @@ Layers, each in its own file (pymunk's layout):
   * ``odin_state.c`` -- bodies' state read and written bit for bit (snapshots);
   * ``odin_kinematic.c`` -- the kinematic drive's forward kinematics, every step;
   * ``odin_query.c`` -- the geometric planner's collision queries;
+  * ``odin_motion.c`` -- its motion check (kinematics and the walk) in one call;
   * this module     -- the build; ``bindings.py`` only re-exports ``ffi, lib``.
 
 Usage: ``python build_ode.py --out DIR [--tmp DIR]`` (CMake runs it during the catkin build).
@@ -47,7 +48,8 @@ def make_builder() -> cffi.FFI:
         "_odin_ode",
         '#include <ode/ode.h>\n#include "odin_step.h"\n',
         sources=[str(HERE / "odin_step.c"), str(HERE / "odin_state.c"),
-                 str(HERE / "odin_kinematic.c"), str(HERE / "odin_query.c")],
+                 str(HERE / "odin_kinematic.c"), str(HERE / "odin_query.c"),
+                 str(HERE / "odin_motion.c")],
         include_dirs=[str(HERE)],
         extra_compile_args=["-O2", "-DdDOUBLE"] + _pkg_config("--cflags"),
         libraries=["ode"],

@@ -290,6 +290,66 @@ void odin_bounds_clearance(OdinWorld *w, const double *bounds, int n, const doub
  * matrix (3 x 3, row by row; orthonormal: ODE makes its quaternion of it)). */
 void odin_place_bodies(dBodyID *bodies, int n, const double *poses);
 
+/* The geometric planner's motion check (odin_motion.c). One robot's kinematics over the
+ * control vector, every array row by row, poses 4 x 4 (m, rad); the links in an order where a
+ * parent comes before its children. The owner (virtual_world.ode.queries.MotionQuery) keeps
+ * the arrays alive and checked. */
+typedef struct OdinKinematicRobot {
+    int n_links, n_joints, n_dofs;  /* links; joints a control moves; normalised DOFs */
+    int part_start, part_len;       /* the robot's slice of the control vector */
+    const double *offset;           /* n_dofs: p = clamp(offset + matrix (c - 0.5), 0, 1) */
+    const double *matrix;           /* n_dofs x part_len */
+    const int *dof_of_joint;        /* n_joints: each joint's DOF */
+    const double *joint_low, *joint_span;  /* n_joints: q = low + p span (rad or m) */
+    const int *joint_link;          /* n_joints: each joint's link */
+    int moves_base, base_turns;     /* DOFs 0-2 place the base in base_box; 3-5 turn it */
+    const double *base_pose;        /* 16: the base's home (world) */
+    const double *base_box;         /* 6: low, high of x, y, z in the home frame (m) */
+    const double *base_rotation;    /* 9: the base's rotation when it never turns */
+    const double *fixed_part, *first_part, *second_part; /* n_links x 16: A, B, C */
+    const int *rotational;          /* n_links: 1 revolute (sin q, 1 - cos q), 0 (q, 0) */
+    const int *parent;              /* n_links: the parent link, -1 the base */
+    const double *offsets;          /* n_links x 16: each body's object frame in its link's */
+    const double *arms;             /* n_links x n_joints: motion bound per unit of joint */
+    const double *reaches;          /* n_links: reach from the base's origin (m) */
+    const double *capsules;         /* n_links x 7: ends a, b, radius (object frame, m) */
+    const double *boxes;            /* n_links x 15: centre, rotation, half sides */
+    const int *boxed;               /* n_links: 1 the box bounds the link more tightly */
+    const int *moved;               /* n_moved: the links a control moves, ascending */
+    int n_moved;
+} OdinKinematicRobot;
+/* The robots and what is asked of the world: the moved links' bodies (robots in order, each
+ * robot's moved links in order) with their centres of mass in the object frame (3 each) and
+ * their geoms; the geoms (sorted addresses) clearances do not ask against; the clearance
+ * tiers (m, descending) and one search hint per moved link (odin_bounds_clearance), those of
+ * the sweep's single tier sweep_gap; the pairs of robot links (indices over the robots' links
+ * end to end) that may touch; the resolution (m). */
+typedef struct OdinMotionChecker {
+    OdinWorld *world;
+    int n_robots;
+    const OdinKinematicRobot *robots;
+    int size;
+    dBodyID *bodies;
+    const double *com;
+    const dGeomID *geoms;
+    int n_geoms;
+    const uintptr_t *apart;
+    int n_apart;
+    const double *tiers;
+    int n_tiers;
+    int *hints;
+    double sweep_gap;
+    int *sweep_hints;
+    const int *pairs;
+    int n_pairs;
+    double resolution;
+} OdinMotionChecker;
+/* 1 when the straight segment of the control space from a (a valid configuration) to b is
+ * collision-free (odin_motion.c), 0 when not, -1 when a configuration on it puts a link beyond
+ * the world's extent or a frame is not a rigid transform (nothing shown to ODE), -2 out of
+ * memory. counts[0] += configurations checked exactly, counts[1] += clearance queries. */
+int odin_motion_valid(OdinMotionChecker *m, const double *a, const double *b, int *counts);
+
 /* Forgets the collision records (contact-less: after a read). */
 void odin_world_clear_records(OdinWorld *w);
 /* Frees the record and contact buffers (close/new scene). */

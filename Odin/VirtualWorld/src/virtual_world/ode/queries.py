@@ -85,3 +85,75 @@ class GeomQuery:
                                       ffi.cast("int *", ffi.from_buffer(self._hints)),
                                       _doubles(out))
         return out
+
+
+ROBOT_ARRAYS = {
+    # field of OdinKinematicRobot -> C type of its array
+    "offset": "double", "matrix": "double", "dof_of_joint": "int", "joint_low": "double",
+    "joint_span": "double", "joint_link": "int", "base_pose": "double", "base_box": "double",
+    "base_rotation": "double", "fixed_part": "double", "first_part": "double",
+    "second_part": "double", "rotational": "int", "parent": "int", "offsets": "double",
+    "arms": "double", "reaches": "double", "capsules": "double", "boxes": "double",
+    "boxed": "int", "moved": "int",
+}
+"""The arrays of one robot's kinematics in odin_motion.c (odin_step.h's OdinKinematicRobot,
+row by row)."""
+ROBOT_COUNTS = ("n_links", "n_joints", "n_dofs", "part_start", "part_len", "moves_base",
+                "base_turns", "n_moved")
+
+
+class MotionQuery:
+    """One OdinMotionChecker (odin_motion.c) over the scene's ``world`` struct: ``robots``
+    (per robot a mapping of ROBOT_COUNTS to ints and ROBOT_ARRAYS to arrays), the moved
+    links' ``bodies`` with their centres of mass ``com`` (n, 3) and ``geoms``, the geoms
+    ``apart`` (addresses), the robot link ``pairs`` (n, 2) that may touch, ``tiers`` (m,
+    descending), ``sweep_gap`` and ``resolution`` (m). Every array is kept here for as long as
+    C may read it; the caller has checked them (virtual_world.core.motion)."""
+
+    def __init__(self, world, size: int, robots: Sequence[dict], bodies: Sequence,
+                 com: np.ndarray, geoms: Sequence, apart: Sequence[int], pairs: np.ndarray,
+                 tiers: np.ndarray, sweep_gap: float, resolution: float):
+        self._keep = []
+        self._robots = ffi.new("OdinKinematicRobot[]", max(len(robots), 1))
+        for struct, robot in zip(self._robots, robots):
+            for name in ROBOT_COUNTS:
+                setattr(struct, name, int(robot[name]))
+            for name, kind in ROBOT_ARRAYS.items():
+                setattr(struct, name, self._array(robot[name], kind))
+        m = self._struct = ffi.new("OdinMotionChecker *")
+        m.world, m.n_robots, m.robots, m.size = world, len(robots), self._robots, int(size)
+        m.bodies = self._kept(ffi.new("dBodyID[]", list(bodies) or 1))
+        m.com = self._array(com, "double")
+        m.geoms = self._kept(ffi.new("dGeomID[]", list(geoms) or 1))
+        m.n_geoms = len(geoms)
+        m.apart = self._kept(ffi.new("uintptr_t[]", sorted(apart) or 1))
+        m.n_apart = len(apart)
+        m.tiers, m.n_tiers = self._array(tiers, "double"), len(tiers)
+        m.hints = self._kept(ffi.new("int[]", max(len(bodies), 1)))
+        m.sweep_gap = float(sweep_gap)
+        m.sweep_hints = self._kept(ffi.new("int[]", max(len(bodies), 1)))
+        m.pairs, m.n_pairs = self._array(pairs, "int"), len(pairs)
+        m.resolution = float(resolution)
+        self._counts = ffi.new("int[2]")
+
+    def _kept(self, cdata):
+        self._keep.append(cdata)
+        return cdata
+
+    def _array(self, values, kind: str):
+        dtype = np.intc if kind == "int" else np.float64
+        array = np.ascontiguousarray(np.asarray(values, dtype=dtype).reshape(-1))
+        if not array.size:
+            array = np.zeros(1, dtype=dtype)
+        self._keep.append(array)
+        return ffi.cast(f"{kind} *", ffi.from_buffer(array))
+
+    @drains_ode_messages
+    def motion_valid(self, a: np.ndarray, b: np.ndarray) -> Tuple[int, int, int]:
+        """(odin_motion_valid's answer: 1 free, 0 not, -1 a frame not fit for ODE, -2 out of
+        memory; configurations checked exactly; clearance queries) for the segment a-b."""
+        a = np.ascontiguousarray(a, dtype=np.float64)
+        b = np.ascontiguousarray(b, dtype=np.float64)
+        self._counts[0] = self._counts[1] = 0
+        answer = lib.odin_motion_valid(self._struct, _doubles(a), _doubles(b), self._counts)
+        return int(answer), int(self._counts[0]), int(self._counts[1])
