@@ -58,6 +58,26 @@ def test_a_run_not_solved_is_an_answer_with_its_time_and_no_path(tmp_path):
         (False, False, 1.002, None, None)
 
 
+APPROXIMATE_BUT_TRUE = """PEER seed 2
+PEER family 2 planner omplRRT
+Info:    ProblemDefinition: Adding approximate solution from planner RRT
+APPROXIMATE_SOLUTION - No exact solution found
+Difference = 0.0525639
+No solution found
+PEER solved 1 wall 15.1277
+PEER states 200
+"""
+
+
+def test_an_approximate_solution_is_not_solved_though_the_driver_says_so(tmp_path):
+    """Kautham 5.1.1's library answered true after an approximate solution (UR3e, seed 2:
+    the path ends 5 cm from the goal); its console's words decide."""
+    task = tmp_path / "path.xml"
+    task.write_text("<Task/>")
+    run = kautham_peer.PeerRun.from_output(APPROXIMATE_BUT_TRUE, "", 0, task)
+    assert (run.solved, run.failed, run.task_file, run.wall_s) == (False, False, None, 15.1277)
+
+
 def test_a_problem_kautham_cannot_load_is_a_failed_run_saying_why_with_stderr_s_tail():
     stderr = "\n".join(f"line {k}" for k in range(20)) + "\n"
     run = kautham_peer.PeerRun.from_output("PEER seed 1\nPEER load failed\n", stderr, 3)

@@ -49,6 +49,11 @@ sets it (src/planner/omplg/omplplanner.cpp)."""
 FAILURES = {3: "Kautham could not load the problem", 4: "Kautham raised an error"}
 """The driver's exit statuses that are not an answer (0 solved, 1 not solved)."""
 TAIL_LINES = 8
+NOT_SOLVED_LINES = ("No exact solution found", "No solution found")
+"""What Kautham prints when its planner found no exact solution, whatever the driver's exit
+status (5.1.1's omplPlanner::trySolve reports an approximate solution this way, and the
+driver's solveAndInherit still answered true: seen on UR3e, the path 5 cm short of the
+goal)."""
 
 
 def peer_dir() -> pathlib.Path:
@@ -109,7 +114,10 @@ class PeerRun:
         fields = _peer_lines(stdout)
         # an answer: exit 0 with "PEER solved 1", or exit 1 with "PEER solved 0"
         answered = returncode in (0, 1) and fields.get("solved") == str(1 - returncode)
-        solved = answered and returncode == 0
+        # Kautham's library returns true after an approximate solution too (its console
+        # says "APPROXIMATE_SOLUTION - No exact solution found"): not a solution
+        solved = answered and returncode == 0 and not any(
+            words in stdout for words in NOT_SOLVED_LINES)
         error = "" if answered else _failure(stdout, stderr, returncode)
         written = task_file if solved and task_file is not None and task_file.is_file() else None
         return PeerRun(solved=solved, wall_s=_number(fields.get("wall"), float),
