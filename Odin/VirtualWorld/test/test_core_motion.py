@@ -354,11 +354,6 @@ def test_a_base_rotation_unfit_for_ode_is_refused_by_the_sweep(core):
     assert core.motion_valid(checker, _xy(-1.0, 1.0), _xy(1.0, 1.0))[0] is True
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "motion._robot checks a box bound's values but not that its rotation (boxes[:, 3:12]) is "
-    "orthonormal, and the C walk checks only the link frames: a zero rotation reaches ODE "
-    "(place_box's dGeomSetRotation) and the sweep calls a slide through the wall free, "
-    "(True, 1, 1), where CollisionProbe.clearances refuses such a box"))
 def test_a_box_bound_whose_rotation_is_not_orthonormal_is_refused(core):
     _wall_scene(core)
     capsule, box = _bounds(SLIDER_HALF)

@@ -20,7 +20,7 @@ from typing import NamedTuple, Optional, Sequence, Tuple
 import numpy as np
 
 from odin_common.limits import shown
-from virtual_world.core.probe import pairs_that_may_touch
+from virtual_world.core.probe import _object_ids, _orthonormal, _tiers, pairs_that_may_touch
 from virtual_world.core.scene import Scene
 from virtual_world.errors import CoreError, InvalidArgument
 from virtual_world.ode.queries import MotionQuery
@@ -66,7 +66,6 @@ class MotionChecker:
 
     def __init__(self, scene: Scene, robots: Sequence[RobotKinematics], size: int,
                  tiers: Sequence[float], sweep_gap: float, resolution: float):
-        from virtual_world.core.probe import _object_ids, _tiers
         extent = scene.parameters.world_extent
         size = _count("size", size, 1, 10_000)
         robots = [_robot(r, size, extent) for r in robots]
@@ -188,6 +187,11 @@ def _robot(r, size: int, extent: float) -> RobotKinematics:
     boxes = _table("boxes", r.boxes, (n, 15), extent)
     if np.any(capsules[:, 6] < 0) or np.any(boxes[:, 12:] < 0):
         raise InvalidArgument("capsules, boxes: radii and half sides not negative")
+    _orthonormal("boxes", boxes[:, 3:12].reshape(-1, 3, 3))     # ODE is shown them, turned
+    arms = _table("arms", r.arms, (n, joints), extent)
+    reaches = _table("reaches", r.reaches, (n,), extent)
+    if np.any(arms < 0) or np.any(reaches < 0):
+        raise InvalidArgument("arms, reaches: bounds of motion, not negative")
     return r._replace(
         links=links, part=(start, length), offset=offset,
         matrix=_table("matrix", r.matrix, (dofs, length), extent),
@@ -202,8 +206,7 @@ def _robot(r, size: int, extent: float) -> RobotKinematics:
         second_part=_table("second_part", r.second_part, (n, 4, 4), extent),
         rotational=np.asarray(r.rotational, dtype=bool).reshape(n), parent=parent,
         offsets=_table("offsets", r.offsets, (n, 4, 4), extent),
-        arms=_table("arms", r.arms, (n, joints), extent),
-        reaches=_table("reaches", r.reaches, (n,), extent), capsules=capsules, boxes=boxes,
+        arms=arms, reaches=reaches, capsules=capsules, boxes=boxes,
         boxed=np.asarray(r.boxed, dtype=bool).reshape(n), moved=moved)
 
 
