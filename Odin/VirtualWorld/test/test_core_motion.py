@@ -95,6 +95,20 @@ def test_a_turn_through_the_post_is_invalid_and_one_away_from_it_valid(core):
     assert core.motion_valid(checker, [_c(80.0)], [_c(170.0)])[0] is True  # starts past it
 
 
+def test_one_configuration_is_checked_as_the_walk_checks_it(core):
+    """Core.configuration_valid: the arm along the post's bearing touches it, elsewhere not;
+    a control vector with NaN or of the wrong length is refused."""
+    _arm_scene(core)
+    checker = _arm_checker(core)
+    assert core.configuration_valid(checker, [_c(45.0)]) is False
+    assert core.configuration_valid(checker, [_c(0.0)]) is True
+    assert core.configuration_valid(checker, [_c(-135.0)]) is True
+    for hostile in ([float("nan")], [0.5, 0.5], []):
+        with pytest.raises(InvalidArgument):
+            core.configuration_valid(checker, hostile)
+    assert core.configuration_valid(checker, [_c(45.0)]) is False
+
+
 def test_the_arm_is_left_at_a_configuration_of_the_motion(core):
     """The walk places the arm's body (Core.motion_valid: it stays where the last exact check
     put it): after a turn from 0 to -90 degrees its object frame is the chain's at some angle

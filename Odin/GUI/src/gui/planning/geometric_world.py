@@ -4,7 +4,7 @@ answers whether configurations of the control space collide, and whether the str
 segment between two does.
 
 A configuration is valid when no link a control moves touches anything (``valid``: the Core's
-collision probe, one C call; ``collisions`` names the pairs and their depths through Check
+motion checker, one C call; ``collisions`` names the pairs and their depths through Check
 Collision). Pairs of parts no control moves relative to each other (a fixed base on its
 table) are not asked about: they are as the problem built them whatever the path does; links
 a joint joins never collide in the world.
@@ -41,7 +41,7 @@ finer check).
 from __future__ import annotations
 
 import math
-from typing import Callable, List, Optional, Sequence
+from typing import Callable, List, Sequence
 
 import numpy as np
 
@@ -79,17 +79,13 @@ class GeometricWorld:
         self.clearance_checks = 0
 
     def _ask_core(self) -> None:
-        """The Core's names of what moves, its collision probe (single configurations) and
-        its motion checker (whole motions, the walk of the module docstring in C)."""
+        """The Core's names of what moves and its motion checker (single configurations and
+        whole motions, the walk of the module docstring, in C)."""
         core = self.world.core
         # k: a 2012 problem's robots end to end, a current problem's one shared vector
         self.size = max(r.part.stop or r.handle.instance.controls.size for r in self.robots)
         self.moved = {name for r in self.robots for body in r.moved_bodies
                       for name in core.geometry_names(body)}
-        ids = [body.body_id for r in self.robots for body in r.handle.bodies]
-        moved = [body.body_id for r in self.robots for k, body in enumerate(r.handle.bodies)
-                 if k in r.moved]
-        self.probe = core.collision_probe(moved, apart=ids)
         self.checker = core.motion_checker([r.kinematics(self.size) for r in self.robots],
                                            self.size, CLEARANCE_TIERS, SWEEP_GAP,
                                            self.resolution)
@@ -101,12 +97,6 @@ class GeometricWorld:
         """Each robot's (base pose, joints) for the control vector."""
         c = np.asarray(controls, dtype=float)
         return Placement(r.configuration(c) for r in self.robots)
-
-    def _frames(self, placement: "Placement") -> List[np.ndarray]:
-        """Each robot's (links, 4, 4) object frames at ``placement`` (computed once)."""
-        if placement.frames is None:
-            placement.frames = [r.object_frames(conf) for r, conf in zip(self.robots, placement)]
-        return placement.frames
 
     def collisions(self, controls: Sequence[float]) -> list:
         """The pairs (first, second, depth m) a control vector's configuration makes that a
@@ -120,15 +110,10 @@ class GeometricWorld:
 
     def valid(self, controls: Sequence[float]) -> bool:
         """Whether no link a control moves touches anything at the control vector's
-        configuration (the pairs ``collisions`` reports, asked through the Core's collision
-        probe: one C call, stopping at the first)."""
-        return self._valid(self.configurations(controls))
-
-    def _valid(self, placement: "Placement") -> bool:
+        configuration (the pairs ``collisions`` reports, asked through the Core's motion
+        checker: one C call, kinematics included, stopping at the first)."""
         self.checks += 1
-        poses = np.concatenate([frames[r.moved] for r, frames in
-                                zip(self.robots, self._frames(placement))])
-        return self.world.core.probe_touching(self.probe, poses) is None
+        return self.world.core.configuration_valid(self.checker, controls)
 
     def _bounds(self, a: list, b: list) -> np.ndarray:
         """(robot links,) m: how far each link of every robot moves at most from
@@ -172,6 +157,4 @@ class GeometricWorld:
 
 
 class Placement(list):
-    """Each robot's (base pose (4, 4), joints) for one control vector, with their object
-    frames once asked (GeometricWorld._frames)."""
-    frames: Optional[List[np.ndarray]] = None
+    """Each robot's (base pose (4, 4), joints) for one control vector."""

@@ -93,18 +93,33 @@ class MotionChecker:
     def motion_valid(self, scene: Scene, a, b) -> Tuple[bool, int, int]:
         """(whether the straight segment from control vector ``a``, a valid configuration,
         to ``b`` is collision-free; configurations checked exactly; clearance queries)."""
+        self._same_scene(scene)
+        a, b = _controls("a", a, self.size), _controls("b", b, self.size)
+        answer, checks, clearances = self._query.motion_valid(a, b)
+        return _answer(answer, "a configuration between a and b", scene), checks, clearances
+
+    def valid(self, scene: Scene, controls) -> bool:
+        """Whether no link a control moves touches anything at the control vector's
+        configuration (the step's pairs; what the walk checks exactly)."""
+        self._same_scene(scene)
+        answer = self._query.configuration_valid(_controls("controls", controls, self.size))
+        return _answer(answer, "the configuration", scene)
+
+    def _same_scene(self, scene: Scene) -> None:
         if scene is not self._scene or scene.revision != self._revision:
             raise InvalidArgument("the world's objects changed since this motion checker was "
                                   "made: make a new one")
-        a, b = _controls("a", a, self.size), _controls("b", b, self.size)
-        answer, checks, clearances = self._query.motion_valid(a, b)
-        if answer == -1:
-            raise InvalidArgument("a configuration between a and b puts a link beyond the "
-                                  f"world's extent ({scene.parameters.world_extent:g} m) or "
-                                  "its frame is not a rigid transform")
-        if answer < 0:
-            raise CoreError("out of memory checking a motion")
-        return bool(answer), checks, clearances
+
+
+def _answer(answer: int, what: str, scene: Scene) -> bool:
+    """odin_motion.c's answer: 1 or 0, else the error it stands for."""
+    if answer == -1:
+        raise InvalidArgument(f"{what} puts a link beyond the world's extent "
+                              f"({scene.parameters.world_extent:g} m) or its frame is not a "
+                              "rigid transform")
+    if answer < 0:
+        raise CoreError("out of memory checking a motion")
+    return bool(answer)
 
 
 def _count(what: str, value, low: int, high: int) -> int:

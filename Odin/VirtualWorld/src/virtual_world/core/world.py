@@ -520,6 +520,12 @@ class Core:
         links stay where the check last put them."""
         return checker.motion_valid(self._scene, a, b)
 
+    @changes_state
+    def configuration_valid(self, checker: motion.MotionChecker, controls) -> bool:
+        """Whether no link a control moves touches anything at the control vector's
+        configuration (MotionChecker.valid; the links stay there)."""
+        return checker.valid(self._scene, controls)
+
     # ------------------------------------------------------------------ step and read-out
 
     @changes_state

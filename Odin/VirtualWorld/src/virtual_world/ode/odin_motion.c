@@ -43,6 +43,7 @@ typedef struct {
     int *firsts;
     int *counts;             /* [configurations checked exactly, clearance queries] */
     int error;               /* 1: a configuration left the world (nothing placed) */
+    double *memory;          /* the block the scratch arrays and placements are in */
 } Walk;
 
 static int robot_values(const OdinKinematicRobot *r) {
@@ -635,31 +636,45 @@ static int clearance_walk(Walk *walk, Placement *here, Placement *end, Placement
     return 1;
 }
 
-int odin_motion_valid(OdinMotionChecker *m, const double *a, const double *b, int *counts) {
+/* The walk's scratch memory (one block) and its `placements` placements (pool); 0 when out of
+ * memory. */
+static int walk_begin(Walk *walk, OdinMotionChecker *m, const double *a, const double *b,
+                      int *counts, Placement *pool, int placements) {
     int links = total_links(m), values = 0, dofs = 0;
     for (int r = 0; r < m->n_robots; ++r) {
         values += robot_values(&m->robots[r]);
         if (m->robots[r].n_dofs > dofs) dofs = m->robots[r].n_dofs;
     }
     int scratch_links = links + 2 * m->n_pairs;
-    int placements = MAX_SWEEP_DEPTH + 8;
-    double *memory = calloc((size_t)placements * values + (size_t)m->size + (size_t)dofs
-                            + (size_t)16 * links + (size_t)ODIN_BOUND_VALUES * links
-                            + (size_t)9 * scratch_links, sizeof(double));
-    int *firsts = calloc((size_t)links + 1, sizeof(int));
-    if (!memory || !firsts) { free(memory); free(firsts); return -2; }
-    Placement pool[MAX_SWEEP_DEPTH + 8];
+    /* every value is written before it is read: no need to clear the block */
+    double *memory = malloc(((size_t)placements * values + (size_t)m->size + (size_t)dofs
+                             + (size_t)16 * links + (size_t)ODIN_BOUND_VALUES * links
+                             + (size_t)9 * scratch_links) * sizeof(double));
+    int *firsts = malloc(((size_t)links + 1) * sizeof(int));
+    if (!memory || !firsts) { free(memory); free(firsts); return 0; }
     double *cursor = memory;
     for (int i = 0; i < placements; ++i, cursor += values) pool[i].values = cursor, pool[i].framed = 0;
-    Walk walk = {.m = m, .a = a, .b = b, .counts = counts, .firsts = firsts, .values = values};
-    walk.controls = cursor; cursor += m->size;
-    walk.dofs = cursor; cursor += dofs;
-    walk.chain = cursor; cursor += 16 * links;
-    walk.bounds = cursor; cursor += ODIN_BOUND_VALUES * links;
-    double **arrays[] = {&walk.moves, &walk.rest, &walk.needed, &walk.out, &walk.obstacles,
-                         &walk.found_obstacles, &walk.gaps, &walk.found_gaps};
+    *walk = (Walk){.m = m, .a = a, .b = b, .counts = counts, .firsts = firsts, .values = values};
+    walk->controls = cursor; cursor += m->size;
+    walk->dofs = cursor; cursor += dofs;
+    walk->chain = cursor; cursor += 16 * links;
+    walk->bounds = cursor; cursor += ODIN_BOUND_VALUES * links;
+    double **arrays[] = {&walk->moves, &walk->rest, &walk->needed, &walk->out, &walk->obstacles,
+                         &walk->found_obstacles, &walk->gaps, &walk->found_gaps};
     for (int i = 0; i < 8; ++i, cursor += scratch_links) *arrays[i] = cursor;
+    walk->memory = memory;
+    return 1;
+}
 
+static void walk_end(Walk *walk) {
+    free(walk->memory);
+    free(walk->firsts);
+}
+
+int odin_motion_valid(OdinMotionChecker *m, const double *a, const double *b, int *counts) {
+    Walk walk;
+    Placement pool[MAX_SWEEP_DEPTH + 8];
+    if (!walk_begin(&walk, m, a, b, counts, pool, MAX_SWEEP_DEPTH + 8)) return -2;
     Placement *here = &pool[0], *end = &pool[1];
     configure(&walk, a, here);
     configure(&walk, b, end);
@@ -671,7 +686,16 @@ int odin_motion_valid(OdinMotionChecker *m, const double *a, const double *b, in
         answer = probes_valid(&walk, here, end, &pool[2])
                  && clearance_walk(&walk, here, end, &pool[2]);
     }
-    free(memory);
-    free(firsts);
+    walk_end(&walk);
+    return walk.error ? -1 : answer;
+}
+
+int odin_configuration_valid(OdinMotionChecker *m, const double *c, int *counts) {
+    Walk walk;
+    Placement pool[1];
+    if (!walk_begin(&walk, m, c, c, counts, pool, 1)) return -2;
+    configure(&walk, c, &pool[0]);
+    int answer = valid(&walk, &pool[0]);
+    walk_end(&walk);
     return walk.error ? -1 : answer;
 }

@@ -349,6 +349,9 @@ typedef struct OdinMotionChecker {
  * the world's extent or a frame is not a rigid transform (nothing shown to ODE), -2 out of
  * memory. counts[0] += configurations checked exactly, counts[1] += clearance queries. */
 int odin_motion_valid(OdinMotionChecker *m, const double *a, const double *b, int *counts);
+/* The same for one configuration c: 1 when no moved link touches anything, 0 when one does,
+ * -1, -2 as above; counts[0] += 1. */
+int odin_configuration_valid(OdinMotionChecker *m, const double *c, int *counts);
 
 /* Forgets the collision records (contact-less: after a read). */
 void odin_world_clear_records(OdinWorld *w);

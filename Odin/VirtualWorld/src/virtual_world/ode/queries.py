@@ -157,3 +157,9 @@ class MotionQuery:
         self._counts[0] = self._counts[1] = 0
         answer = lib.odin_motion_valid(self._struct, _doubles(a), _doubles(b), self._counts)
         return int(answer), int(self._counts[0]), int(self._counts[1])
+
+    @drains_ode_messages
+    def configuration_valid(self, controls: np.ndarray) -> int:
+        """odin_configuration_valid's answer for one control vector (as motion_valid's)."""
+        controls = np.ascontiguousarray(controls, dtype=np.float64)
+        return int(lib.odin_configuration_valid(self._struct, _doubles(controls), self._counts))
