@@ -62,6 +62,8 @@ def test_open_solve_show_and_run_the_arm(ros_master, tmp_path):
         page.seed.setValue(1)
         wait_for(lambda: window.scene.world_robots and window.scene.robot_points(), 10,
                  "the arm's links in world_update")
+        # the camera comes from the Viewer on its own time: Frame before it says so (CI)
+        wait_for(lambda: window.viewer_panel.camera is not None, 15, "the Viewer's camera")
         click(window.viewer_panel.frame_button)
         click(page.solve_button)
         wait_for(lambda: not page.solving, 60, "the search", page.result_label.text)

@@ -184,3 +184,23 @@ def test_prm_solves_and_ends_in_its_time(tmp_path, seed):
                           timeout=30)
     assert done.returncode == 0, done.stderr[-2000:]
     assert done.stdout.split()[-2:] == ["solved", "True"]
+
+
+def test_the_search_measures_controls_as_kautham_measures_configurations(tmp_path):
+    """Kautham's OMPL space is the configuration space (joints in rad, a base's position in
+    m), where its Range is a distance; Odin's is the control space scaled per control
+    (geometric_robots.control_scales), so that a distance there is the same joints' or
+    base's distance: checked on random pairs of the arm (two revolute joints) and of the
+    plate (a base sliding in a 1 m box)."""
+    from gui.planning.geometric_robots import control_scales
+    rng = np.random.default_rng(5)
+    (tmp_path / "arm").mkdir()
+    (tmp_path / "plate").mkdir()
+    for plan in (_plan(_problem(tmp_path / "arm")), _plate_plan(tmp_path / "plate")):
+        robot = planned_robots(plan)[0]
+        scales = control_scales([robot], 2)
+        for _ in range(20):
+            a, b = rng.random(2), rng.random(2)
+            (base_a, q_a), (base_b, q_b) = robot.configuration(a), robot.configuration(b)
+            kautham = np.linalg.norm(np.r_[q_b - q_a, base_b[:3, 3] - base_a[:3, 3]])
+            assert np.linalg.norm((b - a) * scales) == pytest.approx(kautham, rel=1e-9)

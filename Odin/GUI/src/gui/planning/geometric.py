@@ -30,7 +30,7 @@ import numpy as np
 from gui.core.kinematics import pose_to_position_quaternion
 from gui.core.plan import BuildPlan
 from gui.errors import PlanningError
-from gui.planning.geometric_robots import planned_robots, robot_parts
+from gui.planning.geometric_robots import control_scales, planned_robots, robot_parts
 from gui.planning.geometric_world import RESOLUTION, GeometricWorld
 
 GEOMETRIC_PLANNERS = {
@@ -207,9 +207,10 @@ class _Checks:
     thread to end (a deadlock). So the search's end by Ctrl-C or a callback's error is asked
     here, on the planner's own thread, at every callback."""
 
-    def __init__(self, world: GeometricWorld, over: Callable[[], bool]):
+    def __init__(self, world: GeometricWorld, over: Callable[[], bool], scales: np.ndarray):
         self.world = world
         self.over = over
+        self.inverse_scales = [1.0 / float(x) for x in scales]
         self.error: Optional[BaseException] = None
         self.end_search: Callable[[], None] = _nothing
 
@@ -220,12 +221,18 @@ class _Checks:
             return True
         return False
 
+    def controls(self, state) -> List[float]:
+        """The control vector of an OMPL state (its coordinates over the search's scales:
+        _Search)."""
+        inverse = self.inverse_scales
+        return [state[i] * inverse[i] for i in range(len(inverse))]
+
     def vector(self, state) -> np.ndarray:
-        return np.fromiter((state[i] for i in range(self.world.size)), float, self.world.size)
+        return np.array(self.controls(state))
 
     def valid(self, state) -> bool:
         try:
-            return not self._ended() and self.world.valid(self.vector(state))
+            return not self._ended() and self.world.valid(self.controls(state))
         except BaseException as error:      # noqa: B902 - raised by solve()
             self.error = self.error or error
             return False
@@ -233,7 +240,7 @@ class _Checks:
     def motion(self, s1, s2) -> bool:
         try:
             return not self._ended() and self.world.motion_valid(
-                self.vector(s1), self.vector(s2), self.over)
+                self.controls(s1), self.controls(s2), self.over)
         except BaseException as error:      # noqa: B902 - raised by solve()
             self.error = self.error or error
             return False
@@ -254,10 +261,12 @@ class _Search:
         self.checks = checks
         size = checks.world.size
         self.space = ob.RealVectorStateSpace(size)
-        unit = ob.RealVectorBounds(size)
-        unit.setLow(0.0)
-        unit.setHigh(1.0)
-        self.space.setBounds(unit)
+        bounds = ob.RealVectorBounds(size)
+        scales = [1.0 / x for x in checks.inverse_scales]
+        for i in range(size):           # control i in [0, 1], scaled
+            bounds.setLow(i, 0.0)
+            bounds.setHigh(i, scales[i])
+        self.space.setBounds(bounds)
         self.setup = og.SimpleSetup(self.space)
         self.si = self.setup.getSpaceInformation()
         self.setup.setStateValidityChecker(checks.valid)
@@ -265,7 +274,7 @@ class _Search:
         self.si.setMotionValidator(self.validator)
         self.start, self.goal = self.si.allocState(), self.si.allocState()
         for i in range(size):
-            self.start[i], self.goal[i] = float(start[i]), float(goal[i])
+            self.start[i], self.goal[i] = float(start[i]) * scales[i], float(goal[i]) * scales[i]
         self.setup.setStartAndGoalStates(self.start, self.goal)
         self.planner = getattr(og, settings.planner)(self.si)
         if settings.range is not None and hasattr(self.planner, "setRange"):
@@ -317,17 +326,19 @@ def solve(plan: BuildPlan, settings: Optional[GeometricSettings] = None,
     world = GeometricWorld(plan, settings.resolution)
     try:
         check_query(world, start, goal)
-        return _search(world, settings, start, goal, seed, stop)
+        scales = control_scales(world.robots, world.size) if plan.problem.format != "2012" \
+            else np.ones(world.size)
+        return _search(world, settings, start, goal, seed, stop, scales)
     finally:
         world.close()
 
 
 def _search(world: GeometricWorld, settings: GeometricSettings, start, goal, seed,
-            stop) -> GeometricResult:
+            stop, scales: np.ndarray) -> GeometricResult:
     checks_before, clearances_before = world.checks, world.clearance_checks
     started = time.perf_counter()
     clock = _Clock(time.monotonic() + settings.time_limit, stop)
-    checks = _Checks(world, clock.over)
+    checks = _Checks(world, clock.over, scales)
     clock.checks = checks
     found = _run(_Search(checks, settings, start, goal), settings.simplify, clock)
     # the search's OMPL objects are gone here, before anything is raised: a traceback holding

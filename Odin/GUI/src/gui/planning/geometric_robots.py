@@ -36,6 +36,11 @@ from odin_common.rotations import quaternion_to_matrix
 from virtual_world.core.motion import RobotKinematics
 
 
+ROTATION_PER_UNIT = math.pi / 2
+"""rad: the turn charged per unit of one of a base's three orientation DOFs (Kautham's
+quaternion parameters): OMPL's SO(3) distance spans [0, pi/2]."""
+
+
 class PlannedRobot:
     """One robot of the plan (``handle``: its gui.core.plan robot handle) and its slice
     ``part`` of the control vector. ``moved``: the indices (of ``handle.bodies``, one per
@@ -108,6 +113,20 @@ class PlannedRobot:
             offsets=self._offsets, arms=self.arms, reaches=self.reaches,
             capsules=self.capsules, boxes=self.boxes, boxed=self.boxed,
             moved=np.array(self.moved, dtype=int))
+
+    def squared_control_lengths(self, size: int) -> np.ndarray:
+        """(size,): per control of the vector, the square of how far a unit of it moves this
+        robot in Kautham's OMPL metric (control_scales)."""
+        matrix = self.handle.instance.controls.matrix
+        squares = np.zeros(size)
+        columns = np.arange(size)[self.part]
+        squares[columns] += np.sum((matrix[self._dof_of_joint]
+                                    * self._joint_span[:, None]) ** 2, axis=0)
+        if self.moves_base:
+            sides = self._base_box[:, 1] - self._base_box[:, 0]
+            squares[columns] += np.sum((matrix[:3] * sides[:, None]) ** 2, axis=0)
+            squares[columns] += np.sum((matrix[3:6] * ROTATION_PER_UNIT) ** 2, axis=0)
+        return squares
 
     def configuration(self, controls: np.ndarray):
         """(base pose (4, 4), joint values) the control vector puts this robot in."""
@@ -328,6 +347,18 @@ def _angle(a: np.ndarray, b: np.ndarray) -> float:
     """rad: the angle of the rotation from ``a`` to ``b`` (3, 3)."""
     cosine = (np.trace(a.T @ b) - 1.0) / 2.0
     return float(math.acos(max(-1.0, min(1.0, cosine))))
+
+
+def control_scales(robots: Sequence[PlannedRobot], size: int) -> np.ndarray:
+    """(size,): per control, how far a unit of it moves the configuration in Kautham's OMPL
+    metric (the Euclidean norm of the joints' values, rad or m, Kautham's links weighing 1;
+    a base's translation, m; its turn, ROTATION_PER_UNIT per orientation DOF), summed over the
+    robots it moves; a control that moves nothing counts 1e-6. Kautham plans in the
+    configuration space, where its ``Range`` is measured; Odin plans in the control space:
+    scaled by these, OMPL's distance there is Kautham's for controls that each move their own
+    DOFs (gui.planning.geometric)."""
+    squares = sum(robot.squared_control_lengths(size) for robot in robots)
+    return np.maximum(np.sqrt(squares), 1e-6)
 
 
 def robot_parts(plan: BuildPlan) -> List[Tuple[object, slice]]:

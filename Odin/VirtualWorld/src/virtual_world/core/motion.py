@@ -94,15 +94,20 @@ class MotionChecker:
         """(whether the straight segment from control vector ``a``, a valid configuration,
         to ``b`` is collision-free; configurations checked exactly; clearance queries)."""
         self._same_scene(scene)
-        a, b = _controls("a", a, self.size), _controls("b", b, self.size)
-        answer, checks, clearances = self._query.motion_valid(a, b)
+        try:
+            answer, checks, clearances = self._query.motion_valid(a, b)
+        except (TypeError, ValueError):
+            raise InvalidArgument(f"a, b: {self.size} finite controls each") from None
         return _answer(answer, "a configuration between a and b", scene), checks, clearances
 
     def valid(self, scene: Scene, controls) -> bool:
         """Whether no link a control moves touches anything at the control vector's
         configuration (the step's pairs; what the walk checks exactly)."""
         self._same_scene(scene)
-        answer = self._query.configuration_valid(_controls("controls", controls, self.size))
+        try:
+            answer = self._query.configuration_valid(controls)
+        except (TypeError, ValueError):
+            raise InvalidArgument(f"controls: {self.size} finite controls") from None
         return _answer(answer, "the configuration", scene)
 
     def _same_scene(self, scene: Scene) -> None:
@@ -113,6 +118,8 @@ class MotionChecker:
 
 def _answer(answer: int, what: str, scene: Scene) -> bool:
     """odin_motion.c's answer: 1 or 0, else the error it stands for."""
+    if answer == -3:
+        raise InvalidArgument("a control is not finite")
     if answer == -1:
         raise InvalidArgument(f"{what} puts a link beyond the world's extent "
                               f"({scene.parameters.world_extent:g} m) or its frame is not a "
@@ -137,16 +144,6 @@ def _positive(what: str, value, extent: float) -> float:
     if not 0.0 < value <= extent:
         raise InvalidArgument(f"{what}={shown(value)}: positive, within the world's extent")
     return value
-
-
-def _controls(what: str, values, size: int) -> np.ndarray:
-    try:
-        array = np.asarray(values, dtype=float).reshape(-1)
-    except (TypeError, ValueError):
-        raise InvalidArgument(f"{what}: not a control vector") from None
-    if array.shape != (size,) or not np.all(np.isfinite(array)):
-        raise InvalidArgument(f"{what}: {size} finite controls")
-    return array
 
 
 def _table(what: str, values, shape: Tuple[int, ...], bound: float) -> np.ndarray:

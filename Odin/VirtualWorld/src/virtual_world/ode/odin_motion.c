@@ -671,7 +671,13 @@ static void walk_end(Walk *walk) {
     free(walk->firsts);
 }
 
+static int finite_controls(const OdinMotionChecker *m, const double *c) {
+    for (int i = 0; i < m->size; ++i) if (!isfinite(c[i])) return 0;
+    return 1;
+}
+
 int odin_motion_valid(OdinMotionChecker *m, const double *a, const double *b, int *counts) {
+    if (!finite_controls(m, a) || !finite_controls(m, b)) return -3;
     Walk walk;
     Placement pool[MAX_SWEEP_DEPTH + 8];
     if (!walk_begin(&walk, m, a, b, counts, pool, MAX_SWEEP_DEPTH + 8)) return -2;
@@ -691,6 +697,7 @@ int odin_motion_valid(OdinMotionChecker *m, const double *a, const double *b, in
 }
 
 int odin_configuration_valid(OdinMotionChecker *m, const double *c, int *counts) {
+    if (!finite_controls(m, c)) return -3;
     Walk walk;
     Placement pool[1];
     if (!walk_begin(&walk, m, c, c, counts, pool, 1)) return -2;

@@ -135,6 +135,9 @@ class MotionQuery:
         m.pairs, m.n_pairs = self._array(pairs, "int"), len(pairs)
         m.resolution = float(resolution)
         self._counts = ffi.new("int[2]")
+        self._size = int(size)
+        self._a = ffi.new("double[]", max(self._size, 1))
+        self._b = ffi.new("double[]", max(self._size, 1))
 
     def _kept(self, cdata):
         self._keep.append(cdata)
@@ -149,17 +152,27 @@ class MotionQuery:
         return ffi.cast(f"{kind} *", ffi.from_buffer(array))
 
     @drains_ode_messages
-    def motion_valid(self, a: np.ndarray, b: np.ndarray) -> Tuple[int, int, int]:
+    def motion_valid(self, a: Sequence[float], b: Sequence[float]) -> Tuple[int, int, int]:
         """(odin_motion_valid's answer: 1 free, 0 not, -1 a frame not fit for ODE, -2 out of
-        memory; configurations checked exactly; clearance queries) for the segment a-b."""
-        a = np.ascontiguousarray(a, dtype=np.float64)
-        b = np.ascontiguousarray(b, dtype=np.float64)
+        memory, -3 a control not finite; configurations checked exactly; clearance queries)
+        for the segment a-b (``size`` floats each: TypeError, ValueError otherwise)."""
+        self._set(self._a, a)
+        self._set(self._b, b)
         self._counts[0] = self._counts[1] = 0
-        answer = lib.odin_motion_valid(self._struct, _doubles(a), _doubles(b), self._counts)
+        answer = lib.odin_motion_valid(self._struct, self._a, self._b, self._counts)
         return int(answer), int(self._counts[0]), int(self._counts[1])
 
     @drains_ode_messages
-    def configuration_valid(self, controls: np.ndarray) -> int:
+    def configuration_valid(self, controls: Sequence[float]) -> int:
         """odin_configuration_valid's answer for one control vector (as motion_valid's)."""
-        controls = np.ascontiguousarray(controls, dtype=np.float64)
-        return int(lib.odin_configuration_valid(self._struct, _doubles(controls), self._counts))
+        self._set(self._a, controls)
+        return int(lib.odin_configuration_valid(self._struct, self._a, self._counts))
+
+    def _set(self, target, values: Sequence[float]) -> None:
+        """Copies ``values`` (a list, tuple or array of ``size`` numbers) into ``target``:
+        a planner asks thousands of times a second, so no array is made on the way."""
+        if isinstance(values, np.ndarray):
+            values = values.tolist()
+        if len(values) != self._size:
+            raise ValueError(f"{len(values)} controls, not {self._size}")
+        target[0:self._size] = values
