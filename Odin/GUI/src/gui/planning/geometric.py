@@ -135,13 +135,15 @@ class GeometricResult:
     ``configurations``: per state, each robot's (base pose (4, 4), joints (rad or m));
     ``time_s``: wall-clock seconds of the search; ``states``: the states of the path;
     ``checks``: configurations checked for collision during the search; ``length``: the
-    path's length in the control space; ``status``: OMPL's planner status;
+    path's length in the search's metric (``scales``); ``status``: OMPL's planner status;
     ``unsimplified_length``: the length of the path the planner found, before simplification;
     ``simplify_s``: wall seconds of the simplification (part of ``time_s``); ``graph_states``:
     the states of the planner's graph or trees when it stopped; ``clearance_checks``: the
     clearance and sweep queries of its motion checks (gui.planning.geometric_world), apart
     from ``checks``, the configurations checked exactly; ``unsimplified_states``: the states
-    of the path the planner found, before simplification (OMPL's solution segments + 1)."""
+    of the path the planner found, before simplification (OMPL's solution segments + 1);
+    ``scales``: per control, the search's scale (Kautham's metric: control_scales; None: 1),
+    which its lengths, Range and interpolation are measured in."""
     planner: str
     seed: Optional[int]
     solved: bool
@@ -155,6 +157,7 @@ class GeometricResult:
     graph_states: int = 0
     clearance_checks: int = 0
     unsimplified_states: int = 0
+    scales: Optional[np.ndarray] = None
 
     @property
     def states(self) -> int:
@@ -171,7 +174,9 @@ class GeometricResult:
                 "unsimplified_path_length": round(self.unsimplified_length, 9),
                 "simplify_s": round(self.simplify_s, 6), "graph_states": self.graph_states,
                 "clearance_checks": self.clearance_checks,
-                "unsimplified_states": self.unsimplified_states}
+                "unsimplified_states": self.unsimplified_states,
+                "control_scales": None if self.scales is None else
+                [round(float(x), 9) for x in self.scales]}
 
 
 def query(plan: BuildPlan) -> Tuple[np.ndarray, np.ndarray]:
@@ -349,9 +354,11 @@ def _search(world: GeometricWorld, settings: GeometricSettings, start, goal, see
         raise PlanningError(f"collision checking failed: {checks.error}") from checks.error
     return GeometricResult(settings.planner, seed, bool(len(found.path)), found.path,
                            time.perf_counter() - started, world.checks - checks_before,
-                           _length(found.path), found.status, _length(found.unsimplified),
+                           _length(found.path, scales), found.status,
+                           _length(found.unsimplified, scales),
                            found.simplify_s, found.graph_states,
-                           world.clearance_checks - clearances_before, len(found.unsimplified))
+                           world.clearance_checks - clearances_before, len(found.unsimplified),
+                           np.asarray(scales, dtype=float))
 
 
 class _Clock:
@@ -374,9 +381,12 @@ class _Clock:
         return max(0.0, self.deadline - time.monotonic())
 
 
-def _length(path: np.ndarray) -> float:
-    """A path's length in the control space (0 for none)."""
-    return float(np.sum(np.linalg.norm(np.diff(path, axis=0), axis=1))) if len(path) else 0.0
+def _length(path: np.ndarray, scales: np.ndarray) -> float:
+    """A path's length in the search's metric (its controls scaled by ``scales``; 0 for
+    none)."""
+    if not len(path):
+        return 0.0
+    return float(np.sum(np.linalg.norm(np.diff(path, axis=0) * scales, axis=1)))
 
 
 class _Found(NamedTuple):

@@ -8,8 +8,11 @@ does that, ``GeometricSettings.simplify``), then, whatever that parameter says, 
 ``ceil(d / L)`` equal pieces, L being the space's longest valid segment. L is 1 % of the
 space's maximum extent (the fraction Kautham's planners set, OMPL's default), except in
 Kautham's RRT and RRTConnect, which take ``Range / 5`` when the Range is at most 4 L, so that
-five states fall within a Range step (their ``_validSegmentCount``). Odin's space is the
-control space [0, 1]^k: its maximum extent is sqrt(k), distances Euclidean.
+five states fall within a Range step (their ``_validSegmentCount``). Kautham's space is the
+configuration space; Odin's search space is the control space [0, 1]^k with each control
+scaled by how far it moves the robots in Kautham's metric (``GeometricResult.scales``,
+gui.planning.geometric_robots.control_scales): lengths are measured there, its maximum extent
+is the norm of the scales (sqrt(k) unscaled, a 2012 problem's).
 
 The interpolation is linear in the control space, and a straight segment of the control space
 is exactly the motion the search checked (``GeometricWorld.motion_points``): every state added
@@ -47,45 +50,52 @@ RANGE_STEP_PLANNERS = frozenset({"RRT", "RRTConnect"})
 (omplRRTplanner.cpp, omplRRTConnectplanner.cpp; Kautham's PRM, RRT* and KPIECE keep 1 %)."""
 
 
-def longest_segment(size: int, planner: str, range_: Optional[float] = None) -> float:
-    """The longest segment the interpolation leaves, in control-space units, for a space of
-    ``size`` controls searched by ``planner`` (OMPL's name) with Kautham's ``Range``
-    ``range_`` (None: OMPL's default, 20 % of the extent, never shortened)."""
+def longest_segment(size: int, planner: str, range_: Optional[float] = None,
+                    scales: Optional[Sequence[float]] = None) -> float:
+    """The longest segment the interpolation leaves, in the search's units (``scales``: its
+    per-control scales, None: all 1), for a space of ``size`` controls searched by
+    ``planner`` (OMPL's name) with Kautham's ``Range`` ``range_`` (None: OMPL's default, 20 %
+    of the extent, never shortened)."""
     if size < 1:
         raise PlanningError(f"a control space of {size} dimensions")
-    longest = LONGEST_SEGMENT_FRACTION * math.sqrt(size)
+    extent = math.sqrt(size) if scales is None else float(np.linalg.norm(scales))
+    longest = LONGEST_SEGMENT_FRACTION * extent
     if planner in RANGE_STEP_PLANNERS and range_ is not None \
             and range_ <= (RANGE_STEP_STATES - 1) * longest:
         longest = range_ / RANGE_STEP_STATES
     return longest
 
 
-def interpolate(path: np.ndarray, longest: float) -> np.ndarray:
+def interpolate(path: np.ndarray, longest: float,
+                scales: Optional[Sequence[float]] = None) -> np.ndarray:
     """``path`` (n, k) with each segment cut into ``ceil(d / longest)`` equal pieces (d its
-    length; one piece for a repeated state), its own states kept: OMPL's
-    ``PathGeometric::interpolate()``. A path of fewer than two states is returned as it is."""
+    length, each control scaled by ``scales``, None: all 1; one piece for a repeated state),
+    its own states kept: OMPL's ``PathGeometric::interpolate()``. A path of fewer than two
+    states is returned as it is."""
     path = np.asarray(path, dtype=float)
+    weights = np.ones(path.shape[1]) if scales is None else np.asarray(scales, dtype=float)
     if not (math.isfinite(longest) and longest > 0):
         raise PlanningError(f"longest segment {longest!r} must be positive")
     if len(path) < 2:
         return path.copy()
     pieces = [path[:1]]
     for a, b in zip(path[:-1], path[1:]):
-        count = max(1, math.ceil(float(np.linalg.norm(b - a)) / longest))
+        count = max(1, math.ceil(float(np.linalg.norm((b - a) * weights)) / longest))
         fractions = np.arange(1, count + 1, dtype=float)[:, None] / count
         inner = a + fractions[:-1] * (b - a)
         pieces += [inner, b[None, :]]       # b itself, not a + 1.0 (b - a): no rounding
     return np.concatenate(pieces)
 
 
-def kautham_path(path: np.ndarray, planner: str, range_: Optional[float] = None
-                 ) -> np.ndarray:
+def kautham_path(path: np.ndarray, planner: str, range_: Optional[float] = None,
+                 scales: Optional[Sequence[float]] = None) -> np.ndarray:
     """A search's path (n, k) (``GeometricResult.path``, simplified as the search's settings
-    asked) interpolated as Kautham does after its simplification (module docstring)."""
+    asked) interpolated as Kautham does after its simplification (module docstring), in the
+    search's metric (``GeometricResult.scales``)."""
     path = np.asarray(path, dtype=float)
     if len(path) < 2:
         return path.copy()
-    return interpolate(path, longest_segment(path.shape[1], planner, range_))
+    return interpolate(path, longest_segment(path.shape[1], planner, range_, scales), scales)
 
 
 def ompl_rows_text(rows: Sequence[Sequence[float]]) -> str:

@@ -208,7 +208,7 @@ def _geometric_search(request: PlanRequest, build_plan, stop) -> GeometricOutcom
     print(f"plan: {settings.planner} searching for up to {settings.time_limit:g} s, seed "
           f"{seed} (--seed {seed} repeats it)", flush=True)
     result = solve(build_plan, settings, seed, stop)
-    written = kautham_path(result.path, settings.planner, settings.range) \
+    written = kautham_path(result.path, settings.planner, settings.range, result.scales) \
         if request.interpolate else result.path
     statistics = result.statistics()
     if len(written) != result.states:

@@ -62,7 +62,8 @@ class Solved(NamedTuple):
         """The path (n, k) as Kautham hands it on and ``rosrun GUI plan`` writes it:
         interpolated (gui.planning.geometric_output)."""
         from gui.planning.geometric_output import kautham_path
-        return kautham_path(self.result.path, self.settings.planner, self.settings.range)
+        return kautham_path(self.result.path, self.settings.planner, self.settings.range,
+                            self.result.scales)
 
     def name(self) -> str:
         """How the path is named in the status lines and the task file."""
