@@ -26,6 +26,7 @@ from __future__ import annotations
 import math
 import os
 import time
+from collections import deque
 from dataclasses import dataclass
 from typing import Callable, List, Optional, Tuple
 
@@ -100,12 +101,13 @@ class _Callbacks:
         self.problem = backend.problem
         self.world_size = world_size
         self.error: Optional[BaseException] = None
+        # the world vector's slots, read and written through map: a propagation moves a few
+        # hundred values each way, one OMPL call per value (the wheel has no bulk copy)
+        self._slots = range(world_size - 1)
 
     # -- state <-> vectors ---------------------------------------------------------------------
     def _vector(self, state) -> np.ndarray:
-        world = state[1]
-        return np.fromiter((world[i] for i in range(self.world_size - 1)), float,
-                           self.world_size - 1)
+        return np.fromiter(map(state[1].__getitem__, self._slots), float, len(self._slots))
 
     def write(self, state, vector: np.ndarray, backend_outcome) -> None:
         robot, world = state[0], state[1]
@@ -118,8 +120,7 @@ class _Callbacks:
         for i in range(3):
             robot[i] = float(position[i])
             robot[3 + i] = float(velocity[i])
-        for i, v in enumerate(vector.tolist()):
-            world[i] = v
+        deque(map(world.__setitem__, self._slots, vector.tolist()), maxlen=0)
         world[self.world_size - 1] = flag
 
     # -- OMPL's callbacks (an exception must not cross into C++: kept and re-raised) -----------

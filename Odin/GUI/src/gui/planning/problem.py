@@ -191,10 +191,12 @@ class PlanningProblem:
                                            and robot_body not in self.tool_bodies)
 
     def in_bounds(self, tracked_position, tracked_velocity) -> bool:
-        low, high = self.base_bounds[:, 0], self.base_bounds[:, 1]
-        position = np.asarray(tracked_position)
-        return bool(np.all(position >= low) and np.all(position <= high)
-                    and np.all(np.abs(tracked_velocity) <= self.settings.max_speed))
+        """Whether the tracked link is in the base's bounds, no faster than max_speed on any
+        axis (NaN is not; plain floats: OMPL asks at every propagation)."""
+        top = self.settings.max_speed
+        return all(low <= float(p) <= high for p, (low, high) in
+                   zip(tracked_position, self.base_bounds.tolist())) \
+            and all(abs(float(v)) <= top for v in tracked_velocity)
 
 
 def _object(name: str) -> str:
