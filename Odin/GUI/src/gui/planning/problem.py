@@ -36,7 +36,7 @@ chain whose base is held to the world, driven at its joints (PlanarChainEnvironm
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Iterable, Optional, Tuple
 
 import numpy as np
@@ -131,6 +131,9 @@ class PlanningProblem:
     settings: SearchSettings
     searched: Tuple[int, ...]
     held: Tuple[float, ...]
+    # (first, second) geometry names -> whether that contact is forbidden, as asked (a few
+    # dozen pairs, asked at every propagation)
+    _verdicts: dict = field(default_factory=dict, init=False, compare=False, repr=False)
 
     def controls(self, searched_values) -> Tuple[float, ...]:
         """The full control row (k values) for the values of the searched controls."""
@@ -176,7 +179,16 @@ class PlanningProblem:
         """The pairs (object IDs or geometry names) that make a motion invalid: the robot
         touching a forbidden obstacle, or any but the ground with a body outside its tool;
         with ``guard_fixed``, anything but the ground touching a forbidden obstacle."""
-        return [(a, b) for a, b in pairs if self._invalid(_object(a), _object(b))]
+        verdicts = self._verdicts
+        forbidden = []
+        for first, second in pairs:
+            key = (first, second)
+            verdict = verdicts.get(key)
+            if verdict is None:
+                verdict = verdicts[key] = self._invalid(_object(first), _object(second))
+            if verdict:
+                forbidden.append(key)
+        return forbidden
 
     def _invalid(self, first: str, second: str) -> bool:
         if self._forbidden_pair(first, second) or self._forbidden_pair(second, first):
