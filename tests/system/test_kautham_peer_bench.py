@@ -22,7 +22,7 @@ def _runs(*times):
 def test_successes_medians_and_comparisons_of_the_two_sides():
     figures = figures_of("p", 1.0, _runs(0.2, 0.4, None), _runs(0.1, 0.1, 0.3))
     assert figures == {"geo_p_kautham_success": 0.667, "geo_p_kautham_median_s": 0.3,
-                       "geo_p_success": 1.0, "geo_p_median_s": 0.1,
+                       "geo_p_success": 1.0, "geo_p_median_s": 0.1, "geo_p_deepest_mm": 0.0,
                        "geo_p_time_over_kautham": 0.333, "geo_p_success_minus_kautham": 0.333}
 
 
@@ -51,7 +51,8 @@ def test_a_run_without_an_answer_refuses_its_side_and_the_comparisons_with_the_r
 
 def test_a_skipped_side_leaves_the_other_sides_figures_and_no_comparison():
     assert figures_of("p", 1.0, None, _runs(0.5)) == {"geo_p_success": 1.0,
-                                                      "geo_p_median_s": 0.5}
+                                                      "geo_p_median_s": 0.5,
+                                                      "geo_p_deepest_mm": 0.0}
     assert set(figures_of("p", 1.0, _runs(0.5), None)) == {"geo_p_kautham_success",
                                                            "geo_p_kautham_median_s"}
 
@@ -59,10 +60,31 @@ def test_a_skipped_side_leaves_the_other_sides_figures_and_no_comparison():
 def test_runs_read_as_attempts_whatever_side_wrote_them():
     runs = [{"solved": True, "time_s": 0.2, "planner": "RRTConnect"},
             {"solved": False, "time_s": 1.0, "error": ""},
-            {"error": "Kautham could not load the problem"}]
+            {"error": "Kautham could not load the problem"},
+            {"solved": True, "time_s": 0.3, "deepest_mm": 0.4, "deepest_pair": "a into b"}]
     assert bench_geometric.attempts(runs) == [
         Attempt(True, 0.2), Attempt(False, 1.0),
-        Attempt(False, None, "Kautham could not load the problem")]
+        Attempt(False, None, "Kautham could not load the problem"), Attempt(True, 0.3, "", 0.4)]
+
+
+def test_the_deepest_figure_is_the_deepest_of_odins_solved_runs():
+    odin = [Attempt(True, 0.1, "", 0.25), Attempt(True, 0.2, "", 0.0),
+            Attempt(True, 0.3, "", 0.61234), Attempt(False, 1.0)]
+    figures = figures_of("p", 1.0, _runs(0.2), odin)
+    assert figures["geo_p_deepest_mm"] == 0.6123
+    assert "geo_p_kautham_deepest_mm" not in figures     # Kautham's paths are not checked
+
+
+def test_the_deepest_figure_is_zero_when_nothing_touched_or_nothing_was_solved():
+    assert figures_of("p", 1.0, None, _runs(0.1, 0.2))["geo_p_deepest_mm"] == 0.0
+    assert figures_of("p", 1.0, _runs(0.2), _runs(None, None))["geo_p_deepest_mm"] == 0.0
+
+
+def test_a_run_without_an_answer_refuses_the_deepest_figure_with_the_reason():
+    odin = [Attempt(True, 0.1, "", 0.3), Attempt(False, None, "gui.planning.geometric: boom")]
+    deepest = figures_of("p", 1.0, None, odin)["geo_p_deepest_mm"]
+    assert isinstance(deepest, Refused)
+    assert deepest.reason == "1 of 2 runs gave no answer: gui.planning.geometric: boom"
 
 
 def test_an_unknown_problem_asked_for_is_refused_naming_the_known_ones(monkeypatch):

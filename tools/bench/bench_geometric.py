@@ -2,8 +2,9 @@
 geometric demos, each solved by both with the same seeds (1..SEEDS) and the same time limit,
 the problem's own (Kautham's ``_Max Planning Time``, kautham_peer.own_time_limit), passed to
 both explicitly. Each run is a process of its own (OMPL seeds its generators once per process):
-Kautham's driver (kautham_peer.solve) and Odin's ``gui.planning.geometric.solve_file`` in a
-forked child; the two alternate who goes first from seed to seed.
+Kautham's driver (kautham_peer.solve) and Odin's ``gui.planning.geometric.solve`` (the problem
+loaded as ``solve_file`` loads it) in a forked child, then, when solved, its path checked
+(``deepest_along``, not timed); the two alternate who goes first from seed to seed.
 
 Per problem P (PROBLEMS' slugs):
   geo_P_kautham_success         fraction of the seeds Kautham solved
@@ -12,6 +13,11 @@ Per problem P (PROBLEMS' slugs):
   geo_P_success, geo_P_median_s the same for Odin (its result's time_s)
   geo_P_time_over_kautham       geo_P_median_s / geo_P_kautham_median_s (goal <= 1)
   geo_P_success_minus_kautham   geo_P_success - geo_P_kautham_success (goal >= 0)
+  geo_P_deepest_mm              the deepest any link of Odin's solved paths goes into
+                                anything (mm; 0 when none solved or none touched), each path
+                                checked after its search (not timed) at DEEPEST_SPACING along
+                                every segment (gui.planning.geometric.deepest_along; goal
+                                <= 1: half the search's 2 mm resolution, issue 43)
 A side that solved no run has the time limit as its median: a bound, not a time. A run that
 gave no answer (Kautham could not load the problem, Odin raised) refuses that side's figures
 and the comparisons (report.Refused, with the first reason). Without the peer built (`make
@@ -57,22 +63,40 @@ PROBLEMS = {
 """Slug -> the problem's path in the corpus (the issue's demos with a geometric planner)."""
 ODIN_MODULE = "gui.planning.geometric"
 PROBLEMS_ENVIRONMENT = "ODIN_BENCH_GEO_PROBLEMS"
+DEEPEST_SPACING = 0.001
+"""m: the spacing Odin's solved paths are checked at (gui.planning.geometric.deepest_along)."""
 
 
 class Attempt(NamedTuple):
     """One side's run: ``solved``, ``time_s`` (wall s; None when it said none), ``error``
-    (empty when the run answered, solved or not)."""
+    (empty when the run answered, solved or not), ``deepest_mm`` (how deep its path goes
+    into anything, mm; None when not checked: not solved, or Kautham's)."""
     solved: bool
     time_s: Optional[float]
     error: str = ""
+    deepest_mm: Optional[float] = None
 
 
 def _odin_solve(problem: str, seed: int, time_limit: float) -> dict:
-    from gui.planning.geometric import solve_file
+    """One Odin run (in a child): the problem loaded and planned as ``solve_file`` does, its
+    search (``time_s`` is the search's own), then, when solved, how deep its path goes
+    (``deepest_along``, after the search, not timed)."""
+    from dataclasses import replace
+
+    from gui.core.kautham.problem import load_problem
+    from gui.core.translate import plan_problem
+    from gui.planning.geometric import GeometricSettings, deepest_along, solve
     logging.disable(logging.WARNING)
-    result = solve_file(problem, seed=seed, time_limit=time_limit)
-    return {"solved": bool(result.solved), "time_s": float(result.time_s),
-            "planner": str(result.planner)}
+    plan = plan_problem(load_problem(problem))
+    settings = replace(GeometricSettings.of_problem(plan), time_limit=time_limit)
+    result = solve(plan, settings, seed)
+    run = {"solved": bool(result.solved), "time_s": float(result.time_s),
+           "planner": str(result.planner)}
+    if result.solved:
+        deepest, pair = deepest_along(plan, result.path, DEEPEST_SPACING)
+        run["deepest_mm"] = deepest * 1000
+        run["deepest_pair"] = " into ".join(pair) if pair else None
+    return run
 
 
 def _odin(problem: pathlib.Path, seed: int, time_limit: float) -> dict:
@@ -90,7 +114,8 @@ def _kautham(problem: pathlib.Path, seed: int, time_limit: float, out_dir: pathl
 
 
 def attempts(runs: List[dict]) -> List[Attempt]:
-    return [Attempt(bool(r.get("solved")), r.get("time_s"), r.get("error") or "") for r in runs]
+    return [Attempt(bool(r.get("solved")), r.get("time_s"), r.get("error") or "",
+                    r.get("deepest_mm")) for r in runs]
 
 
 def _side(prefix: str, runs: List[Attempt], limit_s: float) -> dict:
@@ -104,6 +129,15 @@ def _side(prefix: str, runs: List[Attempt], limit_s: float) -> dict:
             f"{prefix}_median_s": round(statistics.median(times), 4) if times else limit_s}
 
 
+def _deepest(runs: List[Attempt]):
+    """The largest ``deepest_mm`` of the solved runs (0.0: none solved or none touched;
+    Refused if a run gave no answer)."""
+    failed = [r.error for r in runs if r.error]
+    if failed:
+        return Refused(f"{len(failed)} of {len(runs)} runs gave no answer: {failed[0]}")
+    return round(max([r.deepest_mm or 0.0 for r in runs if r.solved], default=0.0), 4)
+
+
 def figures_of(slug: str, limit_s: float, kautham: Optional[List[Attempt]],
                odin: Optional[List[Attempt]]) -> dict:
     """A problem's figures (module docstring) from each side's runs (None: side skipped)."""
@@ -111,6 +145,8 @@ def figures_of(slug: str, limit_s: float, kautham: Optional[List[Attempt]],
     for prefix, runs in ((f"geo_{slug}_kautham", kautham), (f"geo_{slug}", odin)):
         if runs:
             figures.update(_side(prefix, runs, limit_s))
+    if odin:
+        figures[f"geo_{slug}_deepest_mm"] = _deepest(odin)
     if not (kautham and odin):
         return figures
     k_success, o_success = figures[f"geo_{slug}_kautham_success"], figures[f"geo_{slug}_success"]
@@ -166,7 +202,11 @@ def side_by_side(problem: pathlib.Path, limit_s: float, with_kautham: bool, with
 def _said(run: dict) -> str:
     if run.get("error"):
         return "FAILED"
-    return f"solved in {run['time_s']:.3f} s" if run["solved"] else "not solved"
+    if not run["solved"]:
+        return "not solved"
+    deepest = run.get("deepest_mm")
+    return f"solved in {run['time_s']:.3f} s" + (
+        f" (deepest {deepest:.3f} mm)" if deepest is not None else "")
 
 
 def run(out_dir: pathlib.Path) -> dict:

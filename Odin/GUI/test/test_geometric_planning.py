@@ -187,3 +187,17 @@ def test_a_path_not_simplified_is_the_path_found(tmp_path):
     result = solve(plan, settings, seed=1)
     assert result.solved and result.simplify_s == 0.0
     assert result.states == result.unsimplified_states
+
+
+def test_deepest_along_names_the_pair_a_path_through_the_post_meets_and_zero_when_free(tmp_path):
+    """The straight start-goal motion sweeps the arm through the post: deepest_along reports
+    a depth and the post's pair; the arm swung the other way (x < 0) touches nothing."""
+    from gui.planning.geometric import deepest_along
+    plan = _plan(_problem(tmp_path))
+    start, goal = query(plan)
+    depth, pair = deepest_along(plan, np.array([start, goal]), spacing=0.005)
+    assert depth > 0 and pair is not None and "post" in pair
+    assert set(pair) & {"arm/fore", "arm/upper"}
+    (tmp_path / "free").mkdir()
+    free = _plan(_problem(tmp_path / "free", init="0.2 0.5", goal="0.2 0.9"))
+    assert deepest_along(free, np.array(query(free)), spacing=0.005) == (0.0, None)

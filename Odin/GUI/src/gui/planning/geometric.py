@@ -474,6 +474,32 @@ def solve_file(problem_file, seed: Optional[int] = None, time_limit: Optional[fl
     return solve(plan, settings, seed)
 
 
+def deepest_along(plan: BuildPlan, path: np.ndarray, spacing: float = 0.001
+                  ) -> Tuple[float, Optional[Tuple[str, str]]]:
+    """How deep any link a control moves goes into anything along ``path`` ((n, k) control
+    vectors, as ``GeometricResult.path``): its first state and every configuration of each
+    segment's straight motion, ``spacing`` m apart at most for any link point
+    (``GeometricWorld.motion_points``), checked by ``GeometricWorld.collisions``. The deepest
+    depth in m (0.0 when nothing touches) and its pair (first, second; None when nothing
+    touches). A path a search passed at resolution r goes no deeper than about r / 2 (1 mm
+    by default), up to the spacing."""
+    deepest, pair = 0.0, None
+    states = np.asarray(path, dtype=float)
+    if len(states) == 0:
+        return deepest, pair
+    world = GeometricWorld(plan, resolution=spacing)
+    try:
+        points = [states[0]] + [point for a, b in zip(states, states[1:])
+                                for point in world.motion_points(a, b)]
+        for point in points:
+            found = world.collisions(point)
+            if found and found[0][2] > deepest:
+                deepest, pair = float(found[0][2]), (found[0][0], found[0][1])
+    finally:
+        world.close()
+    return deepest, pair
+
+
 def task_rows(plan: BuildPlan, path: np.ndarray) -> List[List[float]]:
     """Each state of ``path`` as a Kautham task file's ``<Conf>`` row: per robot in the
     problem's order, for one whose controls move its base its position x y z (m, world) and
