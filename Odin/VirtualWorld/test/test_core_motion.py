@@ -393,3 +393,18 @@ def test_a_checker_refuses_every_call_once_the_world_changed(core):
     with pytest.raises(InvalidArgument, match="changed"):
         core.motion_valid(checker, [_c(0.0)], [_c(90.0)])
     assert core.motion_valid(_arm_checker(core), [_c(0.0)], [_c(90.0)])[0] is False
+
+
+def test_a_walk_past_its_deadline_stops_and_takes_no_motion(core):
+    """A search's time limit holds inside a motion (one near heavy meshes took 5 s): past the
+    deadline the walk asks nothing more and answers False; without one, the same free turn
+    is valid."""
+    import time
+    _arm_scene(core)
+    checker = _arm_checker(core)
+    free = ([_c(0.0)], [_c(-90.0)])
+    assert core.motion_valid(checker, *free)[0] is True
+    assert core.motion_valid(checker, *free, deadline=time.monotonic() + 60.0)[0] is True
+    valid, checks, clearances = core.motion_valid(checker, *free,
+                                                  deadline=time.monotonic() - 1.0)
+    assert (valid, checks, clearances) == (False, 0, 0)

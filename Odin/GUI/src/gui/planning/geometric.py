@@ -212,9 +212,11 @@ class _Checks:
     thread to end (a deadlock). So the search's end by Ctrl-C or a callback's error is asked
     here, on the planner's own thread, at every callback."""
 
-    def __init__(self, world: GeometricWorld, over: Callable[[], bool], scales: np.ndarray):
+    def __init__(self, world: GeometricWorld, over: Callable[[], bool], scales: np.ndarray,
+                 deadline: Callable[[], float] = lambda: math.inf):
         self.world = world
         self.over = over
+        self.deadline = deadline
         self.inverse_scales = [1.0 / float(x) for x in scales]
         self.error: Optional[BaseException] = None
         self.end_search: Callable[[], None] = _nothing
@@ -245,7 +247,7 @@ class _Checks:
     def motion(self, s1, s2) -> bool:
         try:
             return not self._ended() and self.world.motion_valid(
-                self.controls(s1), self.controls(s2), self.over)
+                self.controls(s1), self.controls(s2), self.over, self.deadline())
         except BaseException as error:      # noqa: B902 - raised by solve()
             self.error = self.error or error
             return False
@@ -343,7 +345,7 @@ def _search(world: GeometricWorld, settings: GeometricSettings, start, goal, see
     checks_before, clearances_before = world.checks, world.clearance_checks
     started = time.perf_counter()
     clock = _Clock(time.monotonic() + settings.time_limit, stop)
-    checks = _Checks(world, clock.over, scales)
+    checks = _Checks(world, clock.over, scales, lambda: clock.deadline)
     clock.checks = checks
     found = _run(_Search(checks, settings, start, goal), settings.simplify, clock)
     # the search's OMPL objects are gone here, before anything is raised: a traceback holding

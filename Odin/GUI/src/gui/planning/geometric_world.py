@@ -41,7 +41,7 @@ finer check).
 from __future__ import annotations
 
 import math
-from typing import Callable, List, Sequence
+from typing import Callable, List, Optional, Sequence
 
 import numpy as np
 
@@ -121,14 +121,16 @@ class GeometricWorld:
         return np.concatenate([r.link_bounds(ca, cb) for r, ca, cb in zip(self.robots, a, b)])
 
     def motion_valid(self, a: Sequence[float], b: Sequence[float],
-                     over: Callable[[], bool] = lambda: False) -> bool:
+                     over: Callable[[], bool] = lambda: False,
+                     deadline: Optional[float] = None) -> bool:
         """Whether the straight segment of the control space from ``a`` (a valid
         configuration) to ``b`` is (module docstring): one call to the Core's motion checker
         (virtual_world.core.motion: the walk, kinematics included, in C); False without a
-        check when ``over()`` is true (the search is over: the motion is not taken)."""
+        check when ``over()`` is true, and False once time.monotonic() passes ``deadline``
+        on the way (the search is over: the motion is not taken)."""
         if over():
             return False
-        valid, checks, clearances = self.world.core.motion_valid(self.checker, a, b)
+        valid, checks, clearances = self.world.core.motion_valid(self.checker, a, b, deadline)
         self.checks += checks
         self.clearance_checks += clearances
         return valid

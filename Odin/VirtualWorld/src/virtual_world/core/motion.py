@@ -15,6 +15,7 @@ held when it was made and refuses every call once any is removed or added.
 """
 from __future__ import annotations
 
+import math
 from typing import NamedTuple, Optional, Sequence, Tuple
 
 import numpy as np
@@ -90,12 +91,17 @@ class MotionChecker:
             np.array(pairs, dtype=int).reshape(-1, 2), _tiers(tiers, extent),
             _positive("sweep_gap", sweep_gap, extent), _positive("resolution", resolution, extent))
 
-    def motion_valid(self, scene: Scene, a, b) -> Tuple[bool, int, int]:
+    def motion_valid(self, scene: Scene, a, b, deadline: Optional[float] = None
+                     ) -> Tuple[bool, int, int]:
         """(whether the straight segment from control vector ``a``, a valid configuration,
-        to ``b`` is collision-free; configurations checked exactly; clearance queries)."""
+        to ``b`` is collision-free; configurations checked exactly; clearance queries).
+        ``deadline`` (time.monotonic() s; None: none): past it the walk stops and answers
+        False (a search's time limit holds on heavy meshes)."""
         self._same_scene(scene)
         try:
-            answer, checks, clearances = self._query.motion_valid(a, b)
+            limit = float(deadline) if deadline is not None and math.isfinite(deadline) \
+                else 0.0
+            answer, checks, clearances = self._query.motion_valid(a, b, limit)
         except (TypeError, ValueError):
             raise InvalidArgument(f"a, b: {self.size} finite controls each") from None
         return _answer(answer, "a configuration between a and b", scene), checks, clearances

@@ -514,11 +514,13 @@ class Core:
         return motion.MotionChecker(self._scene, robots, size, tiers, sweep_gap, resolution)
 
     @changes_state
-    def motion_valid(self, checker: motion.MotionChecker, a, b) -> Tuple[bool, int, int]:
+    def motion_valid(self, checker: motion.MotionChecker, a, b,
+                     deadline: Optional[float] = None) -> Tuple[bool, int, int]:
         """(whether the straight segment of the control space from ``a`` (valid) to ``b``
-        is collision-free; configurations checked exactly; clearance queries). The moved
-        links stay where the check last put them."""
-        return checker.motion_valid(self._scene, a, b)
+        is collision-free; configurations checked exactly; clearance queries), False once
+        time.monotonic() passes ``deadline``. The moved links stay where the check last put
+        them."""
+        return checker.motion_valid(self._scene, a, b, deadline)
 
     @changes_state
     def configuration_valid(self, checker: motion.MotionChecker, controls) -> bool:

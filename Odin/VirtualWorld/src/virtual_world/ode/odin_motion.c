@@ -14,6 +14,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include "odin_step.h"
 
 #define SHRINKS 4            /* halvings of a step before a resolution step */
@@ -44,7 +45,20 @@ typedef struct {
     int *counts;             /* [configurations checked exactly, clearance queries] */
     int error;               /* 1: a configuration left the world (nothing placed) */
     double *memory;          /* the block the scratch arrays and placements are in */
+    double deadline;         /* CLOCK_MONOTONIC s after which the walk gives up (0: never) */
+    int timed_out;           /* the deadline passed: every query answers 0 from then on */
 } Walk;
+
+/* Whether the walk's deadline has passed, read before every query (tens of ns; one query near
+ * heavy meshes can take tens of ms, and the search's time limit must hold). */
+static int over(Walk *walk) {
+    if (walk->timed_out) return 1;
+    if (walk->deadline <= 0.0) return 0;
+    struct timespec now;
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    walk->timed_out = now.tv_sec + 1e-9 * now.tv_nsec >= walk->deadline;
+    return walk->timed_out;
+}
 
 static int robot_values(const OdinKinematicRobot *r) {
     return 16 + r->n_joints + 16 * r->n_links;
@@ -235,6 +249,7 @@ static int frame_sane(const double *T, double extent) {
  * not sane (nothing placed). */
 static int valid(Walk *walk, Placement *p) {
     OdinMotionChecker *m = walk->m;
+    if (over(walk)) return 0;   /* the search is over: the motion is not taken */
     frames(walk, p);
     walk->counts[0]++;
     int n = 0;
@@ -318,6 +333,7 @@ static double segment_distance(const double *p, const double *q) {
  * (per link): no tier beyond the smallest reaching it is asked. 0: a frame is not sane. */
 static int clearances(Walk *walk, Placement *p, const double *needed) {
     OdinMotionChecker *m = walk->m;
+    if (over(walk)) return 0;
     frames(walk, p);
     walk->counts[1]++;
     int n = 0, base = 0;
@@ -466,6 +482,7 @@ static void swept_box(const OdinKinematicRobot *r, int link, const double *Ta, c
 /* Whether nothing is in what the moved links sweep from p to q. */
 static int swept_free(Walk *walk, Placement *p, Placement *q) {
     OdinMotionChecker *m = walk->m;
+    if (over(walk)) return 0;
     frames(walk, p);
     frames(walk, q);
     walk->counts[1]++;
@@ -495,7 +512,7 @@ static int swept_free(Walk *walk, Placement *p, Placement *q) {
 static int sweep_valid(Walk *walk, double t0, Placement *p, double t1, Placement *q,
                        Placement *spare, int depth, double *checked) {
     if (swept_free(walk, p, q)) return 1;
-    if (walk->error) return 0;
+    if (walk->error || walk->timed_out) return 0;
     if (max_bound(walk, p, q) <= walk->m->resolution) {
         if (t0 != 0.0 && t0 != *checked && !valid(walk, p)) return 0;
         if (t1 != 1.0 && !valid(walk, q)) return 0;
@@ -676,11 +693,13 @@ static int finite_controls(const OdinMotionChecker *m, const double *c) {
     return 1;
 }
 
-int odin_motion_valid(OdinMotionChecker *m, const double *a, const double *b, int *counts) {
+int odin_motion_valid(OdinMotionChecker *m, const double *a, const double *b, double deadline,
+                      int *counts) {
     if (!finite_controls(m, a) || !finite_controls(m, b)) return -3;
     Walk walk;
     Placement pool[MAX_SWEEP_DEPTH + 8];
     if (!walk_begin(&walk, m, a, b, counts, pool, MAX_SWEEP_DEPTH + 8)) return -2;
+    walk.deadline = deadline;
     Placement *here = &pool[0], *end = &pool[1];
     configure(&walk, a, here);
     configure(&walk, b, end);

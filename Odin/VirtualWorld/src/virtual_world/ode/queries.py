@@ -152,14 +152,17 @@ class MotionQuery:
         return ffi.cast(f"{kind} *", ffi.from_buffer(array))
 
     @drains_ode_messages
-    def motion_valid(self, a: Sequence[float], b: Sequence[float]) -> Tuple[int, int, int]:
+    def motion_valid(self, a: Sequence[float], b: Sequence[float], deadline: float = 0.0
+                     ) -> Tuple[int, int, int]:
         """(odin_motion_valid's answer: 1 free, 0 not, -1 a frame not fit for ODE, -2 out of
         memory, -3 a control not finite; configurations checked exactly; clearance queries)
-        for the segment a-b (``size`` floats each: TypeError, ValueError otherwise)."""
+        for the segment a-b (``size`` floats each: TypeError, ValueError otherwise), given up
+        (answered 0) once time.monotonic() passes ``deadline`` (0: never)."""
         self._set(self._a, a)
         self._set(self._b, b)
         self._counts[0] = self._counts[1] = 0
-        answer = lib.odin_motion_valid(self._struct, self._a, self._b, self._counts)
+        answer = lib.odin_motion_valid(self._struct, self._a, self._b, float(deadline),
+                                       self._counts)
         return int(answer), int(self._counts[0]), int(self._counts[1])
 
     @drains_ode_messages
