@@ -81,15 +81,10 @@ def _odin_solve(problem: str, seed: int, time_limit: float) -> dict:
     """One Odin run (in a child): the problem loaded and planned as ``solve_file`` does, its
     search (``time_s`` is the search's own), then, when solved, how deep its path goes
     (``deepest_along``, after the search, not timed)."""
-    from dataclasses import replace
-
-    from gui.core.kautham.problem import load_problem
-    from gui.core.translate import plan_problem
-    from gui.planning.geometric import GeometricSettings, deepest_along, solve
+    from gui.planning.geometric import deepest_along, load_plan, settings_of, solve
     logging.disable(logging.WARNING)
-    plan = plan_problem(load_problem(problem))
-    settings = replace(GeometricSettings.of_problem(plan), time_limit=time_limit)
-    result = solve(plan, settings, seed)
+    plan = load_plan(problem)
+    result = solve(plan, settings_of(plan, time_limit), seed)
     run = {"solved": bool(result.solved), "time_s": float(result.time_s),
            "planner": str(result.planner)}
     if result.solved:

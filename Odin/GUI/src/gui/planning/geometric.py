@@ -217,7 +217,8 @@ class _Checks:
         self.world = world
         self.over = over
         self.deadline = deadline
-        self.inverse_scales = [1.0 / float(x) for x in scales]
+        self.scales = [float(x) for x in scales]
+        self.inverse_scales = [1.0 / x for x in self.scales]
         self.error: Optional[BaseException] = None
         self.end_search: Callable[[], None] = _nothing
 
@@ -269,7 +270,7 @@ class _Search:
         size = checks.world.size
         self.space = ob.RealVectorStateSpace(size)
         bounds = ob.RealVectorBounds(size)
-        scales = [1.0 / x for x in checks.inverse_scales]
+        scales = checks.scales
         for i in range(size):           # control i in [0, 1], scaled
             bounds.setLow(i, 0.0)
             bounds.setHigh(i, scales[i])
@@ -456,24 +457,36 @@ def _simplify(og, search: _Search, over: Callable[[], bool]) -> None:
             break
 
 
-def solve_file(problem_file, seed: Optional[int] = None, time_limit: Optional[float] = None,
-               planner: Optional[str] = None) -> GeometricResult:
-    """``solve`` for a Kautham problem file, built as ``rosrun GUI load_problem`` builds it
-    (its warnings silenced); ``time_limit`` s and ``planner`` (OMPL's name) override the
-    problem's."""
+def load_plan(problem_file) -> BuildPlan:
+    """A Kautham problem file's plan, built as ``rosrun GUI load_problem`` builds it (its
+    warnings silenced)."""
     from gui.core.kautham.problem import load_problem
     from gui.core.translate import plan_problem
     logging.disable(logging.WARNING)
     try:
-        plan = plan_problem(load_problem(problem_file))
+        return plan_problem(load_problem(problem_file))
     finally:
         logging.disable(logging.NOTSET)
+
+
+def settings_of(plan: BuildPlan, time_limit: Optional[float] = None,
+                planner: Optional[str] = None) -> GeometricSettings:
+    """The problem's own settings (GeometricSettings.of_problem), ``time_limit`` s and
+    ``planner`` (OMPL's name) overriding them when given."""
     settings = GeometricSettings.of_problem(plan)
     if time_limit is not None:
         settings = replace(settings, time_limit=time_limit)
     if planner is not None:
         settings = replace(settings, planner=planner)
-    return solve(plan, settings, seed)
+    return settings
+
+
+def solve_file(problem_file, seed: Optional[int] = None, time_limit: Optional[float] = None,
+               planner: Optional[str] = None) -> GeometricResult:
+    """``solve`` for a Kautham problem file (``load_plan``); ``time_limit`` s and ``planner``
+    (OMPL's name) override the problem's."""
+    plan = load_plan(problem_file)
+    return solve(plan, settings_of(plan, time_limit, planner), seed)
 
 
 def deepest_along(plan: BuildPlan, path: np.ndarray, spacing: float = 0.001
@@ -542,4 +555,5 @@ def write_task(path, name: str, rows: Sequence[Sequence[float]]) -> None:
 
 __all__ = ["GEOMETRIC_PLANNERS", "NEAREST_PLANNERS", "OMPL_PLANNERS", "RESOLUTION",
            "GeometricResult", "GeometricSettings", "GeometricWorld", "Simplification",
-           "check_query", "query", "solve", "solve_file", "task_rows", "write_task"]
+           "check_query", "deepest_along", "load_plan", "query", "settings_of", "solve",
+           "solve_file", "task_rows", "write_task"]
