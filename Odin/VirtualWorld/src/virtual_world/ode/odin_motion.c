@@ -162,7 +162,8 @@ static void robot_frames(const OdinKinematicRobot *r, double *block, double *cha
         double q = 0.0;
         for (int j = 0; j < r->n_joints; ++j)
             if (r->joint_link[j] == i) q = joints[j];
-        double first = r->rotational[i] ? sin(q) : q, second = r->rotational[i] ? 1.0 - cos(q) : 0.0;
+        double first = r->rotational[i] ? sin(q) : q;
+        double second = r->rotational[i] ? 1.0 - cos(q) : 0.0;
         const double *A = r->fixed_part + 16 * i, *B = r->first_part + 16 * i,
                      *C = r->second_part + 16 * i;
         for (int k = 0; k < 16; ++k) local[k] = A[k] + first * B[k] + second * C[k];
@@ -239,10 +240,19 @@ static int frame_sane(const double *T, double extent) {
         if (!(fabs(T[4 * i + 3]) <= extent)) return 0;
     for (int i = 0; i < 3; ++i)
         for (int k = 0; k < 3; ++k) {
-            double dot = T[4 * i] * T[4 * k] + T[4 * i + 1] * T[4 * k + 1] + T[4 * i + 2] * T[4 * k + 2];
+            double dot = T[4 * i] * T[4 * k] + T[4 * i + 1] * T[4 * k + 1]
+                         + T[4 * i + 2] * T[4 * k + 2];
             if (!(fabs(dot - (i == k)) <= ORTHONORMAL_TOLERANCE)) return 0;
         }
     return 1;
+}
+
+/* Robot r's link frame at p when ODE may be shown it (frame_sane); else NULL, walk->error set. */
+static const double *checked_frame(Walk *walk, const Placement *p, int r, int link) {
+    const double *T = frame_of(walk->m, p, r, link);
+    if (frame_sane(T, walk->m->world->extent)) return T;
+    walk->error = 1;
+    return NULL;
 }
 
 /* Whether no moved link touches anything at p (the step's pairs); walk->error when a frame is
@@ -256,8 +266,8 @@ static int valid(Walk *walk, Placement *p) {
     for (int r = 0; r < m->n_robots; ++r) {
         const OdinKinematicRobot *robot = &m->robots[r];
         for (int k = 0; k < robot->n_moved; ++k, ++n) {
-            const double *T = frame_of(m, p, r, robot->moved[k]), *com = m->com + 3 * n;
-            if (!frame_sane(T, m->world->extent)) { walk->error = 1; return 0; }
+            const double *T = checked_frame(walk, p, r, robot->moved[k]), *com = m->com + 3 * n;
+            if (!T) return 0;
             double *pose = walk->bounds + 12 * n;
             for (int i = 0; i < 3; ++i) {
                 pose[i] = T[4 * i + 3] + T[4 * i] * com[0] + T[4 * i + 1] * com[1]
@@ -307,7 +317,11 @@ static void world_bound(const OdinKinematicRobot *r, int link, const double *T, 
 static double segment_distance(const double *p, const double *q) {
     const double tiny = 1e-18;
     double d1[3], d2[3], r[3];
-    for (int i = 0; i < 3; ++i) { d1[i] = p[3 + i] - p[i]; d2[i] = q[3 + i] - q[i]; r[i] = p[i] - q[i]; }
+    for (int i = 0; i < 3; ++i) {
+        d1[i] = p[3 + i] - p[i];
+        d2[i] = q[3 + i] - q[i];
+        r[i] = p[i] - q[i];
+    }
     double a = 0, e = 0, f = 0, c = 0, b = 0;
     for (int i = 0; i < 3; ++i) {
         a += d1[i] * d1[i]; e += d2[i] * d2[i]; f += d2[i] * r[i]; c += d1[i] * r[i];
@@ -341,8 +355,8 @@ static int clearances(Walk *walk, Placement *p, const double *needed) {
         const OdinKinematicRobot *robot = &m->robots[r];
         for (int k = 0; k < robot->n_moved; ++k, ++n) {
             int link = robot->moved[k];
-            const double *T = frame_of(m, p, r, link);
-            if (!frame_sane(T, m->world->extent)) { walk->error = 1; return 0; }
+            const double *T = checked_frame(walk, p, r, link);
+            if (!T) return 0;
             world_bound(robot, link, T, walk->bounds + ODIN_BOUND_VALUES * n);
             int reaching = 0;   /* tiers (descending) at least the need */
             while (reaching < m->n_tiers && m->tiers[reaching] >= needed[base + link]) ++reaching;
@@ -357,7 +371,8 @@ static int clearances(Walk *walk, Placement *p, const double *needed) {
     n = 0, base = 0;
     for (int r = 0; r < m->n_robots; ++r) {
         const OdinKinematicRobot *robot = &m->robots[r];
-        for (int k = 0; k < robot->n_moved; ++k) walk->obstacles[base + robot->moved[k]] = walk->out[n++];
+        for (int k = 0; k < robot->n_moved; ++k)
+            walk->obstacles[base + robot->moved[k]] = walk->out[n++];
         base += robot->n_links;
     }
     for (int i = 0; i < m->n_pairs; ++i) {
@@ -457,7 +472,8 @@ static void swept_box(const OdinKinematicRobot *r, int link, const double *Ta, c
         double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
         for (int n = 0; n < 16; ++n)
             for (int j = 0; j < 3; ++j) {
-                double x = points[n][0] * axes[j] + points[n][1] * axes[3 + j] + points[n][2] * axes[6 + j];
+                double x = points[n][0] * axes[j] + points[n][1] * axes[3 + j]
+                           + points[n][2] * axes[6 + j];
                 if (x < lo[j]) lo[j] = x;
                 if (x > hi[j]) hi[j] = x;
             }
@@ -491,11 +507,9 @@ static int swept_free(Walk *walk, Placement *p, Placement *q) {
         const OdinKinematicRobot *robot = &m->robots[r];
         for (int k = 0; k < robot->n_moved; ++k, ++n) {
             int link = robot->moved[k];
-            const double *Ta = frame_of(m, p, r, link), *Tb = frame_of(m, q, r, link);
-            if (!frame_sane(Ta, m->world->extent) || !frame_sane(Tb, m->world->extent)) {
-                walk->error = 1;
-                return 0;
-            }
+            const double *Ta = checked_frame(walk, p, r, link);
+            const double *Tb = checked_frame(walk, q, r, link);
+            if (!Ta || !Tb) return 0;
             swept_box(robot, link, Ta, Tb, walk->bounds + ODIN_BOUND_VALUES * n);
             walk->firsts[n] = 0;
         }
@@ -640,7 +654,8 @@ static int clearance_walk(Walk *walk, Placement *here, Placement *end, Placement
             walk->obstacles[i] = left > 0.0 ? left : 0.0;
         }
         for (int i = 0; i < m->n_pairs; ++i) {
-            double left = walk->gaps[i] - walk->moves[m->pairs[2 * i]] - walk->moves[m->pairs[2 * i + 1]];
+            double left = walk->gaps[i] - walk->moves[m->pairs[2 * i]]
+                          - walk->moves[m->pairs[2 * i + 1]];
             walk->gaps[i] = left > 0.0 ? left : 0.0;
         }
         /* here <- there (the placements swap buffers) */
@@ -670,7 +685,10 @@ static int walk_begin(Walk *walk, OdinMotionChecker *m, const double *a, const d
     int *firsts = malloc(((size_t)links + 1) * sizeof(int));
     if (!memory || !firsts) { free(memory); free(firsts); return 0; }
     double *cursor = memory;
-    for (int i = 0; i < placements; ++i, cursor += values) pool[i].values = cursor, pool[i].framed = 0;
+    for (int i = 0; i < placements; ++i, cursor += values) {
+        pool[i].values = cursor;
+        pool[i].framed = 0;
+    }
     *walk = (Walk){.m = m, .a = a, .b = b, .counts = counts, .firsts = firsts, .values = values};
     walk->controls = cursor; cursor += m->size;
     walk->dofs = cursor; cursor += dofs;
@@ -706,7 +724,8 @@ int odin_motion_valid(OdinMotionChecker *m, const double *a, const double *b, do
     int answer;
     if (sweeps(&walk, here, end)) {
         double checked = 0.0;
-        answer = valid(&walk, end) && sweep_valid(&walk, 0.0, here, 1.0, end, &pool[2], 0, &checked);
+        answer = valid(&walk, end)
+                 && sweep_valid(&walk, 0.0, here, 1.0, end, &pool[2], 0, &checked);
     } else {
         answer = probes_valid(&walk, here, end, &pool[2])
                  && clearance_walk(&walk, here, end, &pool[2]);
