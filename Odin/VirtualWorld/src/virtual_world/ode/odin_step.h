@@ -348,7 +348,8 @@ typedef struct OdinMotionChecker {
  * collision-free (odin_motion.c), 0 when not, -1 when a configuration on it puts a link beyond
  * the world's extent or a frame is not a rigid transform (nothing shown to ODE), -2 out of
  * memory, -3 a control not finite (a and b: m->size values each). deadline: CLOCK_MONOTONIC
- * seconds (Python's time.monotonic) after which the walk stops and answers 0 (0: none). counts[0] += configurations checked exactly, counts[1] += clearance queries. */
+ * seconds (Python's time.monotonic) after which the walk stops and answers 0 (0: none).
+ * counts[0] += configurations checked exactly, counts[1] += clearance queries. */
 int odin_motion_valid(OdinMotionChecker *m, const double *a, const double *b, double deadline,
                       int *counts);
 /* The same for one configuration c: 1 when no moved link touches anything, 0 when one does,
