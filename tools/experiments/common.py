@@ -399,6 +399,21 @@ class Session:
         quats = np.array([q for _, (_, q) in rows]).reshape(-1, 4)
         return times, positions, quats
 
+    def trajectories(self, *names: str) -> tuple:
+        """(times (n,), {name: (positions (n, 3), quaternions (n, 4))}) of tracked geometries
+        at the times every one of them was published: a world update sent between two Build
+        Object calls (a paused world publishes at its rate) holds the first geometry and not
+        the second, so their own trajectories can differ by a sample, and pairing them index
+        by index would compare poses from different cycles."""
+        with self.record.lock:
+            rows = [(t, poses) for t, poses in sorted(self.record.poses.items())
+                    if all(name in poses for name in names)]
+        times = np.array([t for t, _ in rows])
+        poses = {name: (np.array([p[name][0] for _, p in rows]).reshape(-1, 3),
+                        np.array([p[name][1] for _, p in rows]).reshape(-1, 4))
+                 for name in names}
+        return times, poses
+
 
 # -- tracked execution, cycle by cycle ---------------------------------------------------------
 def session_tracking_port(session: Session, frame_every: int = 0):

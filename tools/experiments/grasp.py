@@ -470,10 +470,9 @@ def release(t: np.ndarray, drift: np.ndarray, can_z: np.ndarray, bottom: np.ndar
 
 def analyse(s: "common.Session", phases: dict) -> dict:
     from odin_common.rotations import quaternion_to_matrix
-    t, can, can_q = s.trajectory(CAN)
-    tp, palm, palm_q = s.trajectory(PALM)
-    n = min(len(t), len(tp))
-    t, can, can_q, palm, palm_q = t[:n], can[:n], can_q[:n], palm[:n], palm_q[:n]
+    t, poses = s.trajectories(CAN, PALM)
+    (can, can_q), (palm, palm_q) = poses[CAN], poses[PALM]
+    n = len(t)
     # the can's centre in the palm's frame
     rel = np.array([quaternion_to_matrix(q).T @ (c - p) for c, p, q in zip(can, palm, palm_q)])
     carried = (t >= phases["carry"]) & (t < phases["open"])
