@@ -105,3 +105,10 @@ def test_a_problem_in_neither_corpus_is_skipped_in_one_line(monkeypatch, tmp_pat
     assert bench_geometric.problems() == {"ur5": ur5}
     out = capsys.readouterr().out
     assert out.count("\n") == 1 and "maze skipped" in out
+
+
+def test_kauthams_checked_paths_give_their_deepest_figure_beside_odins():
+    kautham = [Attempt(True, 0.6, "", 0.488), Attempt(True, 0.7, "", 0.0), Attempt(False, 1.0)]
+    figures = figures_of("p", 1.0, kautham, _runs(0.1))
+    assert figures["geo_p_kautham_deepest_mm"] == 0.488
+    assert figures["geo_p_deepest_mm"] == 0.0

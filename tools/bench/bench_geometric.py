@@ -18,6 +18,10 @@ Per problem P (PROBLEMS' slugs):
                                 checked after its search (not timed) at DEEPEST_SPACING along
                                 every segment (gui.planning.geometric.deepest_along; goal
                                 <= 1: half the search's 2 mm resolution, issue 43)
+  geo_P_kautham_deepest_mm      the same for Kautham's solved paths (its task files read back
+                                as controls: gui.planning.geometric.path_of_solution), when
+                                Odin is here to check them; not a goal, what Kautham's own
+                                motion checks let through
 A side that solved no run has the time limit as its median: a bound, not a time. A run that
 gave no answer (Kautham could not load the problem, Odin raised) refuses that side's figures
 and the comparisons (report.Refused, with the first reason). Without the peer built (`make
@@ -101,11 +105,33 @@ def _odin(problem: pathlib.Path, seed: int, time_limit: float) -> dict:
         return {"error": str(error)}
 
 
-def _kautham(problem: pathlib.Path, seed: int, time_limit: float, out_dir: pathlib.Path) -> dict:
+def _kautham(problem: pathlib.Path, seed: int, time_limit: float, out_dir: pathlib.Path,
+             with_odin: bool = True) -> dict:
+    """One Kautham run; when solved (and Odin is here to check it), how deep its path goes
+    on the problem's geometry, as Odin's paths are checked (``deepest_mm``, or
+    ``deepest_error`` when Odin cannot read the path back as controls)."""
     run = kautham_peer.solve(problem, seed, time_limit, out_dir)
-    return {"solved": run.solved, "time_s": run.wall_s, "planner": run.planner,
+    said = {"solved": run.solved, "time_s": run.wall_s, "planner": run.planner,
             "states": run.states, "returncode": run.returncode, "error": run.error,
             "task_file": str(run.task_file) if run.task_file else None}
+    if run.solved and run.task_file and with_odin:
+        try:
+            said.update(in_child(_path_depth, str(problem), str(run.task_file)))
+        except RuntimeError as error:
+            said["deepest_error"] = str(error).splitlines()[-1] if str(error) else "failed"
+    return said
+
+
+def _path_depth(problem: str, task_file: str) -> dict:
+    """(in a child) How deep the path of ``task_file`` goes into anything, checked as
+    ``_odin_solve`` checks Odin's (gui.planning.geometric.path_of_solution, deepest_along)."""
+    from gui.core.kautham.solutions import read_solution
+    from gui.planning.geometric import deepest_along, load_plan, path_of_solution
+    logging.disable(logging.WARNING)
+    plan = load_plan(problem)
+    path = path_of_solution(plan, read_solution(task_file, plan.problem))
+    deepest, pair = deepest_along(plan, path, DEEPEST_SPACING)
+    return {"deepest_mm": deepest * 1000, "deepest_pair": " into ".join(pair) if pair else None}
 
 
 def attempts(runs: List[dict]) -> List[Attempt]:
@@ -142,6 +168,8 @@ def figures_of(slug: str, limit_s: float, kautham: Optional[List[Attempt]],
             figures.update(_side(prefix, runs, limit_s))
     if odin:
         figures[f"geo_{slug}_deepest_mm"] = _deepest(odin)
+    if kautham and any(r.deepest_mm is not None for r in kautham):
+        figures[f"geo_{slug}_kautham_deepest_mm"] = _deepest(kautham)
     if not (kautham and odin):
         return figures
     k_success, o_success = figures[f"geo_{slug}_kautham_success"], figures[f"geo_{slug}_success"]
@@ -186,7 +214,7 @@ def side_by_side(problem: pathlib.Path, limit_s: float, with_kautham: bool, with
     for seed in range(1, SEEDS + 1):
         for side in (("kautham", "odin") if seed % 2 else ("odin", "kautham")):
             if side == "kautham" and with_kautham:
-                runs[side].append(_kautham(problem, seed, limit_s, out_dir))
+                runs[side].append(_kautham(problem, seed, limit_s, out_dir, with_odin))
             elif side == "odin" and with_odin:
                 runs[side].append(_odin(problem, seed, limit_s))
         print(f"    seed {seed}: " + ", ".join(

@@ -515,6 +515,61 @@ def deepest_along(plan: BuildPlan, path: np.ndarray, spacing: float = 0.001
     return deepest, pair
 
 
+PATH_MATCH = 1e-6
+"""rad or m: how far a configuration of a path file may be from the one its controls give
+(``path_of_solution``)."""
+
+
+def path_of_solution(plan: BuildPlan, solution) -> np.ndarray:
+    """The control vectors (n, k) of a path file read for ``plan``'s problem
+    (gui.core.kautham.solutions.Solution: a Kautham task file, as Kautham's GUI or ``plan``
+    writes it): per waypoint, the controls that put every robot in its configuration (least
+    squares over ``PlannedRobot.control_equations``), so that ``deepest_along`` checks the
+    path as the search would have moved. PlanningError when a robot of the problem has no
+    path in the file, or a waypoint is no configuration of the control space (farther than
+    PATH_MATCH from the one its controls give, e.g. a joint no control moves away from its
+    fixed value)."""
+    robots = planned_robots(plan)
+    size = max(r.part.stop or r.handle.instance.controls.size for r in robots)
+    missing = [r.handle.name for r in robots if r.handle.name not in solution.paths]
+    if missing:
+        raise PlanningError(f"{solution.source}: no path for robot {missing[0]}")
+    counts = {len(solution.paths[r.handle.name].joints) for r in robots}
+    if len(counts) != 1:
+        raise PlanningError(f"{solution.source}: the robots' paths differ in length")
+    path = []
+    for k in range(counts.pop()):
+        wanted = [(_waypoint_base(r, solution.paths[r.handle.name], k),
+                   solution.paths[r.handle.name].joints[k]) for r in robots]
+        equations = [r.control_equations(base, joints, size)
+                     for r, (base, joints) in zip(robots, wanted)]
+        a = np.vstack([e[0] for e in equations])
+        b = np.concatenate([e[1] for e in equations])
+        controls = np.linalg.lstsq(a, b, rcond=None)[0]
+        _check_waypoint(solution, robots, controls, wanted, k)
+        path.append(controls)
+    return np.array(path).reshape(-1, size)
+
+
+def _waypoint_base(robot, waypoints, k: int) -> np.ndarray:
+    """The robot's base pose at waypoint k: the file's, or its home when the file has none."""
+    if waypoints.base_poses is None:
+        return robot.handle.instance.base_pose
+    return waypoints.base_poses[k]
+
+
+def _check_waypoint(solution, robots, controls: np.ndarray, wanted, k: int) -> None:
+    for robot, (base, joints) in zip(robots, wanted):
+        got_base, got_joints = robot.configuration(controls)
+        off = max(float(np.max(np.abs(got_joints - joints), initial=0.0)),
+                  float(np.max(np.abs(got_base[:3, 3] - base[:3, 3]))))
+        if off > PATH_MATCH:
+            line = solution.paths[robot.handle.name].lines[k]
+            raise PlanningError(f"{solution.source}:{line}: robot {robot.handle.name}'s "
+                                f"configuration is {off:.3g} from any of the problem's "
+                                "control space")
+
+
 def task_rows(plan: BuildPlan, path: np.ndarray) -> List[List[float]]:
     """Each state of ``path`` as a Kautham task file's ``<Conf>`` row: per robot in the
     problem's order, for one whose controls move its base its position x y z (m, world) and

@@ -128,6 +128,34 @@ class PlannedRobot:
             squares[columns] += np.sum((matrix[3:6] * ROTATION_PER_UNIT) ** 2, axis=0)
         return squares
 
+    def control_equations(self, base_pose, joints, size: int) -> Tuple[np.ndarray, np.ndarray]:
+        """(A (m, size), b (m,)): the linear equations ``A c = b`` a control vector c meets
+        when ``configuration(c)`` is (``base_pose`` (4, 4) world, ``joints`` rad or m of the
+        movable links), unclamped: a row per joint and, for a base the controls move, per
+        coordinate of its position. PlanningError for a base the controls turn (its
+        orientation is not linear in them)."""
+        matrix = self.handle.instance.controls.matrix
+        offset = self.handle.instance.controls.offset
+        columns = np.arange(size)[self.part]
+        span = self._joint_span[:, None]
+        rows = [(span * matrix[self._dof_of_joint],
+                 np.asarray(joints, dtype=float) - self._joint_low
+                 - self._joint_span * (offset[self._dof_of_joint]
+                                       - 0.5 * matrix[self._dof_of_joint].sum(axis=1)))]
+        if self.moves_base:
+            if self._base_turns:
+                raise PlanningError(f"robot {self.handle.name}: a path that turns its base is "
+                                    "not read as controls")
+            home = self.handle.instance.base_pose
+            local = home[:3, :3].T @ (np.asarray(base_pose, dtype=float)[:3, 3] - home[:3, 3])
+            box = self._base_box
+            sides = (box[:, 1] - box[:, 0])[:, None]
+            rows.append((sides * matrix[:3], local - box[:, 0] - sides[:, 0]
+                         * (offset[:3] - 0.5 * matrix[:3].sum(axis=1))))
+        a = np.zeros((sum(len(r) for r, _ in rows), size))
+        a[:, columns] = np.vstack([r for r, _ in rows])
+        return a, np.concatenate([b for _, b in rows])
+
     def configuration(self, controls: np.ndarray):
         """(base pose (4, 4), joint values) the control vector puts this robot in."""
         instance = self.handle.instance
