@@ -13,6 +13,18 @@ ODE's collision detection, no contacts made, nothing stepped (gui.planning.geome
 which says how clearances and the resolution guarantee it; the robots and their bounds:
 gui.planning.geometric_robots).
 
+The problem's planner runs as OMPL runs it, with one difference a user can turn off
+(``GeometricSettings.restarts``): a tree planner that finds no path (RESTARTED_PLANNERS) is
+cleared and started again, in rounds. An RRT's goal bias keeps extending the tree's node
+nearest the goal; when that node sits behind an obstacle, the tree can grow for ever without
+reaching the goal (Kautham's UR5 demo: 4 seeds in 10 never solved in 30 s, the others in a
+fifth of a second). RRT's solve times are heavy-tailed, and restarts cut the tail (Wedge and
+Branicky, "On heavy-tailed runtimes and restarts in rapidly-exploring random trees", 2008).
+Round r ends after RESTART_MOTIONS x luby(r) motion checks (Luby's sequence 1 1 2 1 1 2 4 ...,
+within a logarithmic factor of the best fixed budget whatever the problem), so a seed's rounds
+are the same on any machine: only the time limit depends on the machine's speed. The next round
+draws from the same random stream.
+
 ``solve(plan, settings)`` answers a ``GeometricResult``; ``solve_file(problem_file, ...)``
 loads and plans a Kautham file first.
 """
@@ -50,6 +62,13 @@ one warning)."""
 OMPL_PLANNERS = ("RRTConnect", "RRT", "RRTstar", "PRM", "PRMstar", "KPIECE1", "BKPIECE1",
                  "LBKPIECE1", "FMT", "BITstar")
 """The geometric planners ``--planner`` may name (OMPL's class names)."""
+RESTARTED_PLANNERS = ("RRTConnect", "RRT", "KPIECE1", "BKPIECE1", "LBKPIECE1")
+"""The planners a search restarts (module docstring): trees for one query that stop at their
+first path. A roadmap (PRM) is kept for the queries after, an optimizing planner (RRT*, FMT,
+BIT*) improves its path until the time limit: neither is restarted."""
+RESTART_MOTIONS = 3000
+"""Motion checks of a search's round per unit of Luby's sequence (module docstring): about what
+Kautham's UR5 demo takes when it solves."""
 DEFAULT_TIME_LIMIT = 10.0
 """s: a search's time when the problem gives none (Kautham's default _Max Planning Time)."""
 RESOLUTION_RANGE = (1e-4, 0.1)
@@ -87,13 +106,15 @@ class GeometricSettings:
     as in Kautham), ``range`` (Kautham's Range: the longest motion a tree
     extends by, in control-space units; None: OMPL's default), ``goal_bias`` (None: OMPL's),
     ``simplify`` (Kautham's Simplify Solution: ``Simplification``),
-    ``resolution`` m (module docstring)."""
+    ``resolution`` m (module docstring), ``restarts``: a planner of RESTARTED_PLANNERS that
+    finds no path is started again (module docstring; False: one round, as OMPL runs it)."""
     planner: str = "RRTConnect"
     time_limit: float = DEFAULT_TIME_LIMIT
     range: Optional[float] = None
     goal_bias: Optional[float] = None
     simplify: int = 2           # Simplification.SHORTEN, Kautham's default
     resolution: float = RESOLUTION
+    restarts: bool = True
 
     @classmethod
     def of_problem(cls, plan: BuildPlan) -> "GeometricSettings":
@@ -143,7 +164,8 @@ class GeometricResult:
     from ``checks``, the configurations checked exactly; ``unsimplified_states``: the states
     of the path the planner found, before simplification (OMPL's solution segments + 1);
     ``scales``: per control, the search's scale (Kautham's metric: control_scales; None: 1),
-    which its lengths, Range and interpolation are measured in."""
+    which its lengths, Range and interpolation are measured in; ``rounds``: the planner's
+    rounds (module docstring: restarts), the last one's graph and status reported."""
     planner: str
     seed: Optional[int]
     solved: bool
@@ -158,6 +180,7 @@ class GeometricResult:
     clearance_checks: int = 0
     unsimplified_states: int = 0
     scales: Optional[np.ndarray] = None
+    rounds: int = 1
 
     @property
     def states(self) -> int:
@@ -176,7 +199,7 @@ class GeometricResult:
                 "clearance_checks": self.clearance_checks,
                 "unsimplified_states": self.unsimplified_states,
                 "control_scales": None if self.scales is None else
-                [round(float(x), 9) for x in self.scales]}
+                [round(float(x), 9) for x in self.scales], "rounds": self.rounds}
 
 
 def query(plan: BuildPlan) -> Tuple[np.ndarray, np.ndarray]:
@@ -221,10 +244,13 @@ class _Checks:
         self.inverse_scales = [1.0 / x for x in self.scales]
         self.error: Optional[BaseException] = None
         self.end_search: Callable[[], None] = _nothing
+        self.motions = 0
+        self.budget = math.inf
 
     def _ended(self) -> bool:
-        """Whether the search is over (then its planner is told to end)."""
-        if self.over():
+        """Whether the search, or its round (``budget`` motion checks), is over (then its
+        planner is told to end)."""
+        if self.over() or self.motions >= self.budget:
             self.end_search()
             return True
         return False
@@ -246,6 +272,7 @@ class _Checks:
             return False
 
     def motion(self, s1, s2) -> bool:
+        self.motions += 1
         try:
             return not self._ended() and self.world.motion_valid(
                 self.controls(s1), self.controls(s2), self.over, self.deadline())
@@ -348,7 +375,9 @@ def _search(world: GeometricWorld, settings: GeometricSettings, start, goal, see
     clock = _Clock(time.monotonic() + settings.time_limit, stop)
     checks = _Checks(world, clock.over, scales, lambda: clock.deadline)
     clock.checks = checks
-    found = _run(_Search(checks, settings, start, goal), settings.simplify, clock)
+    search = _Search(checks, settings, start, goal)
+    found = _rounds(search, settings, clock)
+    del search
     # the search's OMPL objects are gone here, before anything is raised: a traceback holding
     # them would keep them to the interpreter's end
     if stop is not None and stop():
@@ -361,7 +390,7 @@ def _search(world: GeometricWorld, settings: GeometricSettings, start, goal, see
                            _length(found.unsimplified, scales),
                            found.simplify_s, found.graph_states,
                            world.clearance_checks - clearances_before, len(found.unsimplified),
-                           np.asarray(scales, dtype=float))
+                           np.asarray(scales, dtype=float), found.rounds)
 
 
 class _Clock:
@@ -401,6 +430,33 @@ class _Found(NamedTuple):
     unsimplified: np.ndarray
     simplify_s: float
     graph_states: int
+    rounds: int = 1
+
+
+def luby(index: int) -> int:
+    """Luby's sequence (1 1 2 1 1 2 4 1 1 2 1 1 2 4 8 ...) at ``index`` (from 0)."""
+    i = index + 1
+    while True:
+        k = i.bit_length()
+        if i == (1 << k) - 1:
+            return 1 << (k - 1)
+        i -= (1 << (k - 1)) - 1
+
+
+def _rounds(search: _Search, settings: GeometricSettings, clock: _Clock) -> _Found:
+    """The search's rounds (module docstring: restarts) until one finds a path, the clock is
+    over, or a callback failed; one round for a planner not restarted."""
+    restarted = settings.restarts and settings.planner in RESTARTED_PLANNERS
+    checks = search.checks
+    rounds = 0
+    while True:
+        checks.motions = 0
+        checks.budget = RESTART_MOTIONS * luby(rounds) if restarted else math.inf
+        found = _run(search, settings.simplify, clock)
+        rounds += 1
+        if len(found.path) or not restarted or clock.over() or checks.motions < checks.budget:
+            return found._replace(rounds=rounds)
+        search.setup.clear()        # the planner's trees and the problem's approximate paths
 
 
 def _run(search: _Search, simplify: int, clock: _Clock) -> _Found:

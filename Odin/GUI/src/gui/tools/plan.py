@@ -59,7 +59,8 @@ class PlanRequest:
     the pool's namespaces, comma-separated, each waited for ``world_timeout`` s.
     ``goal_tolerance`` (m), ``min_control_steps``, ``max_control_steps``: a control search's
     settings (None: the problem's, ``gui.planning.problem.SearchSettings``); ``resolution``
-    (m): a geometric search's (None: ``gui.planning.geometric.RESOLUTION``). ``planner``:
+    (m): a geometric search's (None: ``gui.planning.geometric.RESOLUTION``), ``restarts``
+    too (gui.planning.geometric: a tree planner that finds no path started again). ``planner``:
     None, the problem's (a control search's: KPIECE1). ``out``: the file to write, as
     ``format`` says (a geometric plan), its states interpolated as Kautham does unless not
     ``interpolate``. ``execute``: run the plan in the running world once written, as
@@ -80,6 +81,7 @@ class PlanRequest:
     max_control_steps: Optional[int] = None
     parallel: int = 1
     resolution: Optional[float] = None
+    restarts: bool = True
     format: OutputFormat = OutputFormat.KAUTHAM
     interpolate: bool = True
     execute: bool = False
@@ -203,7 +205,8 @@ def _geometric_search(request: PlanRequest, build_plan, stop) -> GeometricOutcom
     settings = replace(settings, planner=request.planner or settings.planner,
                        time_limit=request.time if request.time is not None
                        else settings.time_limit,
-                       resolution=request.resolution or RESOLUTION)
+                       resolution=request.resolution or RESOLUTION,
+                       restarts=request.restarts)
     seed = request.seed if request.seed is not None else _fresh_seed(1)
     print(f"plan: {settings.planner} searching for up to {settings.time_limit:g} s, seed "
           f"{seed} (--seed {seed} repeats it)", flush=True)
@@ -229,6 +232,7 @@ def search(request: PlanRequest, stop: Callable[[], bool]):
     if not build_plan.physics:
         return _geometric_search(request, build_plan, stop)
     for option, given in (("--resolution", request.resolution is not None),
+                          ("--no-restarts", not request.restarts),
                           ("--format ompl", request.format is OutputFormat.OMPL),
                           ("--no-interpolate", not request.interpolate)):
         if given:
@@ -359,6 +363,10 @@ def _parser() -> ToolParser:
                         help="a geometric search: no link moves more than M between two "
                         "checked configurations of a motion, so none goes deeper than M/2 "
                         f"into anything [{RESOLUTION}]")
+    parser.add_argument("--no-restarts", dest="restarts", action="store_false",
+                        help="a geometric search: run the planner once, as OMPL and Kautham "
+                        "do [an RRT, RRTConnect or KPIECE search that finds no path is "
+                        "cleared and started again, in rounds of growing length]")
     _output_options(parser)
     add_build_options(parser)
     return parser
@@ -394,7 +402,7 @@ def _request(args) -> PlanRequest:
         world_timeout=args.world_timeout, robot=args.robot,
         goal_tolerance=args.goal_tolerance, min_control_steps=args.min_control_steps,
         max_control_steps=args.max_control_steps, parallel=args.parallel,
-        resolution=args.resolution, format=OutputFormat(args.format),
+        resolution=args.resolution, restarts=args.restarts, format=OutputFormat(args.format),
         interpolate=args.interpolate, execute=args.execute, from_here=args.from_here,
         real_time=not args.fast)
 
