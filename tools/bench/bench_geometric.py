@@ -124,12 +124,18 @@ def _kautham(problem: pathlib.Path, seed: int, time_limit: float, out_dir: pathl
 
 def _path_depth(problem: str, task_file: str) -> dict:
     """(in a child) How deep the path of ``task_file`` goes into anything, checked as
-    ``_odin_solve`` checks Odin's (gui.planning.geometric.path_of_solution, deepest_along)."""
+    ``_odin_solve`` checks Odin's (gui.planning.geometric.path_of_solution, deepest_along);
+    ``deepest_error`` when the path cannot be read as the problem's (Kautham writes the chess
+    gripper's mimic joints outside their limits)."""
     from gui.core.kautham.solutions import read_solution
+    from gui.errors import GuiError
     from gui.planning.geometric import deepest_along, load_plan, path_of_solution
     logging.disable(logging.WARNING)
     plan = load_plan(problem)
-    path = path_of_solution(plan, read_solution(task_file, plan.problem))
+    try:
+        path = path_of_solution(plan, read_solution(task_file, plan.problem))
+    except GuiError as error:
+        return {"deepest_error": str(error)}
     deepest, pair = deepest_along(plan, path, DEEPEST_SPACING)
     return {"deepest_mm": deepest * 1000, "deepest_pair": " into ".join(pair) if pair else None}
 

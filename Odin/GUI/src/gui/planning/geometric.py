@@ -56,6 +56,11 @@ NEAREST_PLANNERS = {
     "omplRRTStarPMD": "RRTstar", "omplLazyRRT": "RRT", "omplpRRT": "RRT", "omplEST": "KPIECE1",
     "omplSBL": "LBKPIECE1", "omplpSBL": "LBKPIECE1", "omplLazyPRM": "PRM",
     "omplTRRT": "RRT", "omplRRTConnectPMD": "RRTConnect",
+    # Kautham's own samplers and costs (synergies, PCA, "first-order synergy" upstream
+    # criteria) over OMPL's trees, and Kautham 2012's roadmaps: the same family of planner
+    "omplFOSRRTStar": "RRTstar", "omplFOSVFRRT": "RRT",
+    "PRMPCA HandArm": "PRM", "PRMAURO HandArm": "PRM", "PRM RobotHand ICRA J": "PRM",
+    "DRM": "PRM",
 }
 """Kautham's geometric planners that OMPL's Python wheel lacks, and the nearest it has (said in
 one warning)."""
