@@ -112,7 +112,12 @@ class GeometricSettings:
     extends by, in control-space units; None: OMPL's default), ``goal_bias`` (None: OMPL's),
     ``simplify`` (Kautham's Simplify Solution: ``Simplification``),
     ``resolution`` m (module docstring), ``restarts``: a planner of RESTARTED_PLANNERS that
-    finds no path is started again (module docstring; False: one round, as OMPL runs it)."""
+    finds no path is started again (module docstring; False: one round, as OMPL runs it).
+    A PRM's neighbour settings (None: OMPL's): ``max_neighbours`` (Kautham's
+    MaxNearestNeighbors, 2012's Max. Neighs: the k nearest milestones a new one is connected
+    to), ``neighbour_distance`` (DistanceThreshold, 2012's Neigh Thresshold: no connection
+    or roadmap expansion longer than this, in the search's metric), ``max_samples`` (2012's
+    Max. Samples: the search ends, unsolved, once it has tried this many samples)."""
     planner: str = "RRTConnect"
     time_limit: float = DEFAULT_TIME_LIMIT
     range: Optional[float] = None
@@ -120,6 +125,9 @@ class GeometricSettings:
     simplify: int = 2           # Simplification.SHORTEN, Kautham's default
     resolution: float = RESOLUTION
     restarts: bool = True
+    max_neighbours: Optional[int] = None
+    neighbour_distance: Optional[float] = None
+    max_samples: Optional[int] = None
 
     @classmethod
     def of_problem(cls, plan: BuildPlan) -> "GeometricSettings":
@@ -138,7 +146,18 @@ class GeometricSettings:
         given = dict(planner.geometric)
         return cls(planner=name, time_limit=given.get("time_limit", DEFAULT_TIME_LIMIT),
                    range=given.get("range"), goal_bias=given.get("goal_bias"),
-                   simplify=Simplification.of_kautham(given.get("simplify")))
+                   simplify=Simplification.of_kautham(given.get("simplify")),
+                   max_neighbours=given.get("max_neighbours"),
+                   neighbour_distance=given.get("neighbour_distance"),
+                   max_samples=given.get("max_samples"))
+
+    def roadmap(self) -> Tuple[float, float]:
+        """(the longest motion a PRM search tries, in the search's metric; the samples it
+        may try): inf for what is not given, and for a planner other than PRM."""
+        if self.planner != "PRM":
+            return math.inf, math.inf
+        return (self.neighbour_distance if self.neighbour_distance is not None else math.inf,
+                self.max_samples if self.max_samples is not None else math.inf)
 
     def check(self) -> None:
         if self.planner not in OMPL_PLANNERS:
@@ -148,6 +167,14 @@ class GeometricSettings:
             raise PlanningError(f"time {self.time_limit!r} s must be positive")
         if self.range is not None and not (math.isfinite(self.range) and self.range > 0):
             raise PlanningError(f"Range {self.range!r} must be positive")
+        for name in ("max_neighbours", "max_samples"):
+            value = getattr(self, name)
+            if value is not None and not (isinstance(value, int) and value >= 1):
+                raise PlanningError(f"{name} {value!r} must be a whole number >= 1")
+        if self.neighbour_distance is not None and not (
+                math.isfinite(self.neighbour_distance) and self.neighbour_distance > 0):
+            raise PlanningError(f"neighbour distance {self.neighbour_distance!r} must be "
+                                "positive")
         low, high = RESOLUTION_RANGE
         if not (math.isfinite(self.resolution) and low <= self.resolution <= high):
             raise PlanningError(f"resolution {self.resolution!r} m must be in [{low:g}, "
@@ -170,7 +197,9 @@ class GeometricResult:
     of the path the planner found, before simplification (OMPL's solution segments + 1);
     ``scales``: per control, the search's scale (Kautham's metric: control_scales; None: 1),
     which its lengths, Range and interpolation are measured in; ``rounds``: the planner's
-    rounds (module docstring: restarts), the last one's graph and status reported."""
+    rounds (module docstring: restarts), the last one's graph and status reported;
+    ``samples``: the configurations the planner asked about (each a sample tried);
+    ``out_of_samples``: the search ended at its Max. Samples (GeometricSettings)."""
     planner: str
     seed: Optional[int]
     solved: bool
@@ -186,6 +215,8 @@ class GeometricResult:
     unsimplified_states: int = 0
     scales: Optional[np.ndarray] = None
     rounds: int = 1
+    samples: int = 0
+    out_of_samples: bool = False
 
     @property
     def states(self) -> int:
@@ -204,7 +235,8 @@ class GeometricResult:
                 "clearance_checks": self.clearance_checks,
                 "unsimplified_states": self.unsimplified_states,
                 "control_scales": None if self.scales is None else
-                [round(float(x), 9) for x in self.scales], "rounds": self.rounds}
+                [round(float(x), 9) for x in self.scales], "rounds": self.rounds,
+                "samples": self.samples, "out_of_samples": self.out_of_samples}
 
 
 def query(plan: BuildPlan) -> Tuple[np.ndarray, np.ndarray]:
@@ -251,11 +283,14 @@ class _Checks:
         self.end_search: Callable[[], None] = _nothing
         self.motions = 0
         self.budget = math.inf
+        self.samples = 0
+        self.max_samples = math.inf
+        self.longest = math.inf
 
     def _ended(self) -> bool:
-        """Whether the search, or its round (``budget`` motion checks), is over (then its
-        planner is told to end)."""
-        if self.over() or self.motions >= self.budget:
+        """Whether the search, or its round (``budget`` motion checks), is over, or it has
+        tried ``max_samples`` samples (then its planner is told to end)."""
+        if self.over() or self.motions >= self.budget or self.samples >= self.max_samples:
             self.end_search()
             return True
         return False
@@ -269,15 +304,24 @@ class _Checks:
     def vector(self, state) -> np.ndarray:
         return np.array(self.controls(state))
 
+    def _length(self, s1, s2) -> float:
+        """A motion's length in the search's metric (OMPL's coordinates are scaled)."""
+        return math.sqrt(sum((s1[i] - s2[i]) ** 2 for i in range(len(self.scales))))
+
     def valid(self, state) -> bool:
         try:
-            return not self._ended() and self.world.valid(self.controls(state))
+            if self._ended():
+                return False
+            self.samples += 1
+            return self.world.valid(self.controls(state))
         except BaseException as error:      # noqa: B902 - raised by solve()
             self.error = self.error or error
             return False
 
     def motion(self, s1, s2) -> bool:
         self.motions += 1
+        if self.longest < math.inf and self._length(s1, s2) > self.longest:
+            return False            # a PRM's neighbour distance: not tried (GeometricSettings)
         try:
             return not self._ended() and self.world.motion_valid(
                 self.controls(s1), self.controls(s2), self.over, self.deadline())
@@ -321,6 +365,8 @@ class _Search:
             self.planner.setRange(settings.range)
         if settings.goal_bias is not None and hasattr(self.planner, "setGoalBias"):
             self.planner.setGoalBias(settings.goal_bias)
+        if settings.max_neighbours is not None and settings.planner == "PRM":
+            self.planner.setMaxNearestNeighbors(settings.max_neighbours)
         self.setup.setPlanner(self.planner)
         self.setup.setup()
 
@@ -395,7 +441,8 @@ def _search(world: GeometricWorld, settings: GeometricSettings, start, goal, see
                            _length(found.unsimplified, scales),
                            found.simplify_s, found.graph_states,
                            world.clearance_checks - clearances_before, len(found.unsimplified),
-                           np.asarray(scales, dtype=float), found.rounds)
+                           np.asarray(scales, dtype=float), found.rounds, found.samples,
+                           found.out_of_samples and not len(found.path))
 
 
 class _Clock:
@@ -436,6 +483,8 @@ class _Found(NamedTuple):
     simplify_s: float
     graph_states: int
     rounds: int = 1
+    samples: int = 0
+    out_of_samples: bool = False
 
 
 def luby(index: int) -> int:
@@ -453,6 +502,7 @@ def _rounds(search: _Search, settings: GeometricSettings, clock: _Clock) -> _Fou
     over, or a callback failed; one round for a planner not restarted."""
     restarted = settings.restarts and settings.planner in RESTARTED_PLANNERS
     checks = search.checks
+    checks.longest, checks.max_samples = settings.roadmap()
     rounds = 0
     while True:
         checks.motions = 0
@@ -460,7 +510,8 @@ def _rounds(search: _Search, settings: GeometricSettings, clock: _Clock) -> _Fou
         found = _run(search, settings.simplify, clock)
         rounds += 1
         if len(found.path) or not restarted or clock.over() or checks.motions < checks.budget:
-            return found._replace(rounds=rounds)
+            return found._replace(rounds=rounds, samples=checks.samples,
+                                  out_of_samples=checks.samples >= checks.max_samples)
         search.setup.clear()        # the planner's trees and the problem's approximate paths
 
 
@@ -482,6 +533,8 @@ def _run(search: _Search, simplify: int, clock: _Clock) -> _Found:
         return _Found(status, none, none, 0.0, graph_states)
     unsimplified = _states(search)
     clock.deadline = math.inf
+    # the simplification's shortcuts are not a PRM's connections, nor its samples
+    search.checks.longest = search.checks.max_samples = math.inf
     over = clock.over
     if simplify == Simplification.NONE:
         return _Found(status, unsimplified, unsimplified, 0.0, graph_states)

@@ -137,7 +137,9 @@ class GeometricOutcome:
     written: np.ndarray
 
     def failure(self, request: PlanRequest) -> str:
-        return (f"{request.problem.path}: no solution within {self.time_limit:g} s "
+        within = f"{self.result.samples} samples (the problem's Max. Samples)" \
+            if self.result.out_of_samples else f"{self.time_limit:g} s"
+        return (f"{request.problem.path}: no solution within {within} "
                 f"({self.result.planner}, seed {self.seed})")
 
     def write(self, request: PlanRequest) -> None:

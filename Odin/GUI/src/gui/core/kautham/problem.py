@@ -86,10 +86,14 @@ PLANNER_SEARCH = {"Min Control Steps": "min_control_steps",
 """The ODE planners' parameters Odin's planning bridge uses (PlannerSearch field names)."""
 PLANNER_GEOMETRIC = {"Range": "range", "Goal Bias": "goal_bias",
                      "_Max Planning Time": "time_limit", "Max Planning Time": "time_limit",
-                     "Simplify Solution": "simplify", "_Simplify Solution": "simplify"}
+                     "Simplify Solution": "simplify", "_Simplify Solution": "simplify",
+                     "MaxNearestNeighbors": "max_neighbours", "Max. Neighs": "max_neighbours",
+                     "DistanceThreshold": "neighbour_distance",
+                     "Neigh Thresshold": "neighbour_distance", "Max. Samples": "max_samples"}
 """The geometric planners' parameters Odin's geometric planning uses (gui.planning.geometric:
 GeometricSettings field names)."""
-_WHOLE_PARAMETERS = ("max_contacts", "min_control_steps", "max_control_steps")
+_WHOLE_PARAMETERS = ("max_contacts", "min_control_steps", "max_control_steps",
+                     "max_neighbours", "max_samples")
 
 _ROBOT_CHILDREN = {
     "home": None, "limits": None, "kauthamname": None,
@@ -365,9 +369,15 @@ class _Loader:
         if unused:
             self.ignore(parameters, f"planner {name or '(unnamed)'} parameters "
                         + ", ".join(f'"{u}"' for u in unused),
-                        "Odin's planning bridge sets these up itself (gui.planning)")
+                        "Odin's planning bridge sets these up itself (gui.planning)" if physics
+                        else "Kautham's drawing, sampler or cost settings, which Odin's "
+                        "geometric planning does not have (gui.planning.geometric)")
         for child in parameters.children:
-            if child.tag.lower() not in ("name", "parameter"):
+            if child.tag.lower() == "localplanner":
+                self.ignore(child, "<Parameters> <LocalPlanner>", "Kautham 2012's local "
+                            "planner's step: Odin checks every motion all along, to its "
+                            "resolution (gui.planning.geometric_world)")
+            elif child.tag.lower() not in ("name", "parameter"):
                 self.ignore(child, f"<Parameters> <{child.tag}>", "a planner's setting")
         if name and not physics:
             self.ignore(name_node, f"planner {name}", "not one of Kautham's ODE planners: "
@@ -477,7 +487,7 @@ def _planner_parameter(node: Node, name: str, field: str, value: float):
         return int(value)
     if field == "goal_bias" and not 0.0 <= value <= 1.0:
         raise node.error(f"Goal Bias {node.text.strip()!r} is not in [0, 1]")
-    if field in ("max_speed", "time_limit", "range") and not value > 0.0:
+    if field in ("max_speed", "time_limit", "range", "neighbour_distance") and not value > 0.0:
         raise node.error(f"{name} {node.text.strip()!r} is not positive")
     return value
 
