@@ -22,7 +22,8 @@ Per problem P (PROBLEMS' slugs):
                                 as controls: gui.planning.geometric.path_of_solution), when
                                 Odin is here to check them; not a goal, what Kautham's own
                                 motion checks let through
-A side that solved no run has the time limit as its median: a bound, not a time. A run that
+Kautham 2012's problems (ODIN_ONLY) have Odin's figures only. A side that solved no run has the
+time limit as its median: a bound, not a time. A run that
 gave no answer (Kautham could not load the problem, Odin raised) refuses that side's figures
 and the comparisons (report.Refused, with the first reason). Without the peer built (`make
 bench-kautham`) the Kautham side is skipped, said in one line, and Odin's figures still come;
@@ -55,6 +56,7 @@ from report import Refused  # noqa: E402
 
 SEEDS = int(os.environ.get("ODIN_BENCH_ROUNDS", 10))
 GEO = pathlib.PurePosixPath("current_2025", "demos", "OMPL_geo_demos")
+LEGACY = pathlib.PurePosixPath("legacy_2012", "examples")
 PROBLEMS = {
     "tx90": GEO / "TX90_IOC" / "OMPL_RRTConnect_TX90_TwoCan.xml",
     "ur5": GEO / "UR5" / "ur5_table.xml",
@@ -63,8 +65,16 @@ PROBLEMS = {
     "maze": GEO / "Cube_Maze_R2" / "OMPL_RRTconnect_bigcube-maze2D_R2.xml",
     "chess": GEO / "chess" / "OMPL_RRTconnect_chess_ur3_gripper_2.xml",
     "tiago": GEO / "Tiago_kitchen" / "tiago_counter_A_topgrasp_simple.xml",
+    "arm2012": LEGACY / "Staubli_R6_two_columns.xml",
+    "se3_2012": LEGACY / "ele_two_columns_SE3.xml",
+    "r2_2012": LEGACY / "table_rooms_R2.xml",
+    "mobile2012": LEGACY / "Staubli_R6_mobileBase_two_columns.xml",
 }
-"""Slug -> the problem's path in the corpus (the issue's demos with a geometric planner)."""
+"""Slug -> the problem's path in the corpus (the issue's demos with a geometric planner: Kautham
+5.1.1's, and Kautham 2012's arm, free-flyers in SE3 and R2 and arm on a mobile base, all PRM)."""
+ODIN_ONLY = {"arm2012", "se3_2012", "r2_2012", "mobile2012"}
+"""Problems Kautham 5.1.1 cannot load (2012's Inventor and VRML models: "iv or wrl extension no
+longer supported"): Odin's side only, said in one line."""
 ODIN_MODULE = "gui.planning.geometric"
 PROBLEMS_ENVIRONMENT = "ODIN_BENCH_GEO_PROBLEMS"
 DEEPEST_SPACING = 0.001
@@ -251,10 +261,13 @@ def run(out_dir: pathlib.Path) -> dict:
         limit_s = kautham_peer.own_time_limit(problem)
         print(f"  geometric: {slug} ({problem.name}, {limit_s:g} s, seeds 1-{SEEDS})",
               flush=True)
-        runs = side_by_side(problem, limit_s, with_kautham, with_odin, work / slug)
+        peer = with_kautham and slug not in ODIN_ONLY
+        if with_kautham and not peer:
+            print(f"  geometric: {slug}: Kautham's side skipped: Kautham 5.1.1 loads no 2012 "
+                  "problem (its Inventor and VRML models)")
+        runs = side_by_side(problem, limit_s, peer, with_odin, work / slug)
         details[slug] = {"problem": str(problem), "time_limit_s": limit_s, **runs}
-        figures.update(figures_of(slug, limit_s,
-                                  attempts(runs["kautham"]) if with_kautham else None,
+        figures.update(figures_of(slug, limit_s, attempts(runs["kautham"]) if peer else None,
                                   attempts(runs["odin"]) if with_odin else None))
     work.mkdir(parents=True, exist_ok=True)
     (work / "runs.json").write_text(json.dumps(details, indent=1) + "\n")
