@@ -297,3 +297,24 @@ def test_a_transfer_carries_the_object_on_a_fixed_joint_made_and_removed_at_its_
     assert report.actuals[-1][0] == pytest.approx(0.9, abs=0.01)
     moved = np.linalg.norm(port.body_state(can)[0] - before)
     assert moved > 0.05                                       # carried by the Shoulder
+
+
+def test_an_arms_wrist_turns_past_a_half_turn_along_its_path_on_the_core(kautham_dir, world,
+                                                                          tmp_path):
+    """The TX90's Arm and Tcp joints range over +-270 degrees: a path takes Arm up through
+    +180 and Tcp down through -180. ODE reads a hinge's angle in [-180, 180]: the joints get
+    no stops (one would be met again a turn later) and their servos take the turn nearest
+    the path, so the arm follows it, and the report says how far, not a turn off."""
+    from gui.planning.geometric import write_task
+    problem = load_problem(KAUTHAM / "legacy_2012" / "examples" / "Staubli_R6_two_columns.xml")
+    plan = plan_problem(problem, BuildDefaults(start_at_query=False))    # at Home: all 0
+    stops = {j.spec.body2: j.spec.parameters for j in plan.steps if hasattr(j, "spec")
+             and getattr(j.spec, "body2", None) in ("TX90/Arm", "TX90/Elbow")}
+    assert stops["TX90/Arm"] == () and len(stops["TX90/Elbow"]) == 2     # +-145 deg: kept
+    world.execute(plan)
+    world.core.set_world_parameters(solver=Solver.WORLDSTEP)
+    rows = [[0.0] * 6, [0.0, 0.0, 0.0, 2.5, 0.0, -2.5], [0.0, 0.0, 0.0, 4.2, 0.0, -4.2]]
+    write_task(tmp_path / "turns.xml", "turns", rows)
+    report = execute_tracked(world, plan, read_solution(tmp_path / "turns.xml", problem))
+    assert report.goal_error <= 0.01 and report.tracking_error_max < 0.05, report.goal_error
+    assert report.actuals[-1][[3, 5]] == pytest.approx([4.2, -4.2], abs=0.01)

@@ -172,3 +172,59 @@ def test_bad_servo_requests_are_refused_and_change_nothing(motors, lists, error)
         core.set_servo(motors, **lists)
     assert core.servo_states() == []
     core.close()
+
+
+def _rod_angle(core) -> float:
+    """rad: the rod's turn about y from where it was built (its x axis in the x-z plane), in
+    (-pi, pi]: what ODE's hinge angle reads."""
+    _, quaternion, _, _ = core.body_state("rod")
+    w, x, y, z = quaternion
+    return math.atan2(2 * (w * y - x * z), 1 - 2 * (y * y + z * z))
+
+
+def test_a_servo_follows_a_path_through_a_half_turn_without_unwinding():
+    """A hinge without stops (a joint whose range passes +-pi: its stops are left unset,
+    gui.core.translate.joints) tracked from 2.6 to 4.0 rad, as a path's servo targets
+    arrive: ODE reads 4.0 rad as -2.28, and a servo that believed it would turn the rod
+    most of a turn back. It takes the turn of each reading nearest the last one."""
+    core, joint, motor = rotor()
+    core.set_servo([motor], [2.6], gains=[20.0], max_speeds=[10.0])
+    core.step(H, 1000)
+    for k in range(1, 141):                         # 1 rad/s for 1.4 s, a target per 10 ms
+        core.set_servo([motor], [2.6 + 0.01 * k], rates=[1.0], gains=[20.0])
+        core.step(H, 10)
+        (state,) = core.servo_states()
+        assert abs(state.errors[0]) < 0.01, (k, state)      # never a turn away
+    core.set_servo([motor], [4.0], gains=[20.0])             # the path's end: held there
+    core.step(H, 1000)
+    (state,) = core.servo_states()
+    assert state.positions[0] == pytest.approx(4.0, abs=1e-3)
+    assert _rod_angle(core) == pytest.approx(4.0 - 2 * math.pi, abs=1e-3)   # the same place
+    core.close()
+
+
+def test_a_servo_set_once_far_past_a_half_turn_goes_the_short_way_to_the_same_place():
+    """Only the turn nearest the target can be told from a reading in [-pi, pi]: a target of
+    4.0 rad from 0 is reached at -2.28 rad, the same place, turning 2.28 rad, not 4."""
+    core, joint, motor = rotor()
+    core.set_servo([motor], [4.0], gains=[20.0], max_speeds=[10.0])
+    core.step(H, 2000)
+    (state,) = core.servo_states()
+    assert state.positions[0] == pytest.approx(4.0, abs=1e-4)
+    assert _rod_angle(core) == pytest.approx(4.0 - 2 * math.pi, abs=1e-4)
+    core.close()
+
+
+def test_a_hinge_with_both_stops_within_a_half_turn_is_read_as_ode_reads_it():
+    """Stops at +-2.5 rad: the reading is unique, and a target 4.8 rad away is reached the
+    long way round, as the stops allow, never through them (the nearest turn would have
+    sent it 1.48 rad the other way, into a stop)."""
+    from virtual_world.core import HI_STOP, LO_STOP
+    core, joint, motor = rotor()
+    core.set_joint_parameters(joint, [(LO_STOP, 1, -2.5), (HI_STOP, 1, 2.5)])
+    core.set_servo([motor], [-2.4], gains=[20.0], max_speeds=[10.0])
+    core.step(H, 1000)
+    core.set_servo([motor], [2.4], gains=[20.0], max_speeds=[10.0])
+    core.step(H, 2000)
+    assert angle(core, joint) == pytest.approx(2.4, abs=1e-4)
+    core.close()

@@ -42,6 +42,7 @@ import numpy as np
 from gui.core.control_path import ServoCommand
 from gui.core.kautham.solutions import ATTACH, Solution
 from gui.core.model import PRISMATIC
+from gui.core.translate.joints import HALF_TURN
 from gui.core.trajectory import BaseLimits, Trajectory, rotation_error
 from gui.core.world_port import WorldPort
 from gui.errors import GuiError, PathFileError
@@ -197,6 +198,30 @@ def _instance_of(body) -> str:
     return body.parts[0].name.split("#")[0]
 
 
+def _turning(robot: _Robot) -> np.ndarray:
+    """Per movable joint, whether the world reads it only up to whole turns: a revolute joint
+    whose range (none: unlimited) passes +-pi from where it was built, which ODE's hinge angle
+    in [-pi, pi] cannot tell apart (its servo takes the turn nearest its target: odin_step.h)."""
+    model = robot.handle.instance.model
+    built = np.asarray(robot.handle.built_at, dtype=float)
+    out = []
+    for k, i in enumerate(model.movable_links()):
+        link = model.links[i]
+        limits = link.limits
+        out.append(link.joint != PRISMATIC and (
+            limits is None or limits[0] - built[k] < -HALF_TURN
+            or limits[1] - built[k] > HALF_TURN))
+    return np.array(out, dtype=bool)
+
+
+def _nearest_turns(values: np.ndarray, reference: np.ndarray, turning: np.ndarray
+                   ) -> np.ndarray:
+    """``values`` with each turning one (``_turning``) the whole turns from it nearest its
+    ``reference`` (rad): the same configuration, read as the path means it."""
+    turns = np.round((reference - values) / (2.0 * math.pi))
+    return np.where(turning, values + 2.0 * math.pi * turns, values)
+
+
 def _present(port: WorldPort, robot: _Robot) -> Tuple[np.ndarray, Optional[np.ndarray]]:
     """A robot's joint values (rad / m) and base pose (4, 4 world) now."""
     h = robot.handle
@@ -234,6 +259,8 @@ def plan_tracking(port: WorldPort, plan, solution: Solution,
         robots.append(robot)
         columns += n
         joints, base_pose = _present(port, robot)
+        if n:
+            joints = _nearest_turns(joints, path.joints[0], _turning(robot))
         start.append(joints)
         if base_pose is not None:
             base_start.append(base_pose)
@@ -398,8 +425,9 @@ def _compare(port: WorldPort, robots: Sequence[_Robot], sample) -> Tuple[np.ndar
     target, actual = [], []
     for r in robots:
         joints, base = _present(port, r)
-        target.append(sample.joints[r.columns])
-        actual.append(joints)
+        wanted = sample.joints[r.columns]
+        target.append(wanted)
+        actual.append(_nearest_turns(joints, wanted, _turning(r)) if len(joints) else joints)
         if r.base is not None:
             wanted = sample.base_pose[r.base]
             angle = float(np.linalg.norm(rotation_error(wanted[:3, :3], base[:3, :3])))

@@ -483,13 +483,28 @@ static double joint_value(dJointID j, int type, int c) {
     }
 }
 
+/* Whether a hinge can turn past +-pi: ODE reads its angle in [-pi, pi] and honours only stops
+ * inside that range, so one without both such stops (gui.core.translate.joints sets none for a
+ * joint whose range passes +-pi) has angles the reading cannot tell apart. */
+static int hinge_turns(dJointID j) {
+    double low = dJointGetHingeParam(j, dParamLoStop), high = dJointGetHingeParam(j, dParamHiStop);
+    return !(low >= -M_PI - 1e-9 && high <= M_PI + 1e-9);
+}
+
+/* The angle one whole turn or more from `angle` nearest `reference` (rad). */
+static double nearest_turn(double angle, double reference) {
+    return angle + 2.0 * M_PI * nearbyint((reference - angle) / (2.0 * M_PI));
+}
+
 static void apply_motor_goals(OdinWorld *w) {
     for (int i = 0; i < w->n_motors; ++i) {
         OdinMotorGoal *g = &w->motors[i];
+        int turns = g->servo && g->joint_type == dJointTypeHinge && hinge_turns(g->joint);
         for (int k = 0; k < g->naxes; ++k) {
             double v = g->velocity[k];
             if (g->servo) {
                 double q = g->sign[k] * joint_value(g->joint, g->joint_type, g->component[k]);
+                if (turns) q = nearest_turn(q, g->read ? g->position[k] : g->target[k]);
                 g->position[k] = q;
                 v = g->target_rate[k] + g->gain[k] * (g->target[k] - q);
                 if (v > g->max_speed[k]) v = g->max_speed[k];
@@ -499,6 +514,7 @@ static void apply_motor_goals(OdinWorld *w) {
             if (g->kind == 0) dJointSetAMotorParam(g->motor, dParamVel + k * dParamGroup, v);
             else dJointSetLMotorParam(g->motor, dParamVel + k * dParamGroup, v);
         }
+        if (g->servo) g->read = 1;
     }
 }
 

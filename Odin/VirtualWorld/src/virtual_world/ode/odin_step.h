@@ -38,7 +38,10 @@ typedef struct OdinJointForce {
  * servo mode (servo 1) the speed of each axis is computed before every step from a position
  * target instead: v = clamp(target_rate + gain (target - q), +-max_speed), applied with the
  * motor's force limit, where q is the driven joint's value on that axis (joint_value) times its
- * sign; target and position are in those signed units. */
+ * sign; target and position are in those signed units. ODE reads a hinge's angle in [-pi, pi]:
+ * a hinge without both stops inside that range (a joint that turns past +-pi) takes the turn
+ * of its angle nearest the servo's last reading, or its target at the first step after the
+ * servo was set (`read` 0), so a path through +-pi is followed, not unwound. */
 typedef struct OdinMotorGoal {
     dJointID motor;
     int kind;
@@ -56,6 +59,7 @@ typedef struct OdinMotorGoal {
     double position[3];      /* out: the joint's value when the last step began */
     double speed[3];         /* out: the speed commanded for the last step (rad/s or m/s): the
                                 goal, or the servo's clamped law */
+    int read;                /* 1 once the servo has read its joint since it was last set */
 } OdinMotorGoal;
 
 /* A link under the kinematic drive (virtual_world.core.kinematic): a kinematic body whose hinge

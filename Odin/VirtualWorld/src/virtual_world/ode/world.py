@@ -239,6 +239,7 @@ class CWorld:
             goal.target_rate[k] = rates[k]
             goal.gain[k] = gains[k]
             goal.max_speed[k] = speeds[k]
+        goal.read = 0           # its first step reads the turn nearest the target (odin_step.h)
         goal.servo = 1
 
     def servo_positions(self, slot: int, signs: Sequence[float]) -> Tuple[float, ...]:

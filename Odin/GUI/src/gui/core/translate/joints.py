@@ -5,6 +5,7 @@ Anchors and axes are world frame, joint values rad (hinge) or m (slider), forces
 """
 from __future__ import annotations
 
+import math
 from typing import List, NamedTuple, Optional, Tuple
 
 import numpy as np
@@ -20,6 +21,11 @@ def floats(a) -> tuple:
     return tuple(float(v) for v in np.asarray(a, dtype=float).ravel())
 
 
+HALF_TURN = math.pi + 1e-9
+"""rad: a revolute joint's stops are set when both lie within this of where it is built
+(link_joint); +-180 degrees read from a file is within it."""
+
+
 def fixed_joint(body1: str, body2: str) -> JointSpec:
     """A FIXED joint between two bodies (planned IDs; "" for the static world)."""
     return JointSpec(type=JointType.FIXED, body1=body1, body2=body2)
@@ -29,15 +35,19 @@ def link_joint(link: LinkModel, frame: np.ndarray, value: float, parent_id: str,
                child_id: str) -> JointSpec:
     """The hinge (revolute) or slider (prismatic) of a movable ``link`` whose joint frame is
     ``frame`` ((4, 4), world) with the joint at ``value`` (rad or m): the parent body1, the
-    child body2, stops from the link's limits relative to ``value``."""
+    child body2, stops from the link's limits relative to ``value``: none for a revolute joint
+    whose range passes +-pi from there (ODE reads a hinge's angle in [-pi, pi]; a stop inside
+    that range would be met again a turn later, where the joint is free to go, and one
+    outside it is not honoured: the servos keep such a joint to its path, odin_step.h)."""
     # ODE measures a hinge's angle (a slider's position) as body1's motion relative to
     # body2; the parent is body1, so the axis is reversed: the world's joint value, its
     # stops and its motor's goal speed then all have the sign of Kautham's joint value.
     axis = -(frame[:3, :3] @ link.axis)
     params = ()
     if link.limits is not None:
-        params = ((JointParameter.LO_STOP, 1, float(link.limits[0] - value)),
-                  (JointParameter.HI_STOP, 1, float(link.limits[1] - value)))
+        low, high = float(link.limits[0] - value), float(link.limits[1] - value)
+        if link.joint != REVOLUTE or (low >= -HALF_TURN and high <= HALF_TURN):
+            params = ((JointParameter.LO_STOP, 1, low), (JointParameter.HI_STOP, 1, high))
     return JointSpec(type=JointType.HINGE if link.joint == REVOLUTE else JointType.SLIDER,
                      body1=parent_id, body2=child_id, anchor=floats(frame[:3, 3]),
                      axis1=floats(axis), parameters=params)
