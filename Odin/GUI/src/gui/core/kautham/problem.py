@@ -370,7 +370,8 @@ class _Loader:
             self.ignore(parameters, f"planner {name or '(unnamed)'} parameters "
                         + ", ".join(f'"{u}"' for u in unused),
                         "Odin's planning bridge sets these up itself (gui.planning)" if physics
-                        else "Kautham's drawing, sampler or cost settings, which Odin's "
+                        else "Kautham's display settings (Speed Factor: the path samples its "
+                        "GUI's animation advances per frame), samplers or costs, which Odin's "
                         "geometric planning does not have (gui.planning.geometric)")
         for child in parameters.children:
             if child.tag.lower() == "localplanner":
