@@ -95,17 +95,23 @@ def _odin_solve(problem: str, seed: int, time_limit: float) -> dict:
     """One Odin run (in a child): the problem loaded and planned as ``solve_file`` does, its
     search (``time_s`` is the search's own), then, when solved, how deep its path goes
     (``deepest_along``, after the search, not timed)."""
-    from gui.planning.geometric import deepest_along, load_plan, settings_of, solve
+    from gui.planning.geometric import load_plan, settings_of, solve
     logging.disable(logging.WARNING)
     plan = load_plan(problem)
     result = solve(plan, settings_of(plan, time_limit), seed)
     run = {"solved": bool(result.solved), "time_s": float(result.time_s),
            "planner": str(result.planner)}
     if result.solved:
-        deepest, pair = deepest_along(plan, result.path, DEEPEST_SPACING)
-        run["deepest_mm"] = deepest * 1000
-        run["deepest_pair"] = " into ".join(pair) if pair else None
+        run.update(_depth(plan, result.path))
     return run
+
+
+def _depth(plan, path) -> dict:
+    """How deep ``path`` (control vectors) goes into anything: ``deepest_mm`` and its pair
+    (gui.planning.geometric.deepest_along at DEEPEST_SPACING)."""
+    from gui.planning.geometric import deepest_along
+    deepest, pair = deepest_along(plan, path, DEEPEST_SPACING)
+    return {"deepest_mm": deepest * 1000, "deepest_pair": " into ".join(pair) if pair else None}
 
 
 def _odin(problem: pathlib.Path, seed: int, time_limit: float) -> dict:
@@ -139,15 +145,14 @@ def _path_depth(problem: str, task_file: str) -> dict:
     gripper's mimic joints outside their limits)."""
     from gui.core.kautham.solutions import read_solution
     from gui.errors import GuiError
-    from gui.planning.geometric import deepest_along, load_plan, path_of_solution
+    from gui.planning.geometric import load_plan, path_of_solution
     logging.disable(logging.WARNING)
     plan = load_plan(problem)
     try:
         path = path_of_solution(plan, read_solution(task_file, plan.problem))
     except GuiError as error:
         return {"deepest_error": str(error)}
-    deepest, pair = deepest_along(plan, path, DEEPEST_SPACING)
-    return {"deepest_mm": deepest * 1000, "deepest_pair": " into ".join(pair) if pair else None}
+    return _depth(plan, path)
 
 
 def attempts(runs: List[dict]) -> List[Attempt]:

@@ -391,13 +391,8 @@ class Session:
 
     def trajectory(self, name: str) -> tuple:
         """(times (n,), positions (n, 3), quaternions (n, 4)) of a tracked geometry."""
-        with self.record.lock:
-            rows = [(t, poses[name]) for t, poses in sorted(self.record.poses.items())
-                    if name in poses]
-        times = np.array([t for t, _ in rows])
-        positions = np.array([p for _, (p, _) in rows]).reshape(-1, 3)
-        quats = np.array([q for _, (_, q) in rows]).reshape(-1, 4)
-        return times, positions, quats
+        times, poses = self.trajectories(name)
+        return (times, *poses[name])
 
     def trajectories(self, *names: str) -> tuple:
         """(times (n,), {name: (positions (n, 3), quaternions (n, 4))}) of tracked geometries

@@ -90,10 +90,15 @@ class AwayFromStart(GuiError):
 @dataclass
 class _Robot:
     """One robot of the run: its handle, its columns in the stacked joint vector, its base's
-    index among the free-flying bases (None: base not driven)."""
+    index among the free-flying bases (None: base not driven); ``turning``: per movable joint,
+    whether the world reads it only up to whole turns (``_turning``, taken once)."""
     handle: object
     columns: slice
     base: Optional[int]
+    turning: np.ndarray = field(init=False)
+
+    def __post_init__(self) -> None:
+        self.turning = _turning(self.handle)
 
 
 @dataclass
@@ -198,12 +203,13 @@ def _instance_of(body) -> str:
     return body.parts[0].name.split("#")[0]
 
 
-def _turning(robot: _Robot) -> np.ndarray:
-    """Per movable joint, whether the world reads it only up to whole turns: a revolute joint
-    whose range (none: unlimited) passes +-pi from where it was built, which ODE's hinge angle
-    in [-pi, pi] cannot tell apart (its servo takes the turn nearest its target: odin_step.h)."""
-    model = robot.handle.instance.model
-    built = np.asarray(robot.handle.built_at, dtype=float)
+def _turning(handle) -> np.ndarray:
+    """Per movable joint of a robot (its plan handle), whether the world reads it only up to
+    whole turns: a revolute joint whose range (none: unlimited) passes +-pi from where it was
+    built, which ODE's hinge angle in [-pi, pi] cannot tell apart (its servo takes the turn
+    nearest its target: odin_step.h)."""
+    model = handle.instance.model
+    built = np.asarray(handle.built_at, dtype=float)
     out = []
     for k, i in enumerate(model.movable_links()):
         link = model.links[i]
@@ -260,7 +266,7 @@ def plan_tracking(port: WorldPort, plan, solution: Solution,
         columns += n
         joints, base_pose = _present(port, robot)
         if n:
-            joints = _nearest_turns(joints, path.joints[0], _turning(robot))
+            joints = _nearest_turns(joints, path.joints[0], robot.turning)
         start.append(joints)
         if base_pose is not None:
             base_start.append(base_pose)
@@ -427,7 +433,7 @@ def _compare(port: WorldPort, robots: Sequence[_Robot], sample) -> Tuple[np.ndar
         joints, base = _present(port, r)
         wanted = sample.joints[r.columns]
         target.append(wanted)
-        actual.append(_nearest_turns(joints, wanted, _turning(r)) if len(joints) else joints)
+        actual.append(_nearest_turns(joints, wanted, r.turning) if len(joints) else joints)
         if r.base is not None:
             wanted = sample.base_pose[r.base]
             angle = float(np.linalg.norm(rotation_error(wanted[:3, :3], base[:3, :3])))

@@ -42,7 +42,8 @@ import numpy as np
 from gui.core.kinematics import pose_to_position_quaternion
 from gui.core.plan import BuildPlan
 from gui.errors import PlanningError
-from gui.planning.geometric_robots import control_scales, planned_robots, robot_parts
+from gui.planning.geometric_robots import (control_scales, control_size, planned_robots,
+                                           robot_parts)
 from gui.planning.geometric_world import RESOLUTION, GeometricWorld
 
 GEOMETRIC_PLANNERS = {
@@ -442,7 +443,7 @@ def _search(world: GeometricWorld, settings: GeometricSettings, start, goal, see
                            found.simplify_s, found.graph_states,
                            world.clearance_checks - clearances_before, len(found.unsimplified),
                            np.asarray(scales, dtype=float), found.rounds, found.samples,
-                           found.out_of_samples and not len(found.path))
+                           found.out_of_samples)
 
 
 class _Clock:
@@ -644,7 +645,7 @@ def path_of_solution(plan: BuildPlan, solution) -> np.ndarray:
     PATH_MATCH from the one its controls give, e.g. a joint no control moves away from its
     fixed value)."""
     robots = planned_robots(plan)
-    size = max(r.part.stop or r.handle.instance.controls.size for r in robots)
+    size = control_size(robots)
     missing = [r.handle.name for r in robots if r.handle.name not in solution.paths]
     if missing:
         raise PlanningError(f"{solution.source}: no path for robot {missing[0]}")

@@ -377,6 +377,12 @@ def _angle(a: np.ndarray, b: np.ndarray) -> float:
     return float(math.acos(max(-1.0, min(1.0, cosine))))
 
 
+def control_size(robots: Sequence[PlannedRobot]) -> int:
+    """The search's control vector's length: a 2012 problem's robots end to end, a current
+    problem's one vector they all share."""
+    return max(r.part.stop or r.handle.instance.controls.size for r in robots)
+
+
 def control_scales(robots: Sequence[PlannedRobot], size: int) -> np.ndarray:
     """(size,): per control, how far a unit of it moves the configuration in Kautham's OMPL
     metric (the Euclidean norm of the joints' values, rad or m, Kautham's links weighing 1;

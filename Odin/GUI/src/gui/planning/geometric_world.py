@@ -46,7 +46,7 @@ from typing import Callable, List, Optional, Sequence
 import numpy as np
 
 from gui.core.plan import BuildPlan
-from gui.planning.geometric_robots import planned_robots
+from gui.planning.geometric_robots import control_size, planned_robots
 
 RESOLUTION = 0.002
 """m: the largest motion of any link point between two configurations checked exactly: no
@@ -82,8 +82,7 @@ class GeometricWorld:
         """The Core's names of what moves and its motion checker (single configurations and
         whole motions, the walk of the module docstring, in C)."""
         core = self.world.core
-        # k: a 2012 problem's robots end to end, a current problem's one shared vector
-        self.size = max(r.part.stop or r.handle.instance.controls.size for r in self.robots)
+        self.size = control_size(self.robots)
         self.moved = {name for r in self.robots for body in r.moved_bodies
                       for name in core.geometry_names(body)}
         self.checker = core.motion_checker([r.kinematics(self.size) for r in self.robots],
