@@ -370,6 +370,14 @@ int odin_pair_never_touches(dGeomID o1, dGeomID o2) {
     return b1 && b2 && dAreConnectedExcluding(b1, b2, dJointTypeContact);
 }
 
+/* A kinematic body that moves (a link under the kinematic drive, a body given a velocity); a
+ * fixed body is kinematic too, but still. */
+static int moving_kinematic(dBodyID b) {
+    if (!b || !dBodyIsKinematic(b)) return 0;
+    const dReal *v = dBodyGetLinearVel(b), *a = dBodyGetAngularVel(b);
+    return v[0] != 0 || v[1] != 0 || v[2] != 0 || a[0] != 0 || a[1] != 0 || a[2] != 0;
+}
+
 static void near_callback(void *data, dGeomID o1, dGeomID o2) {
     OdinWorld *w = (OdinWorld *)data;
     if (odin_pair_never_touches(o1, o2)) return;
@@ -385,7 +393,17 @@ static void near_callback(void *data, dGeomID o1, dGeomID o2) {
     }
     if (!w->contact_less) {
         int dynamic = (b1 && !dBodyIsKinematic(b1)) || (b2 && !dBodyIsKinematic(b2));
-        if (!dynamic) return; /* nothing can move: no contact needed */
+        /* nothing the solver can move: no contact needed; but a moving kinematic body (two
+         * arms under the kinematic drive, one driven through a wall) still meets what it
+         * passes through, and a recording pass must say so */
+        if (!dynamic && !(w->recording && (moving_kinematic(b1) || moving_kinematic(b2))))
+            return;
+        if (!dynamic) {
+            dContact met[ODIN_MAX_CONTACTS];
+            int n = dCollide(o1, o2, w->max_contacts, &met[0].geom, sizeof(dContact));
+            if (n > 0) record_pair(w, o1, o2, met, n);
+            return;
+        }
     }
     dContact contact[ODIN_MAX_CONTACTS];
     int n = dCollide(o1, o2, w->max_contacts, &contact[0].geom, sizeof(dContact));
