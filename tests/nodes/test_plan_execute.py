@@ -14,7 +14,8 @@ sys.path.insert(0, str(ROOT / "Odin" / "GUI" / "test"))     # the arm problem's 
 from test_geometric_planning import _problem  # noqa: E402
 
 SUMMARY = re.compile(r"^(\w+) path of (\d+) waypoints: goal error ([0-9.e+-]+), tracking error "
-                     r"max [0-9.e+-]+, [0-9.]+ s simulated, (\d+) colliding pairs, solver \w+$")
+                     r"max [0-9.e+-]+, [0-9.]+ s simulated, (\d+) colliding pairs? made by "
+                     r"the path(?: \(.*\))?, \d+ resting contacts?, solver \w+$")
 
 
 def _statistics(stdout: str) -> dict:
@@ -81,7 +82,8 @@ def test_a_physics_plan_is_run_as_a_control_path_ending_where_plan_said(world, k
     assert run.returncode == 0, run.stderr
     statistics = _statistics(run.stdout)
     last = re.match(r"^SphereDE: (\d+) control rows done \([0-9.]+ s simulated\), ends "
-                    r"([0-9.]+) m from the goal$", run.stdout.splitlines()[-1])
+                    r"([0-9.]+) m from the goal, \d+ colliding pairs? made by the path"
+                    r"(?: \(.*\))?, \d+ resting contacts?$", run.stdout.splitlines()[-1])
     assert last, run.stdout[-500:]
     assert int(last.group(1)) == statistics["rows"]
     assert abs(float(last.group(2)) - statistics["goal_distance_m"]) < 1e-3

@@ -15,6 +15,7 @@ holds a robot where it is (what Ctrl-C leaves of a path).
 """
 from __future__ import annotations
 
+import math
 import os
 import pathlib
 from dataclasses import dataclass
@@ -22,6 +23,7 @@ from typing import Callable, List, Optional, Sequence, Tuple
 
 import numpy as np
 
+from gui.core.contacts import ContactLedger
 from gui.core.kautham import environment
 from gui.core.model import CAR, FREE_BODY, MOBILE
 from gui.core.paths import read_rows
@@ -255,11 +257,13 @@ def run_control_path(port: WorldPort, handle, rows: Sequence[ControlRow],
                      defaults: ControlDefaults = ControlDefaults(),
                      progress: Optional[Callable[[RowResult], None]] = None,
                      stop: Optional[Callable[[], bool]] = None,
-                     watch: Optional[str] = None) -> List[RowResult]:
+                     watch: Optional[str] = None,
+                     contacts: Optional[ContactLedger] = None) -> List[RowResult]:
     """Applies ``rows`` in order to ``handle``'s robot through ``port``; returns the base's
     position after each row, and the state of body ``watch`` (a world ID: the link a planner
     tracked) when given. ``stop()`` true (asked before each row) ends the path there: the
-    rows run so far are returned."""
+    rows run so far are returned. ``contacts``: told every pair met, s from the path's
+    start."""
     size = control_size(handle)
     for k, row in enumerate(rows, start=1):
         if len(row.controls) != size:
@@ -267,6 +271,7 @@ def run_control_path(port: WorldPort, handle, rows: Sequence[ControlRow],
                                 f"{handle.name} takes {size}")
     base_id = handle.bodies[0].body_id
     results = []
+    elapsed = 0.0
     for k, row in enumerate(rows, start=1):
         if stop is not None and stop():
             break
@@ -276,7 +281,12 @@ def run_control_path(port: WorldPort, handle, rows: Sequence[ControlRow],
             port.set_servo(act.servo)
         if act.base_velocity is not None:
             port.set_body_velocity(*act.base_velocity, (0.0, 0.0, 0.0))
-        port.advance(row.duration, act.forces)
+        met = port.advance(row.duration, act.forces)
+        if contacts is not None:
+            for first, second, depth, when in met:
+                contacts.see(first, second, depth, elapsed + (when if math.isfinite(when)
+                                                              else 0.0))
+        elapsed += row.duration
         result = RowResult(k, port.body_state(base_id)[0], act,
                            None if watch is None else port.body_state(watch))
         results.append(result)

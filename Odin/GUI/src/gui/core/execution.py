@@ -8,7 +8,10 @@ feed-forward, its mean rate over the period (Set Servo; the servo's speed is
 clamp(rate + gain (target - q), +-limit) each step, under the joint's effort limit); a
 free-flying base gets the velocity rate + ``base_gain`` error (linear and angular, world frame)
 and a force cancelling gravity on the robot's mass, as a velocity servo of its own (a base the
-build holds kinematic, outside Kautham's physics, moves at that velocity exactly); then the
+build holds kinematic, outside Kautham's physics, moves at that velocity exactly); a planar
+mobile base under Kautham's physics (``_planar_base``) stands on its floor instead: servoed
+along x, y and about z only, with the gain that closes the error within the period, its
+height and tilt left to its floor and its weight uncancelled; then the
 world runs the period with contacts on (one kept Propagate), and the joints are read.
 Attach/detach events become a FIXED joint between the link's body and the obstacle's, made and
 removed at their waypoint's time (the robot is at rest there); an obstacle the build holds
@@ -25,8 +28,9 @@ targets are held ``settle`` s; the servos stay on afterwards (they hold the goal
 The report: ``goal_error`` (largest joint error from the last waypoint when execution ends,
 rad or m; a base's position error in m and its rotation error in rad count as joints),
 ``tracking_error_max`` (the largest along the way, against the trajectory's value at the same
-time), ``duration_s`` (simulated, trajectory and settling), the collisions met (pairs of
-geometries, first time, deepest depth), per-joint series of target, actual and error, the
+time), ``duration_s`` (simulated, trajectory and settling), the collisions the path made (pairs of
+geometries, first time, deepest depth) apart from the contacts the scene rested on when it
+began (``support``; ``gui.core.contacts``), per-joint series of target, actual and error, the
 ``segments`` run (the move to the path's start, with how far it was; the path; the settling;
 each with its start and end, s) and a ``.kps`` file's ``query`` (its Init and Goal samples).
 """
@@ -39,9 +43,10 @@ from typing import Callable, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
+from gui.core.contacts import ContactLedger
 from gui.core.control_path import ServoCommand
 from gui.core.kautham.solutions import ATTACH, Solution
-from gui.core.model import PRISMATIC
+from gui.core.model import MOBILE, PRISMATIC
 from gui.core.translate.joints import HALF_TURN
 from gui.core.trajectory import BaseLimits, Trajectory, rotation_error
 from gui.core.world_port import WorldPort
@@ -91,14 +96,17 @@ class AwayFromStart(GuiError):
 class _Robot:
     """One robot of the run: its handle, its columns in the stacked joint vector, its base's
     index among the free-flying bases (None: base not driven); ``turning``: per movable joint,
-    whether the world reads it only up to whole turns (``_turning``, taken once)."""
+    whether the world reads it only up to whole turns (``_turning``, taken once);
+    ``planar``: its base is a planar mobile base on its floor (``_planar_base``)."""
     handle: object
     columns: slice
     base: Optional[int]
     turning: np.ndarray = field(init=False)
+    planar: bool = field(init=False)
 
     def __post_init__(self) -> None:
         self.turning = _turning(self.handle)
+        self.planar = _planar_base(self.handle)
 
 
 @dataclass
@@ -122,7 +130,7 @@ class TrackingReport:
     settle_s: float
     period_s: float
     wall_time_s: float
-    collisions: List[dict]
+    collisions: List[dict]            # made by the path (gui.core.contacts)
     events: List[dict]
     names: List[str]
     units: List[str]
@@ -132,6 +140,8 @@ class TrackingReport:
     segments: List[dict] = field(default_factory=list)
     query: Optional[dict] = None
     start_tolerance: float = TrackingDefaults.start_tolerance
+    support: List[dict] = field(default_factory=list)      # rested on (gui.core.contacts)
+    contacts: str = ""                                     # ContactLedger.describe()
 
     @property
     def errors(self) -> np.ndarray:
@@ -156,7 +166,8 @@ class TrackingReport:
             tracking_error_max=self.tracking_error_max, duration_s=self.duration_s,
             trajectory_s=self.trajectory_s, settle_s=self.settle_s, period_s=self.period_s,
             wall_time_s=self.wall_time_s, real_time_factor=self.real_time_factor,
-            collisions=self.collisions, events=self.events, segments=self.segments,
+            collisions=self.collisions, support=self.support, events=self.events,
+            segments=self.segments,
             query=self.query, units=dict(angle="rad", length="m", time="s"),
             series=dict(time=self.times.tolist(), joints=[
                 dict(name=n, unit=u, target=self.targets[:, k].tolist(),
@@ -201,6 +212,16 @@ def _instance_of(body) -> str:
     if hasattr(body, "name"):
         return body.name
     return body.parts[0].name.split("#")[0]
+
+
+def _planar_base(handle) -> bool:
+    """Whether a robot's base is a planar mobile base standing on its floor: a mobile robot
+    under Kautham's physics (its base a free dynamic body) whose controls move the base along
+    x and y, never along z (Kautham's mobile bases: ``Limits`` Z min = max). Its floor, not a
+    servo, carries its weight and holds its height and tilt (``_drive_base``)."""
+    controls = handle.instance.controls
+    return (handle.kind == MOBILE and not handle.base_held and controls is not None
+            and controls.se3 and 2 not in controls.moved_base_axes())
 
 
 def _turning(handle) -> np.ndarray:
@@ -337,7 +358,7 @@ def execute_tracked(port: WorldPort, plan, solution: Solution,
     gravity = port.gravity()
     made: Dict[Tuple[str, str], str] = {}
     holds = plan.holds()
-    collisions: Dict[Tuple[str, str], List[float]] = {}
+    contacts = ContactLedger(port.check_collision([]))
     times, targets, actuals = [], [], []
     pending = sorted(events, key=lambda e: e.time)
     started = time.monotonic()
@@ -357,13 +378,13 @@ def execute_tracked(port: WorldPort, plan, solution: Solution,
                 port.set_servo(_servo(r.handle, middle.joints[r.columns],
                                       rates[r.columns], defaults))
             if r.base is not None:
-                forces.append(_drive_base(port, r, middle, end, weights[r.handle.name],
-                                          gravity, defaults))
+                force = _drive_base(port, r, middle, end, weights[r.handle.name], gravity,
+                                    defaults, period)
+                if force is not None:
+                    forces.append(force)
         wall = time.monotonic()
         for first, second, depth, when in port.advance(period, forces):
-            seen = collisions.setdefault((first, second), [t + (when if math.isfinite(when)
-                                                                 else 0.0), depth])
-            seen[1] = max(seen[1], depth)
+            contacts.see(first, second, depth, t + (when if math.isfinite(when) else 0.0))
         if real_time:
             sleep(max(0.0, period - (time.monotonic() - wall)))
         target, actual = _compare(port, robots, end)
@@ -384,8 +405,7 @@ def execute_tracked(port: WorldPort, plan, solution: Solution,
         duration_s=done * period, trajectory_s=trajectory.duration,
         settle_s=max(0.0, done * period - trajectory.duration), period_s=period,
         wall_time_s=wall_time,
-        collisions=[dict(first=a, second=b, first_time_s=v[0], depth_m=v[1])
-                    for (a, b), v in sorted(collisions.items(), key=lambda i: i[1][0])],
+        collisions=contacts.made, support=contacts.support, contacts=contacts.describe(),
         events=[dict(time_s=e.time, what=e.label) for e in events],
         names=names, units=units, times=np.array(times), targets=targets, actuals=actuals,
         segments=_segments(robots, trajectory, done * period),
@@ -410,16 +430,31 @@ def _base_weights(port: WorldPort, robots: Sequence[_Robot]) -> Dict[str, float]
 
 
 def _drive_base(port: WorldPort, robot: _Robot, middle, end, mass: float,
-                gravity: np.ndarray, defaults: TrackingDefaults) -> Tuple[str, tuple]:
+                gravity: np.ndarray, defaults: TrackingDefaults, period: float
+                ) -> Optional[Tuple[str, tuple]]:
     """Sets the base body's velocity toward its target; returns the gravity-cancelling force
-    (the robot's whole mass, on the base body)."""
+    (the robot's whole mass, on the base body). A planar base (``_Robot.planar``) is servoed
+    along x, y and about z only: its vertical and tilting velocities stay what contacts and
+    gravity make them, and no force cancels its weight, which its floor carries (cancelled,
+    the floor's push lifted a cart 7.6 mm and tilted it 0.04 rad as its arm swung)."""
     body = robot.handle.bodies[0]
-    position, quaternion, _, _ = port.body_state(body.body_id)
+    position, quaternion, linear_now, angular_now = port.body_state(body.body_id)
     target = middle.base_pose[robot.base] @ body.offset
     R_now = quaternion_to_matrix(quaternion)
     linear = end.base_linear[robot.base] + defaults.base_gain * (target[:3, 3] - position)
     angular = end.base_angular[robot.base] + defaults.base_gain * rotation_error(
         target[:3, :3], R_now)
+    if robot.planar:
+        # deadbeat: the velocity that closes the whole error within the period, for the
+        # floor's friction takes up to mu g h of it every step (a gain of 10/s left a
+        # cart dragged 9 mm behind its target)
+        gain = 1.0 / period
+        linear = end.base_linear[robot.base] + gain * (target[:3, 3] - position)
+        angular = end.base_angular[robot.base] + gain * rotation_error(target[:3, :3], R_now)
+        linear[2] = linear_now[2]
+        angular[:2] = angular_now[:2]
+        port.set_body_velocity(body.body_id, linear, angular)
+        return None
     port.set_body_velocity(body.body_id, linear, angular)
     return body.body_id, tuple(float(v) for v in -mass * gravity)
 

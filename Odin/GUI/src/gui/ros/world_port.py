@@ -15,6 +15,7 @@ from typing import Callable, Dict, List, Optional, Sequence
 
 import numpy as np
 
+from gui.core.contacts import ContactLedger
 from gui.core.control_path import ControlRow, RowResult, hold, run_control_path
 from gui.core.execution import TrackingDefaults, TrackingReport, execute_tracked
 from gui.core.kautham.solutions import Solution
@@ -137,14 +138,15 @@ def run_on_client(client, handle, rows: Sequence[ControlRow],
                   progress: Optional[Callable[[RowResult], None]] = None,
                   sleep: Callable[[float], None] = time.sleep,
                   stop: Optional[Callable[[], bool]] = None,
-                  watch: Optional[str] = None) -> List[RowResult]:
+                  watch: Optional[str] = None,
+                  contacts: Optional[ContactLedger] = None) -> List[RowResult]:
     """``gui.core.control_path.run_control_path`` on ``client``'s world (``watch``: its body
-    to report), the world paused meanwhile. Stopped by ``stop()``, the robot is held where it
+    to report; ``contacts``: told the pairs met), the world paused meanwhile. Stopped by ``stop()``, the robot is held where it
     is (``gui.core.control_path.hold``) before the world runs again."""
     def run() -> List[RowResult]:
         port = ClientWorldPort(client, real_time, sleep)
         results = run_control_path(port, handle, rows, progress=progress, stop=stop,
-                                   watch=watch)
+                                   watch=watch, contacts=contacts)
         if stop is not None and stop():
             hold(port, handle)
         return results

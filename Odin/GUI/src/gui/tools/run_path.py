@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Callable, Dict, Optional, Sequence
 
 import numpy as np
 
+from gui.core.contacts import ContactLedger
 from gui.errors import GuiError, PlanningError
 from gui.tools.common import (ProblemFile, ToolParser, add_build_options, add_timeout_option,
                               check_master, check_output, count, hertz, one_line_errors,
@@ -159,7 +160,11 @@ class _Stopped(Exception):
 
 def _run_rows(request: PathRequest, build_plan: BuildPlan, handle: RobotHandle) -> int:
     """--position, --velocity: a row per cycle at ``request.rate`` (the world's publication
-    rate when 0), a line per row. A position path is checked for jumps before any is sent."""
+    rate when 0), a line per row. A position path is checked for jumps before any is sent.
+    After each row the world's Check Collision says what touches (a position row places the
+    robot, so only then can it be inside something): the pairs the path made are told from
+    those the scene rested on before the first row (``gui.core.contacts``), a line each as
+    they come and in the last line."""
     path = _read_rows(request, build_plan, handle)
     from gui.ros.client import WorldClient, run_position_path, run_velocity_path
     client = WorldClient(timeout=request.timeout)
@@ -167,11 +172,17 @@ def _run_rows(request: PathRequest, build_plan: BuildPlan, handle: RobotHandle) 
     rows = path.rows if velocity else _position_rows(request, path, client, handle)
     rate = request.rate if request.rate > 0 else client.publication_rate()
     done = [0]
+    contacts = ContactLedger(client.check_collision([]))
     with stop_on_ctrl_c() as stop:
 
         def progress(k: int) -> None:
             done[0] = k
-            print(f"[{k}/{len(rows)}]", flush=True)
+            known = len(contacts.made)
+            for first, second, depth in client.check_collision([]):
+                contacts.see(first, second, depth, k / rate)
+            news = "".join(f"; {c['first']} | {c['second']} collide, {c['depth_m'] * 1000:.1f}"
+                           " mm" for c in contacts.made[known:])
+            print(f"[{k}/{len(rows)}]{news}", flush=True)
             if stop:                    # between two calls: none is cut in the middle
                 raise _Stopped
 
@@ -185,7 +196,7 @@ def _run_rows(request: PathRequest, build_plan: BuildPlan, handle: RobotHandle) 
                 client.set_velocities(handle.motor_ids, np.zeros(len(handle.motor_ids)))
             return _interrupted(f"row {done[0]} of {len(rows)} ({done[0] / rate:.2f} s "
                                 f"of {len(rows) / rate:.2f} s)")
-    print(f"{handle.name}: {len(rows)} rows at {rate:g} Hz done")
+    print(f"{handle.name}: {len(rows)} rows at {rate:g} Hz done, {contacts.describe()}")
     return 0
 
 
@@ -239,16 +250,17 @@ def _run_controls(request: PathRequest, build_plan: BuildPlan, handle: RobotHand
         print(f"[{result.index}/{len(rows)}] t={elapsed[0]:.3f} s {watched} at {where}"
               f"{to_goal}", flush=True)
 
+    contacts = ContactLedger(client.check_collision([]))
     with stop_on_ctrl_c() as stop:
         results = run_on_client(client, handle, rows, real_time=request.real_time,
-                                progress=progress, stop=stop, watch=watched)
+                                progress=progress, stop=stop, watch=watched, contacts=contacts)
     if stop:
         total = sum(row.duration for row in rows)
         return _interrupted(f"row {len(results)} of {len(rows)} ({elapsed[0]:.2f} s of "
                             f"{total:.2f} s)")
     ends = "" if distance[0] is None else f", ends {distance[0]:.4f} m from the goal"
     print(f"{handle.name}: {len(rows)} control rows done ({elapsed[0]:.3f} s simulated)"
-          f"{ends}")
+          f"{ends}, {contacts.describe()}")
     return 0
 
 
@@ -297,7 +309,7 @@ def _run_tracked(request: PathRequest, build_plan: BuildPlan, handle: RobotHandl
     print(f"{solution.format} path of {solution.waypoint_count} waypoints{query}"
           f"{report.start_move()}: goal error {report.goal_error:.3g}, tracking error max "
           f"{report.tracking_error_max:.3g}, {report.duration_s:.2f} s simulated, "
-          f"{len(report.collisions)} colliding pairs, solver {solver}")
+          f"{report.contacts}, solver {solver}")
     if request.tracked.summary:
         with open(request.tracked.summary, "w") as out:
             json.dump(dict(report.to_json(), solver=solver), out, indent=1)

@@ -423,7 +423,7 @@ class MotionTab(QWidget):
             text = (f"tracked path {name}{report.start_move()}: goal error "
                     f"{report.goal_error:.3g}, tracking error "
                     f"max {report.tracking_error_max:.3g}, {report.duration_s:.2f} s, "
-                    f"{len(report.collisions)} colliding pairs")
+                    f"{report.contacts}")
             self._path_state(text, False)
             self.window.show_info(f"{robots}: {text}")
 

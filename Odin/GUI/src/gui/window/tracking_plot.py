@@ -25,7 +25,7 @@ def draw(painter: QPainter, width: int, height: int, report) -> None:
         return
     painter.drawText(QPointF(8, 14), f"goal error {report.goal_error:.2g}   tracking error max "
                      f"{report.tracking_error_max:.2g}   {report.duration_s:.2f} s, "
-                     f"{len(report.collisions)} colliding pairs")
+                     f"{report.contacts}")
     names = report.names
     top, bottom = 22.0, 18.0
     strip = (height - top - bottom) / max(len(names), 1)
