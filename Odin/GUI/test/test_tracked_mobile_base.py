@@ -8,7 +8,6 @@ import math
 import pathlib
 
 import numpy as np
-import pytest
 
 from gui.core.execution import execute_tracked
 from gui.core.kautham.problem import load_problem

@@ -141,8 +141,9 @@ def run_on_client(client, handle, rows: Sequence[ControlRow],
                   watch: Optional[str] = None,
                   contacts: Optional[ContactLedger] = None) -> List[RowResult]:
     """``gui.core.control_path.run_control_path`` on ``client``'s world (``watch``: its body
-    to report; ``contacts``: told the pairs met), the world paused meanwhile. Stopped by ``stop()``, the robot is held where it
-    is (``gui.core.control_path.hold``) before the world runs again."""
+    to report; ``contacts``: told the pairs met), the world paused meanwhile. Stopped by
+    ``stop()``, the robot is held where it is (``gui.core.control_path.hold``) before the
+    world runs again."""
     def run() -> List[RowResult]:
         port = ClientWorldPort(client, real_time, sleep)
         results = run_control_path(port, handle, rows, progress=progress, stop=stop,
