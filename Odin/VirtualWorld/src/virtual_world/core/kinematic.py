@@ -21,8 +21,9 @@ their own axis:
 - ODE leaves every joint and motor between two kinematic bodies, or a kinematic body and the
   world, out of its LCP: an arm under the drive costs the solver nothing. A joint between a link
   and a dynamic body stays in the LCP, the link's side moving as commanded (a finger on a
-  kinematic palm). Under the contact policy a link meets only dynamic bodies: its collisions with
-  static geometry, fixed objects and other links are not looked for (no contact could act);
+  kinematic palm). Under the contact policy a link gets contacts with dynamic bodies only (none
+  could act on static geometry, fixed objects or other links); while it moves, its pairs with
+  those are still collided on the steps that record pairs, and reported, without contacts;
 - the links hang from what never moves: each joint's other body must be the world, a fixed
   object or the link of another kinematic joint (a chain is driven from its base outwards). A
   request that would leave a link without such a parent, a joint of another type or a motor not
