@@ -251,7 +251,13 @@ def render_kautham() -> str:
     return ("## Kautham problems and control paths\n\n"
             "The GUI (`rosrun GUI gui`, `load_problem`, `problem_info`) builds a Kautham problem "
             "with the services above (`gui.core.translate`); `problem_info PROBLEM` shows the "
-            "plan as JSON, with what Odin does not use under `ignored`. How a problem maps to "
+            "plan as JSON, with what Odin does not use under `ignored`, and its query checked "
+            "(unless `--no-checks`: the problem is built in a Core of its own process): the "
+            "parts built inside each other (`overlaps`, as `load_problem` warns), per robot the "
+            "pairs its start and its goal put inside each other (`collisions`: at, first, "
+            "second, depth m; robot with robot included) and the DOFs they ask past their "
+            "limits, which Kautham's controls clamp (`outside_limits`), each also a warning "
+            "line on stderr. How a problem maps to "
             f"the world:\n\n{mapping}\n\n### Control paths\n\n{MAPPING.strip()}\n\n"
             + render_tracked() + render_kinematic())
 

@@ -350,8 +350,15 @@ def test_motion_tab_forces_joints_motors_and_robot_paths(window, kautham_dir, tm
     initial.write_text("90 0 0 0 0 0 0\n")
     tab.run_path("initial", str(initial))
     wait_for(lambda: "initial position set" in window.last_info, 5, "initial position")
+    # a position path is checked for jumps as run_path checks it: its first row against
+    # where the robot is in the world (joint 1 at 90 deg), on the path worker
+    far = tmp_path / "far.txt"
+    far.write_text("".join(f"{k} 10 0 0 0 0 0\n" for k in range(0, 40, 10)))
+    tab.run_path("position", str(far))
+    wait_for(lambda: "from where the robot is" in window.last_error, 5, "the jump refused")
+    assert "far.txt:1: joint " in window.last_error and "Allow jumps" in window.last_error
     position = tmp_path / "position.txt"
-    position.write_text("".join(f"{k} 10 0 0 0 0 0\n" for k in range(0, 40, 10)))
+    position.write_text("".join(f"{90 + k} 10 0 0 0 0 0\n" for k in range(0, 40, 10)))
     tab.double.setValue(1)                           # 4 rows -> 7
     tab.run_path("position", str(position))
     wait_for(lambda: "position path done (7 rows)" in window.last_info, 10, "position path")

@@ -122,8 +122,11 @@ def test_problem_info_lists_what_odin_does_not_use_and_warns_once_each():
     assert any("Constraint Force Mixing" in w for w in whats)
     assert any("<inertial>" in w for w in whats)             # the placeholder inertias
     warnings = [line for line in result.stderr.splitlines()
-                if line.startswith("problem_info: warning:")]
+                if line.startswith("problem_info: warning: not used: ")]
     assert len(warnings) == len(set(warnings)) == len(info["ignored"])
+    # and the one line load_problem writes too: the sphere starts 5 cm into the ground
+    others = [line for line in result.stderr.splitlines() if line not in warnings]
+    assert len(others) == 1 and "SphereDE in ground by 50.0 mm" in others[0], others
     robot = info["robots"][0]
     assert robot["kind"] == "free body" and robot["start"]["controls"] == [0.544, 0.433, 0.4]
     assert info["world"]["parameters"]["gravity"] == [0.0, 0.0, -9.8]

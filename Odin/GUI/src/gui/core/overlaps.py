@@ -69,8 +69,7 @@ def goal_overlaps(world, plan, built: Sequence[Overlap]) -> List[Overlap]:
     (where a part can move): every robot with a goal placed there at once by forward
     kinematics, asked of ``world`` (a gui.core.world_port.WorldPort) by Check Collision, which
     changes nothing; the pairs ``built`` so (``settle_overlaps``' answer) are not counted."""
-    poses = [pose for handle in plan.robots if handle.goal is not None
-             for pose in handle.situations(handle.goal.joints, handle.goal.base_pose)]
+    poses = _query_poses(plan, "goal")
     if not poses:
         return []
     known = {frozenset((o.first, o.second)) for o in built}
@@ -78,15 +77,44 @@ def goal_overlaps(world, plan, built: Sequence[Overlap]) -> List[Overlap]:
                                  if frozenset(pair[:2]) not in known])
 
 
+def start_overlaps(world, plan) -> List[Overlap]:
+    """The pairs inside each other where the robots start, deeper than BUILT_OVERLAP (where a
+    part can move): every robot with a query's start placed there at once by forward
+    kinematics, the others where they were built, asked of ``world`` (a
+    gui.core.world_port.WorldPort) by Check Collision, which changes nothing and, unlike
+    ``settle_overlaps``, leaves no pair exempt. A robot is built at its start unless the
+    build says otherwise (gui.core.translate): these are then the pairs of ``plan``'s robots
+    that ``settle_overlaps`` found, exempt or not."""
+    return built_overlaps(plan, world.check_collision(_query_poses(plan, "start")))
+
+
+def _query_poses(plan, at: str) -> list:
+    """(body ID, position m, quaternion (w, x, y, z)), world frame, of every link of each of
+    ``plan``'s robots with a query, at its ``at`` ("start" or "goal") configuration."""
+    poses = []
+    for handle in plan.robots:
+        configuration = getattr(handle, at)
+        if configuration is not None:
+            poses.extend(handle.situations(configuration.joints, configuration.base_pose))
+    return poses
+
+
 def goal_warning(source: str, overlaps: Sequence[Overlap]) -> str:
     """One line for the user: ``source`` (the problem file) and the deepest pairs its goal
     puts inside each other."""
+    return query_warning(source, overlaps, "goal")
+
+
+def query_warning(source: str, overlaps: Sequence[Overlap], at: str) -> str:
+    """One line for the user: ``source`` (the problem file) and the deepest pairs the query's
+    ``at`` ("start" or "goal") puts inside each other."""
     named = ", ".join(f"{o.first} in {o.second} by {o.depth * 1000:.1f} mm"
                       for o in overlaps[:PAIRS_NAMED])
     more = len(overlaps) - PAIRS_NAMED
     rest = f" and {more} more pair{'s' if more > 1 else ''}" if more > 0 else ""
-    return (f"{source}: the query's goal puts parts inside each other: {named}{rest}; a path "
-            "to it ends in collision")
+    path = "a path to it ends" if at == "goal" else "a path from it begins"
+    return (f"{source}: the query's {at} puts parts inside each other: {named}{rest}; {path} "
+            "in collision")
 
 
 #: what the world does with the pairs of a problem Kautham never simulates
