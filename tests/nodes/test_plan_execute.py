@@ -81,9 +81,9 @@ def test_a_physics_plan_is_run_as_a_control_path_ending_where_plan_said(world, k
                      str(tmp_path / "sphere.path")], check=False, timeout=180)
     assert run.returncode == 0, run.stderr
     statistics = _statistics(run.stdout)
-    last = re.match(r"^SphereDE: (\d+) control rows done \([0-9.]+ s simulated\), ends "
-                    r"([0-9.]+) m from the goal, \d+ colliding pairs? made by the path"
-                    r"(?: \(.*\))?, \d+ resting contacts?$", run.stdout.splitlines()[-1])
+    last = re.match(r"^SphereDE: (\d+) control rows done \([0-9.]+ s simulated\), \d+ "
+                    r"colliding pairs? made by the path(?: \(.*\))?, \d+ resting contacts?, "
+                    r"ends ([0-9.]+) m from the goal$", run.stdout.splitlines()[-1])
     assert last, run.stdout[-500:]
     assert int(last.group(1)) == statistics["rows"]
     assert abs(float(last.group(2)) - statistics["goal_distance_m"]) < 1e-3

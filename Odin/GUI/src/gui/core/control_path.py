@@ -25,6 +25,7 @@ import numpy as np
 
 from gui.core.contacts import ContactLedger
 from gui.core.kautham import environment
+from gui.core.kautham.controls import control_parts
 from gui.core.model import CAR, FREE_BODY, MOBILE
 from gui.core.paths import read_rows
 from gui.core.plan import ServoCommand
@@ -71,6 +72,14 @@ kind of robot:
 
 The last row's servo settings stay in force after it (its forces act only for its duration).
 A row whose values leave [0, 1] is refused with its file and line.
+
+A problem of several robots has one control vector for all of them, as its query's `<Init>`
+(`control_parts`): a 2012 problem's robots each have their own controls, end to end in robot
+order; a current problem's share one control file, each robot mapping the whole vector. A
+row of that vector and a duration drives every robot with controls at once, each its share,
+in one Propagate per row; a row of one robot's controls and a duration (a 2012 problem's)
+drives that robot alone, `run_path --robot`'s (the first robot by default). `--robot` with a
+row of every robot's is refused: it would do nothing.
 
 After each row `run_path --controls` prints where the link the planner tracks is (its body's
 position, m, world: a held chain's tool, any other robot's base) and, for a problem with a
@@ -133,6 +142,39 @@ def read_control_path(path: os.PathLike | str, size: int) -> List[ControlRow]:
                                 "a row)", p, line)
         out.append(ControlRow(tuple(float(v) for v in controls), duration))
     return out
+
+
+def read_control_paths(path: os.PathLike | str, handles: Sequence, legacy: bool,
+                       robot: Optional[str] = None) -> List[Tuple[object, List[ControlRow]]]:
+    """A control path for a problem's robots (``handles``: their gui.core.plan.RobotHandle,
+    robots only, the problem's order; ``legacy``: a 2012 problem), as (handle, its rows) per
+    robot it drives. A row of the problem's whole control vector and a duration drives every
+    robot with controls, each its share (``gui.core.kautham.controls.control_parts``: a 2012
+    problem's robots' controls end to end, a current problem's one set they all map; cars,
+    whose rows are CarEnvironment's two controls, are not shared out); else a row is one
+    robot's controls and a duration, ``robot``'s (the first by default)."""
+    p = pathlib.Path(path)
+    chosen = next((h for h in handles if robot in (None, h.name)), None)
+    if chosen is None:
+        raise PathFileError(f"no robot named {robot!r} (robots: "
+                            + ", ".join(h.name for h in handles) + ")", p)
+    by_instance = {id(h.instance): h for h in handles}
+    parts = [(by_instance[id(i)], part) for i, part in
+             control_parts([h.instance for h in handles], legacy)]
+    if len(parts) > 1 and all(h.kind != CAR for h, _ in parts):
+        every = max(part.stop for _, part in parts)
+        width = read_rows(p)[0].shape[1]
+        if width == every + 1:
+            rows = read_control_path(p, every)
+            return [(h, [ControlRow(r.controls[part], r.duration) for r in rows])
+                    for h, part in parts]
+        own = control_size(chosen)
+        if width != own + 1:
+            shared = "" if legacy else ", which every robot maps"
+            raise PathFileError(f"{width} values a row, expected {every + 1} (the problem's "
+                                f"{every} controls{shared}, and a duration) or {own + 1} "
+                                f"({chosen.name}'s {own} controls and a duration)", p)
+    return [(chosen, read_control_path(p, control_size(chosen)))]
 
 
 def write_control_path(path: os.PathLike | str, rows: Sequence[ControlRow],
@@ -258,30 +300,34 @@ def run_control_path(port: WorldPort, handle, rows: Sequence[ControlRow],
                      progress: Optional[Callable[[RowResult], None]] = None,
                      stop: Optional[Callable[[], bool]] = None,
                      watch: Optional[str] = None,
-                     contacts: Optional[ContactLedger] = None) -> List[RowResult]:
+                     contacts: Optional[ContactLedger] = None,
+                     others: Sequence[Tuple[object, Sequence[ControlRow]]] = ()
+                     ) -> List[RowResult]:
     """Applies ``rows`` in order to ``handle``'s robot through ``port``; returns the base's
     position after each row, and the state of body ``watch`` (a world ID: the link a planner
     tracked) when given. ``stop()`` true (asked before each row) ends the path there: the
     rows run so far are returned. ``contacts``: told every pair met, s from the path's
-    start."""
-    size = control_size(handle)
-    for k, row in enumerate(rows, start=1):
-        if len(row.controls) != size:
-            raise PathFileError(f"row {k} has {len(row.controls)} controls, robot "
-                                f"{handle.name} takes {size}")
+    start. ``others``: more robots driven at the same time, each (handle, its rows: as many,
+    of the same durations; one path's rows split per robot, ``read_control_paths``)."""
+    robots = [(handle, rows), *others]
+    for robot, its_rows in robots:
+        size = control_size(robot)
+        for k, row in enumerate(its_rows, start=1):
+            if len(row.controls) != size:
+                raise PathFileError(f"row {k} has {len(row.controls)} controls, robot "
+                                    f"{robot.name} takes {size}")
+        if len(its_rows) != len(rows):
+            raise PathFileError(f"robot {robot.name} has {len(its_rows)} rows, robot "
+                                f"{handle.name} {len(rows)}")
     base_id = handle.bodies[0].body_id
     results = []
     elapsed = 0.0
     for k, row in enumerate(rows, start=1):
         if stop is not None and stop():
             break
-        state = port.body_state(base_id)
-        act = actuation(handle, row, state, defaults)
-        if act.servo is not None:
-            port.set_servo(act.servo)
-        if act.base_velocity is not None:
-            port.set_body_velocity(*act.base_velocity, (0.0, 0.0, 0.0))
-        met = port.advance(row.duration, act.forces)
+        acts = [_actuate(port, robot, its_rows[k - 1], defaults) for robot, its_rows in robots]
+        act = acts[0]
+        met = port.advance(row.duration, tuple(f for a in acts for f in a.forces))
         if contacts is not None:
             for first, second, depth, when in met:
                 contacts.see(first, second, depth, elapsed + (when if math.isfinite(when)
@@ -292,9 +338,21 @@ def run_control_path(port: WorldPort, handle, rows: Sequence[ControlRow],
         results.append(result)
         if progress is not None:
             progress(result)
-    if handle.base_held:                # a kinematic base keeps its velocity: it stops here
-        port.set_body_velocity(base_id, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+    for robot, _ in robots:             # a kinematic base keeps its velocity: it stops here
+        if robot.base_held:
+            port.set_body_velocity(robot.bodies[0].body_id, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
     return results
+
+
+def _actuate(port: WorldPort, handle, row: ControlRow, defaults: ControlDefaults) -> Actuation:
+    """Sets what ``row`` asks of ``handle``'s robot for its duration (its servos, a held
+    base's velocity) and returns the actuation, whose forces the caller applies."""
+    act = actuation(handle, row, port.body_state(handle.bodies[0].body_id), defaults)
+    if act.servo is not None:
+        port.set_servo(act.servo)
+    if act.base_velocity is not None:
+        port.set_body_velocity(*act.base_velocity, (0.0, 0.0, 0.0))
+    return act
 
 
 def hold_servo(handle, present: Sequence[float]) -> ServoCommand:
@@ -329,5 +387,5 @@ def hold(port: WorldPort, handle) -> None:
 
 
 __all__ = ["MAPPING", "ControlDefaults", "ControlRow", "ServoCommand", "Actuation",
-           "control_size", "read_control_path", "write_control_path", "actuation",
-           "run_control_path", "RowResult", "hold_servo", "hold"]
+           "control_size", "read_control_path", "read_control_paths", "write_control_path",
+           "actuation", "run_control_path", "RowResult", "hold_servo", "hold"]

@@ -8,7 +8,8 @@ IDs, ``WorldParameters`` or ``StepValues``. A refusal (``success: false``) or a 
 connection raises ``gui.errors.WorldError`` carrying the world's message. ``execute(plan)``
 sends a ``gui.core.plan.BuildPlan`` (each step sends itself, then declares each robot it built
 with Set Robot: its robot_description, namespace and joint names, gui.core.robot_description);
-``run_position_path`` / ``run_velocity_path`` drive a robot. Messages are built only by
+``run_position_path`` / ``run_velocity_path`` drive a robot, ``run_position_rows`` /
+``run_velocity_rows`` several (their bases too) at once. Messages are built only by
 ``odin_common.messages`` and here.
 
 The Qt window must not call these from its GUI thread (each call blocks until the world
@@ -28,6 +29,7 @@ from typing import Callable, Dict, NamedTuple, Optional, Sequence, Tuple
 import numpy as np
 
 from gui.core.overlaps import goal_overlaps, goal_warning, overlap_warning
+from gui.core.paths import RobotRows
 from gui.core.plan import BuildPlan, BuiltIds, RobotHandle
 from gui.core.world_port import Built, Progress, build
 from gui.core.robot_description import RobotDescription, describe_robot
@@ -509,16 +511,28 @@ def robot_mesh_dir() -> str:
 def run_position_path(client: WorldClient, handle: RobotHandle, rows: np.ndarray,
                       rate: float, progress: Optional[Callable[[int], None]] = None,
                       sleep: Callable[[float], None] = time.sleep) -> None:
-    """One Set Position (every link, by forward kinematics) per row, ``rate`` rows per
-    second (thesis 7.4.3: the robot moves even while the simulation is paused)."""
+    """One Set Position (every link, by forward kinematics) per row of ``handle``'s movable
+    joints, its base where it was built, ``rate`` rows per second (thesis 7.4.3: the robot
+    moves even while the simulation is paused)."""
+    run_position_rows(client, [RobotRows(handle, np.asarray(rows, dtype=float))], rate,
+                      progress, sleep)
+
+
+def run_position_rows(client: WorldClient, robots: Sequence[RobotRows], rate: float,
+                      progress: Optional[Callable[[int], None]] = None,
+                      sleep: Callable[[float], None] = time.sleep) -> None:
+    """One Set Position per row of every robot's links and bases at once
+    (``gui.core.paths.RobotRows.situations``), ``rate`` rows per second."""
     period = 1.0 / rate
     start = time.monotonic()
-    for k, row in enumerate(rows, start=1):
-        client.set_position(handle.situations(row), reset_velocity=True)
+    count = len(robots[0].rows)
+    for k in range(count):
+        client.set_position([s for robot in robots for s in robot.situations(k)],
+                            reset_velocity=True)
         if progress is not None:
-            progress(k)
-        delay = start + k * period - time.monotonic()
-        if delay > 0 and k < len(rows):
+            progress(k + 1)
+        delay = start + (k + 1) * period - time.monotonic()
+        if delay > 0 and k + 1 < count:
             sleep(delay)
 
 
@@ -528,16 +542,45 @@ def run_velocity_path(client: WorldClient, handle: RobotHandle, rows: np.ndarray
     """One Set Velocity of every motor per row, ``rate`` rows per second (the world's
     publication rate: one row per cycle); the motors are stopped at the end unless ``stop``
     is False."""
-    if not handle.motor_ids:
-        raise WorldError("set_velocity", f"robot {handle.name} has no motors")
+    run_velocity_rows(client, [RobotRows(handle, np.asarray(rows, dtype=float))], rate,
+                      progress, sleep, stop)
+
+
+def run_velocity_rows(client: WorldClient, robots: Sequence[RobotRows], rate: float,
+                      progress: Optional[Callable[[int], None]] = None,
+                      sleep: Callable[[float], None] = time.sleep, stop: bool = True) -> None:
+    """Per row, one Set Velocity of every robot's motors at once and one of each base whose
+    columns the rows carry (``gui.core.paths.RobotRows``), ``rate`` rows per second; all
+    stopped at the end (``stop_velocity_rows``) unless ``stop`` is False."""
+    motors = [m for robot in robots for m in robot.handle.motor_ids]
+    for robot in robots:
+        if robot.speeds(0).size and not robot.handle.motor_ids:
+            raise WorldError("set_velocity", f"robot {robot.handle.name} has no motors")
     period = 1.0 / rate
     start = time.monotonic()
-    for k, row in enumerate(rows, start=1):
-        client.set_velocities(handle.motor_ids, row)
+    for k in range(len(robots[0].rows)):
+        if motors:
+            client.set_velocities(motors, np.concatenate([r.speeds(k) for r in robots]))
+        for robot in robots:
+            base = robot.base_velocity(k)
+            if base is not None:
+                client.set_body_velocity(base[0], linear=base[1])
         if progress is not None:
-            progress(k)
-        delay = start + k * period - time.monotonic()
+            progress(k + 1)
+        delay = start + (k + 1) * period - time.monotonic()
         if delay > 0:
             sleep(delay)
     if stop:
-        client.set_velocities(handle.motor_ids, np.zeros(len(handle.motor_ids)))
+        stop_velocity_rows(client, robots)
+
+
+def stop_velocity_rows(client: WorldClient, robots: Sequence[RobotRows]) -> None:
+    """Stops what a velocity path drives: every robot's motors (speed 0) and the bases whose
+    columns it carries (linear and angular velocity 0)."""
+    motors = [m for robot in robots for m in robot.handle.motor_ids]
+    if motors:
+        client.set_velocities(motors, np.zeros(len(motors)))
+    for robot in robots:
+        if robot.base_axes:
+            client.set_body_velocity(robot.handle.bodies[0].body_id, linear=(0.0, 0.0, 0.0),
+                                     angular=(0.0, 0.0, 0.0))

@@ -139,17 +139,19 @@ def run_on_client(client, handle, rows: Sequence[ControlRow],
                   sleep: Callable[[float], None] = time.sleep,
                   stop: Optional[Callable[[], bool]] = None,
                   watch: Optional[str] = None,
-                  contacts: Optional[ContactLedger] = None) -> List[RowResult]:
+                  contacts: Optional[ContactLedger] = None,
+                  others: Sequence = ()) -> List[RowResult]:
     """``gui.core.control_path.run_control_path`` on ``client``'s world (``watch``: its body
-    to report; ``contacts``: told the pairs met), the world paused meanwhile. Stopped by
-    ``stop()``, the robot is held where it is (``gui.core.control_path.hold``) before the
-    world runs again."""
+    to report; ``contacts``: told the pairs met; ``others``: more robots and their rows),
+    the world paused meanwhile. Stopped by ``stop()``, the robots are held where they are
+    (``gui.core.control_path.hold``) before the world runs again."""
     def run() -> List[RowResult]:
         port = ClientWorldPort(client, real_time, sleep)
         results = run_control_path(port, handle, rows, progress=progress, stop=stop,
-                                   watch=watch, contacts=contacts)
+                                   watch=watch, contacts=contacts, others=others)
         if stop is not None and stop():
-            hold(port, handle)
+            for robot in [handle, *(other for other, _ in others)]:
+                hold(port, robot)
         return results
     return _paused(client, run)
 

@@ -9,7 +9,7 @@ import enum
 import json
 import sys
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Callable, Dict, Optional, Sequence
+from typing import TYPE_CHECKING, Callable, Dict, List, Optional, Sequence
 
 import numpy as np
 
@@ -21,7 +21,7 @@ from gui.tools.common import (ProblemFile, ToolParser, add_build_options, add_ti
 from odin_common.tool import stop_on_ctrl_c
 
 if TYPE_CHECKING:
-    from gui.core.paths import RobotPath
+    from gui.core.paths import RobotPath, RobotRows
     from gui.core.plan import BuildPlan, RobotHandle
     from gui.ros.client import WorldClient
 
@@ -95,43 +95,73 @@ def run_path(request: PathRequest) -> int:
 
 # ------------------------------------------------------- initial, position and velocity rows
 
-def _read_rows(request: PathRequest, build_plan: BuildPlan, handle: RobotHandle) -> RobotPath:
-    """The path file read; a position path's rows checked for jumps between them (before any
-    doubling: the midpoints halve them) unless ``allow_jumps``, its doubling checked."""
-    from gui.core.paths import DEGREES, RADIANS, check_row_jumps, read_robot_path
+def _read_rows(request: PathRequest, build_plan: BuildPlan, handle: RobotHandle
+               ) -> List[RobotPath]:
+    """The path file read for the robots it drives (``gui.core.paths.read_robot_paths``:
+    every robot's columns, or the request's robot's; ``handle`` is that robot); a position
+    path's rows checked for jumps between them (before any doubling: the midpoints halve
+    them) unless ``allow_jumps``, its doubling checked."""
+    from gui.core.paths import DEGREES, RADIANS, check_row_jumps, read_robot_paths
     units = request.units or (DEGREES if build_plan.problem.format == "2012" else RADIANS)
     with reading("path file", request.path):
-        path = read_robot_path(request.path, handle, units)
+        paths = read_robot_paths(request.path, _robots(build_plan), units, request.robot)
+    _one_robot(request, [path.robot for path in paths], "columns")
     if request.mode is PathMode.POSITION:
         if not request.allow_jumps:
-            check_row_jumps(path)
+            for path in paths:
+                check_row_jumps(path)
         if request.double:
-            _doublings(request.double, len(path.rows))
-    return path
+            _doublings(request.double, len(paths[0].rows))
+    return paths
 
 
-def _position_rows(request: PathRequest, path: RobotPath, client: WorldClient,
-                   handle: RobotHandle) -> np.ndarray:
-    """A position path's rows (SI) to send, its precision doubled as asked, once its first
-    row is checked against where the robot is in the world unless ``allow_jumps``."""
-    from gui.core.paths import check_first_row, refine
-    if not request.allow_jumps:
-        check_first_row(path, _present_joints(client, handle))
-    return refine(path.rows, request.double)
+def _robots(build_plan: BuildPlan) -> List[RobotHandle]:
+    """The problem's robots (not its movable multi-link obstacles), in its order."""
+    return [h for h in build_plan.robots if h.instance.role == "robot"]
 
 
-def _present_joints(client: WorldClient, handle: RobotHandle) -> np.ndarray:
-    """Where the robot's movable joints are in the world (rad / m): ``built_at`` plus each
-    world joint's reading; NaN for a joint the world does not read as its first value (a
-    car's wheel spin) or holds no joint for."""
-    present = np.full(len(handle.built_at), np.nan)
-    ids = list(handle.joint_ids)
-    axes = list(handle.joint_axes) or [0] * len(ids)
-    readings = client.joint_positions(ids)
-    for j, (value, axis) in enumerate(zip(readings, axes)):
-        if axis == 0:
-            present[j] = handle.built_at[j] + value
-    return present
+def _one_robot(request: PathRequest, driven: List[str], what: str) -> None:
+    """GuiError when --robot names a robot and the file drives others too (it holds every
+    robot's ``what``): the option would do nothing."""
+    if request.robot is not None and driven != [request.robot]:
+        raise GuiError(f"--robot {request.robot}: {request.path} holds every robot's {what} "
+                       f"({', '.join(driven)}): without --robot it drives them all")
+
+
+def _robot_rows(request: PathRequest, paths: List[RobotPath], client: WorldClient,
+                build_plan: BuildPlan) -> List[RobotRows]:
+    """Each path's robot with its rows as sent and where its base is in the world now (a
+    base the rows do not carry stays there, ``gui.core.paths.RobotRows``); a position path's
+    first row checked against where the robots are unless ``allow_jumps`` (a base's columns
+    against its position now), then its precision doubled as asked. Every robot is checked
+    before any row is sent."""
+    from gui.core.paths import RobotRows, check_first_row, present_joints, refine
+    position = request.mode is PathMode.POSITION
+    out = []
+    for path in paths:
+        handle = build_plan.robot(path.robot)
+        base = _present_base(client, handle)
+        if position and not request.allow_jumps:
+            check_first_row(path, np.concatenate([base[list(path.base_axes), 3],
+                                                  present_joints(client, handle)]))
+        rows = refine(path.rows, request.double) if position else path.rows
+        out.append(RobotRows(handle, rows, path.base_axes, base))
+    return out
+
+
+def _present_base(client: WorldClient, handle: RobotHandle) -> np.ndarray:
+    """(4, 4), world: where the robot's base link is now. A base that can move (a free body,
+    a mobile base, a car) is read from the world; a held one is where it was built."""
+    from gui.core.model import CAR, FREE_BODY, MOBILE
+    from gui.core.paths import base_link_pose
+    if handle.kind not in (FREE_BODY, MOBILE, CAR):
+        return np.array(handle.base_pose, dtype=float)
+    position, quaternion, _, _ = client.body_kinematics(handle.bodies[0].body_id)
+    return base_link_pose(handle, position, quaternion)
+
+
+def _names(robots: List[RobotRows]) -> str:
+    return ", ".join(robot.handle.name for robot in robots)
 
 
 def _doublings(times: int, rows: int) -> int:
@@ -144,13 +174,17 @@ def _doublings(times: int, rows: int) -> int:
 
 
 def _set_initial(request: PathRequest, build_plan: BuildPlan, handle: RobotHandle) -> int:
-    """--initial: the robot set at the file's first row, its speeds zeroed (a placement, so
-    not checked for a jump from where the robot is)."""
-    rows = _read_rows(request, build_plan, handle).rows
+    """--initial: the robots set at the file's first row, their speeds zeroed (a placement,
+    so not checked for a jump from where they are); a base the row does not carry stays
+    where it is."""
+    paths = _read_rows(request, build_plan, handle)
     from gui.ros.client import WorldClient
     client = WorldClient(timeout=request.timeout)
-    client.set_position(handle.situations(rows[0]), reset_velocity=True)
-    print(f"{handle.name}: initial position set ({len(handle.bodies)} bodies)")
+    robots = _robot_rows(request, paths, client, build_plan)
+    client.set_position([s for robot in robots for s in robot.situations(0)],
+                        reset_velocity=True)
+    print(f"{_names(robots)}: initial position set "
+          f"({sum(len(robot.handle.bodies) for robot in robots)} bodies)")
     return 0
 
 
@@ -165,11 +199,13 @@ def _run_rows(request: PathRequest, build_plan: BuildPlan, handle: RobotHandle) 
     robot, so only then can it be inside something): the pairs the path made are told from
     those the scene rested on before the first row (``gui.core.contacts``), a line each as
     they come and in the last line."""
-    path = _read_rows(request, build_plan, handle)
-    from gui.ros.client import WorldClient, run_position_path, run_velocity_path
+    paths = _read_rows(request, build_plan, handle)
+    from gui.ros.client import (WorldClient, run_position_rows, run_velocity_rows,
+                                stop_velocity_rows)
     client = WorldClient(timeout=request.timeout)
     velocity = request.mode is PathMode.VELOCITY
-    rows = path.rows if velocity else _position_rows(request, path, client, handle)
+    robots = _robot_rows(request, paths, client, build_plan)
+    rows = robots[0].rows
     rate = request.rate if request.rate > 0 else client.publication_rate()
     done = [0]
     contacts = ContactLedger(client.check_collision([]))
@@ -187,16 +223,16 @@ def _run_rows(request: PathRequest, build_plan: BuildPlan, handle: RobotHandle) 
                 raise _Stopped
 
         try:
-            run = run_velocity_path if velocity else run_position_path
-            run(client, handle, rows, rate, progress=progress)
+            run = run_velocity_rows if velocity else run_position_rows
+            run(client, robots, rate, progress=progress)
         except _Stopped:
             pass
         if stop:
             if velocity:                # the last row's speeds would drive on
-                client.set_velocities(handle.motor_ids, np.zeros(len(handle.motor_ids)))
+                stop_velocity_rows(client, robots)
             return _interrupted(f"row {done[0]} of {len(rows)} ({done[0] / rate:.2f} s "
                                 f"of {len(rows) / rate:.2f} s)")
-    print(f"{handle.name}: {len(rows)} rows at {rate:g} Hz done, {contacts.describe()}")
+    print(f"{_names(robots)}: {len(rows)} rows at {rate:g} Hz done, {contacts.describe()}")
     return 0
 
 
@@ -228,39 +264,48 @@ def _run_controls(request: PathRequest, build_plan: BuildPlan, handle: RobotHand
     per row: its time, where the link the planner tracks is and, for a problem with a query,
     its distance to the goal in the planner's metric (``_goal_meter``): the figure ``plan``
     printed for the same path."""
-    from gui.core.control_path import control_size, read_control_path
+    from gui.core.control_path import read_control_paths
     from gui.ros.world_port import run_on_client
     with reading("control path", request.path):
-        rows = read_control_path(request.path, control_size(handle))
-    meter = _goal_meter(build_plan, handle)
+        drives = read_control_paths(request.path, _robots(build_plan),
+                                    build_plan.problem.format == "2012", request.robot)
+    _one_robot(request, [h.name for h, _ in drives], "controls")
+    handle, rows = drives[0]
+    meters = [_goal_meter(build_plan, h) for h, _ in drives]
     from gui.ros.client import WorldClient
     client = WorldClient(timeout=request.timeout)
     _check_world_holds(client, build_plan)
-    watched = handle.bodies[0].body_id if meter is None else meter.tracked_body
-    elapsed, distance = [0.0], [None]
+    watched = [h.bodies[0].body_id if meter is None else meter.tracked_body
+               for (h, _), meter in zip(drives, meters)]
+    elapsed, distance = [0.0], {}
 
     def progress(result) -> None:
         elapsed[0] += result.actuation.duration
-        position, quaternion = result.watched[0], result.watched[1]
-        where = np.round(position, 3).tolist()
-        to_goal = ""
-        if meter is not None:
-            distance[0] = meter.body_goal_distance(position, quaternion)
-            to_goal = f", {distance[0]:.4f} m from the goal"
-        print(f"[{result.index}/{len(rows)}] t={elapsed[0]:.3f} s {watched} at {where}"
-              f"{to_goal}", flush=True)
+        states = [result.watched] + [client.body_kinematics(w) for w in watched[1:]]
+        said = []
+        for (robot, _), body, meter, state in zip(drives, watched, meters, states):
+            to_goal = ""
+            if meter is not None:
+                distance[robot.name] = meter.body_goal_distance(state[0], state[1])
+                to_goal = f", {distance[robot.name]:.4f} m from the goal"
+            said.append(f"{body} at {np.round(state[0], 3).tolist()}{to_goal}")
+        print(f"[{result.index}/{len(rows)}] t={elapsed[0]:.3f} s {'; '.join(said)}",
+              flush=True)
 
     contacts = ContactLedger(client.check_collision([]))
     with stop_on_ctrl_c() as stop:
         results = run_on_client(client, handle, rows, real_time=request.real_time,
-                                progress=progress, stop=stop, watch=watched, contacts=contacts)
+                                progress=progress, stop=stop, watch=watched[0],
+                                contacts=contacts, others=drives[1:])
     if stop:
         total = sum(row.duration for row in rows)
         return _interrupted(f"row {len(results)} of {len(rows)} ({elapsed[0]:.2f} s of "
                             f"{total:.2f} s)")
-    ends = "" if distance[0] is None else f", ends {distance[0]:.4f} m from the goal"
-    print(f"{handle.name}: {len(rows)} control rows done ({elapsed[0]:.3f} s simulated)"
-          f"{ends}, {contacts.describe()}")
+    ends = "" if not distance else ", ends " + ", ".join(
+        f"{name + ' ' if len(drives) > 1 else ''}{d:.4f} m" for name, d in distance.items()
+    ) + " from the goal"
+    print(f"{', '.join(h.name for h, _ in drives)}: {len(rows)} control rows done "
+          f"({elapsed[0]:.3f} s simulated), {contacts.describe()}{ends}")
     return 0
 
 
@@ -289,6 +334,7 @@ def _run_tracked(request: PathRequest, build_plan: BuildPlan, handle: RobotHandl
     with reading("plan", request.path):         # the word its users know: a Kautham plan
         solution = read_solution(request.path, build_plan.problem, request.robot,
                                  request.units)
+    _one_robot(request, list(solution.paths), "configuration")
     client, solver = _tracked_world(request, build_plan, solution)
     shown = [0]
     reached = [0.0, 0.0]
@@ -386,7 +432,10 @@ def _parser() -> ToolParser:
                        help="values in degrees (mm) [default for 2012 problems]")
     units.add_argument("--radians", action="store_true",
                        help="values in radians (m) [default for current problems]")
-    parser.add_argument("--robot", help="robot name (default: the first robot)")
+    parser.add_argument("--robot", help="the robot a file of one robot's values drives "
+                        "[default: the first robot]; a file of every robot's (rows as long as "
+                        "all their columns, a task file, a .kps of all the controls) drives "
+                        "them all and is refused with --robot")
     parser.add_argument("--double", type=count(0, MAX_DOUBLINGS), default=0, metavar="N",
                         help="double the path precision N times (position paths)")
     parser.add_argument("--allow-jumps", action="store_true",

@@ -5,9 +5,11 @@ velocity; vectors and points in the world or the body frame. Forces and torques 
 deleted: their IDs (the world's answers) are listed for deletion. Velocities act once.
 Move joint: a force / torque per joint axis (as many magnitudes as the joint type takes), with
 the list of joint forces. Move motor: goal speeds. Move robot: initial position, velocity
-path and position path files (``gui.core.paths``), optionally refined by double path precision,
-and control paths (rows of the robot's Kautham controls in [0, 1] with a duration, applied as
-Kautham's ODE environment does: ``gui.core.control_path``, docs/INTERFACE.md), and tracked
+path and position path files (``gui.core.paths``), optionally refined by double path precision
+(a position path is refused, as run_path refuses it, where a row jumps or its first row is far
+from where the robot is, unless "Allow jumps" is ticked: ``JUMP_OPTIONS``), and control paths
+(rows of the robot's Kautham controls in [0, 1] with a duration, applied as Kautham's ODE
+environment does: ``gui.core.control_path``, docs/INTERFACE.md), and tracked
 paths (a Kautham plan: .kps solution, task file, OMPL or raw rows, timed within the joints'
 limits and followed by the joint servos under full physics, ``gui.core.execution``; its
 target against actual per joint is plotted below); a path runs on a worker of its own (Stop
@@ -23,6 +25,7 @@ from typing import Optional
 from PyQt5.QtWidgets import (QCheckBox, QComboBox, QFileDialog, QLabel, QListWidget,
                              QPushButton, QToolBox, QVBoxLayout, QWidget)
 
+from gui.core.paths import MAX_ROW_JUMP, MAX_ROW_SLIDE, JumpOptions
 from gui.errors import GuiError
 from gui.window.fields import ChoiceButtons, VectorRow, int_spin
 from gui.window.forms import form_grid, growing, span
@@ -37,6 +40,12 @@ ACTIONS = ["force", "torque", "angular velocity", "linear velocity"]
 FORCE_ACTIONS = {0: ForceKind.FORCE, 1: ForceKind.TORQUE}
 ANGULAR_VELOCITY = 2
 SOLVE_TITLE = "Solve query"
+UNITS = ["degrees (mm)", "radians (m)"]
+"""The Move robot page's units in files (the index: 0 degrees, 1 radians)."""
+ALLOW_JUMPS = "Allow jumps"
+JUMP_OPTIONS = JumpOptions(degrees=f'Units in files "{UNITS[0]}"',
+                           radians=f'Units in files "{UNITS[1]}"', allow=f'"{ALLOW_JUMPS}"')
+"""The page's controls a refused jump names (run_path's --degrees, --radians, --allow-jumps)."""
 
 
 class MotionTab(QWidget):
@@ -110,7 +119,7 @@ class MotionTab(QWidget):
         page = QWidget()
         self.robot = QComboBox()
         self.units = QComboBox()
-        self.units.addItems(["degrees (mm)", "radians (m)"])
+        self.units.addItems(UNITS)
         self.initial_button = QPushButton("Set initial position...")
         self.velocity_button = QPushButton("Velocity path...")
         self.position_button = QPushButton("Position path...")
@@ -122,6 +131,12 @@ class MotionTab(QWidget):
                                        "followed by the joint servos with contacts on")
         self.tracking_plot = TrackingPlot()
         self.double = int_spin(0, 0, 6, "times the path precision is doubled (2^n finer)")
+        self.allow_jumps = QCheckBox(ALLOW_JUMPS)
+        self.allow_jumps.setToolTip(
+            f"position paths: run rows that move a revolute joint more than {MAX_ROW_JUMP:g} "
+            f"rad or a prismatic one more than {MAX_ROW_SLIDE:g} m from the row before, or the "
+            "first row from where the robot is (refused otherwise: a path read in the wrong "
+            "unit, said)")
         self.stop_button = QPushButton("Stop path")
         self.stop_button.setEnabled(False)
         self.path_status = QLabel("No path running.")
@@ -129,7 +144,7 @@ class MotionTab(QWidget):
                    ["Units in files", self.units],
                    [None, self.initial_button],
                    [self.velocity_button, self.position_button, self.controls_button],
-                   ["Double path precision (times)", self.double],
+                   ["Double path precision (times)", self.double, self.allow_jumps],
                    [self.tracked_button, self.stop_button],
                    [span(self.path_status, 3)],
                    growing(span(self.tracking_plot, 3))], page)
@@ -317,7 +332,8 @@ class MotionTab(QWidget):
     def run_path(self, kind: str, path: str) -> None:
         """``kind``: "initial", "velocity", "position", "control" or "tracked"; runs on the
         path worker."""
-        from gui.core.paths import DEGREES, RADIANS, load_robot_path, refine
+        from gui.core.paths import (DEGREES, RADIANS, check_first_row, check_row_jumps,
+                                    present_joints, read_robot_path, refine)
         handle = self.window.scene.robots.get(self.robot.currentData())
         if handle is None:
             self.window.show_error("Move robot: open a problem with a robot first")
@@ -329,11 +345,16 @@ class MotionTab(QWidget):
         if kind == "tracked":
             self.run_tracked_path(handle, path, units)
             return
+        # jumps as run_path checks them: between rows here, the first row on the worker
+        check_jumps = kind == "position" and not self.allow_jumps.isChecked()
         try:
-            rows = load_robot_path(path, handle, units)
+            read = read_robot_path(path, handle, units)
+            if check_jumps:
+                check_row_jumps(read, JUMP_OPTIONS)
         except Exception as error:  # a bad file is the user's: say what and where
             self.window.show_error(f"Move robot: {error}")
             return
+        rows = read.rows
         if kind == "initial":
             self.window.call("Initial position", lambda client, job: client.set_position(
                 handle.situations(rows[0]), reset_velocity=True),
@@ -348,6 +369,8 @@ class MotionTab(QWidget):
             from gui.ros.client import run_position_path, run_velocity_path
             runner = run_position_path if kind == "position" else run_velocity_path
             from gui.window.worker import Cancelled
+            if check_jumps:
+                check_first_row(read, present_joints(client, handle), JUMP_OPTIONS)
             try:
                 runner(client, handle, rows, rate, progress=job.progress, sleep=job.sleep)
             except Cancelled:

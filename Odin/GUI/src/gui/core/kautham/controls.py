@@ -33,7 +33,7 @@ from __future__ import annotations
 import math
 import pathlib
 from dataclasses import dataclass
-from typing import Optional, Sequence, Tuple
+from typing import List, NamedTuple, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -51,6 +51,9 @@ LEGACY_OFFSET_DEFAULT = 0.0
 """Kautham 2012's offset of a DOF a .rob's own control set does not list."""
 CONTINUOUS_LIMITS = (-2.0 * math.pi, 2.0 * math.pi)
 """rad: the range Kautham gives a URDF continuous joint."""
+PAST_LIMIT_SLACK = 1e-9
+"""How far past [0, 1] a DOF's normalised value may be and still count as within its limits
+(``ControlMap.past_limits``): rounding of the mapping's sums, not a query's request."""
 
 
 MAX_CONTROL_WEIGHT = 1e6
@@ -121,15 +124,42 @@ class ControlMap:
         """Indices 0..2 (X, Y, Z) of the base position DOFs some control moves."""
         return tuple(i for i in range(3) if np.any(self.matrix[i] != 0.0))
 
-    def parameters(self, controls: Sequence[float]) -> Tuple[np.ndarray, bool]:
-        """Normalised DOF values p (n_dofs,) in [0, 1] for controls c (k,), and whether they
-        were within bounds before clamping (Kautham's answer)."""
+    def unclamped(self, controls: Sequence[float]) -> np.ndarray:
+        """Normalised DOF values p (n_dofs,) for controls c (k,) before Kautham's clamp to
+        [0, 1] (a value outside it asks for a DOF past its limits)."""
         c = np.asarray(controls, dtype=float)
         if c.shape != (self.size,):
             raise ValueError(f"{self.robot}: {self.size} controls expected, got {c.size}")
-        p = self.offset + self.matrix @ (c - 0.5)
+        return self.offset + self.matrix @ (c - 0.5)
+
+    def parameters(self, controls: Sequence[float]) -> Tuple[np.ndarray, bool]:
+        """Normalised DOF values p (n_dofs,) in [0, 1] for controls c (k,), and whether they
+        were within bounds before clamping (Kautham's answer)."""
+        p = self.unclamped(controls)
         within = bool(np.all((p >= 0.0) & (p <= 1.0)))
         return np.clip(p, 0.0, 1.0), within
+
+    def past_limits(self, instance: Instance, controls: Sequence[float]) -> List["PastLimit"]:
+        """The DOFs of ``instance`` (the robot this map is of) that controls c (k,) ask past
+        their limits, which ``configuration`` clamps them into as Kautham does (the query's
+        start or goal is then not the one written): its movable joints, and the base's DOFs
+        when the set moves the base."""
+        p = self.unclamped(controls)
+        index = {name: i for i, name in enumerate(self.dofs)}
+        model = instance.model
+        past = []
+        if self.se3:
+            past.extend(PastLimit(dof, float(p[index[dof]])) for dof in BASE_DOFS
+                        if _past(p[index[dof]]))
+        for i, name in zip(model.movable_links(), model.joint_names()):
+            link = model.links[i]
+            value = p[index[link.name]]
+            if _past(value):
+                low, high = joint_limits(link)
+                past.append(PastLimit(link.name, float(value), name,
+                                      float(low + value * (high - low)),
+                                      (float(low), float(high))))
+        return past
 
     def configuration(self, instance: Instance, controls: Sequence[float]) -> Configuration:
         """The configuration controls c put ``instance`` in (module docstring)."""
@@ -146,6 +176,22 @@ class ControlMap:
             base = base_pose(instance.base_pose, instance.limits, p[:6])
         return Configuration(base, np.array(joints, dtype=float),
                              tuple(float(v) for v in controls))
+
+
+class PastLimit(NamedTuple):
+    """A DOF a control vector asks past its limits (``ControlMap.past_limits``): ``dof`` (a
+    BASE_DOFS name or a link's), ``parameter`` (its normalised value before Kautham's clamp;
+    [0, 1] is within the limits); for a joint, its ``joint`` name, the ``value`` asked (rad
+    or m) and its ``limits`` (low, high; rad or m), None for a base DOF."""
+    dof: str
+    parameter: float
+    joint: Optional[str] = None
+    value: Optional[float] = None
+    limits: Optional[Tuple[float, float]] = None
+
+
+def _past(parameter: float) -> bool:
+    return not -PAST_LIMIT_SLACK <= parameter <= 1.0 + PAST_LIMIT_SLACK
 
 
 def joint_limits(link) -> Tuple[float, float]:
@@ -247,6 +293,25 @@ def control_map(instance: Instance, control_set: ControlSet, prefixed: bool,
                       offset, matrix, se3, control_set.source)
 
 
+def control_parts(robots: Sequence[Instance], legacy: bool) -> List[Tuple[Instance, slice]]:
+    """Each of ``robots`` that has controls, with its slice of one control vector for all of
+    them (a query's ``<Init>``/``<Goal>``, a ``.kps`` sample, a control path's row), in robot
+    order. A current problem's robots share one control set (its .cntr), so each maps the
+    whole vector; a 2012 problem's (``legacy``) each have their own (their .rob's) and take
+    the next ``size`` values end to end (Kautham 2012's ``WorkSpace::moveRobotsTo``). The
+    vector's length is the largest slice's end."""
+    parts, end = [], 0
+    for robot in robots:
+        if robot.controls is None:
+            continue
+        size = robot.controls.size
+        parts.append((robot, slice(end, end + size) if legacy else slice(0, size)))
+        end += size if legacy else 0
+    return parts
+
+
 __all__ = ["BASE_DOFS", "OFFSET_DEFAULT", "LEGACY_OFFSET_DEFAULT", "CONTINUOUS_LIMITS",
-           "parse_control_set", "free_flyer_control_set", "read_cntr", "ControlMap",
-           "joint_limits", "home_frame_limits", "kuffner_quaternion", "base_pose", "control_map"]
+           "PAST_LIMIT_SLACK", "parse_control_set", "free_flyer_control_set", "read_cntr",
+           "ControlMap", "PastLimit",
+           "joint_limits", "home_frame_limits", "kuffner_quaternion", "base_pose", "control_map",
+           "control_parts"]

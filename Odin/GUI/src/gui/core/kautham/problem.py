@@ -49,7 +49,7 @@ from typing import List, Optional
 import numpy as np
 
 from gui.core.kautham.controls import (BASE_DOFS, LEGACY_OFFSET_DEFAULT, control_map,
-                                       free_flyer_control_set, read_cntr)
+                                       control_parts, free_flyer_control_set, read_cntr)
 from gui.core.kautham.robot_rob import read_dh_robot, read_shape_robot
 from gui.core.kautham.units import LEGACY, SI, Units, scale_problem
 from gui.core.kautham.urdf import read_urdf
@@ -409,17 +409,14 @@ class _Loader:
         every robot maps the whole vector; in a 2012 problem each robot has its own set and the
         vector is theirs end to end, in robot order (Kautham 2012's
         ``WorkSpace::moveRobotsTo``: robot i takes the next ``getNumControls()`` values)."""
-        mapped = [r for r in robots if r.controls is not None]
+        mapped = control_parts(robots, legacy=not self.current)
         if not mapped:
             self.ignore(query, "<Query>", "no robot has controls to map it through")
             return
         if self.current:
-            names = mapped[0].controls.names
-            parts = [slice(None)] * len(mapped)
+            names = mapped[0][0].controls.names
         else:
-            names = tuple(n for r in mapped for n in r.controls.names)
-            ends = np.cumsum([r.controls.size for r in mapped])
-            parts = [slice(end - r.controls.size, end) for r, end in zip(mapped, ends)]
+            names = tuple(n for r, _ in mapped for n in r.controls.names)
         size = len(names)
         init = goal = None
         for child in query.children:
@@ -440,7 +437,7 @@ class _Loader:
             else:
                 self.ignore(child, f"<Query> <{child.tag}>", "obstacle controls: Odin does "
                             "not move obstacles by controls")
-        for robot, part in zip(mapped, parts):
+        for robot, part in mapped:
             if init is not None:
                 robot.start = robot.controls.configuration(robot, _fill(init)[part])
             if goal is not None:

@@ -6,8 +6,12 @@ space, with the attach/detach events of a task (ROS-free).
 - a legacy solution file (``.kps``, Kautham 2012's ``Planner::saveData``): a root ``<Planner>``
   holding ``<SampleSet>`` (``<Sample>`` rows of normalised control values in [0, 1]) and
   ``<Queries>``; the first ``<Query Solved="True">``'s ``<Result name="Path">`` lists sample
-  indices. Each sample maps through every robot's controls and limits as the query's
-  ``<Init>`` does (``gui.core.kautham.controls``). The query's ``Init`` and ``Goal`` are
+  indices. A sample is a control vector as the query's ``<Init>`` is
+  (``gui.core.kautham.controls.control_parts``): every robot's controls (a current problem's
+  robots share one vector; a 2012 problem's take theirs end to end, robot order), each
+  robot's share mapped through its controls and limits; in a 2012 problem of several robots
+  a sample as long as one robot's controls is that robot's alone (``robot``'s, the first
+  by default), the others not moved by the plan. The query's ``Init`` and ``Goal`` are
   indices into the ``<SampleSet>`` (``Planner::loadData`` sets its start and goal samples from
   them and moves the robots to the path's first sample): the path runs from ``Init`` to
   ``Goal``, which may be the problem's query reversed, so a file whose path starts or ends
@@ -20,7 +24,8 @@ space, with the attach/detach events of a task (ROS-free).
   ``<Initialstate>`` (obstacle poses) is refused: Odin builds obstacles where the problem
   puts them;
 - OMPL's path output (``PathGeometric::printAsMatrix``, Kautham's ``getPath``): plain rows;
-- raw rows of one robot's movable joints (the thesis's path files, ``gui.core.paths``).
+- raw rows of one robot's movable joints (the thesis's path files, ``gui.core.paths``), or of
+  every robot's, end to end in robot order.
 
 A ``<Conf>`` row and an OMPL row are a mapped configuration of every robot in the problem's
 order (Kautham's ``loadSampleFromLine``): for a robot whose controls move its base (Kautham's
@@ -29,8 +34,13 @@ x y z w as Kautham and OMPL write it); then one value per joint of the robot (ra
 link but the base counted, fixed ones too (Kautham's ``getNumJoints``; the values of fixed
 joints are read and dropped). A row with only the movable joints' values per robot is read
 too. Plain rows of a 2012 problem are raw rows (degrees and mm unless ``units`` says
-otherwise); of a current problem, OMPL rows when their length is the problem's layout, raw
-rows of ``robot`` otherwise.
+otherwise); of a current problem, OMPL rows when their length is the problem's layout (and
+not ``robot``'s movable joints), raw rows otherwise.
+
+``robot`` names the robot a file of one robot's values drives (default: the first); a file
+of every robot's (a task file, OMPL rows, a .kps sample of all the controls, raw rows of
+all the robots) drives every robot it holds whatever ``robot`` says: ``Solution.paths`` says
+which robots a plan moves (``run_path --robot`` with a plan of several robots is refused).
 
 Any malformed or mismatched file raises ``PathFileError`` naming the file and the row's line;
 nothing is returned in part.
@@ -45,6 +55,7 @@ from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
+from gui.core.kautham.controls import control_parts
 from gui.core.kautham.xmlfile import Node, parse_xml_bytes
 from gui.core.model import Instance, Problem
 from gui.core.paths import DEGREES, RADIANS, read_rows, to_si
@@ -118,12 +129,14 @@ def read_solution(path: os.PathLike | str, problem: Problem, robot: Optional[str
     p = pathlib.Path(path)
     if not problem.robots:
         raise PathFileError(f"problem {problem.source} has no robot to move", p)
+    if robot is not None:
+        _robot(p, problem, robot)               # a name that is no robot's: said first
     data = read_input_file(p, "path file", PathFileError)
     text = data.decode(errors="replace")
     if text.lstrip().startswith("<"):
         root = _parse_xml(p, data)
         if root.tag == "Planner" or root.find("SampleSet") is not None:
-            return _read_kps(p, root, problem)
+            return _read_kps(p, root, problem, robot)
         if root.tag == "Task":
             return _read_task(p, root, problem)
         raise PathFileError(f"root element <{root.tag}> is neither a Kautham solution "
@@ -142,7 +155,8 @@ def _parse_xml(p: pathlib.Path, data: bytes) -> Node:
 
 
 # -- legacy .kps ---------------------------------------------------------------------------------
-def _read_kps(p: pathlib.Path, root: Node, problem: Problem) -> Solution:
+def _read_kps(p: pathlib.Path, root: Node, problem: Problem, robot: Optional[str]
+              ) -> Solution:
     sample_set = root.find("SampleSet")
     if sample_set is None:
         raise PathFileError("<Planner> holds no <SampleSet>: no configuration", p, root.line)
@@ -156,8 +170,7 @@ def _read_kps(p: pathlib.Path, root: Node, problem: Problem) -> Solution:
     if not indices:
         raise PathFileError("<Result name=\"Path\"> lists no sample", p, result.line)
     query = _kps_query(p, query_node, indices, len(samples))
-    robots = _mapped_robots(p, problem)
-    size = robots[0].controls.size
+    parts = _mapped_robots(p, problem)
     vectors, lines = [], []
     for index in indices:
         if not 0 <= index < len(samples):
@@ -165,18 +178,20 @@ def _read_kps(p: pathlib.Path, root: Node, problem: Problem) -> Solution:
                                 f"{len(samples) - 1})", p, result.line)
         sample = samples[index]
         values = _numbers(p, sample)
+        if not vectors:                 # the path's first sample says whose controls it holds
+            parts = _sample_robots(p, parts, robot, len(values), index, sample.line)
+        size = max(part.stop for _, part in parts)
         if len(values) != size:
             raise PathFileError(f"<Sample> {index} has {len(values)} values, the controls are "
-                                f"{size} ({', '.join(robots[0].controls.names)})", p,
-                                sample.line)
+                                f"{size} ({_describe_parts(parts)})", p, sample.line)
         if not all(0.0 <= v <= 1.0 for v in values):
             raise PathFileError(f"<Sample> {index} holds values outside [0, 1] (normalised "
                                 "controls)", p, sample.line)
         vectors.append(values)
         lines.append(sample.line)
     paths = {}
-    for instance in robots:
-        configurations = [instance.controls.configuration(instance, v) for v in vectors]
+    for instance, part in parts:
+        configurations = [instance.controls.configuration(instance, v[part]) for v in vectors]
         base = None
         if instance.controls.se3:
             base = np.array([c.base_pose for c in configurations])
@@ -228,15 +243,38 @@ def _kps_path_result(p: pathlib.Path, root: Node) -> Tuple[Node, Node]:
     raise PathFileError("no solved <Query> has a <Result name=\"Path\">", p, found[0].line)
 
 
-def _mapped_robots(p: pathlib.Path, problem: Problem) -> List[Instance]:
-    robots = [r for r in problem.robots if r.controls is not None]
-    if not robots:
+def _mapped_robots(p: pathlib.Path, problem: Problem) -> List[Tuple[Instance, slice]]:
+    """The robots with controls and their slices of a sample (``control_parts``)."""
+    parts = control_parts(problem.robots, legacy=problem.format == "2012")
+    if not parts:
         raise PathFileError(f"no robot of {problem.source} has controls to map the file's "
                             "normalised samples through", p)
-    if len({r.controls.size for r in robots}) > 1:
-        raise PathFileError("the robots' control sets differ in size: a sample cannot map "
-                            "through all of them", p)
-    return robots
+    return parts
+
+
+def _sample_robots(p: pathlib.Path, parts: List[Tuple[Instance, slice]], robot: Optional[str],
+                   size: int, index: int, line: int) -> List[Tuple[Instance, slice]]:
+    """Whose controls a sample of ``size`` values holds: every robot's (``parts``) when it
+    is as long as their vector, else ``robot``'s (the first robot with controls by default)
+    when as long as its own controls (a 2012 problem's robots each have theirs)."""
+    every = max(part.stop for _, part in parts)
+    if size == every:
+        return parts
+    chosen = next((r for r, _ in parts if robot in (None, r.name)), None)
+    if chosen is not None and size == chosen.controls.size:
+        return [(chosen, slice(0, size))]
+    one = "" if chosen is None or chosen.controls.size == every else \
+        f", or {chosen.controls.size} ({chosen.name}'s: {', '.join(chosen.controls.names)})"
+    raise PathFileError(f"<Sample> {index} has {size} values, the controls are {every} "
+                        f"({_describe_parts(parts)}){one}", p, line)
+
+
+def _describe_parts(parts: List[Tuple[Instance, slice]]) -> str:
+    """The controls of a sample of ``parts``: their names, by robot when several share it
+    end to end."""
+    if len(parts) == 1 or parts[-1][1].start == 0:      # one robot, or a shared vector
+        return ", ".join(parts[0][0].controls.names)
+    return " + ".join(f"{r.name}: {r.controls.size}" for r, _ in parts)
 
 
 def _numbers(p: pathlib.Path, node: Node) -> List[float]:
@@ -432,25 +470,38 @@ def _check_limits(p: pathlib.Path, instance: Instance, rows: Sequence[np.ndarray
 # -- plain rows ----------------------------------------------------------------------------------
 def _read_plain_rows(p: pathlib.Path, data: bytes, problem: Problem, robot: Optional[str],
                      units: Optional[str]) -> Solution:
+    """OMPL rows (a current problem's layout, unless as long as ``robot``'s movable joints),
+    else raw rows of one robot's movable joints or, as long as every robot's, of all of them
+    end to end (module docstring)."""
     instance = _robot(p, problem, robot)
     movable = len(instance.model.movable_links())
-    if problem.format == "2012":
-        raw, lines = read_rows(p, movable, data=data)
-    else:
+    first, _ = read_rows(p, None, data=data)
+    width = first.shape[1]
+    layout = None
+    if problem.format != "2012":
         layout = RowLayout.of(problem)
-        first, _ = read_rows(p, None, data=data)
-        if first.shape[1] in (layout.size, RowLayout.of(problem, movable_only=True).size) \
-                and robot is None:
-            raw, lines = read_rows(p, first.shape[1], f"a configuration: {layout.describe()}",
-                                   data)
+        if width in (layout.size, RowLayout.of(problem, movable_only=True).size) \
+                and (robot is None or width != movable):
+            raw, lines = read_rows(p, width, f"a configuration: {layout.describe()}", data)
             return Solution(str(p), OMPL, layout.split(p, raw.tolist(), lines))
-        raw, lines = read_rows(p, movable, f"one per movable joint of {instance.name}", data)
+    every = [r for r in problem.robots if r.model.movable_links()]
+    total = sum(len(r.model.movable_links()) for r in every)
+    robots = every if len(every) > 1 and width == total else [instance]
+    meaning = f"one per movable joint of {instance.name}"
+    if len(every) > 1:
+        meaning += f"; {total} for every robot's, end to end"
+    if layout is not None:
+        meaning += f"; {layout.size} for a configuration: {layout.describe()}"
+    raw, lines = read_rows(p, sum(len(r.model.movable_links()) for r in robots), meaning, data)
     unit = units or (DEGREES if problem.format == "2012" else RADIANS)
-    kinds = [instance.model.links[i].joint for i in instance.model.movable_links()]
-    joints = to_si(raw, kinds, unit)
-    _check_limits(p, instance, list(joints), lines)
-    return Solution(str(p), ROWS, {instance.name: RobotWaypoints(
-        instance.name, joints, None, tuple(lines))})
+    paths, k = {}, 0
+    for one in robots:
+        kinds = [one.model.links[i].joint for i in one.model.movable_links()]
+        joints = to_si(raw[:, k:k + len(kinds)], kinds, unit)
+        k += len(kinds)
+        _check_limits(p, one, list(joints), lines)
+        paths[one.name] = RobotWaypoints(one.name, joints, None, tuple(lines))
+    return Solution(str(p), ROWS, paths)
 
 
 def _robot(p: pathlib.Path, problem: Problem, name: Optional[str]) -> Instance:
