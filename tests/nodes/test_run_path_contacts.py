@@ -58,3 +58,15 @@ def test_a_tracked_run_reports_the_booms_met_under_either_drive(world, tmp_path,
     last = run.stdout.splitlines()[-1]
     assert "1 colliding pair made by the path (crane/boom | crane_2/boom" in last, last
     assert ", 0 resting contacts, solver " in last, last
+
+
+def test_an_initial_position_inside_the_other_crane_says_so(world, tmp_path):
+    problem = _problem(tmp_path)
+    path = tmp_path / "across.path"
+    path.write_text("1.5\n")
+    world.run(["rosrun", "GUI", "load_problem", str(problem)], timeout=60)
+    run = world.run(["rosrun", "GUI", "run_path", str(problem), "--initial", str(path),
+                     "--robot", "crane_2"], timeout=60)
+    last = run.stdout.splitlines()[-1]
+    assert last.startswith("crane_2: initial position set (2 bodies), 1 colliding pair made by "
+                           "the path (crane/boom | crane_2/boom "), last

@@ -204,3 +204,39 @@ def test_one_control_path_drives_both_arms_at_once(tmp_path, world):
     run_control_path(world, left, rows, others=[(right, rows)])
     swings = world.joint_positions([left.joint_ids[0], right.joint_ids[0]])
     np.testing.assert_allclose(swings, [swing(0.75), swing(0.25)], atol=0.01)
+
+
+class _StandingClient:
+    """What rows_to_send asks of the world: a base body's kinematics (frame origin m,
+    quaternion (w, x, y, z), world) and joint readings (rad, from where they were built)."""
+
+    def __init__(self, position, quaternion, readings):
+        self.position, self.quaternion, self.readings = position, quaternion, readings
+
+    def body_kinematics(self, body_id):
+        return self.position, self.quaternion, np.zeros(3), np.zeros(3)
+
+    def joint_positions(self, joint_ids):
+        return np.asarray(self.readings[:len(joint_ids)], dtype=float)
+
+
+def test_rows_to_send_start_from_where_a_mobile_base_is_for_run_path_and_the_window(tmp_path):
+    """run_path and the window's Move robot page send rows through rows_to_send: a row of the
+    pan joint alone keeps the rover's base where the world has it (0.2, 0.2 m), not where it
+    was built, and the first row is checked against the base's x and y there."""
+    from gui.core.paths import COMMAND_LINE, read_robot_paths
+    from gui.ros.client import rows_to_send
+    handle = _robots(plan_problem(load_problem(rover(tmp_path))))[0]
+    body = handle.bodies[0]
+    here = np.eye(4)
+    here[:3, 3] = (0.2, 0.2, 0.05)
+    position, quaternion = pose_to_position_quaternion(here @ body.offset)
+    client = _StandingClient(position, quaternion, [0.0])
+    pan = read_robot_paths(_write(tmp_path, "0.1\n0.2\n"), [handle], RADIANS)
+    sent = rows_to_send(client, pan, {handle.name: handle}, double=1, first_row=COMMAND_LINE)
+    np.testing.assert_allclose(sent[0].rows, [[0.1], [0.15], [0.2]], atol=1e-15)
+    base, _ = _base_situation(sent[0].situations(0), body.body_id)
+    np.testing.assert_allclose(base, position, atol=1e-12)
+    far = read_robot_paths(_write(tmp_path, "1.0 0.2 0.1\n"), [handle], RADIANS)
+    with pytest.raises(PathFileError, match="from where the robot is"):
+        rows_to_send(client, far, {handle.name: handle}, first_row=COMMAND_LINE)

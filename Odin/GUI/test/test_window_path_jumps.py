@@ -93,8 +93,8 @@ def test_the_first_row_is_checked_against_where_the_robot_is_on_the_path_worker(
     tab, plan, folder = crane
     world.execute(plan)                       # the crane stands at slew 0 rad, hoist 0 m
     runs = []
-    monkeypatch.setattr("gui.ros.client.run_position_path",
-                        lambda client, handle, rows, *a, **k: runs.append(rows.tolist()))
+    monkeypatch.setattr("gui.ros.client.run_position_rows",
+                        lambda client, robots, *a, **k: runs.append(robots[0].rows.tolist()))
     job = SimpleNamespace(progress=lambda value: None, sleep=lambda seconds: None)
     degrees = _path(folder, "60 0\n60.2 0\n")    # close rows, far from where the crane is
     tab.run_path("position", degrees)

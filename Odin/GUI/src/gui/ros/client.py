@@ -24,7 +24,7 @@ import dataclasses
 import logging
 import os
 import time
-from typing import Callable, Dict, NamedTuple, Optional, Sequence, Tuple
+from typing import Callable, Dict, List, NamedTuple, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -506,6 +506,38 @@ def robot_mesh_dir() -> str:
     (docs/ROS.md: several machines)."""
     import rospkg
     return os.path.join(rospkg.get_ros_home(), "odin", "robot_meshes")
+
+
+def present_base(client: WorldClient, handle: RobotHandle) -> np.ndarray:
+    """(4, 4), world: where the robot's base link is now. A base that can move (a free body,
+    a mobile base, a car) is read from the world; a held one is where it was built."""
+    from gui.core.model import CAR, FREE_BODY, MOBILE
+    from gui.core.paths import base_link_pose
+    if handle.kind not in (FREE_BODY, MOBILE, CAR):
+        return np.array(handle.base_pose, dtype=float)
+    position, quaternion, _, _ = client.body_kinematics(handle.bodies[0].body_id)
+    return base_link_pose(handle, position, quaternion)
+
+
+def rows_to_send(client: WorldClient, paths: Sequence, handles: Dict[str, RobotHandle],
+                 double: int = 0, first_row: Optional[object] = None) -> List[RobotRows]:
+    """Each of ``paths`` (gui.core.paths.RobotPath, of the robots ``handles`` names) with its
+    rows as sent and where its base is in the world now (``present_base``: a base the rows do
+    not carry stays there); with ``first_row`` (gui.core.paths.JumpOptions), a position
+    path's first row checked against where its robot is (a base's columns against its
+    position now), before its precision is doubled ``double`` times. Every robot is checked
+    before the caller sends any row."""
+    from gui.core.paths import check_first_row, present_joints, refine
+    out = []
+    for path in paths:
+        handle = handles[path.robot]
+        base = present_base(client, handle)
+        if first_row is not None:
+            check_first_row(path, np.concatenate([base[list(path.base_axes), 3],
+                                                  present_joints(client, handle)]), first_row)
+        rows = refine(path.rows, double) if double else path.rows
+        out.append(RobotRows(handle, rows, path.base_axes, base))
+    return out
 
 
 def run_position_path(client: WorldClient, handle: RobotHandle, rows: np.ndarray,

@@ -135,29 +135,12 @@ def _robot_rows(request: PathRequest, paths: List[RobotPath], client: WorldClien
     first row checked against where the robots are unless ``allow_jumps`` (a base's columns
     against its position now), then its precision doubled as asked. Every robot is checked
     before any row is sent."""
-    from gui.core.paths import RobotRows, check_first_row, present_joints, refine
+    from gui.core.paths import COMMAND_LINE
+    from gui.ros.client import rows_to_send
     position = request.mode is PathMode.POSITION
-    out = []
-    for path in paths:
-        handle = build_plan.robot(path.robot)
-        base = _present_base(client, handle)
-        if position and not request.allow_jumps:
-            check_first_row(path, np.concatenate([base[list(path.base_axes), 3],
-                                                  present_joints(client, handle)]))
-        rows = refine(path.rows, request.double) if position else path.rows
-        out.append(RobotRows(handle, rows, path.base_axes, base))
-    return out
-
-
-def _present_base(client: WorldClient, handle: RobotHandle) -> np.ndarray:
-    """(4, 4), world: where the robot's base link is now. A base that can move (a free body,
-    a mobile base, a car) is read from the world; a held one is where it was built."""
-    from gui.core.model import CAR, FREE_BODY, MOBILE
-    from gui.core.paths import base_link_pose
-    if handle.kind not in (FREE_BODY, MOBILE, CAR):
-        return np.array(handle.base_pose, dtype=float)
-    position, quaternion, _, _ = client.body_kinematics(handle.bodies[0].body_id)
-    return base_link_pose(handle, position, quaternion)
+    return rows_to_send(client, paths, {h.name: h for h in _robots(build_plan)},
+                        request.double if position else 0,
+                        COMMAND_LINE if position and not request.allow_jumps else None)
 
 
 def _names(robots: List[RobotRows]) -> str:
@@ -176,15 +159,20 @@ def _doublings(times: int, rows: int) -> int:
 def _set_initial(request: PathRequest, build_plan: BuildPlan, handle: RobotHandle) -> int:
     """--initial: the robots set at the file's first row, their speeds zeroed (a placement,
     so not checked for a jump from where they are); a base the row does not carry stays
-    where it is."""
+    where it is. What the placement put inside something it did not touch before is said
+    (``gui.core.contacts``)."""
     paths = _read_rows(request, build_plan, handle)
     from gui.ros.client import WorldClient
     client = WorldClient(timeout=request.timeout)
     robots = _robot_rows(request, paths, client, build_plan)
+    contacts = ContactLedger(client.check_collision([]))
     client.set_position([s for robot in robots for s in robot.situations(0)],
                         reset_velocity=True)
+    for first, second, depth in client.check_collision([]):
+        contacts.see(first, second, depth, 0.0)
     print(f"{_names(robots)}: initial position set "
-          f"({sum(len(robot.handle.bodies) for robot in robots)} bodies)")
+          f"({sum(len(robot.handle.bodies) for robot in robots)} bodies), "
+          f"{contacts.describe()}")
     return 0
 
 

@@ -332,8 +332,7 @@ class MotionTab(QWidget):
     def run_path(self, kind: str, path: str) -> None:
         """``kind``: "initial", "velocity", "position", "control" or "tracked"; runs on the
         path worker."""
-        from gui.core.paths import (DEGREES, RADIANS, check_first_row, check_row_jumps,
-                                    present_joints, read_robot_path, refine)
+        from gui.core.paths import DEGREES, RADIANS, check_row_jumps, read_robot_paths, refine
         handle = self.window.scene.robots.get(self.robot.currentData())
         if handle is None:
             self.window.show_error("Move robot: open a problem with a robot first")
@@ -345,41 +344,51 @@ class MotionTab(QWidget):
         if kind == "tracked":
             self.run_tracked_path(handle, path, units)
             return
-        # jumps as run_path checks them: between rows here, the first row on the worker
+        # read as run_path reads it: a file of every robot's values drives them all, one of
+        # a robot's the chosen one; a base the rows do not carry stays where it is. Jumps as
+        # run_path checks them: between rows here, the first row on the worker
+        robots = {h.name: h for h in self.window.scene.robots.values()
+                  if h.instance.role == "robot"}
         check_jumps = kind == "position" and not self.allow_jumps.isChecked()
         try:
-            read = read_robot_path(path, handle, units)
+            paths = read_robot_paths(path, list(robots.values()), units, handle.name)
             if check_jumps:
-                check_row_jumps(read, JUMP_OPTIONS)
+                for read in paths:
+                    check_row_jumps(read, JUMP_OPTIONS)
         except Exception as error:  # a bad file is the user's: say what and where
             self.window.show_error(f"Move robot: {error}")
             return
-        rows = read.rows
+        names = ", ".join(read.robot for read in paths)
+        double = int(self.double.value()) if kind == "position" else 0
+
+        def sent(client):
+            from gui.ros.client import rows_to_send
+            return rows_to_send(client, paths, robots, double,
+                                JUMP_OPTIONS if check_jumps else None)
+
         if kind == "initial":
             self.window.call("Initial position", lambda client, job: client.set_position(
-                handle.situations(rows[0]), reset_velocity=True),
-                lambda _: self.window.show_info(f"{handle.name}: initial position set"))
+                [s for robot in sent(client) for s in robot.situations(0)],
+                reset_velocity=True),
+                lambda _: self.window.show_info(f"{names}: initial position set"))
             return
-        if kind == "position" and self.double.value():
-            rows = refine(rows, int(self.double.value()))
         rate = self.window.publication_rate or StepValues().rate
-        total = len(rows)
+        total = len(refine(paths[0].rows, double))
 
         def work(client, job):
-            from gui.ros.client import run_position_path, run_velocity_path
-            runner = run_position_path if kind == "position" else run_velocity_path
+            from gui.ros.client import run_position_rows, run_velocity_rows, stop_velocity_rows
             from gui.window.worker import Cancelled
-            if check_jumps:
-                check_first_row(read, present_joints(client, handle), JUMP_OPTIONS)
+            rows = sent(client)
+            runner = run_position_rows if kind == "position" else run_velocity_rows
             try:
-                runner(client, handle, rows, rate, progress=job.progress, sleep=job.sleep)
+                runner(client, rows, rate, progress=job.progress, sleep=job.sleep)
             except Cancelled:
-                if kind == "velocity":   # leave the robot still, as a finished path does
-                    client.set_velocities(handle.motor_ids, [0.0] * len(handle.motor_ids))
+                if kind == "velocity":   # leave the robots still, as a finished path does
+                    stop_velocity_rows(client, rows)
                 raise
             return total
 
-        self.submit_path(f"{kind} path", pathlib.Path(path).name, handle.name, total, work,
+        self.submit_path(f"{kind} path", pathlib.Path(path).name, names, total, work,
                          f" at {rate:g} Hz")
 
     def run_control_path(self, handle, path: str) -> None:
