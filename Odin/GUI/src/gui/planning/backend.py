@@ -23,8 +23,9 @@ import numpy as np
 from gui.core.control_path import Actuation, ControlRow, ServoCommand, actuation
 from gui.core.plan import BuildPlan
 from gui.core.world_port import BodyState
+from gui.errors import PlanningError
 from gui.planning.core_world import CoreWorld
-from gui.planning.problem import PlanningProblem
+from gui.planning.problem import PlanningProblem, goal_refusal, start_refusal
 from odin_common.interface import BODY_STATE_SIZE, BODY_STATE_SLICES
 from odin_common.rotations import quaternion_to_matrix
 
@@ -56,6 +57,9 @@ class Backend(Protocol):
         """One propagation step per (state vector, control in [0, 1]^k); outcomes in order."""
 
     def close(self) -> None: ...
+
+    # optional: ``check_query()``, PlanningError when the query cannot be solved whatever the
+    # search does (gui.planning.problem.check_query); ``bridge.plan`` asks it before searching
 
 
 def step_actuation(problem: PlanningProblem, control: Sequence[float], base) -> Actuation:
@@ -152,8 +156,37 @@ class CoreBackend:
         position, linear = self._tracked(result.state)
         return Outcome(result.state, position, linear, result.pairs)
 
+    def refusal(self) -> Optional[Tuple[str, str]]:
+        """(OMPL's status, one line) when the problem's query cannot be solved whatever the
+        search does: "Invalid start" (gui.planning.problem.start_refusal) or "Invalid goal"
+        (goal_refusal), asked of this world put back in its start state; None when it can."""
+        self.world.core.set_body_state_vector(self._start)
+        for status, refused in (("Invalid start", start_refusal),
+                                ("Invalid goal", goal_refusal)):
+            why = refused(self.problem, self.world)
+            if why is not None:
+                return status, why
+        return None
+
+    def check_query(self) -> None:
+        """PlanningError with ``refusal``'s line when the query cannot be solved."""
+        refusal = self.refusal()
+        if refusal is not None:
+            raise PlanningError(refusal[1])
+
     def close(self) -> None:
         self.world.close()
 
 
-__all__ = ["Outcome", "Backend", "CoreBackend", "VectorBodies", "step_actuation"]
+def check_query_in_core(plan: BuildPlan, problem: PlanningProblem) -> None:
+    """``CoreBackend.check_query`` in a world of its own, built and closed here (a few ms):
+    the check before any search, whatever back end the search then uses."""
+    backend = CoreBackend(plan, problem)
+    try:
+        backend.check_query()
+    finally:
+        backend.close()
+
+
+__all__ = ["Outcome", "Backend", "CoreBackend", "VectorBodies", "check_query_in_core",
+           "step_actuation"]

@@ -5,8 +5,11 @@ OMPL's geometric planners over Odin's collision checks (``gui.planning.geometric
 
 ``prepare`` turns experiments (``gui.planning.benchmark_spec``) into ``RunTask``s after checking
 everything a run needs (every problem loads and plans, every planner exists): bad input is one
-``OdinError`` before any run starts; a geometric problem whose query collides is not bad input
-but a finding, recorded in each of its runs (status and reason) without a search. Run k of every
+``OdinError`` before any run starts; a query no search can solve (a geometric problem's start
+or goal that collides, a physics problem's start touching what it must not or goal inside a
+fixed obstacle or outside the limits) is not bad input but a finding, recorded in each of its
+runs (status and reason) without a search. A physics run counts as solved only when its plan's
+replay ends in the goal region with no invalid step (``gui.planning.bridge.plan``). Run k of every
 planner of an experiment has seed ``seed + k``, so the planners meet the same draws and ``rosrun
 GUI plan PROBLEM --planner P --seed S`` repeats any run. ``execute`` runs the tasks serially
 (``workers=0``) or on Dask (``DaskRunner``: a local cluster of worker processes, or an existing
@@ -46,9 +49,9 @@ giving up (``--scheduler-timeout``)."""
 class PlannedEntry:
     """One planner configuration as it runs: its name in the log, the OMPL planner, the time
     limit (s) and the problem (path); ``geometric``: a geometric planner's search
-    (``gui.planning.geometric_benchmark``); ``refusal``: (OMPL's status, the reason) when its
-    problem's query collides (its runs are recorded unsearched); ``common``: the settings its
-    planner runs with, (name, value) pairs for the log."""
+    (``gui.planning.geometric_benchmark``); ``refusal``: (OMPL's status, the reason) when no
+    search can solve its problem's query (its runs are recorded unsearched); ``common``: the
+    settings its planner runs with, (name, value) pairs for the log."""
     name: str
     planner: str
     time_limit: float
@@ -81,7 +84,7 @@ class Prepared:
 
 def _load_for_planning(problem: str, overrides: dict):
     """Loads and builds ``problem`` as a run does, and its world once: (its BuildPlan, the
-    refusal of a geometric problem whose query collides: (status, reason), else ())."""
+    refusal of a query no search can solve: (OMPL's status, reason), else ())."""
     from gui.core.kautham.problem import load_problem
     from gui.core.translate import BuildDefaults, plan_problem
     from gui.planning import geometric_benchmark as geometric
@@ -92,8 +95,11 @@ def _load_for_planning(problem: str, overrides: dict):
         geometric.run_settings(build, None, DEFAULT_TIME_S, overrides)
         return build, geometric.check_problem(build) or ()
     settings = SearchSettings.of_problem(build, **overrides)
-    CoreBackend(build, planning_problem(build, None, settings)).close()
-    return build, ()
+    backend = CoreBackend(build, planning_problem(build, None, settings))
+    try:
+        return build, backend.refusal() or ()
+    finally:
+        backend.close()
 
 
 def _load(row, overrides: dict, loaded: Dict[str, tuple]) -> tuple:
@@ -111,8 +117,9 @@ def _load(row, overrides: dict, loaded: Dict[str, tuple]) -> tuple:
     return loaded[row.problem]
 
 
-def _control_entry(row, build, max_time: Optional[float]) -> PlannedEntry:
-    """``row``'s entry for a physics problem: an OMPL control planner."""
+def _control_entry(row, build, max_time: Optional[float], refusal: tuple) -> PlannedEntry:
+    """``row``'s entry for a physics problem: an OMPL control planner (``refusal``: its
+    query's, its runs recorded unsearched)."""
     from gui.planning.bridge import PLANNERS, UNCONSTRUCTIBLE
     own = build.problem.planner
     planner = row.planner or OMPL_PLANNER_OF.get(own.name if own else "")
@@ -129,7 +136,7 @@ def _control_entry(row, build, max_time: Optional[float]) -> PlannedEntry:
     own_time = own.search.time_limit if own is not None else None
     limit = max_time or own_time or DEFAULT_TIME_S
     return PlannedEntry(row.name(planner), planner, float(limit), row.problem,
-                        own.name if own else "")
+                        own.name if own else "", refusal=tuple(refusal))
 
 
 def _geometric_entry(row, build, max_time: Optional[float], refusal: tuple,
@@ -165,7 +172,7 @@ def prepare(experiments: Sequence[Experiment], seed: int = 1,
             build, refusal, relative, files = _load(row, overrides, loaded)
             max_time = experiment.request.max_time
             entry = _geometric_entry(row, build, max_time, refusal, overrides) \
-                if not build.physics else _control_entry(row, build, max_time)
+                if not build.physics else _control_entry(row, build, max_time, refusal)
             if any(e.name == entry.name for e in entries):
                 raise PlanningError(f"{row.where}: experiment {experiment.name!r} already has "
                                     f"a planner named {entry.name!r} (PlannerAlias)")

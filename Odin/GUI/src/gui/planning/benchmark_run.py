@@ -98,8 +98,9 @@ class GeometricMeasures:
 
 @dataclass(frozen=True)
 class RunResult:
-    """What one run measured. ``solved``: an exact solution (OMPL's "solved"); ``approximate``:
-    a path that ends outside the goal region; ``status``: OMPL's planner status; ``time_s``: s
+    """What one run measured. ``solved``: an exact solution (OMPL's "solved"; a control run's
+    only when its replay confirms it: ``gui.planning.bridge.PlanResult.solved``);
+    ``approximate``: a path that is not a solution; ``status``: OMPL's planner status; ``time_s``: s
     of wall clock in the search (a geometric run's: the planner's, without the simplification);
     ``solution_length_s``: s, the plan's simulated duration (OMPL's PathControl length: the sum
     of its control durations; 0 without a path or for a geometric run);
@@ -107,8 +108,8 @@ class RunResult:
     ``propagations``: propagation steps run; ``memory_mb``: MB, the run process's peak resident
     memory; ``digest``: sha256 of the plan's rows (controls and durations, or a geometric
     path's states, exactly), equal for equal plans; ``host``: where it ran; ``error``: why the
-    run failed or was not searched ("" when it did not); ``geometric``: a geometric run's own
-    measures (None for a control run)."""
+    run failed, was not searched, or its plan's replay refuted the search ("" when none of
+    these); ``geometric``: a geometric run's own measures (None for a control run)."""
     experiment: str
     entry: str
     run: int
@@ -325,7 +326,9 @@ def search(problem: str, planner: str, seed: int, time_limit: float, overrides: 
            stop: Callable[[], bool], memory_limit_mb: Optional[float] = None) -> dict:
     """The search ``rosrun GUI plan problem --planner P --seed S --time T`` makes (the Core
     back end, the problem's own settings changed by ``overrides``), ended also by
-    ``memory_limit_mb`` (``bridge.plan``); the RunResult fields it measures."""
+    ``memory_limit_mb`` (``bridge.plan``); the RunResult fields it measures. Solved only as
+    plan counts it (``PlanResult.solved``): a plan OMPL called exact that its replay refutes
+    is recorded with the status "Approximate solution" and ``error`` saying what differs."""
     from gui.core.kautham.problem import load_problem
     from gui.core.translate import BuildDefaults, plan_problem
     from gui.planning.backend import CoreBackend
@@ -341,14 +344,19 @@ def search(problem: str, planner: str, seed: int, time_limit: float, overrides: 
     digest = hashlib.sha256()
     for row in result.rows:
         digest.update(repr((tuple(row.controls), row.duration)).encode())
+    # solved as plan counts it (its replay in the goal region, no invalid step): a plan OMPL
+    # called exact that its replay refutes is recorded as a path, not a solution, and why
+    status = "Approximate solution" if result.disagreement else result.status
     return dict(solved=result.solved, approximate=bool(result.rows) and not result.solved,
-                status=result.status, time_s=result.time_s,
+                status=status, time_s=result.time_s,
                 solution_length_s=result.duration,
                 solution_difference_m=result.goal_distance if result.rows else None,
                 propagations=result.propagations,
                 memory_mb=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
                 digest=digest.hexdigest() if result.rows else "",
-                host=socket.gethostname())
+                host=socket.gethostname(),
+                error=f"the replay disagrees with the search: {result.disagreement}"
+                if result.disagreement else "")
 
 
 def _die_with_parent(parent: int) -> None:

@@ -6,7 +6,7 @@ The OMPL problem (``gui.planning.problem`` says what each part means):
   problem's limits and ``max_speed``; weight 1:
   planners measure distances and cells here) and the whole world's body state vector
   (``Core.body_state_vector``, weight 0: carried, never measured) with one value appended,
-  1 when the step into the state touched an obstacle the robot must not;
+  1 when the step into the state made a forbidden contact (``forbidden_contacts``);
 - control space: [0, 1]^k, the robot's `.cntr` controls (those searched); a control lasts
   ``min_control_steps`` to ``max_control_steps`` propagation steps of ``step`` s;
 - propagator: the back end's (restore, apply the row, step, read);
@@ -17,9 +17,10 @@ The OMPL problem (``gui.planning.problem`` says what each part means):
   region.
 
 ``plan(backend, planner, time_limit, seed)`` solves and answers a ``PlanResult`` whose
-``rows`` are the control path (one row per propagation step). The planner classes the wheel's
-bindings construct are in ``PLANNERS``; OMPL 2.0.1's wheel defines no constructor for SST and
-PDST (``UNCONSTRUCTIBLE``).
+``rows`` are the control path (one row per propagation step), solved only when its replay
+from the start (``verify``) ends in the goal region with no invalid step. The planner
+classes the wheel's bindings construct are in ``PLANNERS``; OMPL 2.0.1's wheel defines no
+constructor for SST and PDST (``UNCONSTRUCTIBLE``).
 """
 from __future__ import annotations
 
@@ -28,7 +29,7 @@ import os
 import time
 from collections import deque
 from dataclasses import dataclass
-from typing import Callable, List, Optional, Tuple
+from typing import Callable, List, NamedTuple, Optional, Tuple
 
 import numpy as np
 
@@ -50,12 +51,16 @@ random generator state, below 2^32, is its largest value)."""
 
 @dataclass(frozen=True)
 class PlanResult:
-    """What a search found. ``solved``: an exact solution (the tracked link in the goal
-    region); ``rows``: the control path (the best approximate one when not solved; empty when
-    the planner found nothing); ``final_position`` (3,) m, world: where the tracked link ends
-    when the rows are run from the start in the back end's world; ``goal_distance``: m, in the
-    plane; ``propagations``: propagation steps the search ran; ``time_s``: wall-clock seconds
-    of the search; ``status``: OMPL's planner status."""
+    """What a search found, as its replay confirms it. ``solved``: OMPL found an exact
+    solution AND the rows, run again from the start in the back end's world, end in the goal
+    region with no invalid step on the way (the search's own rule: no forbidden contact, the
+    tracked link in bounds); ``rows``: the control path (the best approximate one when not
+    solved; empty when the planner found nothing); ``final_position`` (3,) m, world: where the
+    tracked link ends in that replay; ``goal_distance``: m, in the plane; ``propagations``:
+    propagation steps the search ran; ``time_s``: wall-clock seconds of the search;
+    ``status``: OMPL's planner status, what the search claimed (not the verdict: ``verdict``);
+    ``invalid``: the replay's first invalid step ("" when none); ``disagreement``: what the
+    replay shows against OMPL's exact solution ("" when they agree)."""
     planner: str
     seed: Optional[int]
     solved: bool
@@ -65,6 +70,22 @@ class PlanResult:
     goal_distance: float
     propagations: int
     time_s: float
+    invalid: str = ""
+    disagreement: str = ""
+
+    @property
+    def verdict(self) -> str:
+        """One line: what the plan's replay does, never OMPL's status alone."""
+        if self.solved:
+            return (f"solved: the replay of its {len(self.rows)} rows ends "
+                    f"{self.goal_distance:.4f} m from the goal, in the goal region, with no "
+                    "forbidden contact and the tracked link in bounds all the way")
+        if self.disagreement:
+            return f"not solved: the replay disagrees with the search: {self.disagreement}"
+        if not self.rows:
+            return f"not solved: no path found ({self.status})"
+        return (f"not solved: the closest plan ends {self.goal_distance:.4f} m from the goal"
+                + (f"; its replay {self.invalid}" if self.invalid else ""))
 
     @property
     def duration(self) -> float:
@@ -79,7 +100,7 @@ class PlanResult:
                 if self.time_s > 0 else None,
                 "rows": len(self.rows), "plan_duration_s": round(self.duration, 4),
                 "final_position_m": [round(float(v), 4) for v in self.final_position],
-                "goal_distance_m": round(self.goal_distance, 4)}
+                "goal_distance_m": round(self.goal_distance, 4), "verdict": self.verdict}
 
 
 def _ompl():
@@ -109,14 +130,16 @@ class _Callbacks:
     def _vector(self, state) -> np.ndarray:
         return np.fromiter(map(state[1].__getitem__, self._slots), float, len(self._slots))
 
-    def write(self, state, vector: np.ndarray, backend_outcome) -> None:
+    def write(self, state, vector: np.ndarray, backend_outcome, touched: bool = False) -> None:
+        """``state`` set to the world ``vector``, its tracked link's from ``backend_outcome``
+        (the last step into it; None: read from the vector), flagged invalid when ``touched``
+        (a forbidden contact on the way in)."""
         robot, world = state[0], state[1]
         if backend_outcome is None:
             position, velocity = self.backend.tracked_state(vector)
-            flag = 0.0
         else:
             position, velocity = backend_outcome.position, backend_outcome.velocity
-            flag = 1.0 if self.problem.forbidden_contacts(backend_outcome.collisions) else 0.0
+        flag = 1.0 if touched else 0.0
         for i in range(3):
             robot[i] = float(position[i])
             robot[3 + i] = float(velocity[i])
@@ -130,11 +153,14 @@ class _Callbacks:
             values = self.problem.controls(
                 [control[i] for i in range(len(self.problem.searched))])
             vector = self._vector(start)
-            outcome = None
+            outcome, touched = None, False
             for _ in range(steps):
                 outcome = self.backend.propagate([(vector, values)])[0]
                 vector = outcome.state
-            self.write(result, vector, outcome)
+                # every step's contacts count, not the last one's only (OMPL asks one step
+                # at a time, but a longer duration must not hide a contact on the way)
+                touched = touched or bool(self.problem.forbidden_contacts(outcome.collisions))
+            self.write(result, vector, outcome, touched)
         except BaseException as error:      # noqa: B902 - handed back to plan()
             self.error = self.error or _without_frames(error)
             self.write(result, self._vector(start), None)
@@ -285,9 +311,16 @@ def plan(backend, planner: str = "KPIECE1", time_limit: float = 10.0,
     what the planner answers). ``stop()`` true ends the search at the
     planner's next iteration (one propagation at most) and raises KeyboardInterrupt: what
     Ctrl-C does under ``odin_common.tool.stop_on_ctrl_c`` (OMPL's solve runs in C++, where
-    no Python signal handler can raise; a propagation cut by an exception would be lost)."""
+    no Python signal handler can raise; a propagation cut by an exception would be lost).
+    A back end with ``check_query`` (the Core's) is asked first: PlanningError, before any
+    search, for a query no search can solve (gui.planning.problem.query_refusal). The plan
+    found is replayed in the back end and checked by the search's rule (``verify``): the
+    result is solved only when that replay holds (``PlanResult``)."""
     if not (math.isfinite(time_limit) and time_limit > 0):
         raise PlanningError(f"time {time_limit!r} s must be positive")
+    check = getattr(backend, "check_query", None)
+    if check is not None:
+        check()                 # a query no search can solve, refused before any search
     if seed is not None:
         seed_ompl(seed)
     setup = _Setup(backend, planner)
@@ -314,11 +347,24 @@ def plan(backend, planner: str = "KPIECE1", time_limit: float = 10.0,
     rows: List[ControlRow] = []
     if setup.setup.haveSolutionPath():
         rows = _rows(setup.setup.getSolutionPath(), setup.problem)
-    final = replay(backend, rows)
-    distance = backend.problem.goal_distance(final)
-    return PlanResult(planner, seed, bool(setup.setup.haveExactSolutionPath()
-                                          and backend.problem.in_goal(final)),
-                      str(status), tuple(rows), final, distance, propagations, elapsed)
+    exact = bool(setup.setup.haveExactSolutionPath())
+    # OMPL's status is what the search claims; the verdict is the replay's, under the rule
+    # the search used, from the start in this back end: a path counts only when it holds there
+    problem = backend.problem
+    checked = verify(backend, rows)
+    final = checked.final_position
+    distance = problem.goal_distance(final)
+    solved = exact and problem.in_goal(final) and not checked.invalid
+    differs = []
+    if exact and not problem.in_goal(final):
+        differs.append(f"its replay ends {distance:.4f} m from the goal, outside the "
+                       f"{problem.settings.goal_tolerance:g} m goal region")
+    if exact and checked.invalid:
+        differs.append(f"its replay {checked.invalid}")
+    disagreement = f"OMPL reports an exact solution, but {' and '.join(differs)}" \
+        if differs else ""
+    return PlanResult(planner, seed, solved, str(status), tuple(rows), final, distance,
+                      propagations, elapsed, checked.invalid, disagreement)
 
 
 MEMORY_CHECK_S = 0.1
@@ -364,22 +410,59 @@ def _rows(path, problem) -> List[ControlRow]:
     return rows
 
 
-def replay(backend, rows) -> np.ndarray:
-    """(3,) m: where the tracked link ends when ``rows`` run from the start state in the back
-    end."""
+class Replay(NamedTuple):
+    """A plan run again from the start state in a back end, checked step by step as the
+    search checks a state (no forbidden contact on the way in, the tracked link in bounds and
+    no faster than max_speed): ``final_position`` (3,) m, world, where the tracked link ends;
+    ``invalid``: the first step that breaks the rule ("makes an invalid step at row 42 (1.260
+    s): ..."), "" when none does."""
+    final_position: np.ndarray
+    invalid: str
+
+
+def verify(backend, rows) -> Replay:
+    """``rows`` run from the start state in the back end and checked (``Replay``)."""
+    problem = backend.problem
     vector = backend.start_state()
     position = None
-    for row in rows:
+    invalid = ""
+    elapsed = 0.0
+    for number, row in enumerate(rows, start=1):
         outcome = backend.propagate([(vector, row.controls)])[0]
         vector, position = outcome.state, outcome.position
+        elapsed += row.duration
+        if not invalid:
+            why = _invalid_step(problem, outcome)
+            if why:
+                invalid = f"makes an invalid step at row {number} ({elapsed:.3f} s): {why}"
     if position is None:
         position = backend.tracked_state(vector)[0]
-    return np.asarray(position)
+    return Replay(np.asarray(position), invalid)
+
+
+def _invalid_step(problem, outcome) -> str:
+    """Why the search would refuse the state ``outcome`` reached ("" when it would not)."""
+    forbidden = problem.forbidden_contacts(outcome.collisions)
+    if forbidden:
+        first, second = forbidden[0]
+        return f"{first} touches {second}, which is forbidden"
+    if not problem.in_bounds(outcome.position, outcome.velocity):
+        at = ", ".join(f"{float(v):.3f}" for v in outcome.position)
+        fast = max(abs(float(v)) for v in outcome.velocity)
+        return (f"{problem.tracked_body} at ({at}) m, {fast:.3f} m/s on its fastest axis: "
+                f"outside the <Limits> or faster than {problem.settings.max_speed:g} m/s")
+    return ""
+
+
+def replay(backend, rows) -> np.ndarray:
+    """(3,) m: where the tracked link ends when ``rows`` run from the start state in the back
+    end (``verify`` also says whether the run keeps the search's rule)."""
+    return verify(backend, rows).final_position
 
 
 def _propagations(backend) -> int:
     return int(getattr(backend, "propagations", 0))
 
 
-__all__ = ["MAX_SEED", "PLANNERS", "UNCONSTRUCTIBLE", "PlanResult", "check_seed", "plan", "replay",
-           "seed_ompl"]
+__all__ = ["MAX_SEED", "PLANNERS", "UNCONSTRUCTIBLE", "PlanResult", "Replay", "check_seed", "plan",
+           "replay", "seed_ompl", "verify"]

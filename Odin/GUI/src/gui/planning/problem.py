@@ -24,14 +24,20 @@ chain whose base is held to the world, driven at its joints (PlanarChainEnvironm
 - the **goal region** is the query's ``<Goal>``: the tracked link within ``goal_tolerance`` m
   of where it is at the goal configuration, in x and y (Kautham's KauthamDEGoalRegion measures
   in the plane too, with a 0.05 m threshold, under planning times of minutes);
-- a **motion is invalid** when the robot touches an obstacle it must not: Kautham's
+- a **motion is invalid** when something touches an obstacle it must not: Kautham's
   KauthamOpenDEEnvironment lets its robots touch the floor and the obstacles it lists as
   manipulable (``MANIPULABLE``: the cubes, boxes and cylinders of its demos), every other
-  obstacle is "fixed" (the arena's walls); a held chain may push manipulable obstacles with its
-  tool only, and nothing may touch a fixed obstacle but the ground (PlanarChainEnvironment: its
-  "tcp" bodies may touch "freeManipulatable" ones; its other links touching any obstacle, and
-  a pushed obstacle or a fixed one touching a fixed one, make the motion invalid); or when the
-  tracked link leaves the bounds.
+  obstacle is "fixed" (the arena's walls), and nothing but the ground may touch a fixed
+  obstacle: not the robot, not a block it pushes, not another fixed obstacle (the rule of
+  Kautham's PlanarChainEnvironment for every robot: its 2D and car environments rule only the
+  robot's contacts, and a block pushed into a wall, a free 2 kg body in both worlds, shoved the
+  wall aside and knocked walls over in plans that counted as solved: issue 41); a held chain
+  may push manipulable obstacles with its tool only (PlanarChainEnvironment's "tcp" bodies);
+  or when the tracked link leaves the bounds.
+
+``query_refusal`` says before any search why a query cannot be solved whatever the search does:
+its start already touching what it must not, its goal outside the bounds or joint limits, or
+the robot at its goal inside a fixed obstacle.
 """
 from __future__ import annotations
 
@@ -44,6 +50,7 @@ import numpy as np
 from gui.core.control_path import control_size
 from gui.core.kautham.environment import MANIPULABLE
 from gui.core.model import CAR, FREE_BODY, MOBILE
+from gui.core.overlaps import BUILT_OVERLAP
 from gui.core.plan import BuildPlan, RobotHandle
 from gui.core.translate import GROUND
 from gui.errors import PlanningError
@@ -112,11 +119,11 @@ class PlanningProblem:
     body and ``tracked_link_origin`` (3,) m, the link's origin in that body's frame (the
     inverse of the body's offset in the link, taken once); ``base_bounds``
     (3, 2): m, world frame, low and high per axis, for the tracked link's origin; ``goal_xy``
-    (2,): m, world frame, the tracked link's origin at the goal; ``forbidden``: object IDs the
-    robot must not touch; ``robot_bodies``: the robot's body IDs; ``tool_bodies``: those that
-    may push manipulable obstacles; ``step``: s, one propagation step; ``searched``: indices
-    of the controls the planner chooses, the others held at ``held`` (the query start's
-    controls)."""
+    (2,): m, world frame, the tracked link's origin at the goal; ``forbidden``: object IDs
+    (the fixed obstacles) nothing but the ground may touch; ``robot_bodies``: the robot's
+    body IDs; ``tool_bodies``: those that may push manipulable obstacles; ``step``: s, one
+    propagation step; ``searched``: indices of the controls the planner chooses, the others
+    held at ``held`` (the query start's controls)."""
     handle: RobotHandle
     base_body: str
     tracked_body: str
@@ -162,12 +169,6 @@ class PlanningProblem:
     def in_goal(self, tracked_position) -> bool:
         return self.goal_distance(tracked_position) < self.settings.goal_tolerance
 
-    @property
-    def guard_fixed(self) -> bool:
-        """Nothing but the ground may touch a forbidden obstacle, not only the robot: a held
-        chain's environment (PlanarChainEnvironment), whose tracked link is its tool."""
-        return self.tracked_body != self.base_body
-
     def robot_contacts(self, pairs: Iterable[Tuple[str, str]]) -> list:
         """The distinct pairs of objects (sorted) among ``pairs`` (object IDs or geometry
         names) where the robot touches something else."""
@@ -176,9 +177,9 @@ class PlanningProblem:
         return sorted(pair for pair in objects if (pair[0] in robot) != (pair[1] in robot))
 
     def forbidden_contacts(self, pairs: Iterable[Tuple[str, str]]) -> list:
-        """The pairs (object IDs or geometry names) that make a motion invalid: the robot
-        touching a forbidden obstacle, or any but the ground with a body outside its tool;
-        with ``guard_fixed``, anything but the ground touching a forbidden obstacle."""
+        """The pairs (object IDs or geometry names) that make a motion invalid: anything but
+        the ground touching a forbidden obstacle, or a robot body outside its tool touching
+        anything but the ground (module docstring)."""
         verdicts = self._verdicts
         forbidden = []
         for first, second in pairs:
@@ -193,7 +194,8 @@ class PlanningProblem:
     def _invalid(self, first: str, second: str) -> bool:
         if self._forbidden_pair(first, second) or self._forbidden_pair(second, first):
             return True
-        return self.guard_fixed and GROUND not in (first, second) and \
+        # a fixed obstacle is a free body in the world: whatever touches it may move it
+        return GROUND not in (first, second) and \
             (first in self.forbidden or second in self.forbidden)
 
     def _forbidden_pair(self, robot_body: str, other: str) -> bool:
@@ -319,4 +321,83 @@ def _forbidden(plan: BuildPlan, handle: RobotHandle) -> list:
             and _object(body.id) not in MANIPULABLE]
 
 
-__all__ = ["SearchSettings", "PlanningProblem", "planning_problem"]
+def query_refusal(problem: PlanningProblem, world) -> Optional[str]:
+    """Why ``problem``'s query cannot be solved whatever a search does, in one line, or None:
+    ``start_refusal``, else ``goal_refusal``. ``world``: the problem's world in its start state
+    (as built), anything answering ``check_collision(poses)`` with (first, second, depth m)
+    pairs, the robot's links placed at ``poses`` (gui.planning.core_world.CoreWorld), which
+    steps nothing and changes nothing."""
+    return start_refusal(problem, world) or goal_refusal(problem, world)
+
+
+def start_refusal(problem: PlanningProblem, world) -> Optional[str]:
+    """One line when something already touches what it must not at the query's start
+    (``forbidden_contacts``): the first step of every motion would be invalid; else None.
+    ``world`` as ``query_refusal`` takes it."""
+    start = problem.forbidden_contacts([(a, b) for a, b, _ in world.check_collision([])])
+    if not start:
+        return None
+    first, second = sorted(start)[0]
+    return (f"the query's start has {first} touching {second}, which is forbidden (nothing "
+            "but the ground may touch a fixed obstacle): every motion from it is invalid")
+
+
+def goal_refusal(problem: PlanningProblem, world) -> Optional[str]:
+    """One line when no motion can reach the query's goal region, else None (``world`` as
+    ``query_refusal`` takes it):
+
+    - the goal puts the tracked link's origin outside ``base_bounds`` (the problem's
+      ``<Limits>``: every state outside them is invalid), or a joint outside its limits;
+    - the goal puts a link of the robot more than BUILT_OVERLAP (1 mm) into a fixed obstacle
+      (``forbidden``): the robot could get there only through the obstacle or by pushing it
+      away, and nothing may touch it (the deepest pair named, with its depth)."""
+    handle = problem.handle
+    goal = handle.goal
+    poses = handle.instance.model.link_poses(goal.base_pose, goal.joints)
+    tracked = [b.body_id for b in handle.bodies].index(problem.tracked_body)
+    position = poses[tracked][:3, 3]
+    at = "(" + ", ".join(f"{v:.3f}" for v in position) + ") m"
+    for axis, value, (low, high) in zip("xyz", position, problem.base_bounds):
+        if not low <= value <= high:
+            return (f"the query's goal puts {problem.tracked_body} at {at}, outside the "
+                    f"problem's <Limits>: {axis} {value:.3f} not in [{low:g}, {high:g}] m")
+    model = handle.instance.model
+    for index, value in zip(model.movable_links(), goal.joints):
+        link = model.links[index]
+        if link.limits is not None and not \
+                link.limits[0] - JOINT_SLACK <= value <= link.limits[1] + JOINT_SLACK:
+            return (f"the query's goal puts joint {link.joint_name or link.name} at "
+                    f"{value:.6g}, outside its limits [{link.limits[0]:.6g}, "
+                    f"{link.limits[1]:.6g}]")
+    robot = set(problem.robot_bodies)
+    inside = []
+    for first, second, depth in world.check_collision(
+            handle.situations(goal.joints, goal.base_pose)):
+        if _object(second) in robot:
+            first, second = second, first
+        if depth > BUILT_OVERLAP and _object(first) in robot and \
+                _object(second) in problem.forbidden:
+            inside.append((float(depth), first, second))
+    if not inside:
+        return None
+    depth, first, second = max(inside)
+    more = f" (and {len(inside) - 1} more pairs)" if len(inside) > 1 else ""
+    return (f"the query's goal (where it puts {problem.tracked_body}: {at}) is inside a fixed "
+            f"obstacle: there {first} is {depth * 1000:.1f} mm into {second}{more}, which "
+            "nothing may touch, so no motion reaches the goal")
+
+
+def check_query(problem: PlanningProblem, world) -> None:
+    """PlanningError with ``query_refusal``'s line when the query cannot be solved."""
+    why = query_refusal(problem, world)
+    if why is not None:
+        raise PlanningError(why)
+
+
+JOINT_SLACK = 1e-9
+"""rad or m: how far past a joint's limit a goal's value may lie and count as at the limit
+(Kautham maps a control of 0 or 1 onto the limit itself, in floating point)."""
+
+
+__all__ = ["SearchSettings", "PlanningProblem", "check_query", "goal_refusal",
+           "planning_problem", "query_refusal", "start_refusal"]

@@ -279,17 +279,27 @@ SETUP = {
 """The first line of a log's setup text, for control (False) and geometric (True) planners."""
 
 
-def _setup_text(prepared, entries, hosts) -> str:
+def _setup_text(prepared, entries, hosts, by_entry=None) -> str:
     """A log's free setup text: how its planners searched, each entry's planner and problem
-    (and why a refused one was not searched), where the workers ran."""
+    (and why a refused one was not searched), why each of its runs in ``by_entry`` ({entry
+    name: results}) that failed or whose replay refuted its search is not solved, where the
+    workers ran."""
     geometric = any(e.geometric for e in entries)
     lines = [f"{SETUP[geometric]}; run k has seed {prepared.seed}+k; rosrun GUI plan PROBLEM "
              "--planner P --seed S --time T repeats a run"]
+    if not geometric:
+        lines[0] += ("; a run counts as solved only when its plan's replay ends in the goal "
+                     "region with no forbidden contact on the way")
     for e in entries:
         line = f"{e.name}: {e.planner} on {e.problem} (its planner: {e.problem_planner})"
+        refused = ""
         if e.refusal:
-            line += f"; not searched ({e.refusal[0]}): {e.refusal[1]}"
+            refused = e.refusal[1]
+            line += f"; not searched ({e.refusal[0]}): {refused}"
         lines.append(line)
+        # a refused entry's runs all carry its reason, said once above
+        lines += [f"{e.name} run {r.run} (seed {r.seed}): not solved: {r.error}"
+                  for r in (by_entry or {}).get(e.name, ()) if r.error and r.error != refused]
     return "\n".join(lines + ([f"workers on: {', '.join(hosts)}"] if hosts else []))
 
 
@@ -311,7 +321,7 @@ def _write_outputs(request, prepared, store, out, started, total_s, hosts) -> No
                   max_time=max(e.time_limit for e in entries),
                   max_mem=experiment.request.max_mem,
                   run_count=experiment.request.run_count, total_s=total_s,
-                  setup=_setup_text(prepared, entries, hosts), started=started,
+                  setup=_setup_text(prepared, entries, hosts, by_entry), started=started,
                   geometric=any(e.geometric for e in entries))
     if request.plots and store.results:
         from gui.planning.benchmark_plots import write_plots

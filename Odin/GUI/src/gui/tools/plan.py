@@ -6,10 +6,15 @@ over Odin's geometry (``gui.planning.geometric``: the problem's own planner and 
 interpolated as Kautham does (``gui.planning.geometric_output``) and written as a Kautham task
 file or, ``--format ompl``, as OMPL rows (``run_path --tracked`` runs either). The search's
 statistics are printed as JSON. ``--execute`` then runs the plan in the running world as
-run_path would (``gui.tools.run_path.run_path``), its lines and summary printed. Exits 1 with
-one line when no solution was found in time, 2 on bad input or when the plan written cannot
-run (no world, a world without the problem), 130 on Ctrl-C (nothing written during the
-search; the robot held where it got to during the run)."""
+run_path would (``gui.tools.run_path.run_path``), its lines and summary printed. A control
+search's plan counts as solved only when its replay from the start ends in the goal region
+with no invalid step (``gui.planning.bridge.PlanResult.verdict``, printed on its own line);
+a query no search can solve (its goal inside a fixed obstacle or outside the limits) is
+refused before any search. Exits 1 with one line when no solution was found in time or the
+replay disagrees with the search (what differs; nothing written), 2 on bad input, a refused
+query, or when the plan written cannot run (no world, a world without the problem), 130 on
+Ctrl-C (nothing written during the search; the robot held where it got to during the
+run)."""
 from __future__ import annotations
 
 import enum
@@ -102,9 +107,14 @@ class PlanOutcome:
     seed: int
 
     def failure(self, request: PlanRequest) -> str:
+        result = self.result
+        if result.disagreement:
+            return (f"{request.problem.path}: the replay disagrees with the search "
+                    f"({result.planner}, seed {result.seed}): {result.disagreement}; "
+                    "nothing written")
         return (f"{request.problem.path}: no solution within {self.time_limit:g} s "
-                f"({self.result.planner}, seed {self.seed}{request.searches()}): the closest "
-                f"plan ends {self.result.goal_distance:.3f} m from the goal")
+                f"({result.planner}, seed {self.seed}{request.searches()}): the closest "
+                f"plan ends {result.goal_distance:.3f} m from the goal")
 
     def write(self, request: PlanRequest) -> None:
         """The motion plan written to ``request.out`` as a control path, its comments
@@ -254,14 +264,23 @@ def search(request: PlanRequest, stop: Callable[[], bool]):
         finally:
             backend.close()
         print(json.dumps(result.statistics(), indent=1), flush=True)
-        return PlanOutcome(result, time_limit, seed)
+        return _verdict(PlanOutcome(result, time_limit, seed))
     from gui.planning.parallel import plan_in_parallel
     print(searching, flush=True)
     result, outcomes = plan_in_parallel(make_backend, request.parallel, planner,
                                         time_limit, seed, stop)
     print(json.dumps({**result.statistics(), "searches": [o.summary() for o in outcomes]},
                      indent=1), flush=True)
-    return PlanOutcome(result, time_limit, seed)
+    return _verdict(PlanOutcome(result, time_limit, seed))
+
+
+def _verdict(outcome: PlanOutcome) -> PlanOutcome:
+    """The plan's verdict said on its own line when it is a solution (its replay ends in the
+    goal region without an invalid step; OMPL's "Exact solution" is only what the search
+    claimed); otherwise main's one error line says why not."""
+    if outcome.result.solved:
+        print(f"plan: {outcome.result.verdict}", flush=True)
+    return outcome
 
 
 def _fresh_seed(searches: int) -> int:
@@ -276,6 +295,7 @@ def _backends(request: PlanRequest, build_plan) -> Tuple[Callable[[int], object]
     time limit s). Every search's back end holds the problem's world: the Core builds one in
     the process calling it; with the pool, search k gets every ``request.parallel``-th world
     of ``request.worlds`` from the k-th."""
+    from gui.planning.backend import check_query_in_core
     from gui.planning.problem import SearchSettings, planning_problem
     if request.parallel < 1:
         raise GuiError(f"--parallel {request.parallel}: need 1 or more searches")
@@ -285,6 +305,8 @@ def _backends(request: PlanRequest, build_plan) -> Tuple[Callable[[int], object]
                                          min_control_steps=request.min_control_steps,
                                          max_control_steps=request.max_control_steps)
     problem = planning_problem(build_plan, request.robot, settings)
+    # a query no search can solve is refused here, before any back end or search starts
+    check_query_in_core(build_plan, problem)
     planner = build_plan.problem.planner
     time_limit = request.time if request.time is not None else \
         (planner.search.time_limit if planner and planner.search.time_limit
