@@ -157,7 +157,8 @@ def test_a_control_path_drives_the_sphere_demo_to_its_goal(world, kautham_dir, t
     result = world.run(["rosrun", "GUI", "run_path", str(problem), "--controls", str(controls),
                         "--fast"], timeout=120)
     lines = result.stdout.splitlines()
-    assert lines[-1].startswith("SphereDE: 12 control rows done (3.600 s simulated), ends ")
+    assert lines[-1].startswith("SphereDE: 12 control rows done (3.600 s simulated), ")
+    assert " made by the path" in lines[-1] and ", ends " in lines[-1], lines[-1]
     goal = np.array([-5 + 10 * 0.426, -5 + 10 * 0.578])     # sp3.cntr and <Limits>: x, y
     start = np.array([-5 + 10 * 0.544, -5 + 10 * 0.433])
     # "[k/12] t=... s SphereDE at [x, y, z], d m from the goal"

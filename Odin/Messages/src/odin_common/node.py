@@ -31,9 +31,11 @@ from odin_common.master_link import MasterRefusal, call_master
 
 
 def init_ros_node(name: str, disable_signals: bool = False, poll: float = 0.5,
-                  master_timeout: Optional[float] = None) -> None:
+                  master_timeout: Optional[float] = None, wall_clock: bool = False) -> None:
     """``rospy.init_node(name)`` once the master answers, with rospy's own signal handling
-    unless ``disable_signals`` (a Qt window handles Ctrl-C itself).
+    unless ``disable_signals`` (a Qt window handles Ctrl-C itself). With ``wall_clock`` the
+    node's ROS time is the wall clock whatever ``/use_sim_time`` says (the world, which
+    publishes /clock and must run on while its clock stands still; docs/ROS.md, "ROS time").
 
     rospy waits for a master that is not up yet only for the node's registration: a private
     parameter on the command line (``_eye:=[...]``) is set on the master first, and with no
@@ -45,7 +47,8 @@ def init_ros_node(name: str, disable_signals: bool = False, poll: float = 0.5,
     ``NoMasterError`` after it (``wait_for_master``)."""
     wait_for_master(name, poll, master_timeout)
     try:
-        rospy.init_node(name, disable_signals=disable_signals)
+        # rospy's disable_rostime: no /clock subscription, rospy.Time.now() the wall clock
+        rospy.init_node(name, disable_signals=disable_signals, disable_rostime=wall_clock)
     except rospy.ROSInitException:
         if rospy.core.is_shutdown_requested():
             raise KeyboardInterrupt from None

@@ -43,6 +43,10 @@ rosbag of what changed the world, see ``recorder``; ``~push_speed``; the resourc
 ``~max_objects``, ``~max_mesh_triangles``, ``~max_snapshots``, ``~max_request_mb``) and every world
 parameter under its own name (``~gravity``, ``~erp``, ... odin_common.world_parameters), with
 units and defaults in docs/parameters.md.
+
+Parameter set: ``/use_sim_time`` to true at start, unless set already (``offer_world_clock``:
+the nodes started afterwards take their time from ``/clock``); the node itself keeps the wall
+clock.
 """
 from __future__ import annotations
 
@@ -316,9 +320,38 @@ def _heard(publisher: rospy.Publisher) -> bool:
     return publisher.get_num_connections() > 0
 
 
+#: the ROS parameter every node reads once, when it starts: true makes its ROS time /clock's
+USE_SIM_TIME = "/use_sim_time"
+
+
+def offer_world_clock() -> bool:
+    """Makes the world clock the ROS time of the nodes started from now on, as ROS's simulators
+    do (gazebo_ros, stage_ros): sets ``/use_sim_time`` to true unless someone set it already
+    (``rosparam set /use_sim_time false`` before the world starts keeps every node on the wall
+    clock). Returns the value in force.
+
+    The world's stamps are simulated time starting near 0: a node on the wall clock takes them
+    for decades old (robot_state_publisher warns so every 10 s), publishes nothing for a
+    restarted world (robot_state_publisher: its stamps are older than the last it published),
+    keeps a restarted world's frames out of its tf buffer as old data, and cannot ask tf for
+    "now" (docs/ROS.md, "ROS time")."""
+    if not rospy.has_param(USE_SIM_TIME):
+        rospy.set_param(USE_SIM_TIME, True)
+        rospy.loginfo("virtual_world: %s set to true: nodes started from now on take their "
+                      "time from the world clock (/clock)", USE_SIM_TIME)
+    value = bool(rospy.get_param(USE_SIM_TIME))
+    if not value:
+        rospy.logwarn("virtual_world: %s is false: nodes keep the wall clock, decades "
+                      "ahead of the world's stamps", USE_SIM_TIME)
+    return value
+
+
 def main() -> None:
-    # the loop runs on this thread: Ctrl-C and SIGTERM only stop it (stop_on_signals)
-    init_ros_node("virtual_world", disable_signals=True)
+    # the loop runs on this thread: Ctrl-C and SIGTERM only stop it (stop_on_signals). The
+    # world keeps the wall clock whatever /use_sim_time says: it publishes /clock, and a node
+    # on /clock would wait for ever in any sleep or timer while the world is paused
+    init_ros_node("virtual_world", disable_signals=True, wall_clock=True)
+    offer_world_clock()
     asked = threading.Event()
     stop_on_signals(asked.set)                  # while the portal is being made
     MasterWatch()
