@@ -215,7 +215,7 @@ def actuation(handle, row: ControlRow, state: Optional[BodyState],
     target = controls.configuration(handle.instance, row.controls)
     servo = _joint_servo(handle, target.joints, defaults) if handle.motor_ids else None
     forces, velocity = (), None
-    if handle.kind in (FREE_BODY, MOBILE) and controls.se3 and controls.moved_base_axes():
+    if reads_base(handle):
         if handle.base_held:
             velocity = _base_velocity(handle, target.base_pose, state, row.duration,
                                       controls.moved_base_axes())
@@ -223,6 +223,15 @@ def actuation(handle, row: ControlRow, state: Optional[BodyState],
             forces = (_base_force(handle, target.base_pose, state, row.duration,
                                   controls.moved_base_axes(), defaults),)
     return Actuation(row.duration, servo, forces, velocity)
+
+
+def reads_base(handle) -> bool:
+    """Whether ``actuation`` of ``handle``'s robot depends on its base's state (a free or mobile
+    base its controls move: a force or velocity toward the row's position); otherwise it
+    depends on the row alone."""
+    controls = handle.instance.controls
+    return handle.kind in (FREE_BODY, MOBILE) and controls is not None and controls.se3 \
+        and bool(controls.moved_base_axes())
 
 
 def _joint_servo(handle, targets: np.ndarray, defaults: ControlDefaults) -> ServoCommand:

@@ -20,7 +20,7 @@ from typing import Dict, List, NamedTuple, Optional, Protocol, Sequence, Tuple
 
 import numpy as np
 
-from gui.core.control_path import Actuation, ControlRow, ServoCommand, actuation
+from gui.core.control_path import Actuation, ControlRow, ServoCommand, actuation, reads_base
 from gui.core.plan import BuildPlan
 from gui.core.world_port import BodyState
 from gui.errors import PlanningError
@@ -122,6 +122,10 @@ class CoreBackend:
                                     for index, b in enumerate(bodies)})
         self.propagations = 0
         self._servo_sent: Optional[ServoCommand] = None
+        # a robot whose actuation depends on its control alone (a car, a chain) is given the
+        # same one for the same control: a control is held over many steps
+        self._reads_base = reads_base(problem.handle)
+        self._last: Tuple[Optional[tuple], Optional[Actuation]] = (None, None)
 
     def start_state(self) -> np.ndarray:
         return self._start.copy()
@@ -142,7 +146,7 @@ class CoreBackend:
         state = np.asarray(state, dtype=np.float64)
         if state.shape != self._start.shape:
             core.checked_state_vector(state)     # raises: the Core's refusal of its size
-        act = step_actuation(problem, control, self.bodies.body(state, problem.base_body))
+        act = self._actuation(state, control)
         if act.servo is not None and act.servo != self._servo_sent:
             core.checked_state_vector(state)     # a bad state changes no servo either
             # the same settings again change nothing: a control held over several steps
@@ -155,6 +159,17 @@ class CoreBackend:
         self.propagations += 1
         position, linear = self._tracked(result.state)
         return Outcome(result.state, position, linear, result.pairs)
+
+    def _actuation(self, state: np.ndarray, control) -> Actuation:
+        """``step_actuation`` for ``control`` from ``state``, the last one again for the same
+        control when the base's state does not enter it."""
+        if self._reads_base:
+            return step_actuation(self.problem, control,
+                                  self.bodies.body(state, self.problem.base_body))
+        key = tuple(control)
+        if key != self._last[0]:
+            self._last = (key, step_actuation(self.problem, key, None))
+        return self._last[1]
 
     def refusal(self) -> Optional[Tuple[str, str]]:
         """(OMPL's status, one line) when the problem's query cannot be solved whatever the

@@ -35,6 +35,7 @@ import numpy as np
 
 from gui.core.control_path import ControlRow
 from gui.errors import PlanningError
+from gui.planning import ompl_memory
 
 PLANNERS = ("KPIECE1", "RRT", "EST")
 """Control planners of OMPL's Python wheel that construct from a SpaceInformation."""
@@ -117,17 +118,22 @@ class _Callbacks:
     problem, never the OMPL objects: a reference from a callback back to the SpaceInformation
     holding it would be a cycle through C++ that Python's collector cannot see."""
 
-    def __init__(self, backend, world_size: int):
+    def __init__(self, backend, world_size: int, direct: bool):
         self.backend = backend
         self.problem = backend.problem
         self.world_size = world_size
+        self.direct = direct
         self.error: Optional[BaseException] = None
-        # the world vector's slots, read and written through map: a propagation moves a few
-        # hundred values each way, one OMPL call per value (the wheel has no bulk copy)
+        # without ``direct`` the world vector's slots are read and written through map: a
+        # propagation moves a few hundred values each way, one OMPL call per value
         self._slots = range(world_size - 1)
 
     # -- state <-> vectors ---------------------------------------------------------------------
     def _vector(self, state) -> np.ndarray:
+        """The world vector of ``state``; with ``direct``, an array over OMPL's own values
+        (gui.planning.ompl_memory), which the back end reads before anything is written."""
+        if self.direct:
+            return ompl_memory.values(state[1], self.world_size - 1)
         return np.fromiter(map(state[1].__getitem__, self._slots), float, len(self._slots))
 
     def write(self, state, vector: np.ndarray, backend_outcome, touched: bool = False) -> None:
@@ -140,6 +146,14 @@ class _Callbacks:
         else:
             position, velocity = backend_outcome.position, backend_outcome.velocity
         flag = 1.0 if touched else 0.0
+        if self.direct:
+            values = ompl_memory.values(world, self.world_size)
+            values[:-1] = vector
+            values[-1] = flag
+            values = ompl_memory.values(robot, ROBOT_VALUES)
+            values[:3] = position
+            values[3:] = velocity
+            return
         for i in range(3):
             robot[i] = float(position[i])
             robot[3 + i] = float(velocity[i])
@@ -239,7 +253,8 @@ class _Setup:
         self.si.setPropagationStepSize(problem.step)
         self.si.setMinMaxControlDuration(settings.min_control_steps,
                                          settings.max_control_steps)
-        self.callbacks = _Callbacks(backend, self.world_size)
+        direct = ompl_memory.LayoutProbe.holds(self.space, (ROBOT_VALUES, self.world_size))
+        self.callbacks = _Callbacks(backend, self.world_size, direct)
         self.si.setStatePropagator(self.callbacks.propagate)
         self.si.setStateValidityChecker(self.callbacks.valid)
         self.si.setup()
