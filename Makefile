@@ -39,7 +39,7 @@ bench-setup:
 bench: setup bench-setup
 	@$(ENV) python tools/bench/run.py
 
-# Kautham 5.1.1, the peer of Odin's geometric planning in `make bench` (bench_geometric.py skips
+# Kautham 5.1.1, Odin's planning peer in `make bench` (bench_geometric and bench_car_kautham skip
 # it until it is built): its build.sh, from $ODIN_KAUTHAM_PEER_DIR (default
 # ../shared/peers/kautham), builds it once into build/kautham/; apt installs its Debian
 # dependencies; about 7 CPU minutes (JOBS=2 sets make's jobs). tools/bench/kautham_peer.py

@@ -202,7 +202,8 @@ def _events(plan, solution: Solution, times: np.ndarray) -> List[_Event]:
             raise PathFileError(f"obstacle \"{e.obstacle}\" is static geometry in this build: "
                                 "it cannot be attached", solution.source, e.line)
         out.append(_Event(float(times[e.index + 1]), e.action, link_body, bodies[e.obstacle],
-                          f"{e.action} {e.obstacle} to {e.robot}/{e.link}"))
+                          f"{e.action} {e.obstacle} {'to' if e.action == ATTACH else 'from'} "
+                          f"{e.robot}/{e.link}"))
     return out
 
 
