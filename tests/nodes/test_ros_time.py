@@ -275,11 +275,12 @@ def test_a_node_started_after_the_world_asks_tf_for_now(ros_master):
     buffer = tf2_ros.Buffer()
     listener = tf2_ros.TransformListener(buffer)  # noqa: F841 - held: it fills buffer
     client.build_object(ObjectSpec("ball", (0.1,), position=(0.5, -0.25, 1.0)))
-    deadline = time.monotonic() + 20
-    while rospy.Time.now().to_sec() < 0.5 and time.monotonic() < deadline:
-        time.sleep(0.05)                # the world clock passes 0.5 s: the ball falls
+    built = rospy.Time.now().to_sec()   # the world ran before the build: the ball falls from
+    deadline = time.monotonic() + 20    # here, 0.5 s of the world clock
+    while rospy.Time.now().to_sec() < built + 0.5 and time.monotonic() < deadline:
+        time.sleep(0.05)
     now = rospy.Time.now()
-    assert 0.5 <= now.to_sec() < 3600, f"this node's time is {now.to_sec()} s"
+    assert built + 0.5 <= now.to_sec() < 3600, f"this node's time is {now.to_sec()} s"
     seen = buffer.lookup_transform("world", "ball", now, rospy.Duration(10))
     assert seen.header.stamp == now
     assert seen.transform.translation.z < 1.0 - 0.5 * 9.81 * 0.4 ** 2   # fallen for 0.5 s
