@@ -86,6 +86,39 @@ def test_servo_controls_through_the_pool_answer_what_the_core_answers(ros_master
         core.close()
 
 
+def test_a_held_control_is_one_round_trip_a_row(ros_master, ode_demos_dir, plan_of):
+    """The chain's control held over many propagations, each from the state the last reached
+    (as OMPL holds a control): the first asks the world for the whole row, the others are
+    answered from it, bit for bit the Core's (issue 42: one round trip a control, not a
+    step); another control, or a state off the row, asks again."""
+    ros_master.rosrun("VirtualWorld", "virtualWorld", "__ns:=/w0")
+    ros_master.wait_for_service(f"{NAMESPACES[0]}/propagate")
+    from gui.planning.backend import CoreBackend
+    from gui.planning.problem import planning_problem
+    from gui.planning.pool import PoolBackend
+    chain = plan_of(ode_demos_dir / "demos" / "OMPL_ode_demos" / "Chain" / "k-PMPChain.xml")
+    problem = planning_problem(chain)
+    core = CoreBackend(chain, problem)
+    pool = PoolBackend(chain, planning_problem(chain), NAMESPACES[:1])
+    trips = []
+    map_calls = pool.pool.map_calls
+    pool.pool.map_calls = lambda calls: (trips.append(len(calls)), map_calls(calls))[1]
+    try:
+        held = problem.settings.max_control_steps
+        for control, steps in (((0.9, 0.1, 0.5), held), ((0.2, 0.7, 0.4), 3)):
+            mine, theirs = pool.start_state(), core.start_state()
+            for _ in range(steps):
+                a = pool.propagate([(mine, control)])[0]
+                b = core.propagate([(theirs, control)])[0]
+                assert _same(a, b)
+                mine, theirs = a.state, b.state
+        assert trips == [1, 1]                   # a round trip for each control's row
+        assert pool.propagations == held + 3
+    finally:
+        pool.close()
+        core.close()
+
+
 def test_parallel_searches_share_the_pool_one_world_each(ros_master, kautham_dir, tmp_path):
     """`plan --parallel 2` over two worlds: each search builds the problem in its own world
     (a process of its own, a node of its own) and the first solution is written."""

@@ -478,3 +478,31 @@ def test_a_collision_query_answers_at_once_and_leaves_the_world_as_it_was(contac
     with pytest.raises(UnknownName):
         core.check_collision([("ghost", (0, 0, 0), (1, 0, 0, 0))])
     core.close()
+
+
+def test_a_row_is_bit_for_bit_its_propagations_one_by_one(core):
+    """propagate_row (a planner's control held over several propagations, one call: what the
+    pool back end asks a world for, issue 42) against propagate_state called as many times,
+    each from the state the last reached: the same states and pairs; without keep the world
+    goes back; a bad row is refused and changes nothing."""
+    arm(core)
+    core.build_object(ObjectSpec("ball", [0.1], position=(2, 0, 0.1)))
+    core.step(H, 50)
+    start, before = core.body_state_vector(), state_bytes(core)
+    row = core.propagate_row(start, 6, 7 * H, H, [("l2", (3.0, -1.0, 0.5))])
+    assert state_bytes(core) == before                       # not kept: put back
+    vector = start
+    for one in row:
+        alone = core.propagate_state(vector, 7 * H, H, [("l2", (3.0, -1.0, 0.5))])
+        assert one.state.tobytes() == alone.state.tobytes()
+        assert one.pairs == alone.pairs and one.steps == alone.steps == 7
+        vector = alone.state
+    kept = core.propagate_row(start, 2, 7 * H, H, keep=True)
+    assert core.body_state_vector().tobytes() == kept[-1].state.tobytes()
+    core.set_body_state_vector(start)
+    before = state_bytes(core)
+    for args, message in (((start, 0, 7 * H, H), "row=0"), ((start[:-1], 3, 7 * H, H), "values"),
+                          ((start, 10 ** 9, 7 * H, H), "body-steps")):
+        with pytest.raises(InvalidArgument, match=message):
+            core.propagate_row(*args)
+        assert state_bytes(core) == before

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import functools
 import time
-from typing import Mapping, Optional, Sequence, Tuple
+from typing import List, Mapping, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -153,6 +153,34 @@ def propagate_state(scene: Scene, start_state: Sequence[float], duration: float,
     scene.sim_time += step_size * steps
     guard.collect(scene, step_size)
     return StatePropagation(state, scene.pair_names(pairs), steps)
+
+
+def propagate_row(scene: Scene, start_state: Sequence[float], count: int, duration: float,
+                  step_size: float, pushes: Sequence[Tuple[str, Sequence[float]]],
+                  keep: bool) -> List[StatePropagation]:
+    """Core.propagate_row: ``count`` planner's propagations of ``duration`` s in a row, each
+    ``propagate_state`` from the state the one before reached (bit for bit those calls one by
+    one), under ``pushes`` in each; back to the state before the call unless ``keep`` (and
+    always after a refusal). Checked first: the count, and its work within
+    limits.MAX_BODY_STEPS_PER_CALL."""
+    count = check.count("row", count)
+    step_size, steps = _steps_of(duration, step_size)
+    check.shared(limits.check_work, f"a row of {count} propagations of {duration:.6g} s at "
+                 f"{step_size:g} s", count * steps, scene.body_array().count)
+    keep = check.flag("keep", keep)
+    before = snapshots.take(scene)
+    row: List[StatePropagation] = []
+    try:
+        state = start_state
+        for _ in range(count):
+            row.append(propagate_state(scene, state, duration, step_size, pushes))
+            state = row[-1].state
+    except Exception:
+        snapshots.put_back(scene, before)   # a refused row changes nothing
+        raise
+    if not keep:
+        snapshots.put_back(scene, before)
+    return row
 
 
 def _run(scene: Scene, steps: int, step_size: float, read_states: bool = True,

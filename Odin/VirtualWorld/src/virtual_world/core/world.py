@@ -442,6 +442,18 @@ class Core:
         return propagation.propagate_state(self._scene, start_state, duration, step_size,
                                            forces)
 
+    @changes_state
+    def propagate_row(self, start_state: Sequence[float], count: int, duration: float,
+                      step_size: float, forces: Sequence[Tuple[str, Sequence[float]]] = (),
+                      keep: bool = False) -> List[StatePropagation]:
+        """A planner's control held over ``count`` propagations, in one call: each
+        ``propagate_state`` of ``duration`` s from the state the one before reached (bit for
+        bit those calls one by one: the first from ``start_state``), under ``forces`` in each;
+        every one's answer, in order. The world goes back to the state before the call unless
+        ``keep``. Everything is checked first."""
+        return propagation.propagate_row(self._scene, start_state, count, duration, step_size,
+                                         forces, keep)
+
     @changes_contents
     def exempt_overlaps(self, min_depth: float) -> List[Collision]:
         """The pairs inside each other now deeper than ``min_depth`` m, where a part has a

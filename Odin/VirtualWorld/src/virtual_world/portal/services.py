@@ -10,10 +10,14 @@ markers and robots for tf, RViz and the robots' topics), which Set Robot declare
 """
 from __future__ import annotations
 
+import time
+
+import numpy as np
 from geometry_msgs.msg import Vector3
+from Messages.msg import CollisionPair
 
 from odin_common import messages
-from odin_common.interface import SetJointAction
+from odin_common.interface import ForceKind, SetJointAction
 from odin_common.limits import shown
 from odin_common.specs import EntitySpec, JointSpec, MotorSpec
 from odin_common.world_parameters import set_world_flags
@@ -257,6 +261,8 @@ class WorldServices:
         self.loop.sim_time = self.core.sim_time
 
     def propagate(self, request) -> dict:
+        if request.row:
+            return self._propagate_row(request)
         goals = self.core.split_per_axis(list(request.motors), list(request.velocities))
         step = request.step or self.loop.step_values.step
         result = self.core.propagate(
@@ -274,6 +280,35 @@ class WorldServices:
                 "wall_time": result.wall_time, "state": result.state.tolist(),
                 "message": f"{result.steps} steps in {result.wall_time:.3g} s"
                            + (", kept" if result.kept else "")}
+
+    def _propagate_row(self, request) -> dict:
+        """Propagate with ``row``: a planner's control held over several propagations
+        (Core.propagate_row), every one's state and pairs answered."""
+        if request.start or request.motors or request.velocities or not len(request.start_state):
+            raise InvalidArgument("row: give start_state, and neither a start snapshot nor "
+                                  "motors (a planner sets its servos first)")
+        step = request.step or self.loop.step_values.step
+        pushes = []
+        for force in request.forces:
+            if force.kind != ForceKind.FORCE or force.at_point or force.vector_in_body_frame:
+                raise InvalidArgument("row: forces only at the centre of mass, world frame")
+            pushes.append((force.object, tuple(force.vector)))
+        start_time = self.core.sim_time
+        started = time.perf_counter()
+        row = self.core.propagate_row(request.start_state, request.row, request.duration, step,
+                                      pushes, keep=request.keep)
+        wall = time.perf_counter() - started
+        if request.keep:
+            self._sync_loop_time()
+        pairs = [pair for one in row for pair in one.pairs]
+        return {"start_time": start_time, "step": step,
+                "steps": sum(one.steps for one in row), "states": [],
+                "collisions": [CollisionPair(first=a, second=b) for a, b in pairs],
+                "first_times": [], "wall_time": wall, "state": row[-1].state.tolist(),
+                "row_states": np.concatenate([one.state for one in row]).tolist(),
+                "row_pairs": [len(one.pairs) for one in row],
+                "message": f"a row of {len(row)} propagations in {wall:.3g} s"
+                           + (", kept" if request.keep else "")}
 
     def check_collision(self, request) -> dict:
         pairs = self.core.check_collision(messages.situation_poses(request.situations))
