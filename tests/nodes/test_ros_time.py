@@ -275,8 +275,10 @@ def test_a_node_started_after_the_world_asks_tf_for_now(ros_master):
     buffer = tf2_ros.Buffer()
     listener = tf2_ros.TransformListener(buffer)  # noqa: F841 - held: it fills buffer
     client.build_object(ObjectSpec("ball", (0.1,), position=(0.5, -0.25, 1.0)))
-    built = rospy.Time.now().to_sec()   # the world ran before the build: the ball falls from
-    deadline = time.monotonic() + 20    # here, 0.5 s of the world clock
+    # the world ran before the build, and this node's /clock can lag the world's on a busy
+    # host: the ball falls from the world's own clock after the build, 0.5 s of it
+    built = client.world().clock
+    deadline = time.monotonic() + 20
     while rospy.Time.now().to_sec() < built + 0.5 and time.monotonic() < deadline:
         time.sleep(0.05)
     now = rospy.Time.now()
