@@ -21,6 +21,7 @@ from gui.core.kautham.problem import load_problem
 from gui.core.model import CAR, MOBILE
 from gui.errors import PathFileError
 from kautham_files import KINEMATIC, SHELF, plan_steps, write_problem
+from several_robots import ROVER_CNTR
 from odin_common.interface import JointParameter, JointType
 
 
@@ -142,15 +143,6 @@ ROVER = """<?xml version="1.0"?><robot name="rover">
   xyz="0 0 0.05"/><axis xyz="0 0 1"/><limit lower="-1.5" upper="1.5" effort="5"
   velocity="1"/></joint>
 </robot>"""
-
-ROVER_CNTR = """<?xml version="1.0"?><ControlSet>
- <Offset><DOF name="rover/X1" value="0"/><DOF name="rover/X2" value="0"/>
-  <DOF name="rover/X3" value="0"/></Offset>
- <Control name="rover/x" eigValue="1"><DOF name="rover/X" value="1"/></Control>
- <Control name="rover/y" eigValue="1"><DOF name="rover/Y" value="1"/></Control>
- <Control name="rover/pan" eigValue="1"><DOF name="rover/mast" value="1"/></Control>
-</ControlSet>"""
-
 
 def _rover(folder: pathlib.Path) -> pathlib.Path:
     return write_problem(

@@ -13,23 +13,9 @@ import sys
 
 import pytest
 
-from kautham_files import write_problem
+from kautham_files import crane_and_post, crane_urdf, write_problem
 
 SCRIPT = pathlib.Path(__file__).resolve().parents[1] / "scripts" / "problem_info"
-
-CRANE = """<?xml version="1.0"?><robot name="{name}">
- <link name="mast"><collision><geometry><box size="0.2 0.2 1"/></geometry></collision></link>
- <link name="boom"><collision><origin xyz="0.5 0 0"/><geometry><box size="1 0.05 0.05"/>
-  </geometry></collision></link>
- <joint name="slew" type="revolute"><parent link="mast"/><child link="boom"/><origin
-  xyz="0 0 0.6"/><axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="30" velocity="1"/>
- </joint>
-</robot>"""
-"""A crane: a 1 m mast and a 1 m boom (5 cm thick) slewing +-3 rad about z 0.6 m up the mast
-(the boom along the base's x at 0 rad)."""
-
-POST = """<?xml version="1.0"?><robot name="post"><link name="base"><collision><geometry>
- <box size="0.1 0.1 0.4"/></geometry></collision></link></robot>"""
 
 # one control slews both cranes: slew = -3 + 6 c rad (offset 0.5, the default)
 TWO_CNTR = """<?xml version="1.0"?><ControlSet>
@@ -49,32 +35,11 @@ TWO_CRANES = """<?xml version="1.0"?><Problem>
   <Queries><Query><Init>0.5</Init><Goal>0.75</Goal></Query></Queries></Planner>
 </Problem>"""
 
-ONE_CNTR = """<?xml version="1.0"?><ControlSet>
- <Control name="crane/slew" eigValue="1.0"><DOF name="crane/boom" value="1.0"/></Control>
-</ControlSet>"""
-
-# c 0.25: the boom along -1.5 rad, clear; c 0.5: along +x, through the post; c 1.2 asks
-# slew 4.2 rad, past its 3 rad limit (Kautham's controls clamp it to 3)
-CRANE_AND_POST = """<?xml version="1.0"?><Problem>
- <Robot robot="crane.urdf"><Home X="0" Y="0" Z="0.5" WX="0" WY="0" WZ="1" TH="0"/></Robot>
- <Obstacle obstacle="post.urdf"><Home X="0.7" Y="0" Z="1.1" WX="0" WY="0" WZ="1" TH="0"/>
- </Obstacle>
- <Controls robot="crane.cntr"/>
- <Planner><Parameters><Name>omplRRTConnect</Name></Parameters>
-  <Queries><Query><Init>0.25</Init><Goal>GOAL</Goal></Query></Queries></Planner>
-</Problem>"""
-
 
 def _two_cranes(folder: pathlib.Path) -> pathlib.Path:
-    return write_problem(folder, {"west.urdf": CRANE.format(name="west"),
-                                  "east.urdf": CRANE.format(name="east"),
+    return write_problem(folder, {"west.urdf": crane_urdf("west"),
+                                  "east.urdf": crane_urdf("east"),
                                   "cranes.cntr": TWO_CNTR}, "cranes.xml", TWO_CRANES)
-
-
-def _crane_and_post(folder: pathlib.Path, goal: str) -> pathlib.Path:
-    return write_problem(folder, {"crane.urdf": CRANE.format(name="crane"),
-                                  "crane.cntr": ONE_CNTR, "post.urdf": POST}, "crane.xml",
-                         CRANE_AND_POST.replace("GOAL", goal))
 
 
 def _info(problem: pathlib.Path, *options: str):
@@ -109,7 +74,7 @@ def test_two_robots_built_through_each_other_are_said_at_the_start(tmp_path):
 
 
 def test_a_goal_through_an_obstacle_is_said_at_the_goal_as_load_problem_says_it(tmp_path):
-    info, lines = _info(_crane_and_post(tmp_path, "0.5"))
+    info, lines = _info(crane_and_post(tmp_path, "0.5"))
     crane = _robot(info, "crane")
     # the boom (5 cm thick) across the post (10 cm): 2.5 + 5 cm deep along the boom's width
     assert crane["collisions"] == [dict(at="goal", first="crane/boom", second="post",
@@ -121,7 +86,7 @@ def test_a_goal_through_an_obstacle_is_said_at_the_goal_as_load_problem_says_it(
 
 
 def test_a_goal_past_a_joint_limit_is_said_with_the_value_asked(tmp_path):
-    info, lines = _info(_crane_and_post(tmp_path, "1.2"))
+    info, lines = _info(crane_and_post(tmp_path, "1.2"))
     crane = _robot(info, "crane")
     assert crane["outside_limits"] == [dict(
         at="goal", dof="boom", joint="slew", parameter=pytest.approx(1.2),
@@ -133,9 +98,9 @@ def test_a_goal_past_a_joint_limit_is_said_with_the_value_asked(tmp_path):
 
 
 def test_a_clear_problem_says_nothing_and_no_checks_builds_nothing(tmp_path):
-    info, lines = _info(_crane_and_post(tmp_path, "0.75"))
+    info, lines = _info(crane_and_post(tmp_path, "0.75"))
     assert _robot(info, "crane")["collisions"] == [] and lines == []
     assert info["overlaps"] == [] and info["goal_overlaps"] == []
-    unchecked, lines = _info(_crane_and_post(tmp_path, "0.5"), "--no-checks")
+    unchecked, lines = _info(crane_and_post(tmp_path, "0.5"), "--no-checks")
     assert _robot(unchecked, "crane")["collisions"] is None and lines == []
     assert unchecked["overlaps"] is None and unchecked["goal_overlaps"] is None
