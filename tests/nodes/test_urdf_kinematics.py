@@ -104,12 +104,13 @@ def _angle(rotation: np.ndarray) -> float:
     return float(np.arccos(np.clip((np.trace(rotation) - 1.0) / 2.0, -1.0, 1.0)))
 
 
-def check_robot(path: pathlib.Path, model, master, namespace: str, seed: int) -> list:
-    """Differences (text) between Odin's link poses and robot_state_publisher's for
-    ``path``'s robot at Home and CONFIGURATIONS random configurations."""
+def _publisher(master, namespace: str, description: str):
+    """Debian's robot_state_publisher for ``description`` in ``namespace``, its tf on the
+    namespace's own topics: (the transforms it publishes, a latched joint_states publisher,
+    its process)."""
     import rospy
     from sensor_msgs.msg import JointState
-    rospy.set_param(f"/{namespace}/robot_description", _with_limits(path))
+    rospy.set_param(f"/{namespace}/robot_description", description)
     transforms = _StampedTransforms(f"/{namespace}/tf", f"/{namespace}/tf_static")
     states = rospy.Publisher(f"/{namespace}/joint_states", JointState, queue_size=10,
                              latch=True)
@@ -117,6 +118,15 @@ def check_robot(path: pathlib.Path, model, master, namespace: str, seed: int) ->
                          f"__ns:={namespace}", f"/tf:=/{namespace}/tf",
                          f"/tf_static:=/{namespace}/tf_static"],
                         log_name=f"robot_state_publisher_{namespace}")
+    return transforms, states, node
+
+
+def check_robot(path: pathlib.Path, model, master, namespace: str, seed: int) -> list:
+    """Differences (text) between Odin's link poses and robot_state_publisher's for
+    ``path``'s robot at Home and CONFIGURATIONS random configurations."""
+    import rospy
+    from sensor_msgs.msg import JointState
+    transforms, states, node = _publisher(master, namespace, _with_limits(path))
     children = {model.links[i].name: model.links[model.links[i].parent].name
                 for i in range(1, len(model.links))}
     names = model.joint_names()
@@ -304,15 +314,8 @@ def test_a_kautham_mobile_base_s_link_poses_equal_robot_state_publisher_s(ros_ma
 
     rospy.init_node("kinematics_check", anonymous=True, disable_signals=True)
     namespace = "mobile"
-    rospy.set_param(f"/{namespace}/robot_description",
-                    _on_base_joints(ROVER_URDF, model.links[0].name))
-    transforms = _StampedTransforms(f"/{namespace}/tf", f"/{namespace}/tf_static")
-    states = rospy.Publisher(f"/{namespace}/joint_states", JointState, queue_size=10,
-                             latch=True)
-    node = ros_master.popen(["rosrun", "robot_state_publisher", "robot_state_publisher",
-                             f"__ns:={namespace}", f"/tf:=/{namespace}/tf",
-                             f"/tf_static:=/{namespace}/tf_static"],
-                            log_name="robot_state_publisher_mobile")
+    transforms, states, node = _publisher(ros_master, namespace,
+                                          _on_base_joints(ROVER_URDF, model.links[0].name))
     names = [name for name, _, _ in BASE_JOINTS] + model.joint_names()
     moving = {model.links[0].name} | {model.links[i].name for i in model.movable_links()}
     links = [link.name for link in model.links]
