@@ -441,17 +441,14 @@ def _drive_base(port: WorldPort, robot: _Robot, middle, end, mass: float,
     body = robot.handle.bodies[0]
     position, quaternion, linear_now, angular_now = port.body_state(body.body_id)
     target = middle.base_pose[robot.base] @ body.offset
-    R_now = quaternion_to_matrix(quaternion)
-    linear = end.base_linear[robot.base] + defaults.base_gain * (target[:3, 3] - position)
-    angular = end.base_angular[robot.base] + defaults.base_gain * rotation_error(
-        target[:3, :3], R_now)
+    # a planar base's gain is deadbeat: the velocity that closes the whole error within the
+    # period, for the floor's friction takes up to mu g h of it every step (a gain of 10/s
+    # left a cart dragged 9 mm behind its target)
+    gain = 1.0 / period if robot.planar else defaults.base_gain
+    linear = end.base_linear[robot.base] + gain * (target[:3, 3] - position)
+    angular = end.base_angular[robot.base] + gain * rotation_error(
+        target[:3, :3], quaternion_to_matrix(quaternion))
     if robot.planar:
-        # deadbeat: the velocity that closes the whole error within the period, for the
-        # floor's friction takes up to mu g h of it every step (a gain of 10/s left a
-        # cart dragged 9 mm behind its target)
-        gain = 1.0 / period
-        linear = end.base_linear[robot.base] + gain * (target[:3, 3] - position)
-        angular = end.base_angular[robot.base] + gain * rotation_error(target[:3, :3], R_now)
         linear[2] = linear_now[2]
         angular[:2] = angular_now[:2]
         port.set_body_velocity(body.body_id, linear, angular)
