@@ -23,14 +23,15 @@ from odin_common.interface import ServoDrive, Solver
 from odin_common.limits import ResourceLimits, shown
 from odin_common.specs import CompositeSpec, EntitySpec, JointSpec, MotorSpec, ObjectSpec
 from odin_common.world_parameters import WorldParameters
-from virtual_world.core import (actuation, exemptions, forces, guard, joints, long_calls,
-                                motion, motors, objects, probe, propagation, readout,
+from virtual_world.core import (actuation, checked_propagation, exemptions, forces, guard, joints,
+                                long_calls, motion, motors, objects, probe, propagation, readout,
                                 snapshots, validation as check)
 from virtual_world.core.requests import changes_contents, changes_state, disturbs, locked
 from virtual_world.core.records import (Built, BuiltEntity, Collision, Divergence,
                                         JointReaction, JointState, MotorState, ObjectState,
                                         Propagation, Removed, ServoState,
                                         StatePropagation)
+from virtual_world.core.checked_propagation import CheckedRow, PlanRule
 from virtual_world.core.scene import Scene
 from virtual_world.errors import Closed, InvalidArgument
 from virtual_world.ode import bodies
@@ -453,6 +454,39 @@ class Core:
         ``keep``. Everything is checked first."""
         return propagation.propagate_row(self._scene, start_state, count, duration, step_size,
                                          forces, keep)
+
+    @locked
+    def plan_rule(self, roles: Mapping[str, int], forbidden: Sequence[Tuple[int, int]],
+                  tracked_body: str, tracked_offset: Sequence[float],
+                  bounds: Sequence[Sequence[float]], max_speed: float) -> PlanRule:
+        """A control planner's validity rule, held in C for ``propagate_checked`` while
+        the world keeps its objects: ``roles`` {object id: role 1..15} (others: role 0),
+        ``forbidden`` the pairs of roles (either order) that may not collide; the tracked
+        link on ``tracked_body``'s body at ``tracked_offset`` (3,) m in its frame, whose origin
+        must stay within ``bounds`` ((3, 2) m, world, low and high per axis) and the body's
+        linear velocity within ``max_speed`` m/s per axis. Everything is checked first."""
+        return checked_propagation.plan_rule(self._scene, roles, forbidden, tracked_body,
+                                             tracked_offset, bounds, max_speed)
+
+    @changes_state
+    def propagate_checked(self, rule: PlanRule, start_state: Sequence[float], duration: float,
+                          step_size: float, forces: Sequence[Tuple[str, Sequence[float]]] = (),
+                          count: int = 1, states: Optional[np.ndarray] = None,
+                          tracked: Optional[np.ndarray] = None,
+                          stop_at_invalid: bool = True) -> CheckedRow:
+        """``count`` planner's propagations in a row, in one C call, each judged by
+        ``rule`` (``plan_rule``): each ``propagate_state`` of ``duration`` s from the state
+        the one before reached (bit for bit: the first from ``start_state``), under
+        ``forces``; invalid when a pair of roles the rule forbids collided on the way or the
+        tracked link ended out of its bounds; with ``stop_at_invalid`` the row ends after the
+        first invalid one. Row i of ``states`` ((count, state size + 1) float64, given or
+        made) gets the i-th state reached and then 1.0 (invalid) or 0.0, row i of ``tracked``
+        ((count, 6)) the tracked link's origin (m) and body velocity (m/s), world frame: arrays
+        may be a planner's own memory. The world stays in the state reached. Everything is
+        checked first."""
+        return checked_propagation.propagate_checked(self._scene, rule, start_state, count,
+                                                     duration, step_size, forces, states,
+                                                     tracked, stop_at_invalid)
 
     @changes_contents
     def exempt_overlaps(self, min_depth: float) -> List[Collision]:

@@ -49,7 +49,7 @@ def make_builder() -> cffi.FFI:
         '#include <ode/ode.h>\n#include "odin_step.h"\n',
         sources=[str(HERE / "odin_step.c"), str(HERE / "odin_state.c"),
                  str(HERE / "odin_kinematic.c"), str(HERE / "odin_query.c"),
-                 str(HERE / "odin_motion.c")],
+                 str(HERE / "odin_motion.c"), str(HERE / "odin_plan.c")],
         include_dirs=[str(HERE)],
         extra_compile_args=["-O2", "-DdDOUBLE"] + _pkg_config("--cflags"),
         libraries=["ode"],

@@ -918,9 +918,20 @@ int odin_world_step(OdinWorld *w, double h, int count) {
 int odin_world_propagate(OdinWorld *w, dBodyID *bodies, int n, const double *state_in,
                          const OdinBodyForce *forces, int n_forces, double h, int count,
                          double *state_out, uintptr_t *pairs, int max_pairs, int *n_pairs) {
+    *n_pairs = 0;
+    int taken = odin_world_propagate_records(w, bodies, n, state_in, forces, n_forces, h, count,
+                                             state_out);
+    if (taken < 0) return taken;
+    *n_pairs = odin_world_record_pairs(w, pairs, max_pairs);
+    if (*n_pairs <= max_pairs) odin_world_clear_records(w);
+    return taken;
+}
+
+int odin_world_propagate_records(OdinWorld *w, dBodyID *bodies, int n, const double *state_in,
+                                 const OdinBodyForce *forces, int n_forces, double h, int count,
+                                 double *state_out) {
     int size = 1 + n * ODIN_BODY_STATE_SIZE;
     int fault = odin_state_vector_fault(state_in, size + w->n_exempt, w->n_exempt);
-    *n_pairs = 0;
     if (fault >= 0) return -1 - fault;
     odin_write_body_states(bodies, n, state_in + 1);
     if (w->n_exempt)
@@ -938,8 +949,6 @@ int odin_world_propagate(OdinWorld *w, dBodyID *bodies, int n, const double *sta
     odin_read_body_states(bodies, n, state_out + 1);
     if (w->n_exempt)
         memcpy(state_out + size, w->exempt_live, (size_t)w->n_exempt * sizeof(double));
-    *n_pairs = odin_world_record_pairs(w, pairs, max_pairs);
-    if (*n_pairs <= max_pairs) odin_world_clear_records(w);
     return taken;
 }
 

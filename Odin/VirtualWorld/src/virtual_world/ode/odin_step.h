@@ -258,6 +258,11 @@ void odin_world_clear_divergences(OdinWorld *w);
 int odin_world_propagate(OdinWorld *w, dBodyID *bodies, int n, const double *state_in,
                          const OdinBodyForce *forces, int n_forces, double h, int count,
                          double *state_out, uintptr_t *pairs, int max_pairs, int *n_pairs);
+/* odin_world_propagate without reading the pairs out: the records of its steps stay in
+ * w->records for the caller, who clears them (odin_plan_propagate reads them in C). */
+int odin_world_propagate_records(OdinWorld *w, dBodyID *bodies, int n, const double *state_in,
+                                 const OdinBodyForce *forces, int n_forces, double h, int count,
+                                 double *state_out);
 /* The recorded pairs' geoms (g1, g2 addresses of each record) into out, which has room for
  * 2 * max values; returns how many records there are. */
 int odin_world_record_pairs(const OdinWorld *w, uintptr_t *out, int max);
@@ -359,6 +364,37 @@ int odin_motion_valid(OdinMotionChecker *m, const double *a, const double *b, do
 /* The same for one configuration c: 1 when no moved link touches anything, 0 when one does,
  * -1, -2 as above; counts[0] += 1. */
 int odin_configuration_valid(OdinMotionChecker *m, const double *c, int *counts);
+
+/* A control planner's rule for its propagations (odin_plan.c): role_of_serial[s] is the role
+ * of the geom of serial s (n_serials of them; a geom past them has role 0); forbidden is an
+ * n_roles x n_roles table, 1 where a colliding pair of those roles makes the motion invalid;
+ * `tracked` the index (in the propagation's `bodies`) of the tracked link's body, com its centre
+ * of mass and offset the link's origin, both m in the body's frame; the link's origin must stay
+ * within [low, high] (m, world) and the body's linear velocity within max_speed (m/s) on each
+ * axis. Arrays owned by Python. */
+typedef struct OdinPlanRule {
+    const unsigned char *role_of_serial; long n_serials;
+    const unsigned char *forbidden; int n_roles;
+    int tracked;
+    double com[3], offset[3], low[3], high[3];
+    double max_speed;
+} OdinPlanRule;
+/* `count` propagations of `steps` steps of h s in a row, the first from state_in, each from the
+ * state the one before reached: odin_world_propagate's ODE calls, so bit for bit those calls
+ * one by one. After each, its state (size values, the body state vector's layout) goes to
+ * states_out + i * stride, followed by its verdict, 1.0 when the propagation was invalid under
+ * `rule` (a forbidden pair collided at one of its steps, or the tracked link ended out of its
+ * bounds) and 0.0 otherwise; the tracked link's origin and velocity (odin_plan_tracked) to
+ * tracked_out + 6 * i. With stop_at_invalid the row ends after its first invalid propagation.
+ * Returns the propagations made; or, changing nothing, -1 - i when value i of state_in cannot be
+ * put back (odin_state_vector_fault). The records are forgotten. */
+int odin_plan_propagate(OdinWorld *w, dBodyID *bodies, int n, const OdinPlanRule *rule,
+                        const double *state_in, const OdinBodyForce *forces, int n_forces,
+                        double h, int steps, int count, int stop_at_invalid,
+                        double *states_out, long stride, double *tracked_out);
+/* The tracked link's origin (m, world) and its body's linear velocity (m/s, world) in the body
+ * state vector `state`, into out[0..6). */
+void odin_plan_tracked(const OdinPlanRule *rule, const double *state, double *out);
 
 /* Forgets the collision records (contact-less: after a read). */
 void odin_world_clear_records(OdinWorld *w);

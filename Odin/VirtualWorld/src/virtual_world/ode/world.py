@@ -303,12 +303,7 @@ class CWorld:
         steps taken or -1 - i when value i of ``start`` cannot be put back, the recorded
         pairs' geom addresses as raw uintptr_t pairs); the world stays in the state reached,
         its collision records forgotten."""
-        pushes = self._pushes
-        if len(forces) > len(pushes):
-            pushes = self._pushes = ffi.new("OdinBodyForce[]", len(forces))
-        for f, (body, vector) in zip(pushes, forces):
-            f.body = body
-            f.vector = vector
+        pushes = self._filled_pushes(forces)
         out = np.empty(start.size)
         taken = lib.odin_world_propagate(
             self.struct, bodies.array, bodies.count, ffi.from_buffer("double[]", start),
@@ -323,6 +318,35 @@ class CWorld:
             lib.odin_world_record_pairs(self.struct, pairs, count)
             lib.odin_world_clear_records(self.struct)
         return out, taken, ffi.buffer(pairs, count * _PAIR_BYTES)[:]
+
+    def _filled_pushes(self, forces: Sequence[Tuple[object, Sequence[float]]]):
+        """This world's OdinBodyForce array holding ``forces`` ((body ptr, force) each)."""
+        pushes = self._pushes
+        if len(forces) > len(pushes):
+            pushes = self._pushes = ffi.new("OdinBodyForce[]", len(forces))
+        for f, (body, vector) in zip(pushes, forces):
+            f.body = body
+            f.vector = vector
+        return pushes
+
+    @drains_ode_messages
+    def propagate_checked(self, bodies: "BodyArray", rule, start: np.ndarray,
+                          forces: Sequence[Tuple[object, Sequence[float]]], step_size: float,
+                          steps: int, count: int, stop_at_invalid: bool, states: np.ndarray,
+                          tracked: np.ndarray) -> int:
+        """A planner's ``count`` propagations of ``steps`` steps in a row, checked by
+        ``rule`` (an ``OdinPlanRule *``), in one C call (odin_step.h, odin_plan_propagate):
+        from the body state vector ``start`` under ``forces`` (as ``propagate``'s), each
+        state and its verdict into a row of ``states`` (float64, C order, each row the state
+        vector then 1.0 invalid or 0.0), the tracked link's origin (m) and velocity (m/s) into
+        a row of ``tracked`` (float64, C order, 6 a row). Returns the propagations made, or
+        -1 - i when value i of ``start`` cannot be put back; the records are forgotten."""
+        pushes = self._filled_pushes(forces)
+        return int(lib.odin_plan_propagate(
+            self.struct, bodies.array, bodies.count, rule, ffi.from_buffer("double[]", start),
+            pushes, len(forces), step_size, steps, count, int(stop_at_invalid),
+            ffi.from_buffer("double[]", states, require_writable=True), states.shape[1],
+            ffi.from_buffer("double[]", tracked, require_writable=True)))
 
     @drains_ode_messages
     def detect(self, any_policy: bool = False) -> None:
