@@ -97,3 +97,52 @@ def test_a_bad_state_is_refused_before_the_servos_change(ode_demos_dir):
             assert core.body_state_vector().tobytes() == before.tobytes()
     finally:
         backend.close()
+
+
+CHAIN = ("demos", "OMPL_ode_demos", "Chain", "k-PMPChain.xml")
+
+
+@pytest.fixture(params=["sphere", "car", "chain"])
+def any_built(request, kautham_dir, ode_demos_dir):
+    if request.param == "sphere":
+        return request.param, quiet_plan(kautham_dir.joinpath(*SPHERE))
+    return request.param, quiet_plan(ode_demos_dir.joinpath(
+        *(CAR if request.param == "car" else CHAIN)))
+
+
+def test_a_step_judged_in_c_is_the_step_and_the_rule_judged_in_python(any_built):
+    """CoreBackend.propagate_into (the search's step: one C call that also judges the state,
+    issue 42) against propagate and the problem's rule in Python (forbidden_contacts,
+    in_bounds), on the Sphere, the car and the held chain (its tool may push boxes, its
+    other links may not; its tracked link is off its body's origin): the same state and
+    tracked link bit for bit, and the same verdict."""
+    name, built = any_built
+    backend = CoreBackend(built, planning_problem(built))
+    problem = backend.problem
+    rng = np.random.default_rng(5)
+    size = backend.start_state().size
+    try:
+        states, verdicts = [backend.start_state()], []
+        for k in range(100):
+            state = states[rng.integers(len(states))]
+            control = tuple(float(v) for v in rng.random(problem.control_size))
+            for _ in range(1 + k % 20):
+                into, tracked = np.full((1, size + 1), np.nan), np.full((1, 6), np.nan)
+                backend.propagate_into(state, control, into, tracked)
+                mine = backend.propagate([(state, control)])[0]
+                assert into[0, :-1].tobytes() == mine.state.tobytes(), k
+                assert tracked[0].tobytes() == np.concatenate(
+                    [mine.position, mine.velocity]).tobytes(), k
+                invalid = bool(problem.forbidden_contacts(mine.collisions)) or \
+                    not problem.in_bounds(mine.position, mine.velocity)
+                assert into[0, -1] == float(invalid), (k, mine.collisions)
+                verdicts.append(invalid)
+                if invalid:
+                    break                       # as OMPL's propagateWhileValid
+                state = mine.state
+            states.append(state)
+        assert False in verdicts
+        if name != "car":                       # the ball and the chain's links hit walls
+            assert True in verdicts             # (the car's are further than it goes)
+    finally:
+        backend.close()

@@ -11,8 +11,14 @@ planner's propagation of a control for n steps is n such calls in a row, exactly
 that the written plan replays bit for bit in a fresh world.
 
 ``CoreBackend``: the VirtualWorld's Core in this process (``gui.planning.core_world``), built
-from the problem's plan (fastest: no messages). ``gui.planning.pool.PoolBackend``: world
-nodes over ROS.
+from the problem's plan (fastest: no messages). It also makes a search's steps whole in C
+(``propagate_into``): the problem's rule of forbidden contacts and bounds held by the Core
+(``Core.plan_rule``), each step's state, verdict and tracked link written straight into the
+planner's memory (``Core.propagate_checked``). ``gui.planning.pool.PoolBackend``: world nodes
+over ROS.
+
+Every back end reads the tracked link out of state vectors by the Core's C arithmetic
+(``tracked_link``), so that a search in C, a replay and every back end agree bit for bit.
 """
 from __future__ import annotations
 
@@ -25,9 +31,11 @@ from gui.core.plan import BuildPlan
 from gui.core.world_port import BodyState
 from gui.errors import PlanningError
 from gui.planning.core_world import CoreWorld
-from gui.planning.problem import PlanningProblem, goal_refusal, start_refusal
+from gui.planning.problem import (FORBIDDEN_ROLE_PAIRS, PlanningProblem, goal_refusal,
+                                  start_refusal)
 from odin_common.interface import BODY_STATE_SIZE, BODY_STATE_SLICES
 from odin_common.rotations import quaternion_to_matrix
+from virtual_world.core.checked_propagation import TrackedLink
 
 
 class Outcome(NamedTuple):
@@ -60,6 +68,15 @@ class Backend(Protocol):
 
     # optional: ``check_query()``, PlanningError when the query cannot be solved whatever the
     # search does (gui.planning.problem.check_query); ``bridge.plan`` asks it before searching
+
+
+def tracked_link(problem: PlanningProblem, slots: Dict[str, Tuple[int, np.ndarray]]
+                 ) -> TrackedLink:
+    """``problem``'s tracked link read out of body state vectors whose bodies are ``slots``
+    ({object id: (index among the vector's bodies, centre of mass (3,) m in the object
+    frame)}), by odin_plan.c's arithmetic."""
+    index, com = slots[problem.tracked_body]
+    return TrackedLink(index, com, problem.tracked_link_origin)
 
 
 def step_actuation(problem: PlanningProblem, control: Sequence[float], base) -> Actuation:
@@ -115,11 +132,17 @@ class CoreBackend:
             core = self.world.core
             self._start = core.body_state_vector()
             bodies = core.state()[0]
+            slots = {b.id: (index, b.center_of_mass) for index, b in enumerate(bodies)}
+            self._rule = core.plan_rule(
+                problem.contact_roles(core.object_ids()), FORBIDDEN_ROLE_PAIRS,
+                problem.tracked_body, problem.tracked_link_origin, problem.base_bounds,
+                problem.settings.max_speed)
+            self._world_step = self.world.step_values().step
         except Exception:
             self.world.close()
             raise
-        self.bodies = VectorBodies({b.id: (index, b.center_of_mass)
-                                    for index, b in enumerate(bodies)})
+        self.bodies = VectorBodies(slots)
+        self._tracked_link = tracked_link(problem, slots)
         self.propagations = 0
         self._servo_sent: Optional[ServoCommand] = None
         # a robot whose actuation depends on its control alone (a car, a chain) is given the
@@ -135,30 +158,48 @@ class CoreBackend:
         return self._tracked(state)
 
     def _tracked(self, state: np.ndarray):
-        body = self.bodies.body(state, self.problem.tracked_body)
-        return self.problem.tracked_origin(body.position, body.quaternion), body.linear.copy()
+        values = self._tracked_link.values(state)
+        return values[:3], values[3:]
 
     def propagate(self, requests):
         return [self._one(state, control) for state, control in requests]
 
     def _one(self, state, control) -> Outcome:
-        core, problem = self.world.core, self.problem
         state = np.asarray(state, dtype=np.float64)
+        act = self._actuate(state, control)
+        # propagate_state checks the state's values before it changes anything
+        result = self.world.core.propagate_state(state, self.problem.step, self._world_step,
+                                                 act.forces)
+        self.propagations += 1
+        position, linear = self._tracked(result.state)
+        return Outcome(result.state, position, linear, result.pairs)
+
+    def propagate_into(self, state: np.ndarray, control, states: np.ndarray,
+                       tracked: np.ndarray) -> None:
+        """One propagation step of ``control`` from ``state`` (float64 body state vector),
+        checked in C by the problem's rule: the state reached and then its verdict (1.0
+        invalid: a forbidden contact on the way, or the tracked link out of its bounds; 0.0
+        valid) into ``states`` ((1, state size + 1) float64), the tracked link's origin (m)
+        and velocity (m/s) into ``tracked`` ((1, 6)). The state is ``propagate``'s, bit for
+        bit; the arrays may be a planner's own memory (gui.planning.ompl_memory)."""
+        act = self._actuate(state, control)
+        self.world.core.propagate_checked(self._rule, state, self.problem.step,
+                                          self._world_step, act.forces, 1, states, tracked)
+        self.propagations += 1
+
+    def _actuate(self, state: np.ndarray, control) -> Actuation:
+        """``control``'s actuation from ``state``, its servo settings sent to the world when
+        they are not the ones it holds."""
         if state.shape != self._start.shape:
-            core.checked_state_vector(state)     # raises: the Core's refusal of its size
+            self.world.core.checked_state_vector(state)     # raises: the Core's refusal
         act = self._actuation(state, control)
         if act.servo is not None and act.servo != self._servo_sent:
-            core.checked_state_vector(state)     # a bad state changes no servo either
+            self.world.core.checked_state_vector(state)     # a bad state changes no servo
             # the same settings again change nothing: a control held over several steps
             # is sent once (this world's servos are set by this back end alone)
             self.world.set_servo(act.servo)
             self._servo_sent = act.servo
-        # propagate_state checks the state's values before it changes anything
-        result = core.propagate_state(state, problem.step, self.world.step_values().step,
-                                      act.forces)
-        self.propagations += 1
-        position, linear = self._tracked(result.state)
-        return Outcome(result.state, position, linear, result.pairs)
+        return act
 
     def _actuation(self, state: np.ndarray, control) -> Actuation:
         """``step_actuation`` for ``control`` from ``state``, the last one again for the same

@@ -6,11 +6,15 @@ The OMPL problem (``gui.planning.problem`` says what each part means):
   problem's limits and ``max_speed``; weight 1:
   planners measure distances and cells here) and the whole world's body state vector
   (``Core.body_state_vector``, weight 0: carried, never measured) with one value appended,
-  1 when the step into the state made a forbidden contact (``forbidden_contacts``);
+  the state's verdict: 1 when the step into it made a forbidden contact
+  (``forbidden_contacts``) or left the tracked link out of bounds, 0 otherwise;
 - control space: [0, 1]^k, the robot's `.cntr` controls (those searched); a control lasts
   ``min_control_steps`` to ``max_control_steps`` propagation steps of ``step`` s;
-- propagator: the back end's (restore, apply the row, step, read);
-- validity: the tracked link in bounds and no forbidden contact on the way in;
+- propagator: the back end's (restore, apply the row, step, read); over the Core's, a step
+  is one C call that also judges the state and writes it, its verdict and the tracked link
+  into OMPL's memory (``CoreBackend.propagate_into``), where the wheel allows it
+  (``gui.planning.ompl_memory``);
+- validity: the verdict: the tracked link in bounds and no forbidden contact on the way in;
 - goal region: the tracked link within ``goal_tolerance`` of where the query's goal puts it,
   in the plane;
 - projection (KPIECE1's grid): the tracked link's x and y, cells of a quarter of the goal
@@ -123,6 +127,8 @@ class _Callbacks:
         self.problem = backend.problem
         self.world_size = world_size
         self.direct = direct
+        # the step whole in C, into OMPL's memory: a back end that can (the Core's)
+        self.into = getattr(backend, "propagate_into", None) if direct else None
         self.error: Optional[BaseException] = None
         # without ``direct`` the world vector's slots are read and written through map: a
         # propagation moves a few hundred values each way, one OMPL call per value
@@ -145,7 +151,7 @@ class _Callbacks:
             position, velocity = self.backend.tracked_state(vector)
         else:
             position, velocity = backend_outcome.position, backend_outcome.velocity
-        flag = 1.0 if touched else 0.0
+        flag = 1.0 if touched or not self.problem.in_bounds(position, velocity) else 0.0
         if self.direct:
             values = ompl_memory.values(world, self.world_size)
             values[:-1] = vector
@@ -167,6 +173,11 @@ class _Callbacks:
             values = self.problem.controls(
                 [control[i] for i in range(len(self.problem.searched))])
             vector = self._vector(start)
+            if steps == 1 and self.into is not None:     # OMPL's every call: one step
+                self.into(vector, values,
+                          ompl_memory.values(result[1], self.world_size).reshape(1, -1),
+                          ompl_memory.values(result[0], ROBOT_VALUES).reshape(1, -1))
+                return
             outcome, touched = None, False
             for _ in range(steps):
                 outcome = self.backend.propagate([(vector, values)])[0]
@@ -181,11 +192,9 @@ class _Callbacks:
             result[1][self.world_size - 1] = 1.0   # invalid: the search stops using it
 
     def valid(self, state) -> bool:
-        robot = state[0]
-        position = [robot[0], robot[1], robot[2]]
-        velocity = [robot[3], robot[4], robot[5]]
-        return state[1][self.world_size - 1] == 0.0 and self.problem.in_bounds(position,
-                                                                                velocity)
+        # the verdict written with the state (a sampled state's is 0, its tracked values
+        # drawn within the bounds)
+        return state[1][self.world_size - 1] == 0.0
 
 
 def _without_frames(error: BaseException) -> BaseException:

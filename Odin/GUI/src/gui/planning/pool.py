@@ -31,7 +31,7 @@ from gui.core.plan import BuildPlan
 from gui.errors import PlanningError
 from gui.core.world_port import build
 from gui.core.control_path import reads_base
-from gui.planning.backend import Outcome, VectorBodies, step_actuation
+from gui.planning.backend import Outcome, VectorBodies, step_actuation, tracked_link
 from gui.planning.core_world import force_requests
 from gui.planning.problem import PlanningProblem
 from odin_common.messages import body_force_message
@@ -74,7 +74,7 @@ class PoolBackend:
                     self.step = client.step_values().step
                 finally:
                     client.close()
-            self._start, self.bodies, self._tracked_index = self._read_start()
+            self._start, self.bodies, self._tracked_link = self._read_start()
         except PoolError as error:
             self.pool.close()
             raise PlanningError(str(error)) from None
@@ -95,7 +95,7 @@ class PoolBackend:
                 raise PlanningError(f"the pool's worlds have no body {name!r}")
             com = answers[0].centers_of_mass[ids.index(name)]
             slots[name] = (ids.index(name), np.array([com.x, com.y, com.z]))
-        return vectors[0], VectorBodies(slots), ids.index(self.problem.tracked_body)
+        return vectors[0], VectorBodies(slots), tracked_link(self.problem, slots)
 
     @property
     def size(self) -> int:
@@ -105,17 +105,20 @@ class PoolBackend:
         return self._start.copy()
 
     def tracked_state(self, state):
-        body = self._body(state, self.problem.tracked_body)
-        return self.problem.tracked_origin(body.position, body.quaternion), body.linear.copy()
+        values = self._tracked_link.values(self._checked(state))
+        return values[:3], values[3:]
 
     def _body(self, state, name: str):
         """A body's state (gui.core.world_port.BodyState) in a state vector of the problem's
         world."""
+        return self.bodies.body(self._checked(state), name)
+
+    def _checked(self, state) -> np.ndarray:
         state = np.asarray(state, dtype=np.float64)
         if state.shape != self._start.shape:
             raise PlanningError(f"a state vector of the problem's world has "
                                 f"{self._start.size} values; got shape {state.shape}")
-        return self.bodies.body(state, name)
+        return state
 
     def propagate(self, requests) -> List[Outcome]:
         out: List[Optional[Outcome]] = []
@@ -161,10 +164,8 @@ class PoolBackend:
         first = None
         at = 0
         for vector, count in zip(vectors, answer.row_pairs):
-            body = self.bodies.body(vector, self.problem.tracked_body)
-            outcome = Outcome(vector, self.problem.tracked_origin(body.position,
-                                                                  body.quaternion),
-                              body.linear.copy(), tuple(pairs[at:at + count]))
+            tracked = self._tracked_link.values(vector)
+            outcome = Outcome(vector, tracked[:3], tracked[3:], tuple(pairs[at:at + count]))
             at += count
             self._next[(control, state.tobytes())] = outcome
             if first is None:
@@ -173,11 +174,9 @@ class PoolBackend:
         return first
 
     def _outcome(self, answer) -> Outcome:
-        body = answer.states[self._tracked_index]
-        position = self.problem.tracked_origin(np.array(body.position),
-                                               np.array(body.orientation))
-        return Outcome(np.asarray(answer.state, dtype=np.float64), position,
-                       np.array(body.linear),
+        state = np.asarray(answer.state, dtype=np.float64)
+        tracked = self._tracked_link.values(state)
+        return Outcome(state, tracked[:3], tracked[3:],
                        tuple((c.first, c.second) for c in answer.collisions))
 
     def close(self) -> None:

@@ -41,6 +41,7 @@ the robot at its goal inside a fixed obstacle.
 """
 from __future__ import annotations
 
+import enum
 import math
 from dataclasses import dataclass, field
 from typing import Iterable, Optional, Tuple
@@ -110,6 +111,31 @@ class SearchSettings:
                 raise PlanningError(f"{name} {value!r} must be positive")
         if not 0.0 <= self.goal_bias <= 1.0:
             raise PlanningError(f"goal_bias {self.goal_bias!r} must be in [0, 1]")
+
+
+class ContactRole(enum.IntEnum):
+    """What an object is to the rule of forbidden contacts (module docstring): a robot body
+    is TOOL when it may push manipulable obstacles, ROBOT otherwise; anything that is not
+    the ground, a fixed obstacle or the robot's is OTHER (manipulable obstacles, other
+    robots' bodies)."""
+    OTHER = 0
+    GROUND = 1
+    FIXED = 2
+    TOOL = 3
+    ROBOT = 4
+
+
+FORBIDDEN_ROLE_PAIRS = (
+    # a fixed obstacle is a free body in the world: whatever but the ground touches it may
+    # move it (another fixed obstacle, the robot, a block it pushes)
+    (ContactRole.FIXED, ContactRole.FIXED), (ContactRole.FIXED, ContactRole.TOOL),
+    (ContactRole.FIXED, ContactRole.ROBOT), (ContactRole.FIXED, ContactRole.OTHER),
+    # the robot touches only the ground and itself, but with its tool
+    (ContactRole.ROBOT, ContactRole.OTHER))
+"""The pairs of ContactRole whose contact makes a motion invalid (either order): the one
+statement of the rule, which PlanningProblem.forbidden_contacts applies to named pairs and
+odin_plan.c to a propagation's pairs (Core.plan_rule)."""
+_FORBIDDEN_ROLES = frozenset(frozenset(pair) for pair in FORBIDDEN_ROLE_PAIRS)
 
 
 @dataclass(frozen=True)
@@ -192,17 +218,26 @@ class PlanningProblem:
         return forbidden
 
     def _invalid(self, first: str, second: str) -> bool:
-        if self._forbidden_pair(first, second) or self._forbidden_pair(second, first):
-            return True
-        # a fixed obstacle is a free body in the world: whatever touches it may move it
-        return GROUND not in (first, second) and \
-            (first in self.forbidden or second in self.forbidden)
+        return frozenset((self.contact_role(first), self.contact_role(second))) \
+            in _FORBIDDEN_ROLES
 
-    def _forbidden_pair(self, robot_body: str, other: str) -> bool:
-        if robot_body not in self.robot_bodies or other in self.robot_bodies:
-            return False
-        return other in self.forbidden or (other != GROUND
-                                           and robot_body not in self.tool_bodies)
+    def contact_role(self, object_id: str) -> "ContactRole":
+        """What ``object_id`` is to the rule of forbidden contacts (``ContactRole``)."""
+        if object_id == GROUND:
+            return ContactRole.GROUND
+        if object_id in self.forbidden:
+            return ContactRole.FIXED
+        if object_id in self.tool_bodies:
+            return ContactRole.TOOL
+        if object_id in self.robot_bodies:
+            return ContactRole.ROBOT
+        return ContactRole.OTHER
+
+    def contact_roles(self, object_ids: Iterable[str]) -> dict:
+        """{object id: its ContactRole} for those of ``object_ids`` whose role is not OTHER
+        (Core.plan_rule's roles: an object not named has role 0, OTHER)."""
+        roles = {name: self.contact_role(name) for name in object_ids}
+        return {name: int(role) for name, role in roles.items() if role != ContactRole.OTHER}
 
     def in_bounds(self, tracked_position, tracked_velocity) -> bool:
         """Whether the tracked link is in the base's bounds, no faster than max_speed on any
