@@ -26,7 +26,7 @@ from virtual_world.core.propagation import (_checked_pushes, _state_vector_fault
 from virtual_world.core.scene import Scene
 from virtual_world.errors import InvalidArgument
 from virtual_world.ode import bodies
-from virtual_world.ode.bindings import ffi, lib
+from virtual_world.ode.plan_rules import RuleMemory
 
 MAX_ROLES = 16
 """Roles a rule may give objects (its table of forbidden pairs is MAX_ROLES squared at most)."""
@@ -38,18 +38,17 @@ class PlanRule:
     not know. ``size``: the body state vector's length in this scene (a row of
     ``propagate_checked``'s ``states`` is size + 1 values: the state, then its verdict)."""
 
-    def __init__(self, scene: Scene, struct, arrays: tuple, size: int, tracked_index: int):
+    def __init__(self, scene: Scene, memory: RuleMemory, size: int):
         self._scene = weakref.ref(scene)
         self._revision = scene.revision
-        self.struct = struct            # OdinPlanRule *, pointing into arrays
-        self._arrays = arrays           # the C arrays, kept alive with the struct
+        self._memory = memory           # the rule's C memory, owned here
+        self.struct = memory.struct     # OdinPlanRule *
         self.size = size
-        self._tracked_index = tracked_index
 
     def tracked_values(self, state: Sequence[float]) -> np.ndarray:
         """(6,) the tracked link's origin (m) and its body's linear velocity (m/s), world
         frame, in the body state vector ``state``: what ``propagate_checked`` writes."""
-        return _tracked_values(self.struct, state, self._tracked_index)
+        return _tracked_values(self._memory, state)
 
     def check_for(self, scene: Scene) -> None:
         if self._scene() is not scene or self._revision != scene.revision:
@@ -109,13 +108,9 @@ def plan_rule(scene: Scene, roles: Mapping[str, int], forbidden: Sequence[Tuple[
     speed = check.number("max_speed", max_speed, allow_inf=True)
     if not speed > 0:
         raise InvalidArgument(f"max_speed={shown(max_speed)} m/s must be positive")
-    role_array = ffi.new("unsigned char[]", serials.tobytes())
-    table_array = ffi.new("unsigned char[]", table.tobytes())
-    index = order.index(body.body.ptr)
-    struct = _rule_struct(index, body.com, offset, role_of_serial=role_array,
-                          n_serials=serials.size, forbidden=table_array, n_roles=MAX_ROLES,
-                          low=box[:, 0].tolist(), high=box[:, 1].tolist(), max_speed=speed)
-    return PlanRule(scene, struct, (role_array, table_array), _state_size(scene), index)
+    memory = RuleMemory(order.index(body.body.ptr), body.com, offset, serials.tobytes(),
+                        table.tobytes(), MAX_ROLES, box[:, 0], box[:, 1], speed)
+    return PlanRule(scene, memory, _state_size(scene))
 
 
 def _state_size(scene: Scene) -> int:
@@ -163,26 +158,15 @@ def _out(what: str, array, shape: Tuple[int, int]) -> np.ndarray:
     return array
 
 
-def _rule_struct(tracked_index: int, com: Sequence[float], offset: Sequence[float], **more):
-    """A new OdinPlanRule for the tracked link (body ``tracked_index`` in the state vectors,
-    its centre of mass ``com`` and the link's origin ``offset``, (3,) m in the body's frame)
-    and ``more`` of its fields."""
-    return ffi.new("OdinPlanRule *", {"tracked": tracked_index,
-                                      "com": [float(v) for v in com],
-                                      "offset": [float(v) for v in offset], **more})
-
-
-def _tracked_values(struct, state, tracked_index: int) -> np.ndarray:
+def _tracked_values(memory: RuleMemory, state) -> np.ndarray:
     """(6,) the tracked link's origin (m) and its body's linear velocity (m/s), world frame,
-    in the body state vector ``state`` (odin_plan_tracked)."""
+    in the body state vector ``state`` (odin_plan_tracked), checked to hold the body."""
     state = np.ascontiguousarray(state, dtype=np.float64)
-    if state.ndim != 1 or state.size < 1 + (tracked_index + 1) * bodies.BODY_STATE_SIZE:
+    index = memory.tracked_index
+    if state.ndim != 1 or state.size < 1 + (index + 1) * bodies.BODY_STATE_SIZE:
         raise InvalidArgument(f"a body state vector of shape {state.shape} has no body "
-                              f"{tracked_index}")
-    out = np.empty(6)
-    lib.odin_plan_tracked(struct, ffi.from_buffer("double[]", state),
-                          ffi.from_buffer("double[]", out, require_writable=True))
-    return out
+                              f"{index}")
+    return memory.tracked_values(state)
 
 
 class TrackedLink:
@@ -192,10 +176,9 @@ class TrackedLink:
     mass is ``com`` (3,) m in that frame."""
 
     def __init__(self, index: int, com: Sequence[float], offset: Sequence[float]):
-        self._index = check.count("tracked body index", index, 0)
-        self._struct = _rule_struct(self._index, check.vector("com", com),
-                                    check.vector("offset", offset))
+        self._memory = RuleMemory(check.count("tracked body index", index, 0),
+                                  check.vector("com", com), check.vector("offset", offset))
 
     def values(self, state: Sequence[float]) -> np.ndarray:
         """(6,) the link's origin (m) and its body's linear velocity (m/s), world frame."""
-        return _tracked_values(self._struct, state, self._index)
+        return _tracked_values(self._memory, state)
