@@ -217,6 +217,9 @@ def set_servos(scene: Scene, servos: Mapping[str, Mapping]) -> None:
             given = fields.get(name)
             if given is None or len(given) == 0:
                 return (default,) * motor.naxes
+            if type(given) is tuple and len(given) == motor.naxes and \
+                    all(type(v) is float and low <= v <= high for v in given):
+                return given    # a planner's, each control: the checks below, without numpy
             values = check.flat_vector(f"{name} of servo {shown(motor_id)}", given)
             if values.size != motor.naxes:
                 raise InvalidArgument(f"servo {shown(motor_id)} has {motor.naxes} axes; got "
