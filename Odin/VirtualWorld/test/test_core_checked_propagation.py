@@ -158,3 +158,21 @@ def test_a_rule_is_refused_once_the_world_has_changed(core):
     with pytest.raises(InvalidArgument, match="another world"):
         other.propagate_checked(checked, other.body_state_vector(), H, H)
     other.close()
+
+
+def test_a_rule_follows_the_state_vector_when_exempt_pairs_change_its_size(core):
+    """Exempt Overlaps adds values to the state vector without adding an object: the rule
+    still holds, and arrays are sized by the world as it is now."""
+    checked = rule(core)
+    old = core.body_state_vector().size
+    core.build_object(ObjectSpec("inside", [0.1, 0.1, 0.1], position=(-1.0, 0, 0.15),
+                                 mass=0.5))          # inside the block
+    checked = rule(core)                              # a new object: a new rule
+    assert core.exempt_overlaps(0.001)
+    start = core.body_state_vector()
+    assert start.size > old + 26                      # the exempt pair's value
+    with pytest.raises(InvalidArgument, match="states"):
+        core.propagate_checked(checked, start, H, H, (), 1, np.empty((1, start.size)))
+    row = core.propagate_checked(checked, start, H, H, (), 1)
+    assert row.states.shape == (1, start.size + 1)
+    assert row.states[0, :-1].tobytes() == core.propagate_state(start, H, H).state.tobytes()

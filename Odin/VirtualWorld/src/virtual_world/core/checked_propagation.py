@@ -35,15 +35,13 @@ MAX_ROLES = 16
 class PlanRule:
     """A planner's validity rule held in C memory for one scene as built (Core.plan_rule):
     the scene it was made for and its revision, so that a rule is never used on geoms it does
-    not know. ``size``: the body state vector's length in this scene (a row of
-    ``propagate_checked``'s ``states`` is size + 1 values: the state, then its verdict)."""
+    not know."""
 
-    def __init__(self, scene: Scene, memory: RuleMemory, size: int):
+    def __init__(self, scene: Scene, memory: RuleMemory):
         self._scene = weakref.ref(scene)
         self._revision = scene.revision
         self._memory = memory           # the rule's C memory, owned here
         self.struct = memory.struct     # OdinPlanRule *
-        self.size = size
 
     def tracked_values(self, state: Sequence[float]) -> np.ndarray:
         """(6,) the tracked link's origin (m) and its body's linear velocity (m/s), world
@@ -110,11 +108,12 @@ def plan_rule(scene: Scene, roles: Mapping[str, int], forbidden: Sequence[Tuple[
         raise InvalidArgument(f"max_speed={shown(max_speed)} m/s must be positive")
     memory = RuleMemory(order.index(body.body.ptr), body.com, offset, serials.tobytes(),
                         table.tobytes(), MAX_ROLES, box[:, 0], box[:, 1], speed)
-    return PlanRule(scene, memory, _state_size(scene))
+    return PlanRule(scene, memory)
 
 
 def _state_size(scene: Scene) -> int:
-    """The length of the scene's body state vectors (propagation.state_vector's layout)."""
+    """The length of the scene's body state vectors now (propagation.state_vector's layout:
+    Exempt Overlaps changes it without adding an object)."""
     return 1 + scene.body_array().count * bodies.BODY_STATE_SIZE + len(scene.exempt_pairs)
 
 
@@ -132,7 +131,7 @@ def propagate_checked(scene: Scene, rule: PlanRule, start_state: Sequence[float]
         check.shared(limits.check_work, f"a row of {count} propagations of {duration:.6g} s at "
                      f"{step_size:g} s", count * steps, scene.body_array().count)
     start_state = sized_state_vector(scene, start_state)
-    states = _out("states", states, (count, rule.size + 1))
+    states = _out("states", states, (count, _state_size(scene) + 1))
     tracked = _out("tracked", tracked, (count, 6))
     checked = _checked_pushes(scene, pushes)
     made = scene.c.propagate_checked(scene.body_array(), rule.struct, start_state, checked,
