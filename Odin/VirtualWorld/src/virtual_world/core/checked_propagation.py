@@ -21,7 +21,7 @@ import numpy as np
 from odin_common import limits
 from odin_common.limits import shown
 from virtual_world.core import guard, validation as check
-from virtual_world.core.propagation import (_checked_pushes, _state_vector_fault, _steps_of,
+from virtual_world.core.propagation import (checked_pushes, state_vector_fault, steps_of,
                                             sized_state_vector)
 from virtual_world.core.scene import Scene
 from virtual_world.errors import InvalidArgument
@@ -111,12 +111,6 @@ def plan_rule(scene: Scene, roles: Mapping[str, int], forbidden: Sequence[Tuple[
     return PlanRule(scene, memory)
 
 
-def _state_size(scene: Scene) -> int:
-    """The length of the scene's body state vectors now (propagation.state_vector's layout:
-    Exempt Overlaps changes it without adding an object)."""
-    return 1 + scene.body_array().count * bodies.BODY_STATE_SIZE + len(scene.exempt_pairs)
-
-
 def propagate_checked(scene: Scene, rule: PlanRule, start_state: Sequence[float], count: int,
                       duration: float, step_size: float,
                       pushes: Sequence[Tuple[str, Sequence[float]]], states, tracked,
@@ -126,18 +120,19 @@ def propagate_checked(scene: Scene, rule: PlanRule, start_state: Sequence[float]
     the state reached."""
     rule.check_for(scene)
     count = check.count("count", count)
-    step_size, steps = _steps_of(duration, step_size)
+    step_size, steps = steps_of(duration, step_size)
     if count > 1:
         check.shared(limits.check_work, f"a row of {count} propagations of {duration:.6g} s at "
                      f"{step_size:g} s", count * steps, scene.body_array().count)
+    # the world's state vector length now (Exempt Overlaps changes it without a new object)
     start_state = sized_state_vector(scene, start_state)
-    states = _out("states", states, (count, _state_size(scene) + 1))
+    states = _out("states", states, (count, start_state.size + 1))
     tracked = _out("tracked", tracked, (count, 6))
-    checked = _checked_pushes(scene, pushes)
+    checked = checked_pushes(scene, pushes)
     made = scene.c.propagate_checked(scene.body_array(), rule.struct, start_state, checked,
                                      step_size, steps, count, stop_at_invalid, states, tracked)
     if made < 0:        # C checks the state's values before it changes anything
-        raise _state_vector_fault(start_state, -1 - made, len(scene.exempt_pairs))
+        raise state_vector_fault(start_state, -1 - made, len(scene.exempt_pairs))
     scene.carried = {}
     scene.sim_time += step_size * steps * made
     guard.collect(scene, step_size)

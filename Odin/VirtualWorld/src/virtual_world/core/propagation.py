@@ -44,7 +44,7 @@ def checked_state_vector(scene: Scene, vector: Sequence[float]) -> np.ndarray:
     vector = sized_state_vector(scene, vector)
     fault = bodies.state_vector_fault(vector, len(scene.exempt_pairs))
     if fault >= 0:
-        raise _state_vector_fault(vector, fault, len(scene.exempt_pairs))
+        raise state_vector_fault(vector, fault, len(scene.exempt_pairs))
     return vector
 
 
@@ -77,7 +77,7 @@ def put_state_vector(scene: Scene, vector: np.ndarray) -> None:
     scene.c.rand_seed = int(vector[0])
 
 
-def _state_vector_fault(vector: np.ndarray, index: int, exempt: int) -> InvalidArgument:
+def state_vector_fault(vector: np.ndarray, index: int, exempt: int) -> InvalidArgument:
     """The refusal of a body state vector whose value ``index`` cannot be put back (its last
     ``exempt`` values are exempt pairs' states)."""
     if index == 0:
@@ -99,7 +99,7 @@ def propagate(scene: Scene, duration: float, step_size: float,
     """Core.propagate: runs the scene from the snapshot ``start``, the body state vector
     ``start_state`` or now, under ``motor_goals`` and ``body_forces``; back to the state
     before the call unless ``keep`` (and always after a refusal or a cancel)."""
-    step_size, steps = _steps_of(duration, step_size)
+    step_size, steps = steps_of(duration, step_size)
     check.shared(limits.check_work, f"propagate {duration:.6g} s at {step_size:g} s",
                  steps, scene.body_array().count)
     keep = check.flag("keep", keep)
@@ -138,17 +138,17 @@ def propagate_state(scene: Scene, start_state: Sequence[float], duration: float,
                     ) -> StatePropagation:
     """Core.propagate_state: from ``start_state``, in one C call, under ``pushes`` ((object
     id, force N world) each); the scene stays in the state reached."""
-    step_size, steps = _steps_of(duration, step_size)
+    step_size, steps = steps_of(duration, step_size)
     start_state = sized_state_vector(scene, start_state)
     try:
-        checked = _checked_pushes(scene, pushes)
+        checked = checked_pushes(scene, pushes)
     except CoreError:
         checked_state_vector(scene, start_state)     # a bad state is said first
         raise
     state, steps, pairs = scene.c.propagate(scene.body_array(), start_state, checked,
                                             step_size, steps)
     if steps < 0:        # C checks the state's values before it changes anything
-        raise _state_vector_fault(start_state, -1 - steps, len(scene.exempt_pairs))
+        raise state_vector_fault(start_state, -1 - steps, len(scene.exempt_pairs))
     scene.carried = {}
     scene.sim_time += step_size * steps
     guard.collect(scene, step_size)
@@ -164,7 +164,7 @@ def propagate_row(scene: Scene, start_state: Sequence[float], count: int, durati
     always after a refusal). Checked first: the count, and its work within
     limits.MAX_BODY_STEPS_PER_CALL."""
     count = check.count("row", count)
-    step_size, steps = _steps_of(duration, step_size)
+    step_size, steps = steps_of(duration, step_size)
     check.shared(limits.check_work, f"a row of {count} propagations of {duration:.6g} s at "
                  f"{step_size:g} s", count * steps, scene.body_array().count)
     keep = check.flag("keep", keep)
@@ -206,7 +206,7 @@ def _run(scene: Scene, steps: int, step_size: float, read_states: bool = True,
                        state_vector(scene))
 
 
-def _checked_pushes(scene: Scene, pushes: Sequence[Tuple[str, Sequence[float]]]) -> list:
+def checked_pushes(scene: Scene, pushes: Sequence[Tuple[str, Sequence[float]]]) -> list:
     """(object id, force N world) pairs as (body ptr, force) for CWorld.propagate, each
     checked as add_body_force checks a force at the centre of mass."""
     checked = []
@@ -220,7 +220,7 @@ def _checked_pushes(scene: Scene, pushes: Sequence[Tuple[str, Sequence[float]]])
     return checked
 
 
-def _steps_of(duration: float, step_size: float) -> Tuple[float, int]:
+def steps_of(duration: float, step_size: float) -> Tuple[float, int]:
     """(step_size, the number of steps) of a propagation of ``duration`` s, both checked;
     remembered for plain floats (a planner asks the same every step)."""
     if type(duration) is float and type(step_size) is float:   # noqa: E721 - not bool

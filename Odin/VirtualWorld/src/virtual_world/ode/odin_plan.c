@@ -1,5 +1,5 @@
 /* A control planner's propagations checked in C (gui.planning through
- * virtual_world.core.propagation.propagate_checked): each one odin_world_propagate's ODE calls
+ * virtual_world.core.checked_propagation.propagate_checked): each one odin_world_propagate's ODE calls
  * in its order, then the planner's validity rule on what it did, so that a search's step asks
  * Python for nothing between the state it starts from and the verdict on the state reached.
  *
@@ -28,9 +28,11 @@ static int forbidden_contact(const OdinWorld *w, const OdinPlanRule *rule) {
 }
 
 /* The tracked link's origin (m, world) and its body's linear velocity (m/s, world) in the
- * body state vector `state`, into out[0..6); the arithmetic of gui.planning.backend's
- * VectorBodies.body and PlanningProblem.tracked_origin (odin_common.rotations'
- * quaternion_to_matrix, then the matrix times the offset row by row), value for value. */
+ * body state vector `state`, into out[0..6): the body's frame origin (its centre of mass less
+ * R com), then plus R offset, R being odin_common.rotations' quaternion_to_matrix and each
+ * product summed row by row, left to right. Every planning back end reads the tracked link
+ * this way (TrackedLink); numpy's matrix product, which the Core's body_state and
+ * PlanningProblem.tracked_origin use, may differ from it in the last bit (BLAS fuses). */
 void odin_plan_tracked(const OdinPlanRule *rule, const double *state, double *out) {
     const double *body = state + 1 + (long)rule->tracked * ODIN_BODY_STATE_SIZE;
     double w = body[3], x = body[4], y = body[5], z = body[6];
@@ -73,7 +75,9 @@ int odin_plan_propagate(OdinWorld *w, dBodyID *bodies, int n, const OdinPlanRule
         double *to = states_out + i * stride;
         int taken = odin_world_propagate_records(w, bodies, n, from, forces, n_forces, h, steps,
                                                  to);
-        if (taken < 0) return i == 0 ? taken : i;  /* a later state is the world's own: never */
+        /* only state_in can be refused: every later one is a state ODE stepped to, which
+         * the divergence guard keeps finite */
+        if (taken < 0) return i == 0 ? taken : i;
         int invalid = forbidden_contact(w, rule);
         odin_world_clear_records(w);
         odin_plan_tracked(rule, to, tracked_out + 6 * (long)i);
